@@ -1,0 +1,54 @@
+# Signorini penalty contact solver. `make run` and `make test` install what is missing first.
+PYTHON  ?= /usr/bin/python3
+MPIEXEC ?= mpiexec
+export OMPI_ALLOW_RUN_AS_ROOT = 1
+export OMPI_ALLOW_RUN_AS_ROOT_CONFIRM = 1
+export OMPI_MCA_rmaps_base_oversubscribe = 1
+
+ifdef PETSC_DIR
+  include $(PETSC_DIR)/lib/petsc/conf/variables
+  PETSC_CFLAGS = $(PETSC_CC_INCLUDES)
+  PETSC_LIBS   = $(PETSC_LIB)
+  CC           = $(PCC)
+else
+  PETSC_CFLAGS = $(shell pkg-config --cflags petsc hdf5-openmpi)
+  PETSC_LIBS   = $(shell pkg-config --libs petsc)
+  CC           = mpicc
+endif
+CFLAGS  ?= -O2 -g
+CFLAGS  += -std=c99 -Wall -Wextra -Wno-unused-parameter -Iinclude
+LDLIBS  += $(PETSC_LIBS) -lm
+
+SRC = $(wildcard src/*.c src/scenes/*.c)
+OBJ = $(SRC:src/%.c=build/%.o)
+BIN = bin/signorini
+
+.PHONY: all deps run test format clean
+all: $(BIN)
+
+deps:
+	@pkg-config --exists petsc && command -v mpicc >/dev/null && command -v mpiexec >/dev/null && \
+	  $(PYTHON) -c "import h5py, numpy, matplotlib, yaml" 2>/dev/null || sh scripts/install-deps.sh
+
+build/%.o: src/%.c include/signorini.h include/compat.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(PETSC_CFLAGS) -c $< -o $@
+
+$(BIN): $(OBJ)
+	@mkdir -p bin
+	$(CC) $(CFLAGS) -o $@ $(OBJ) $(LDLIBS)
+
+run: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(MPIEXEC) -n 1 ./$(BIN) -options_file options/square.yaml
+	$(PYTHON) scripts/plot_contact.py output/square.h5 -o output/square_contact.png
+
+test: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) tests/run_tests.py
+
+format:
+	clang-format -i src/*.c src/scenes/*.c include/*.h
+
+clean:
+	rm -rf build bin output tests/out

@@ -1,0 +1,151 @@
+/* The nodes of Gamma_C: where the contact acts, their gap and their lumped boundary mass. */
+#include "signorini.h"
+
+static void f0_bd_one(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[],
+                      const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[],
+                      PetscReal t, const PetscReal x[], const PetscReal n[], PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
+{
+  for (PetscInt c = 0; c < dim; ++c) f0[c] = 1.0;
+}
+
+/* m_i = integral over Gamma_C of the basis function of node i, in the global vector M. */
+static PetscErrorCode ContactLumpedMass(DM dm, AppCtx *user, Vec M)
+{
+  PetscWeakForm wf;
+  PetscFormKey  key;
+  Vec           locX, locM;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscWeakFormCreate(PetscObjectComm((PetscObject)dm), &wf));
+  PetscCall(PetscWeakFormSetNumFields(wf, 1));
+  PetscCall(PetscWeakFormSetIndexBdResidual(wf, user->face_sets, user->scene.contact_id, 0, 0, 0, f0_bd_one, 0, NULL));
+  key.label = user->face_sets;
+  key.value = user->scene.contact_id;
+  key.field = 0;
+  key.part  = 0;
+  PetscCall(DMGetLocalVector(dm, &locX));
+  PetscCall(DMGetLocalVector(dm, &locM));
+  PetscCall(VecZeroEntries(locX));
+  PetscCall(VecZeroEntries(locM));
+  PetscCall(CompatComputeBdResidualSingle(dm, wf, key, locX, locM));
+  PetscCall(VecZeroEntries(M));
+  PetscCall(DMLocalToGlobal(dm, locM, ADD_VALUES, M));
+  PetscCall(DMRestoreLocalVector(dm, &locX));
+  PetscCall(DMRestoreLocalVector(dm, &locM));
+  PetscCall(PetscWeakFormDestroy(&wf));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Position of a node: the vertex itself, or the centroid of the edge/face that carries it (Lagrange P2/Q2). */
+static PetscErrorCode NodePosition(DM dm, PetscInt p, PetscReal x[])
+{
+  PetscInt depth, cdim;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetCoordinateDim(dm, &cdim));
+  PetscCall(DMPlexGetPointDepth(dm, p, &depth));
+  if (depth == 0) {
+    DM           cdm;
+    PetscSection cs;
+    Vec          coords;
+    PetscInt     off;
+    const PetscScalar *a;
+
+    PetscCall(DMGetCoordinateDM(dm, &cdm));
+    PetscCall(DMGetLocalSection(cdm, &cs));
+    PetscCall(DMGetCoordinatesLocal(dm, &coords));
+    PetscCall(PetscSectionGetOffset(cs, p, &off));
+    PetscCall(VecGetArrayRead(coords, &a));
+    for (PetscInt d = 0; d < cdim; ++d) x[d] = PetscRealPart(a[off + d]);
+    PetscCall(VecRestoreArrayRead(coords, &a));
+  } else PetscCall(DMPlexComputeCellGeometryFVM(dm, p, NULL, x, NULL));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
+{
+  MPI_Comm        comm = PetscObjectComm((PetscObject)dm);
+  PetscSection    lsec, gsec;
+  IS              is;
+  PetscInt        dim, fStart, fEnd, npts = 0, *pts = NULL, rstart;
+  Vec             M;
+  const PetscScalar *m;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(cs, sizeof(*cs)));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMGetLocalSection(dm, &lsec));
+  PetscCall(DMGetGlobalSection(dm, &gsec));
+  PetscCall(DMPlexGetHeightStratum(dm, 1, &fStart, &fEnd));
+  PetscCall(DMLabelGetStratumIS(user->face_sets, user->scene.contact_id, &is));
+  if (is) {
+    const PetscInt *faces;
+    PetscInt        nf;
+
+    PetscCall(ISGetLocalSize(is, &nf));
+    PetscCall(ISGetIndices(is, &faces));
+    PetscCall(PetscMalloc1(nf * 27, &pts)); /* closure of a face: at most 9 vertices, 12 edges, 1 face (Q2 hex) */
+    for (PetscInt i = 0; i < nf; ++i) {
+      PetscInt *closure = NULL, ncl;
+
+      if (faces[i] < fStart || faces[i] >= fEnd) continue;
+      PetscCall(DMPlexGetTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
+      for (PetscInt j = 0; j < ncl; ++j) {
+        PetscInt dof;
+
+        PetscCall(PetscSectionGetDof(lsec, closure[2 * j], &dof));
+        if (dof > 0) pts[npts++] = closure[2 * j];
+      }
+      PetscCall(DMPlexRestoreTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
+    }
+    PetscCall(ISRestoreIndices(is, &faces));
+    PetscCall(ISDestroy(&is));
+  }
+  else PetscCall(PetscMalloc1(1, &pts));
+  PetscCall(PetscSortRemoveDupsInt(&npts, pts));
+
+  PetscCall(DMGetGlobalVector(dm, &M));
+  PetscCall(ContactLumpedMass(dm, user, M));
+  PetscCall(VecGetOwnershipRange(M, &rstart, NULL));
+  PetscCall(VecGetArrayRead(M, &m));
+  PetscCall(PetscMalloc4(npts, &cs->point, npts, &cs->local_off, npts, &cs->global_off, npts, &cs->is_vertex));
+  PetscCall(PetscMalloc4(npts, &cs->gap, npts, &cs->weight, npts, &cs->active, npts, &cs->pressure));
+  for (PetscInt i = 0; i < npts; ++i) {
+    const PetscInt p = pts[i];
+    PetscInt       dof, cdof, gdof, goff, depth;
+    PetscReal      x[3] = {0.0, 0.0, 0.0}, xn = 0.0;
+
+    PetscCall(PetscSectionGetDof(lsec, p, &dof));
+    PetscCall(PetscSectionGetConstraintDof(lsec, p, &cdof));
+    PetscCall(PetscSectionGetDof(gsec, p, &gdof));
+    PetscCheck(dof == dim, comm, PETSC_ERR_SUP, "Contact needs one node per mesh point on Gamma_C (Lagrange degree 1 or 2); point %" PetscInt_FMT " has %" PetscInt_FMT " dofs",
+               p, dof);
+    if (cdof > 0 || gdof <= 0) continue; /* clamped by Gamma_D, or owned by another rank */
+    PetscCall(PetscSectionGetOffset(gsec, p, &goff));
+    PetscCall(DMPlexGetPointDepth(dm, p, &depth));
+    PetscCall(NodePosition(dm, p, x));
+    for (PetscInt d = 0; d < dim; ++d) xn += x[d] * user->scene.obstacle_normal[d];
+    cs->point[cs->n] = p;
+    PetscCall(PetscSectionGetOffset(lsec, p, &cs->local_off[cs->n]));
+    cs->global_off[cs->n] = goff - rstart;
+    cs->is_vertex[cs->n]  = (PetscBool)(depth == 0);
+    cs->gap[cs->n]        = user->scene.obstacle_offset - xn;
+    cs->weight[cs->n]     = PetscRealPart(m[goff - rstart]);
+    cs->active[cs->n]     = PETSC_FALSE;
+    cs->pressure[cs->n]   = 0.0;
+    cs->n++;
+  }
+  PetscCall(VecRestoreArrayRead(M, &m));
+  PetscCall(DMRestoreGlobalVector(dm, &M));
+  PetscCall(PetscFree(pts));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode ContactSetDestroy(ContactSet *cs)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree4(cs->point, cs->local_off, cs->global_off, cs->is_vertex));
+  PetscCall(PetscFree4(cs->gap, cs->weight, cs->active, cs->pressure));
+  cs->n = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,115 @@
+/* Isotropic linear elasticity (plane strain in 2D): material options, pointwise kernels, discretization. */
+#include "signorini.h"
+
+/* sigma(u) = 2 mu eps(u) + lambda tr(eps(u)) I */
+static void f1_u(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[], const PetscScalar u_x[],
+                 const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[],
+                 PetscInt numConstants, const PetscScalar constants[], PetscScalar f1[])
+{
+  const PetscReal lambda = PetscRealPart(constants[CONST_LAMBDA]), mu = PetscRealPart(constants[CONST_MU]);
+  PetscScalar     trace  = 0.0;
+
+  for (PetscInt c = 0; c < dim; ++c) trace += u_x[c * dim + c];
+  for (PetscInt c = 0; c < dim; ++c) {
+    for (PetscInt d = 0; d < dim; ++d) f1[c * dim + d] = mu * (u_x[c * dim + d] + u_x[d * dim + c]);
+    f1[c * dim + c] += lambda * trace;
+  }
+}
+
+/* d sigma_{cd} / d (du_e/dx_f) */
+static void g3_uu(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[], const PetscScalar u_x[],
+                  const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, PetscReal u_tShift,
+                  const PetscReal x[], PetscInt numConstants, const PetscScalar constants[], PetscScalar g3[])
+{
+  const PetscReal lambda = PetscRealPart(constants[CONST_LAMBDA]), mu = PetscRealPart(constants[CONST_MU]);
+
+  for (PetscInt c = 0; c < dim; ++c)
+    for (PetscInt d = 0; d < dim; ++d) {
+      g3[((c * dim + c) * dim + d) * dim + d] += mu;
+      g3[((c * dim + d) * dim + d) * dim + c] += mu;
+      g3[((c * dim + d) * dim + c) * dim + d] += lambda;
+    }
+}
+
+static PetscErrorCode ZeroVector(PetscInt dim, PetscReal t, const PetscReal x[], PetscInt Nc, PetscScalar u[], void *ctx)
+{
+  for (PetscInt c = 0; c < Nc; ++c) u[c] = 0.0;
+  return PETSC_SUCCESS;
+}
+
+static PetscErrorCode CreateRigidBodyModes(DM dm, PetscInt origField, PetscInt field, MatNullSpace *nullspace)
+{
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexCreateRigidBody(dm, origField, nullspace));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat)
+{
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, NULL, "Linear elastic material", "Signorini");
+  mat->young_modulus = 1.0;
+  PetscCall(PetscOptionsReal("-young_modulus", "Young's modulus E", NULL, mat->young_modulus, &mat->young_modulus, NULL));
+  mat->poisson_ratio = 0.3;
+  PetscCall(PetscOptionsReal("-poisson_ratio", "Poisson ratio nu, in (-1, 0.5)", NULL, mat->poisson_ratio, &mat->poisson_ratio, NULL));
+  PetscOptionsEnd();
+  PetscCheck(mat->young_modulus > 0.0, comm, PETSC_ERR_USER_INPUT, "-young_modulus must be positive, got %g", (double)mat->young_modulus);
+  PetscCheck(mat->poisson_ratio > -1.0 && mat->poisson_ratio < 0.5, comm, PETSC_ERR_USER_INPUT, "-poisson_ratio must lie in (-1, 0.5), got %g", (double)mat->poisson_ratio);
+  mat->lambda = mat->young_modulus * mat->poisson_ratio / ((1.0 + mat->poisson_ratio) * (1.0 - 2.0 * mat->poisson_ratio));
+  mat->mu     = mat->young_modulus / (2.0 * (1.0 + mat->poisson_ratio));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Writes the material, penalty, obstacle and scene parameters into the constants[] of the kernels. */
+PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user)
+{
+  PetscDS     ds;
+  PetscScalar c[CONST_SCENE_MAX];
+
+  PetscFunctionBeginUser;
+  c[CONST_LAMBDA]          = user->material.lambda;
+  c[CONST_MU]              = user->material.mu;
+  c[CONST_PENALTY]         = (user->contact.method == CONTACT_PENALTY) ? 1.0 / user->eps : 0.0;
+  c[CONST_NORMAL_X]        = user->scene.obstacle_normal[0];
+  c[CONST_NORMAL_Y]        = user->scene.obstacle_normal[1];
+  c[CONST_NORMAL_Z]        = user->scene.obstacle_normal[2];
+  c[CONST_OBSTACLE_OFFSET] = user->scene.obstacle_offset;
+  for (PetscInt i = 0; i < user->scene.num_constants; ++i) c[CONST_SCENE + i] = user->scene.constants[i];
+  PetscCall(DMGetDS(dm, &ds));
+  PetscCall(PetscDSSetConstants(ds, CONST_SCENE + user->scene.num_constants, c));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The displacement field (PetscFE, prefix displacement_), the bulk weak form and Gamma_D. */
+PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user)
+{
+  MPI_Comm        comm = PetscObjectComm((PetscObject)dm);
+  const Scene    *scene = &user->scene;
+  PetscFE         fe;
+  PetscSpace      space;
+  PetscDS         ds;
+  PetscInt        dim;
+  PetscBool       simplex, has_degree;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-displacement_petscspace_degree", &has_degree));
+  if (!has_degree) PetscCall(PetscOptionsSetValue(NULL, "-displacement_petscspace_degree", "1")); /* P1 by default */
+  PetscCall(DMPlexIsSimplex(dm, &simplex));
+  PetscCall(PetscFECreateDefault(comm, dim, dim, simplex, "displacement_", PETSC_DETERMINE, &fe));
+  PetscCall(PetscObjectSetName((PetscObject)fe, "displacement"));
+  PetscCall(PetscFEGetBasisSpace(fe, &space));
+  PetscCall(PetscSpaceGetDegree(space, &user->degree, NULL));
+  PetscCall(DMSetField(dm, 0, NULL, (PetscObject)fe));
+  PetscCall(PetscFEDestroy(&fe));
+  PetscCall(DMCreateDS(dm));
+  PetscCall(DMGetDS(dm, &ds));
+  PetscCall(PetscDSSetResidual(ds, 0, scene->f0_body, f1_u));
+  PetscCall(PetscDSSetJacobian(ds, 0, 0, NULL, NULL, NULL, g3_uu));
+  if (scene->exact) PetscCall(PetscDSSetExactSolution(ds, 0, scene->exact, NULL));
+  PetscCall(DMAddBoundary(dm, DM_BC_ESSENTIAL, "Gamma_D", user->face_sets, scene->num_dirichlet, scene->dirichlet_ids, 0, 0, NULL,
+                          (void (*)(void))(scene->dirichlet_value ? scene->dirichlet_value : ZeroVector), NULL, NULL, NULL));
+  PetscCall(DMSetNearNullSpaceConstructor(dm, 0, CreateRigidBodyModes));
+  PetscCall(ElasticityUpdateConstants(dm, user));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,96 @@
+static const char help[] = "Frictionless Signorini contact in linear elasticity by the penalty method (Chouly & Hild 2013),\n"
+                           "with SNESVI as the reference for the exact constraint. 2D plane strain and 3D, DMPlex + PetscFE.\n\n";
+
+#include "signorini.h"
+
+static PetscErrorCode PrintSummary(DM dm, AppCtx *user, Vec u)
+{
+  MPI_Comm        comm = PetscObjectComm((PetscObject)dm);
+  const RunStats *s    = &user->stats;
+  PetscInt        dim, ndofs;
+  PetscMPIInt     size;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(VecGetSize(u, &ndofs));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PetscPrintf(comm, "scene %s, %" PetscInt_FMT "D, method %s", user->scene.name, dim, ContactMethods[user->contact.method]));
+  if (user->contact.method == CONTACT_PENALTY) PetscCall(PetscPrintf(comm, " (%s quadrature, eps = %g)", PenaltyQuadratures[user->contact.quadrature], (double)user->eps));
+  PetscCall(PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, h = %g, %d rank(s)\n", user->degree, ndofs, (double)user->h, size));
+  PetscCall(PetscPrintf(comm, "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, |F| = %g\n", SNESConvergedReasons[s->reason], s->newton_its,
+                        s->ksp_its, (double)s->residual_norm));
+  PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g, contact force %g, energy %.10g\n", s->active_vertices,
+                        (double)s->max_penetration, (double)s->contact_force, (double)s->energy));
+  PetscCall(PetscPrintf(comm, "  time: setup %.3f s, solve %.3f s, total %.3f s\n", s->time_setup, s->time_solve, s->time_total));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+int main(int argc, char **argv)
+{
+  AppCtx         user;
+  DM             dm;
+  SNES           snes;
+  Vec            u;
+  MPI_Comm       comm;
+  PetscLogDouble t0, t1;
+
+  PetscCall(PetscInitialize(&argc, &argv, NULL, help));
+  comm = PETSC_COMM_WORLD;
+  PetscCall(PetscTime(&t0));
+  PetscCall(PetscMemzero(&user, sizeof(user)));
+  PetscCall(SceneRegisterAll());
+  PetscCall(SceneGetOptions(comm, user.scene_name, sizeof(user.scene_name)));
+  PetscCall(ElasticityGetOptions(comm, &user.material));
+  PetscCall(ContactGetOptions(comm, &user.contact));
+  PetscCall(OutputGetOptions(comm, &user));
+
+  PetscCall(MeshCreate(comm, &dm));
+  PetscCall(SceneCreate(user.scene_name, dm, &user.scene));
+  PetscCall(MeshCheckContactBoundary(dm, user.scene.contact_id));
+  PetscCall(DMGetLabel(dm, "Face Sets", &user.face_sets));
+  PetscCall(MeshGetMaxCellDiameter(dm, &user.h));
+  PetscCall(ContactComputeEps(&user));
+  if (user.contact.method == CONTACT_VI) {
+    PetscInt  dim, axis;
+    PetscReal sign;
+
+    PetscCall(DMGetDimension(dm, &dim));
+    PetscCall(VIAxisOfNormal(&user, dim, &axis, &sign));
+  }
+  PetscCall(ElasticitySetUpDiscretization(dm, &user));
+  PetscCall(ContactSetCreate(dm, &user, &user.cset));
+  if (user.contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, &user));
+  PetscCall(SolverAssembleBulk(dm, &user));
+  PetscCall(SolverCreateSNES(dm, &user, &snes));
+  PetscCall(DMCreateGlobalVector(dm, &u));
+  PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
+  PetscCall(PetscTime(&t1));
+  user.stats.time_setup = t1 - t0;
+
+  PetscCall(SolverSolve(snes, &user, u));
+  PetscCall(PostprocessContact(dm, &user, u));
+  PetscCall(PetscTime(&t1));
+  user.stats.time_total = t1 - t0;
+  PetscCall(PrintSummary(dm, &user, u));
+  PetscCall(OutputWriteHDF5(dm, &user, u));
+  PetscCall(PetscPrintf(comm, "  output: %s\n", user.output));
+  if (!user.stats.converged)
+    PetscCall(PetscPrintf(comm, "ERROR: the nonlinear solve failed: %s after %" PetscInt_FMT " Newton steps, residual %g; written with converged = 0\n",
+                          SNESConvergedReasons[user.stats.reason], user.stats.newton_its, (double)user.stats.residual_norm));
+
+  PetscCall(VecDestroy(&u));
+  PetscCall(SNESDestroy(&snes));
+  PetscCall(MatDestroy(&user.K));
+  PetscCall(VecDestroy(&user.r0));
+  PetscCall(VecDestroy(&user.xl));
+  PetscCall(VecDestroy(&user.xu));
+  PetscCall(PetscWeakFormDestroy(&user.wf_penalty));
+  PetscCall(ContactSetDestroy(&user.cset));
+  PetscCall(DMDestroy(&dm));
+  PetscCall(SceneFinalize());
+  {
+    const PetscBool converged = user.stats.converged;
+    PetscCall(PetscFinalize());
+    return converged ? 0 : 3;
+  }
+}

@@ -1,0 +1,118 @@
+/* Mesh creation: PETSc's box and file readers, plus the project's simplex box generator. */
+#include "signorini.h"
+
+/* Creates the mesh from PETSc's own options; simplex boxes, which PETSc 3.18 cannot generate
+   without Triangle/CTetGen, come from MeshCreateSimplexBox(). */
+PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
+{
+  PetscInt    dim, faces[3], nfaces = 3, nlower = 3, nupper = 3;
+  PetscReal   lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
+  PetscBool   simplex, has_file;
+  char        filename[PETSC_MAX_PATH_LEN] = "";
+  PetscMPIInt size;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscOptionsBegin(comm, NULL, "Mesh options (PETSc's names)", "DMPLEX");
+  PetscCall(PetscOptionsString("-dm_plex_filename", "Mesh file (Gmsh, ExodusII, HDF5)", "DMPlexCreateFromFile", filename, filename, sizeof(filename), &has_file));
+  dim = 2;
+  PetscCall(PetscOptionsRangeInt("-dm_plex_dim", "Dimension of the box mesh", "DMPlexCreateBoxMesh", dim, &dim, NULL, 2, 3));
+  simplex = PETSC_TRUE;
+  PetscCall(PetscOptionsBool("-dm_plex_simplex", "Simplices (triangles, tetrahedra) or tensor cells (quads, hexes)", "DMPlexCreateBoxMesh", simplex, &simplex, NULL));
+  faces[0] = faces[1] = faces[2] = (dim == 2) ? 8 : 4;
+  PetscCall(PetscOptionsIntArray("-dm_plex_box_faces", "Number of cells along each side of the box", "DMPlexCreateBoxMesh", faces, &nfaces, NULL));
+  PetscCall(PetscOptionsRealArray("-dm_plex_box_lower", "Lower corner of the box", "DMPlexCreateBoxMesh", lower, &nlower, NULL));
+  PetscCall(PetscOptionsRealArray("-dm_plex_box_upper", "Upper corner of the box", "DMPlexCreateBoxMesh", upper, &nupper, NULL));
+  PetscOptionsEnd();
+  for (PetscInt d = 0; d < dim; ++d) {
+    PetscCheck(faces[d] >= 1, comm, PETSC_ERR_USER_INPUT, "-dm_plex_box_faces: need at least one cell per side, got %" PetscInt_FMT, faces[d]);
+    PetscCheck(upper[d] > lower[d], comm, PETSC_ERR_USER_INPUT, "-dm_plex_box_upper must exceed -dm_plex_box_lower in every direction");
+  }
+
+  if (has_file) {
+    PetscBool exists;
+
+    PetscCall(PetscTestFile(filename, 'r', &exists));
+    PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "Mesh file '%s' (-dm_plex_filename) does not exist or cannot be read", filename);
+  }
+  if (simplex && !has_file) {
+    PetscCall(MeshCreateSimplexBox(comm, dim, faces, lower, upper, dm));
+    if (size > 1) {
+      DM dist = NULL;
+
+      PetscCall(DMPlexDistribute(*dm, 0, NULL, &dist));
+      if (dist) {
+        PetscCall(DMDestroy(dm));
+        *dm = dist;
+      }
+    }
+    PetscCall(DMSetFromOptions(*dm)); /* refinement and the rest of PETSc's mesh options */
+  } else {
+    PetscCall(DMCreate(comm, dm));
+    PetscCall(DMSetType(*dm, DMPLEX));
+    PetscCall(DMSetFromOptions(*dm));
+  }
+  PetscCall(PetscObjectSetName((PetscObject)*dm, "mesh"));
+  PetscCall(DMViewFromOptions(*dm, NULL, "-dm_view"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* h: the largest cell diameter (largest distance between two vertices of a cell) over all ranks. */
+PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h)
+{
+  DM           cdm;
+  PetscSection csection;
+  Vec          coords;
+  PetscInt     cStart, cEnd, cdim;
+  PetscReal    hmax = 0.0;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetCoordinateDim(dm, &cdim));
+  PetscCall(DMGetCoordinateDM(dm, &cdm));
+  PetscCall(DMGetLocalSection(cdm, &csection));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    PetscScalar *x = NULL;
+    PetscInt     n;
+
+    PetscCall(DMPlexVecGetClosure(cdm, csection, coords, c, &n, &x));
+    for (PetscInt i = 0; i < n / cdim; ++i)
+      for (PetscInt j = i + 1; j < n / cdim; ++j) {
+        PetscReal d2 = 0.0;
+        for (PetscInt d = 0; d < cdim; ++d) d2 += PetscSqr(PetscRealPart(x[i * cdim + d] - x[j * cdim + d]));
+        hmax = PetscMax(hmax, PetscSqrtReal(d2));
+      }
+    PetscCall(DMPlexVecRestoreClosure(cdm, csection, coords, c, &n, &x));
+  }
+  PetscCall(MPIU_Allreduce(&hmax, h, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Refuses a mesh whose "Face Sets" label has no face with the value of Gamma_C. */
+PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id)
+{
+  DMLabel  label;
+  PetscInt n = 0, ntotal, fStart, fEnd;
+  IS       is;
+  MPI_Comm comm = PetscObjectComm((PetscObject)dm);
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetLabel(dm, "Face Sets", &label));
+  PetscCheck(label, comm, PETSC_ERR_USER_INPUT, "The mesh has no \"Face Sets\" label, so it has no contact boundary Gamma_C (Face Sets value %" PetscInt_FMT ")", contact_id);
+  PetscCall(DMPlexGetHeightStratum(dm, 1, &fStart, &fEnd));
+  PetscCall(DMLabelGetStratumIS(label, contact_id, &is));
+  if (is) {
+    const PetscInt *points;
+    PetscInt        np;
+
+    PetscCall(ISGetLocalSize(is, &np));
+    PetscCall(ISGetIndices(is, &points));
+    for (PetscInt i = 0; i < np; ++i) n += (points[i] >= fStart && points[i] < fEnd);
+    PetscCall(ISRestoreIndices(is, &points));
+    PetscCall(ISDestroy(&is));
+  }
+  PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, comm));
+  PetscCheck(ntotal > 0, comm, PETSC_ERR_USER_INPUT, "The mesh has no contact boundary: no face carries \"Face Sets\" value %" PetscInt_FMT " (Gamma_C)", contact_id);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,318 @@
+/* HDF5 writer: mesh and vertex fields in PETSc's layout (petsc_gen_xdmf.py reads it), run metadata
+   as attributes of /run, an .xdmf beside it. Written under FILE.part and renamed when complete. */
+#include <petscsf.h>
+#include <petscviewerhdf5.h>
+#include "signorini.h"
+
+PetscErrorCode OutputGetOptions(MPI_Comm comm, AppCtx *user)
+{
+  char      dir[PETSC_MAX_PATH_LEN], *slash;
+  PetscBool set, exists;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, NULL, "Output", "Signorini");
+  PetscCall(PetscSNPrintf(user->output, sizeof(user->output), "output/%s.h5", user->scene_name));
+  PetscCall(PetscOptionsString("-output", "HDF5 output file (default output/<scene>.h5)", NULL, user->output, user->output, sizeof(user->output), &set));
+  PetscOptionsEnd();
+  PetscCall(PetscStrncpy(dir, user->output, sizeof(dir)));
+  PetscCall(PetscStrrchr(dir, '/', &slash));
+  if (slash != dir) {
+    slash[-1] = '\0';
+    PetscCall(PetscTestDirectory(dir, 'w', &exists));
+    if (!exists && !set) { /* the default directory is created; a user's directory must exist */
+      PetscCall(PetscMkdir(dir));
+      PetscCall(PetscTestDirectory(dir, 'w', &exists));
+    }
+    PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "Output directory '%s' (-output %s) does not exist or is not writable", dir, user->output);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* A DM on the same mesh with nc unknowns at each vertex: the layout of a vertex field. */
+static PetscErrorCode CreateVertexFieldDM(DM dm, PetscInt nc, DM *vdm)
+{
+  PetscSection s;
+  PetscInt     pStart, pEnd, vStart, vEnd;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMClone(dm, vdm));
+  PetscCall(PetscSectionCreate(PetscObjectComm((PetscObject)dm), &s));
+  PetscCall(PetscSectionSetNumFields(s, 1));
+  PetscCall(PetscSectionSetFieldComponents(s, 0, nc));
+  PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(PetscSectionSetChart(s, pStart, pEnd));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    PetscCall(PetscSectionSetDof(s, v, nc));
+    PetscCall(PetscSectionSetFieldDof(s, v, 0, nc));
+  }
+  PetscCall(PetscSectionSetUp(s));
+  PetscCall(DMSetLocalSection(*vdm, s));
+  PetscCall(PetscSectionDestroy(&s));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Number of points of a stratum owned by this rank, summed over ranks. */
+static PetscErrorCode CountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count)
+{
+  PetscSF         sf;
+  PetscInt        nleaves, n = 0;
+  const PetscInt *leaves;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetPointSF(dm, &sf));
+  PetscCall(PetscSFGetGraph(sf, NULL, &nleaves, &leaves, NULL));
+  n = pEnd - pStart;
+  if (nleaves > 0 && leaves)
+    for (PetscInt l = 0; l < nleaves; ++l) n -= (leaves[l] >= pStart && leaves[l] < pEnd);
+  PetscCall(MPIU_Allreduce(&n, count, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The vertex fields: displacement, contact pressure, normal gap g - u_n, Gamma_C indicator,
+   and the exact solution and error when the scene has one. */
+static PetscErrorCode WriteVertexFields(DM dm, AppCtx *user, Vec u, PetscViewer viewer)
+{
+  const ContactSet  *cs = &user->cset;
+  DM                 vdm, sdm, cdm;
+  Vec                locU, disp, pressure, gap, mask, exact = NULL, error = NULL, coords;
+  PetscSection       usec, vsec, ssec, csec;
+  PetscInt           dim, vStart, vEnd, vrstart, srstart;
+  const PetscScalar *lu, *xc, *x;
+  PetscScalar       *d, *p, *g, *m, *ex = NULL, *er = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(CreateVertexFieldDM(dm, dim, &vdm));
+  PetscCall(CreateVertexFieldDM(dm, 1, &sdm));
+  PetscCall(DMGetLocalSection(dm, &usec));
+  PetscCall(DMGetGlobalSection(vdm, &vsec));
+  PetscCall(DMGetGlobalSection(sdm, &ssec));
+  PetscCall(DMGetCoordinateDM(dm, &cdm));
+  PetscCall(DMGetLocalSection(cdm, &csec));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(DMCreateGlobalVector(vdm, &disp));
+  PetscCall(DMCreateGlobalVector(sdm, &pressure));
+  PetscCall(DMCreateGlobalVector(sdm, &gap));
+  PetscCall(DMCreateGlobalVector(sdm, &mask));
+  PetscCall(PetscObjectSetName((PetscObject)disp, "displacement"));
+  PetscCall(PetscObjectSetName((PetscObject)pressure, "contact_pressure"));
+  PetscCall(PetscObjectSetName((PetscObject)gap, "normal_gap"));
+  PetscCall(PetscObjectSetName((PetscObject)mask, "contact_boundary"));
+  PetscCall(VecZeroEntries(pressure));
+  PetscCall(VecZeroEntries(gap));
+  PetscCall(VecZeroEntries(mask));
+  if (user->scene.exact) {
+    PetscCall(VecDuplicate(disp, &exact));
+    PetscCall(VecDuplicate(disp, &error));
+    PetscCall(PetscObjectSetName((PetscObject)exact, "exact_displacement"));
+    PetscCall(PetscObjectSetName((PetscObject)error, "error"));
+    PetscCall(VecGetArray(exact, &ex));
+    PetscCall(VecGetArray(error, &er));
+  }
+  PetscCall(VecGetOwnershipRange(disp, &vrstart, NULL));
+  PetscCall(VecGetOwnershipRange(pressure, &srstart, NULL));
+
+  PetscCall(DMGetLocalVector(dm, &locU));
+  PetscCall(VecZeroEntries(locU));
+  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, locU, 0.0, NULL, NULL, NULL));
+  PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, locU));
+  PetscCall(VecGetArrayRead(locU, &lu));
+  PetscCall(VecGetArrayRead(coords, &xc));
+  PetscCall(VecGetArray(disp, &d));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    PetscInt goff, uoff, coff;
+
+    PetscCall(PetscSectionGetOffset(vsec, v, &goff));
+    if (goff < 0) continue; /* not owned */
+    goff -= vrstart;
+    PetscCall(PetscSectionGetOffset(usec, v, &uoff));
+    for (PetscInt c = 0; c < dim; ++c) d[goff + c] = lu[uoff + c];
+    if (ex) {
+      PetscReal xv[3];
+
+      PetscCall(PetscSectionGetOffset(csec, v, &coff));
+      for (PetscInt c = 0; c < dim; ++c) xv[c] = PetscRealPart(xc[coff + c]);
+      PetscCall((*user->scene.exact)(dim, 0.0, xv, dim, &ex[goff], NULL));
+      for (PetscInt c = 0; c < dim; ++c) er[goff + c] = d[goff + c] - ex[goff + c];
+    }
+  }
+  PetscCall(VecRestoreArray(disp, &d));
+  PetscCall(VecRestoreArrayRead(coords, &xc));
+  PetscCall(VecRestoreArrayRead(locU, &lu));
+  PetscCall(DMRestoreLocalVector(dm, &locU));
+  if (ex) {
+    PetscCall(VecRestoreArray(exact, &ex));
+    PetscCall(VecRestoreArray(error, &er));
+  }
+
+  PetscCall(VecGetArrayRead(u, &x));
+  PetscCall(VecGetArray(pressure, &p));
+  PetscCall(VecGetArray(gap, &g));
+  PetscCall(VecGetArray(mask, &m));
+  for (PetscInt i = 0; i < cs->n; ++i) {
+    PetscInt goff;
+
+    if (!cs->is_vertex[i]) continue;
+    PetscCall(PetscSectionGetOffset(ssec, cs->point[i], &goff));
+    goff -= srstart;
+    p[goff] = cs->pressure[i];
+    g[goff] = -ContactNodePenetration(user, dim, i, x);
+    m[goff] = 1.0;
+  }
+  PetscCall(VecRestoreArray(mask, &m));
+  PetscCall(VecRestoreArray(gap, &g));
+  PetscCall(VecRestoreArray(pressure, &p));
+  PetscCall(VecRestoreArrayRead(u, &x));
+
+  PetscCall(VecView(disp, viewer));
+  PetscCall(VecView(pressure, viewer));
+  PetscCall(VecView(gap, viewer));
+  PetscCall(VecView(mask, viewer));
+  if (exact) {
+    PetscCall(VecView(exact, viewer));
+    PetscCall(VecView(error, viewer));
+  }
+  PetscCall(VecDestroy(&exact));
+  PetscCall(VecDestroy(&error));
+  PetscCall(VecDestroy(&disp));
+  PetscCall(VecDestroy(&pressure));
+  PetscCall(VecDestroy(&gap));
+  PetscCall(VecDestroy(&mask));
+  PetscCall(DMDestroy(&vdm));
+  PetscCall(DMDestroy(&sdm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode WriteRealAttr(PetscViewer v, const char name[], PetscReal value)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", name, PETSC_REAL, &value));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode WriteIntAttr(PetscViewer v, const char name[], PetscInt value)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", name, PETSC_INT, &value));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v, PetscInt ncells, PetscInt nverts)
+{
+  const RunStats *s = &user->stats;
+  PetscMPIInt     size;
+  PetscInt        dim, ndofs;
+  char            method[64];
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)dm), &size));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(VecGetSize(u, &ndofs));
+  PetscCall(PetscStrncpy(method, ContactMethods[user->contact.method], sizeof(method)));
+  PetscCall(PetscViewerHDF5WriteGroup(v, "/run"));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "scene", PETSC_STRING, user->scene.name));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "method", PETSC_STRING, method));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_quadrature", PETSC_STRING, PenaltyQuadratures[user->contact.quadrature]));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "snes_reason", PETSC_STRING, SNESConvergedReasons[s->reason]));
+  PetscCall(WriteIntAttr(v, "dim", dim));
+  PetscCall(WriteIntAttr(v, "degree", user->degree));
+  PetscCall(WriteIntAttr(v, "nprocs", size));
+  PetscCall(WriteIntAttr(v, "n_cells", ncells));
+  PetscCall(WriteIntAttr(v, "n_vertices", nverts));
+  PetscCall(WriteIntAttr(v, "n_dofs", ndofs));
+  PetscCall(WriteRealAttr(v, "h", user->h));
+  PetscCall(WriteRealAttr(v, "eps", user->contact.method == CONTACT_PENALTY ? user->eps : 0.0));
+  PetscCall(WriteRealAttr(v, "young_modulus", user->material.young_modulus));
+  PetscCall(WriteRealAttr(v, "poisson_ratio", user->material.poisson_ratio));
+  PetscCall(WriteIntAttr(v, "converged", s->converged ? 1 : 0));
+  PetscCall(WriteIntAttr(v, "snes_reason_code", (PetscInt)s->reason));
+  PetscCall(WriteIntAttr(v, "newton_its", s->newton_its));
+  PetscCall(WriteIntAttr(v, "ksp_its", s->ksp_its));
+  PetscCall(WriteRealAttr(v, "residual_norm", s->residual_norm));
+  PetscCall(WriteRealAttr(v, "time_setup", s->time_setup));
+  PetscCall(WriteRealAttr(v, "time_solve", s->time_solve));
+  PetscCall(WriteRealAttr(v, "time_total", s->time_total));
+  PetscCall(WriteIntAttr(v, "active_vertices", s->active_vertices));
+  PetscCall(WriteRealAttr(v, "max_penetration", s->max_penetration));
+  PetscCall(WriteRealAttr(v, "contact_force", s->contact_force));
+  PetscCall(WriteRealAttr(v, "energy", s->energy));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* XDMF for ParaView, pointing into the final .h5 (rank 0 only). */
+static PetscErrorCode WriteXdmf(AppCtx *user, PetscInt dim, PetscInt ncells, PetscInt ncorners, PetscInt nverts)
+{
+  const char *fields[]  = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "exact_displacement", "error"};
+  const PetscInt ncomp[] = {dim, 1, 1, 1, dim, dim};
+  const PetscInt nfields = user->scene.exact ? 6 : 4;
+  const char    *topo = dim == 2 ? (ncorners == 3 ? "Triangle" : "Quadrilateral") : (ncorners == 4 ? "Tetrahedron" : "Hexahedron");
+  char           xdmf[PETSC_MAX_PATH_LEN + 8], part[PETSC_MAX_PATH_LEN + 16], *h5name, *slash;
+  FILE          *fp;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscStrrchr(user->output, '/', &slash));
+  h5name = slash;
+  PetscCall(PetscStrncpy(xdmf, user->output, sizeof(xdmf)));
+  {
+    size_t len;
+    PetscCall(PetscStrlen(xdmf, &len));
+    if (len > 3 && !strcmp(xdmf + len - 3, ".h5")) xdmf[len - 3] = '\0';
+    PetscCall(PetscStrlcat(xdmf, ".xdmf", sizeof(xdmf)));
+  }
+  PetscCall(PetscSNPrintf(part, sizeof(part), "%s.part", xdmf));
+  fp = fopen(part, "w");
+  PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Cannot write %s", part);
+  fprintf(fp, "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"2.0\">\n <Domain>\n  <Grid Name=\"mesh\" GridType=\"Uniform\">\n");
+  fprintf(fp, "   <Topology TopologyType=\"%s\" NumberOfElements=\"%d\">\n", topo, (int)ncells);
+  fprintf(fp, "    <DataItem Dimensions=\"%d %d\" NumberType=\"Int\" Format=\"HDF\">%s:/viz/topology/cells</DataItem>\n   </Topology>\n", (int)ncells, (int)ncorners, h5name);
+  fprintf(fp, "   <Geometry GeometryType=\"%s\">\n", dim == 2 ? "XY" : "XYZ");
+  fprintf(fp, "    <DataItem Dimensions=\"%d %d\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n   </Geometry>\n", (int)nverts, (int)dim, h5name);
+  for (PetscInt f = 0; f < nfields; ++f) {
+    fprintf(fp, "   <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", fields[f], ncomp[f] > 1 ? "Vector" : "Scalar");
+    if (ncomp[f] > 1) fprintf(fp, "    <DataItem Dimensions=\"%d %d\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n", (int)nverts, (int)ncomp[f], h5name, fields[f]);
+    else fprintf(fp, "    <DataItem Dimensions=\"%d\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n", (int)nverts, h5name, fields[f]);
+    fprintf(fp, "   </Attribute>\n");
+  }
+  fprintf(fp, "  </Grid>\n </Domain>\n</Xdmf>\n");
+  PetscCheck(fclose(fp) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot write %s", part);
+  PetscCheck(rename(part, xdmf) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot rename %s to %s", part, xdmf);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
+{
+  MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
+  char        part[PETSC_MAX_PATH_LEN + 8];
+  PetscViewer viewer;
+  PetscInt    dim, cStart, cEnd, vStart, vEnd, ncells, nverts, ncorners = 0;
+  PetscMPIInt rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(CountOwned(dm, cStart, cEnd, &ncells));
+  PetscCall(CountOwned(dm, vStart, vEnd, &nverts));
+  if (cEnd > cStart) PetscCall(DMPlexGetConeSize(dm, cStart, &ncorners));
+  if (dim == 3 && ncorners == 6) ncorners = 8; /* a hex has 6 faces and 8 corners; a triangle, quad or tet as many corners as faces */
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ncorners, 1, MPIU_INT, MPI_MAX, comm));
+
+  PetscCall(PetscSNPrintf(part, sizeof(part), "%s.part", user->output));
+  PetscCall(PetscViewerHDF5Open(comm, part, FILE_MODE_WRITE, &viewer));
+  PetscCall(PetscViewerPushFormat(viewer, PETSC_VIEWER_HDF5_VIZ));
+  PetscCall(DMView(dm, viewer));
+  PetscCall(WriteVertexFields(dm, user, u, viewer));
+  PetscCall(PetscViewerPopFormat(viewer));
+  PetscCall(WriteRunMetadata(dm, user, u, viewer, ncells, nverts));
+  PetscCall(PetscViewerDestroy(&viewer));
+  PetscCallMPI(MPI_Barrier(comm));
+  if (rank == 0) {
+    PetscCheck(rename(part, user->output) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot rename %s to %s", part, user->output);
+    PetscCall(WriteXdmf(user, dim, ncells, ncorners, nverts));
+  }
+  PetscCallMPI(MPI_Barrier(comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
