@@ -69,6 +69,29 @@ static PetscErrorCode CountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Writes /vertex_fields/<name of v> as an (n_vertices, nc) dataset in the vertex order of /geometry/vertices. */
+static PetscErrorCode ViewVertexField(Vec v, PetscInt nc, PetscViewer viewer)
+{
+  Vec                plain;
+  PetscInt           n;
+  const PetscScalar *a;
+  const char        *name;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetLocalSize(v, &n));
+  PetscCall(VecGetArrayRead(v, &a));
+  PetscCall(VecCreateMPIWithArray(PetscObjectComm((PetscObject)v), nc, n, PETSC_DECIDE, a, &plain));
+  PetscCall(PetscObjectGetName((PetscObject)v, &name));
+  PetscCall(PetscObjectSetName((PetscObject)plain, name));
+  PetscCall(PetscViewerHDF5PushGroup(viewer, "/vertex_fields"));
+  PetscCall(VecView(plain, viewer));
+  PetscCall(PetscViewerHDF5WriteObjectAttribute(viewer, (PetscObject)plain, "vector_field_type", PETSC_STRING, nc > 1 ? "vector" : "scalar"));
+  PetscCall(PetscViewerHDF5PopGroup(viewer));
+  PetscCall(VecDestroy(&plain));
+  PetscCall(VecRestoreArrayRead(v, &a));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The vertex fields: displacement, contact pressure, normal gap g - u_n, Gamma_C indicator,
    and the exact solution and error when the scene has one. */
 static PetscErrorCode WriteVertexFields(DM dm, AppCtx *user, Vec u, PetscViewer viewer)
@@ -166,13 +189,13 @@ static PetscErrorCode WriteVertexFields(DM dm, AppCtx *user, Vec u, PetscViewer 
   PetscCall(VecRestoreArray(pressure, &p));
   PetscCall(VecRestoreArrayRead(u, &x));
 
-  PetscCall(VecView(disp, viewer));
-  PetscCall(VecView(pressure, viewer));
-  PetscCall(VecView(gap, viewer));
-  PetscCall(VecView(mask, viewer));
+  PetscCall(ViewVertexField(disp, dim, viewer));
+  PetscCall(ViewVertexField(pressure, 1, viewer));
+  PetscCall(ViewVertexField(gap, 1, viewer));
+  PetscCall(ViewVertexField(mask, 1, viewer));
   if (exact) {
-    PetscCall(VecView(exact, viewer));
-    PetscCall(VecView(error, viewer));
+    PetscCall(ViewVertexField(exact, dim, viewer));
+    PetscCall(ViewVertexField(error, dim, viewer));
   }
   PetscCall(VecDestroy(&exact));
   PetscCall(VecDestroy(&error));

@@ -31,24 +31,28 @@ static void g0_bd_penalty(PetscInt dim, PetscInt Nf, PetscInt NfAux, const Petsc
     for (PetscInt e = 0; e < dim; ++e) g0[c * dim + e] = constants[CONST_PENALTY] * constants[CONST_NORMAL_X + c] * constants[CONST_NORMAL_X + e];
 }
 
-/* (1/2eps) [u_n - g]_+^2, the penalty energy density */
-static void penalty_energy_density(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[],
-                                   const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[],
-                                   const PetscScalar a_x[], PetscReal t, const PetscReal x[], const PetscReal n[], PetscInt numConstants, const PetscScalar constants[],
-                                   PetscScalar f[])
+/* (1/2eps) [u_n - g]_+^2, the penalty energy density, in the first component: summed over the
+   entries of the local boundary residual it gives the integral (the basis is a partition of unity). */
+static void f0_bd_penalty_energy(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[],
+                                 const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[],
+                                 PetscReal t, const PetscReal x[], const PetscReal n[], PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
 {
   const PetscReal d = Penetration(dim, u, x, constants);
 
-  f[0] = d > 0.0 ? 0.5 * constants[CONST_PENALTY] * d * d : 0.0;
+  for (PetscInt c = 1; c < dim; ++c) f0[c] = 0.0;
+  f0[0] = d > 0.0 ? 0.5 * constants[CONST_PENALTY] * d * d : 0.0;
 }
+
+enum { PENALTY_PART_TERM, PENALTY_PART_ENERGY }; /* parts of the penalty weak form */
 
 PetscErrorCode PenaltySetUp(DM dm, AppCtx *user)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscWeakFormCreate(PetscObjectComm((PetscObject)dm), &user->wf_penalty));
   PetscCall(PetscWeakFormSetNumFields(user->wf_penalty, 1));
-  PetscCall(PetscWeakFormSetIndexBdResidual(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, 0, 0, f0_bd_penalty, 0, NULL));
-  PetscCall(PetscWeakFormSetIndexBdJacobian(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, 0, 0, 0, g0_bd_penalty, 0, NULL, 0, NULL, 0, NULL));
+  PetscCall(PetscWeakFormSetIndexBdResidual(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, PENALTY_PART_TERM, 0, f0_bd_penalty, 0, NULL));
+  PetscCall(PetscWeakFormSetIndexBdResidual(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, PENALTY_PART_ENERGY, 0, f0_bd_penalty_energy, 0, NULL));
+  PetscCall(PetscWeakFormSetIndexBdJacobian(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, 0, PENALTY_PART_TERM, 0, g0_bd_penalty, 0, NULL, 0, NULL, 0, NULL));
   if (user->contact.quadrature == PENALTY_QUADRATURE_NODAL) {
     PetscInt bad = 0, nbad;
 
@@ -71,6 +75,24 @@ static PetscErrorCode GetLocalSolution(DM dm, Vec X, Vec *locX)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* locF = the local boundary residual of one part of the penalty weak form (Gauss rule). */
+static PetscErrorCode ComputePenaltyPartLocal(DM dm, AppCtx *user, PetscInt part, Vec X, Vec locF)
+{
+  PetscFormKey key;
+  Vec          locX;
+
+  PetscFunctionBeginUser;
+  key.label = user->face_sets;
+  key.value = user->scene.contact_id;
+  key.field = 0;
+  key.part  = part;
+  PetscCall(GetLocalSolution(dm, X, &locX));
+  PetscCall(VecZeroEntries(locF));
+  PetscCall(CompatComputeBdResidualSingle(dm, user->wf_penalty, key, locX, locF));
+  PetscCall(DMRestoreLocalVector(dm, &locX));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F)
 {
   const PetscReal kappa = 1.0 / user->eps;
@@ -79,16 +101,12 @@ PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F)
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   if (user->contact.quadrature == PENALTY_QUADRATURE_GAUSS) {
-    PetscFormKey key = {user->face_sets, user->scene.contact_id, 0, 0};
-    Vec          locX, locF;
+    Vec locF;
 
-    PetscCall(GetLocalSolution(dm, X, &locX));
     PetscCall(DMGetLocalVector(dm, &locF));
-    PetscCall(VecZeroEntries(locF));
-    PetscCall(CompatComputeBdResidualSingle(dm, user->wf_penalty, key, locX, locF));
+    PetscCall(ComputePenaltyPartLocal(dm, user, PENALTY_PART_TERM, X, locF));
     PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, F));
     PetscCall(DMRestoreLocalVector(dm, &locF));
-    PetscCall(DMRestoreLocalVector(dm, &locX));
   } else {
     const PetscScalar *x;
     PetscScalar       *f;
@@ -150,10 +168,15 @@ PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy)
   *energy = 0.0;
   if (user->contact.method != CONTACT_PENALTY) PetscFunctionReturn(PETSC_SUCCESS);
   if (user->contact.quadrature == PENALTY_QUADRATURE_GAUSS) {
-    PetscScalar integral[1] = {0.0};
+    Vec         locE;
+    PetscScalar e;
 
-    PetscCall(DMPlexComputeBdIntegral(dm, X, user->face_sets, 1, &user->scene.contact_id, penalty_energy_density, integral, NULL));
-    *energy = PetscRealPart(integral[0]);
+    /* each face is integrated on one rank only, so the local sums add up to the integral */
+    PetscCall(DMGetLocalVector(dm, &locE));
+    PetscCall(ComputePenaltyPartLocal(dm, user, PENALTY_PART_ENERGY, X, locE));
+    PetscCall(VecSum(locE, &e));
+    PetscCall(DMRestoreLocalVector(dm, &locE));
+    PetscCall(MPIU_Allreduce(&e, energy, 1, MPIU_SCALAR, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
   } else {
     const PetscScalar *x;
     PetscReal          e = 0.0;
