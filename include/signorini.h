@@ -24,6 +24,11 @@ extern const char *const ContactMethods[];
 typedef enum { PENALTY_QUADRATURE_GAUSS, PENALTY_QUADRATURE_NODAL } PenaltyQuadrature;
 extern const char *const PenaltyQuadratures[];
 
+typedef struct {
+  PetscReal young_modulus, poisson_ratio;
+  PetscReal lambda, mu;
+} Material;
+
 /* Pointwise function with PETSc's signature for boundary values and exact solutions. */
 typedef PetscErrorCode (*ScenePointFn)(PetscInt dim, PetscReal t, const PetscReal x[], PetscInt Nc, PetscScalar u[], void *ctx);
 
@@ -33,21 +38,16 @@ typedef struct {
   PetscInt       contact_id;        /* "Face Sets" value of Gamma_C */
   PetscInt       num_dirichlet;     /* "Face Sets" values of Gamma_D (clamped or prescribed) */
   PetscInt       dirichlet_ids[6];
-  ScenePointFn   dirichlet_value;   /* NULL: clamped, u = 0 */
+  ScenePointFn   dirichlet_value;   /* NULL: clamped, u = 0; called with ctx = constants */
   PetscPointFunc f0_body;           /* volume residual term, -f; NULL: no body force */
   PetscReal      obstacle_normal[3];
   PetscReal      obstacle_offset;
-  ScenePointFn   exact;             /* exact solution, NULL if none */
+  ScenePointFn   exact;             /* exact solution, NULL if none; called with ctx = constants */
   PetscInt       num_constants;     /* scene constants, stored from constants[CONST_SCENE] on */
   PetscScalar    constants[CONST_SCENE_MAX - CONST_SCENE];
 } Scene;
 
-typedef PetscErrorCode (*SceneCreateFn)(DM dm, Scene *scene);
-
-typedef struct {
-  PetscReal young_modulus, poisson_ratio;
-  PetscReal lambda, mu;
-} Material;
+typedef PetscErrorCode (*SceneCreateFn)(DM dm, const Material *mat, Scene *scene);
 
 /* Options of the contact treatment and the penalty parameter. */
 typedef struct {
@@ -100,9 +100,10 @@ typedef struct {
 /* scenes/registry.c */
 PetscErrorCode SceneRegisterAll(void);
 PetscErrorCode SceneFinalize(void);
-PetscErrorCode SceneCreate(const char name[], DM dm, Scene *scene);
+PetscErrorCode SceneCreate(const char name[], DM dm, const Material *mat, Scene *scene);
 PetscErrorCode SceneGetOptions(MPI_Comm comm, char name[], size_t len);
-PetscErrorCode SceneCreate_Square(DM, Scene *);
+PetscErrorCode SceneCreate_Square(DM, const Material *, Scene *);
+PetscErrorCode SceneCreate_Patch(DM, const Material *, Scene *);
 
 /* mesh.c, mesh_box_simplex.c */
 PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm);

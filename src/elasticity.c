@@ -106,9 +106,9 @@ PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user)
   PetscCall(DMGetDS(dm, &ds));
   PetscCall(PetscDSSetResidual(ds, 0, scene->f0_body, f1_u));
   PetscCall(PetscDSSetJacobian(ds, 0, 0, NULL, NULL, NULL, g3_uu));
-  if (scene->exact) PetscCall(PetscDSSetExactSolution(ds, 0, scene->exact, NULL));
+  if (scene->exact) PetscCall(PetscDSSetExactSolution(ds, 0, scene->exact, (void *)scene->constants));
   PetscCall(DMAddBoundary(dm, DM_BC_ESSENTIAL, "Gamma_D", user->face_sets, scene->num_dirichlet, scene->dirichlet_ids, 0, 0, NULL,
-                          (void (*)(void))(scene->dirichlet_value ? scene->dirichlet_value : ZeroVector), NULL, NULL, NULL));
+                          (void (*)(void))(scene->dirichlet_value ? scene->dirichlet_value : ZeroVector), NULL, (void *)scene->constants, NULL));
   PetscCall(DMSetNearNullSpaceConstructor(dm, 0, CreateRigidBodyModes));
   PetscCall(ElasticityUpdateConstants(dm, user));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -25,6 +25,29 @@ static PetscErrorCode PrintSummary(DM dm, AppCtx *user, Vec u)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* A misspelled option must not pass unnoticed: every option given must have been read by now. */
+static PetscErrorCode CheckAllOptionsUsed(MPI_Comm comm)
+{
+  const char *read_at_finalize[] = {"-options_left", "-malloc_dump", "-memory_view", "-objects_dump"};
+  PetscInt    N, nleft;
+  char   **names, **values, list[1024] = "";
+
+  PetscFunctionBeginUser;
+  for (size_t i = 0; i < sizeof(read_at_finalize) / sizeof(read_at_finalize[0]); ++i) {
+    PetscBool set;
+    PetscCall(PetscOptionsHasName(NULL, NULL, read_at_finalize[i], &set)); /* marks them used */
+  }
+  PetscCall(PetscOptionsLeftGet(NULL, &N, &names, &values));
+  nleft = N; /* PetscOptionsLeftRestore() zeroes N */
+  for (PetscInt i = 0; i < N; ++i) {
+    PetscCall(PetscStrlcat(list, " -", sizeof(list)));
+    PetscCall(PetscStrlcat(list, names[i], sizeof(list)));
+  }
+  PetscCall(PetscOptionsLeftRestore(NULL, &N, &names, &values));
+  PetscCheck(nleft == 0, comm, PETSC_ERR_USER_INPUT, "%" PetscInt_FMT " option(s) given but never used (misspelled? see -help):%s", nleft, list);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 int main(int argc, char **argv)
 {
   AppCtx         user;
@@ -45,7 +68,7 @@ int main(int argc, char **argv)
   PetscCall(OutputGetOptions(comm, &user));
 
   PetscCall(MeshCreate(comm, &dm));
-  PetscCall(SceneCreate(user.scene_name, dm, &user.scene));
+  PetscCall(SceneCreate(user.scene_name, dm, &user.material, &user.scene));
   PetscCall(MeshCheckContactBoundary(dm, user.scene.contact_id));
   PetscCall(DMGetLabel(dm, "Face Sets", &user.face_sets));
   PetscCall(MeshGetMaxCellDiameter(dm, &user.h));
@@ -71,6 +94,7 @@ int main(int argc, char **argv)
   PetscCall(PostprocessContact(dm, &user, u));
   PetscCall(PetscTime(&t1));
   user.stats.time_total = t1 - t0;
+  PetscCall(CheckAllOptionsUsed(comm));
   PetscCall(PrintSummary(dm, &user, u));
   PetscCall(OutputWriteHDF5(dm, &user, u));
   PetscCall(PetscPrintf(comm, "  output: %s\n", user.output));

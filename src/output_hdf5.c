@@ -157,7 +157,7 @@ static PetscErrorCode WriteVertexFields(DM dm, AppCtx *user, Vec u, PetscViewer 
 
       PetscCall(PetscSectionGetOffset(csec, v, &coff));
       for (PetscInt c = 0; c < dim; ++c) xv[c] = PetscRealPart(xc[coff + c]);
-      PetscCall((*user->scene.exact)(dim, 0.0, xv, dim, &ex[goff], NULL));
+      PetscCall((*user->scene.exact)(dim, 0.0, xv, dim, &ex[goff], (void *)user->scene.constants));
       for (PetscInt c = 0; c < dim; ++c) er[goff + c] = d[goff + c] - ex[goff + c];
     }
   }

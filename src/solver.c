@@ -82,8 +82,13 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscFunctionBeginUser;
   PetscCall(SNESCreate(comm, snes));
   PetscCall(SNESSetDM(*snes, dm));
-  if (user->contact.method == CONTACT_PENALTY) PetscCall(MatDuplicate(user->K, MAT_COPY_VALUES, &J));
-  else {
+  if (user->contact.method == CONTACT_PENALTY) {
+    MatNullSpace rigid;
+
+    PetscCall(MatDuplicate(user->K, MAT_COPY_VALUES, &J));
+    PetscCall(MatGetNearNullSpace(user->K, &rigid));
+    PetscCall(MatSetNearNullSpace(J, rigid));
+  } else {
     J = user->K; /* the Jacobian is K itself */
     PetscCall(PetscObjectReference((PetscObject)J));
   }
@@ -105,6 +110,14 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscCall(SNESSetFromOptions(*snes));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)*snes, &is_vi, SNESVINEWTONRSLS, SNESVINEWTONSSLS, ""));
   PetscCall(SNESGetType(*snes, &type));
+  {
+    PetscBool is_gamg, is_rsls;
+
+    PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &is_gamg));
+    PetscCall(PetscObjectTypeCompare((PetscObject)*snes, SNESVINEWTONRSLS, &is_rsls));
+    PetscCheck(!(is_gamg && is_rsls), comm, PETSC_ERR_USER_INPUT,
+               "-pc_type gamg cannot follow the reduced system of -snes_type vinewtonrsls (its size changes between steps): use hypre or mumps with -contact_method vi");
+  }
   PetscCheck(is_vi == (user->contact.method == CONTACT_VI), comm, PETSC_ERR_USER_INPUT,
              "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type,
              ContactMethods[user->contact.method]);

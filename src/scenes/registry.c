@@ -7,6 +7,7 @@ PetscErrorCode SceneRegisterAll(void)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscFunctionListAdd(&scene_list, "square", SceneCreate_Square));
+  PetscCall(PetscFunctionListAdd(&scene_list, "patch", SceneCreate_Patch));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -28,7 +29,7 @@ PetscErrorCode SceneGetOptions(MPI_Comm comm, char name[], size_t len)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SceneCreate(const char name[], DM dm, Scene *scene)
+PetscErrorCode SceneCreate(const char name[], DM dm, const Material *mat, Scene *scene)
 {
   SceneCreateFn create;
 
@@ -37,6 +38,6 @@ PetscErrorCode SceneCreate(const char name[], DM dm, Scene *scene)
   PetscCheck(create, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT, "Unknown scene '%s' (-scene); run with -help to list the registered scenes", name);
   PetscCall(PetscMemzero(scene, sizeof(*scene)));
   PetscCall(PetscStrncpy(scene->name, name, sizeof(scene->name)));
-  PetscCall((*create)(dm, scene));
+  PetscCall((*create)(dm, mat, scene));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -16,7 +16,7 @@ static void f0_body_square(PetscInt dim, PetscInt Nf, PetscInt NfAux, const Pets
   f0[dim - 1] = -beta * (x[0] - x0);
 }
 
-PetscErrorCode SceneCreate_Square(DM dm, Scene *scene)
+PetscErrorCode SceneCreate_Square(DM dm, const Material *mat, Scene *scene)
 {
   PetscInt  dim;
   PetscReal beta, x0;

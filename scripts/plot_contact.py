@@ -1,0 +1,119 @@
+#!/usr/bin/python3
+"""Plot contact pressure and normal gap along the contact boundary Gamma_C.
+
+Reads a solver HDF5 output file, selects the vertices with
+/vertex_fields/contact_boundary == 1 and plots, against the first coordinate
+x_1, the contact pressure (top) and the normal gap g - u_n (bottom). In 3D,
+where many vertices share an x_1 value, the values are scattered and the mean
+per distinct x_1 is overlaid as a line.
+
+Usage:
+    plot_contact.py FILE.h5 [-o OUT.png]
+
+The default output is FILE with .h5 replaced by _contact.png. Exit code 2 if
+the file cannot be read or has no contact-boundary vertices.
+"""
+import argparse
+import sys
+
+import h5py
+import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def default_output(h5path):
+    """FILE.h5 -> FILE_contact.png (suffix appended if not ending in .h5)."""
+    base = h5path[:-3] if h5path.endswith(".h5") else h5path
+    return base + "_contact.png"
+
+
+def read_contact(h5path):
+    """Return (x1, pressure, gap, run_attrs) for the Gamma_C vertices.
+
+    Raises ValueError if the file cannot be read, lacks a needed dataset, or
+    has no contact-boundary vertices.
+    """
+    try:
+        with h5py.File(h5path, "r") as f:
+            x = f["geometry/vertices"][()]
+            vf = f["vertex_fields"]
+            mask = np.isclose(vf["contact_boundary"][()], 1.0)
+            p = vf["contact_pressure"][()]
+            g = vf["normal_gap"][()]
+            run = {}
+            if "run" in f:
+                for k, v in f["run"].attrs.items():
+                    run[k] = v.decode() if isinstance(v, bytes) else v
+    except Exception as exc:
+        raise ValueError(f"{h5path}: cannot read contact data ({exc})") from exc
+    if not mask.any():
+        raise ValueError(f"{h5path}: no contact_boundary vertices (Gamma_C is empty)")
+    x1 = x[mask, 0] if x.ndim == 2 else x[mask]
+    order = np.argsort(x1, kind="stable")
+    return x1[order], p[mask][order], g[mask][order], run
+
+
+def mean_per_x(x1, values, decimals=10):
+    """Mean of `values` per distinct x1 (rounded to `decimals`); sorted."""
+    keys, inverse = np.unique(np.round(x1, decimals), return_inverse=True)
+    sums = np.bincount(inverse, weights=values, minlength=len(keys))
+    counts = np.bincount(inverse, minlength=len(keys))
+    return keys, sums / counts
+
+
+def make_title(run):
+    """Title string from the /run attributes (missing ones shown as '?')."""
+    def fmt(key):
+        v = run.get(key, "?")
+        return "%.4g" % v if isinstance(v, (float, np.floating)) else str(v)
+    return (f"{fmt('scene')} | {fmt('method')} | dim={fmt('dim')} | h={fmt('h')}"
+            f" | eps={fmt('eps')} | converged={fmt('converged')}")
+
+
+def plot_contact(h5path, pngpath):
+    """Plot pressure and gap along Gamma_C of `h5path` into `pngpath`; return it."""
+    x1, p, g, run = read_contact(h5path)
+    keys = np.unique(np.round(x1, 10))
+    many = len(keys) < len(x1)  # several vertices per x_1 (3D faces)
+    fig, (ax_p, ax_g) = plt.subplots(2, 1, sharex=True, figsize=(8, 6.5))
+    for ax, vals, label, color in ((ax_p, p, "contact pressure", "tab:red"),
+                                   (ax_g, g, "normal gap $g - u_n$", "tab:blue")):
+        if many:
+            ax.scatter(x1, vals, s=12, alpha=0.5, color=color, label="vertices")
+            xm, vm = mean_per_x(x1, vals)
+            ax.plot(xm, vm, "-o", ms=3, color="k", lw=1.2, label="mean per $x_1$")
+            ax.legend(loc="best", fontsize=8)
+        else:
+            ax.plot(x1, vals, "-o", ms=4, color=color)
+        ax.set_ylabel(label)
+        ax.grid(True, alpha=0.3)
+    ax_g.axhline(0.0, color="gray", lw=1, ls="--")
+    ax_g.set_xlabel("$x_1$")
+    fig.suptitle(make_title(run), fontsize=10)
+    fig.tight_layout()
+    fig.savefig(pngpath, dpi=120)
+    plt.close(fig)
+    return pngpath
+
+
+def main(argv=None):
+    """Command-line entry point; returns the process exit code."""
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("h5file", metavar="FILE.h5", help="solver HDF5 output file")
+    ap.add_argument("-o", "--output", metavar="OUT.png", default=None,
+                    help="output PNG (default: FILE_contact.png)")
+    args = ap.parse_args(argv)
+    out = args.output or default_output(args.h5file)
+    try:
+        plot_contact(args.h5file, out)
+    except ValueError as exc:
+        print(f"plot_contact.py: error: {exc}", file=sys.stderr)
+        return 2
+    print(out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
