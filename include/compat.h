@@ -4,16 +4,18 @@
 #include <petscdmplex.h>
 
 #if PETSC_VERSION_LT(3, 19, 0)
-  #define PETSC_SUCCESS 0
+#  define PETSC_SUCCESS 0
 #endif
 
 /* DMPlexComputeBdResidualSingle/BdJacobianSingle moved the time argument in 3.20. */
 #if PETSC_VERSION_LT(3, 20, 0)
-  #define CompatComputeBdResidualSingle(dm, wf, key, locX, locF) DMPlexComputeBdResidualSingle(dm, 0.0, wf, key, locX, NULL, locF)
-  #define CompatComputeBdJacobianSingle(dm, wf, label, n, vals, locX, J) DMPlexComputeBdJacobianSingle(dm, 0.0, wf, label, n, vals, 0, locX, NULL, 0.0, J, J)
+#  define CompatComputeBdResidualSingle(dm, wf, key, locX, locF) DMPlexComputeBdResidualSingle(dm, 0.0, wf, key, locX, NULL, locF)
+#  define CompatComputeBdJacobianSingle(dm, wf, label, n, vals, locX, J) \
+    DMPlexComputeBdJacobianSingle(dm, 0.0, wf, label, n, vals, 0, locX, NULL, 0.0, J, J)
 #else
-  #define CompatComputeBdResidualSingle(dm, wf, key, locX, locF) DMPlexComputeBdResidualSingle(dm, wf, key, locX, NULL, 0.0, locF)
-  #define CompatComputeBdJacobianSingle(dm, wf, label, n, vals, locX, J) DMPlexComputeBdJacobianSingle(dm, wf, label, n, vals, 0, locX, NULL, 0.0, 0.0, J, J)
+#  define CompatComputeBdResidualSingle(dm, wf, key, locX, locF) DMPlexComputeBdResidualSingle(dm, wf, key, locX, NULL, 0.0, locF)
+#  define CompatComputeBdJacobianSingle(dm, wf, label, n, vals, locX, J) \
+    DMPlexComputeBdJacobianSingle(dm, wf, label, n, vals, 0, locX, NULL, 0.0, 0.0, J, J)
 #endif
 
 /* DMPlexSNESComputeResidualFEM/JacobianFEM keep their arguments; DMPlexSetSNESLocalFEM is not used. */

@@ -35,15 +35,15 @@ typedef PetscErrorCode (*ScenePointFn)(PetscInt dim, PetscReal t, const PetscRea
 /* What a scene (a problem set-up) provides; filled by its SceneCreate_* function. */
 typedef struct {
   char           name[64];
-  PetscInt       contact_id;        /* "Face Sets" value of Gamma_C */
-  PetscInt       num_dirichlet;     /* "Face Sets" values of Gamma_D (clamped or prescribed) */
+  PetscInt       contact_id;    /* "Face Sets" value of Gamma_C */
+  PetscInt       num_dirichlet; /* "Face Sets" values of Gamma_D (clamped or prescribed) */
   PetscInt       dirichlet_ids[6];
-  ScenePointFn   dirichlet_value;   /* NULL: clamped, u = 0; called with ctx = constants */
-  PetscPointFunc f0_body;           /* volume residual term, -f; NULL: no body force */
+  ScenePointFn   dirichlet_value; /* NULL: clamped, u = 0; called with ctx = constants */
+  PetscPointFunc f0_body;         /* volume residual term, -f; NULL: no body force */
   PetscReal      obstacle_normal[3];
   PetscReal      obstacle_offset;
-  ScenePointFn   exact;             /* exact solution, NULL if none; called with ctx = constants */
-  PetscInt       num_constants;     /* scene constants, stored from constants[CONST_SCENE] on */
+  ScenePointFn   exact;         /* exact solution, NULL if none; called with ctx = constants */
+  PetscInt       num_constants; /* scene constants, stored from constants[CONST_SCENE] on */
   PetscScalar    constants[CONST_SCENE_MAX - CONST_SCENE];
 } Scene;
 
@@ -60,24 +60,24 @@ typedef struct {
 /* The nodes of Gamma_C owned by this rank and free to move: the unknowns the contact acts on. */
 typedef struct {
   PetscInt   n;
-  PetscInt  *point;     /* DMPlex point holding the node */
-  PetscInt  *local_off; /* offset of its first component in the local vector */
-  PetscInt  *global_off;/* offset of its first component in the global vector (ownership start subtracted) */
+  PetscInt  *point;      /* DMPlex point holding the node */
+  PetscInt  *local_off;  /* offset of its first component in the local vector */
+  PetscInt  *global_off; /* offset of its first component in the global vector (ownership start subtracted) */
   PetscBool *is_vertex;
-  PetscReal *gap;       /* g = offset - x . n at the node */
-  PetscReal *weight;    /* lumped boundary mass, the integral of the node's basis function over Gamma_C */
-  PetscBool *active;    /* active set at the last monitor call */
-  PetscReal *pressure;  /* contact pressure -sigma_n at the node, after the solve */
+  PetscReal *gap;      /* g = offset - x . n at the node */
+  PetscReal *weight;   /* lumped boundary mass, the integral of the node's basis function over Gamma_C */
+  PetscBool *active;   /* active set at the last monitor call */
+  PetscReal *pressure; /* contact pressure -sigma_n at the node, after the solve */
 } ContactSet;
 
 typedef struct {
-  PetscInt  newton_its, ksp_its;
-  PetscBool converged;
+  PetscInt            newton_its, ksp_its;
+  PetscBool           converged;
   SNESConvergedReason reason;
-  PetscReal residual_norm;
-  PetscReal time_setup, time_solve, time_total;
-  PetscInt  active_vertices;
-  PetscReal max_penetration, contact_force, energy;
+  PetscReal           residual_norm;
+  PetscReal           time_setup, time_solve, time_total;
+  PetscInt            active_vertices;
+  PetscReal           max_penetration, contact_force, energy;
 } RunStats;
 
 typedef struct {

@@ -43,7 +43,9 @@ PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx
   if (!user->contact.monitor) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetSolution(snes, &X));
   PetscCall(ContactCountActive(user, X, PETSC_TRUE, &active, &entered, &left));
-  PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes), "  %3" PetscInt_FMT " contact: |F| %12.6e  active vertices %6" PetscInt_FMT "  entered %5" PetscInt_FMT "  left %5" PetscInt_FMT "\n", it,
-                        (double)fnorm, active, entered, left));
+  PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes),
+                        "  %3" PetscInt_FMT " contact: |F| %12.6e  active vertices %6" PetscInt_FMT "  entered %5" PetscInt_FMT
+                        "  left %5" PetscInt_FMT "\n",
+                        it, (double)fnorm, active, entered, left));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -11,22 +11,25 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, NULL, "Contact on Gamma_C", "Signorini");
   opts->method = CONTACT_PENALTY;
-  PetscCall(PetscOptionsEnum("-contact_method", "Contact treatment: penalty, vi (SNESVI reference), none (no contact)", NULL, ContactMethods, (PetscEnum)opts->method,
-                             (PetscEnum *)&opts->method, NULL));
+  PetscCall(PetscOptionsEnum("-contact_method", "Contact treatment: penalty, vi (SNESVI reference), none (no contact)", NULL, ContactMethods,
+                             (PetscEnum)opts->method, (PetscEnum *)&opts->method, NULL));
   opts->quadrature = PENALTY_QUADRATURE_GAUSS;
-  PetscCall(PetscOptionsEnum("-penalty_quadrature", "Quadrature of the penalty term: gauss (L2 product) or nodal (lumped, vertex rule)", NULL, PenaltyQuadratures,
-                             (PetscEnum)opts->quadrature, (PetscEnum *)&opts->quadrature, NULL));
+  PetscCall(PetscOptionsEnum("-penalty_quadrature", "Quadrature of the penalty term: gauss (L2 product) or nodal (lumped, vertex rule)", NULL,
+                             PenaltyQuadratures, (PetscEnum)opts->quadrature, (PetscEnum *)&opts->quadrature, NULL));
   opts->eps0 = 1.0;
   PetscCall(PetscOptionsReal("-penalty_eps0", "eps = eps0 h^power / E: the factor eps0", NULL, opts->eps0, &opts->eps0, NULL));
   opts->eps_power = 1.0;
-  PetscCall(PetscOptionsReal("-penalty_eps_power", "eps = eps0 h^power / E: the power of h, in [0, 4]", NULL, opts->eps_power, &opts->eps_power, NULL));
+  PetscCall(
+      PetscOptionsReal("-penalty_eps_power", "eps = eps0 h^power / E: the power of h, in [0, 4]", NULL, opts->eps_power, &opts->eps_power, NULL));
   opts->eps_fixed = 0.0;
   PetscCall(PetscOptionsReal("-penalty_eps", "Set eps directly (overrides eps0 and power)", NULL, opts->eps_fixed, &opts->eps_fixed, &eps_set));
   opts->monitor = PETSC_FALSE;
-  PetscCall(PetscOptionsBool("-contact_monitor", "Print residual and active-set changes at each Newton step", NULL, opts->monitor, &opts->monitor, NULL));
+  PetscCall(
+      PetscOptionsBool("-contact_monitor", "Print residual and active-set changes at each Newton step", NULL, opts->monitor, &opts->monitor, NULL));
   PetscOptionsEnd();
   PetscCheck(opts->eps0 > 0.0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0 must be positive, got %g", (double)opts->eps0);
-  PetscCheck(opts->eps_power >= 0.0 && opts->eps_power <= 4.0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps_power must lie in [0, 4], got %g", (double)opts->eps_power);
+  PetscCheck(opts->eps_power >= 0.0 && opts->eps_power <= 4.0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps_power must lie in [0, 4], got %g",
+             (double)opts->eps_power);
   PetscCheck(!eps_set || opts->eps_fixed > 0.0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps must be positive, got %g", (double)opts->eps_fixed);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -35,7 +38,9 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
 PetscErrorCode ContactComputeEps(AppCtx *user)
 {
   PetscFunctionBeginUser;
-  if (user->contact.eps_fixed > 0.0) user->eps = user->contact.eps_fixed;
-  else user->eps = user->contact.eps0 * PetscPowReal(user->h, user->contact.eps_power) / user->material.young_modulus;
+  if (user->contact.eps_fixed > 0.0)
+    user->eps = user->contact.eps_fixed;
+  else
+    user->eps = user->contact.eps0 * PetscPowReal(user->h, user->contact.eps_power) / user->material.young_modulus;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

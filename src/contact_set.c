@@ -1,9 +1,10 @@
 /* The nodes of Gamma_C: where the contact acts, their gap and their lumped boundary mass. */
 #include "signorini.h"
 
-static void f0_bd_one(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[],
-                      const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[],
-                      PetscReal t, const PetscReal x[], const PetscReal n[], PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
+static void f0_bd_one(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
+                      const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
+                      const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[], const PetscReal n[], PetscInt numConstants,
+                      const PetscScalar constants[], PetscScalar f0[])
 {
   for (PetscInt c = 0; c < dim; ++c) f0[c] = 1.0;
 }
@@ -45,10 +46,10 @@ static PetscErrorCode NodePosition(DM dm, PetscInt p, PetscReal x[])
   PetscCall(DMGetCoordinateDim(dm, &cdim));
   PetscCall(DMPlexGetPointDepth(dm, p, &depth));
   if (depth == 0) {
-    DM           cdm;
-    PetscSection cs;
-    Vec          coords;
-    PetscInt     off;
+    DM                 cdm;
+    PetscSection       cs;
+    Vec                coords;
+    PetscInt           off;
     const PetscScalar *a;
 
     PetscCall(DMGetCoordinateDM(dm, &cdm));
@@ -58,17 +59,18 @@ static PetscErrorCode NodePosition(DM dm, PetscInt p, PetscReal x[])
     PetscCall(VecGetArrayRead(coords, &a));
     for (PetscInt d = 0; d < cdim; ++d) x[d] = PetscRealPart(a[off + d]);
     PetscCall(VecRestoreArrayRead(coords, &a));
-  } else PetscCall(DMPlexComputeCellGeometryFVM(dm, p, NULL, x, NULL));
+  } else
+    PetscCall(DMPlexComputeCellGeometryFVM(dm, p, NULL, x, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
 {
-  MPI_Comm        comm = PetscObjectComm((PetscObject)dm);
-  PetscSection    lsec, gsec;
-  IS              is;
-  PetscInt        dim, fStart, fEnd, npts = 0, *pts = NULL, rstart;
-  Vec             M;
+  MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
+  PetscSection       lsec, gsec;
+  IS                 is;
+  PetscInt           dim, fStart, fEnd, npts = 0, *pts = NULL, rstart;
+  Vec                M;
   const PetscScalar *m;
 
   PetscFunctionBeginUser;
@@ -100,8 +102,8 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
     }
     PetscCall(ISRestoreIndices(is, &faces));
     PetscCall(ISDestroy(&is));
-  }
-  else PetscCall(PetscMalloc1(1, &pts));
+  } else
+    PetscCall(PetscMalloc1(1, &pts));
   PetscCall(PetscSortRemoveDupsInt(&npts, pts));
 
   PetscCall(DMGetGlobalVector(dm, &M));
@@ -118,8 +120,9 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
     PetscCall(PetscSectionGetDof(lsec, p, &dof));
     PetscCall(PetscSectionGetConstraintDof(lsec, p, &cdof));
     PetscCall(PetscSectionGetDof(gsec, p, &gdof));
-    PetscCheck(dof == dim, comm, PETSC_ERR_SUP, "Contact needs one node per mesh point on Gamma_C (Lagrange degree 1 or 2); point %" PetscInt_FMT " has %" PetscInt_FMT " dofs",
-               p, dof);
+    PetscCheck(dof == dim, comm, PETSC_ERR_SUP,
+               "Contact needs one node per mesh point on Gamma_C (Lagrange degree 1 or 2); point %" PetscInt_FMT " has %" PetscInt_FMT " dofs", p,
+               dof);
     if (cdof > 0 || gdof <= 0) continue; /* clamped by Gamma_D, or owned by another rank */
     PetscCall(PetscSectionGetOffset(gsec, p, &goff));
     PetscCall(DMPlexGetPointDepth(dm, p, &depth));

@@ -2,12 +2,13 @@
 #include "signorini.h"
 
 /* sigma(u) = 2 mu eps(u) + lambda tr(eps(u)) I */
-static void f1_u(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[], const PetscScalar u_x[],
-                 const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[],
-                 PetscInt numConstants, const PetscScalar constants[], PetscScalar f1[])
+static void f1_u(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
+                 const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
+                 const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[], PetscInt numConstants,
+                 const PetscScalar constants[], PetscScalar f1[])
 {
   const PetscReal lambda = PetscRealPart(constants[CONST_LAMBDA]), mu = PetscRealPart(constants[CONST_MU]);
-  PetscScalar     trace  = 0.0;
+  PetscScalar     trace = 0.0;
 
   for (PetscInt c = 0; c < dim; ++c) trace += u_x[c * dim + c];
   for (PetscInt c = 0; c < dim; ++c) {
@@ -17,9 +18,10 @@ static void f1_u(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[
 }
 
 /* d sigma_{cd} / d (du_e/dx_f) */
-static void g3_uu(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[], const PetscScalar u_x[],
-                  const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, PetscReal u_tShift,
-                  const PetscReal x[], PetscInt numConstants, const PetscScalar constants[], PetscScalar g3[])
+static void g3_uu(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
+                  const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
+                  const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, PetscReal u_tShift, const PetscReal x[], PetscInt numConstants,
+                  const PetscScalar constants[], PetscScalar g3[])
 {
   const PetscReal lambda = PetscRealPart(constants[CONST_LAMBDA]), mu = PetscRealPart(constants[CONST_MU]);
 
@@ -54,7 +56,8 @@ PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat)
   PetscCall(PetscOptionsReal("-poisson_ratio", "Poisson ratio nu, in (-1, 0.5)", NULL, mat->poisson_ratio, &mat->poisson_ratio, NULL));
   PetscOptionsEnd();
   PetscCheck(mat->young_modulus > 0.0, comm, PETSC_ERR_USER_INPUT, "-young_modulus must be positive, got %g", (double)mat->young_modulus);
-  PetscCheck(mat->poisson_ratio > -1.0 && mat->poisson_ratio < 0.5, comm, PETSC_ERR_USER_INPUT, "-poisson_ratio must lie in (-1, 0.5), got %g", (double)mat->poisson_ratio);
+  PetscCheck(mat->poisson_ratio > -1.0 && mat->poisson_ratio < 0.5, comm, PETSC_ERR_USER_INPUT, "-poisson_ratio must lie in (-1, 0.5), got %g",
+             (double)mat->poisson_ratio);
   mat->lambda = mat->young_modulus * mat->poisson_ratio / ((1.0 + mat->poisson_ratio) * (1.0 - 2.0 * mat->poisson_ratio));
   mat->mu     = mat->young_modulus / (2.0 * (1.0 + mat->poisson_ratio));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -83,13 +86,13 @@ PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user)
 /* The displacement field (PetscFE, prefix displacement_), the bulk weak form and Gamma_D. */
 PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user)
 {
-  MPI_Comm        comm = PetscObjectComm((PetscObject)dm);
-  const Scene    *scene = &user->scene;
-  PetscFE         fe;
-  PetscSpace      space;
-  PetscDS         ds;
-  PetscInt        dim;
-  PetscBool       simplex, has_degree;
+  MPI_Comm     comm  = PetscObjectComm((PetscObject)dm);
+  const Scene *scene = &user->scene;
+  PetscFE      fe;
+  PetscSpace   space;
+  PetscDS      ds;
+  PetscInt     dim;
+  PetscBool    simplex, has_degree;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));

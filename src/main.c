@@ -1,5 +1,6 @@
-static const char help[] = "Frictionless Signorini contact in linear elasticity by the penalty method (Chouly & Hild 2013),\n"
-                           "with SNESVI as the reference for the exact constraint. 2D plane strain and 3D, DMPlex + PetscFE.\n\n";
+static const char help[] =
+    "Frictionless Signorini contact in linear elasticity by the penalty method (Chouly & Hild 2013),\n"
+    "with SNESVI as the reference for the exact constraint. 2D plane strain and 3D, DMPlex + PetscFE.\n\n";
 
 #include "signorini.h"
 
@@ -15,12 +16,13 @@ static PetscErrorCode PrintSummary(DM dm, AppCtx *user, Vec u)
   PetscCall(VecGetSize(u, &ndofs));
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PetscPrintf(comm, "scene %s, %" PetscInt_FMT "D, method %s", user->scene.name, dim, ContactMethods[user->contact.method]));
-  if (user->contact.method == CONTACT_PENALTY) PetscCall(PetscPrintf(comm, " (%s quadrature, eps = %g)", PenaltyQuadratures[user->contact.quadrature], (double)user->eps));
+  if (user->contact.method == CONTACT_PENALTY)
+    PetscCall(PetscPrintf(comm, " (%s quadrature, eps = %g)", PenaltyQuadratures[user->contact.quadrature], (double)user->eps));
   PetscCall(PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, h = %g, %d rank(s)\n", user->degree, ndofs, (double)user->h, size));
-  PetscCall(PetscPrintf(comm, "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, |F| = %g\n", SNESConvergedReasons[s->reason], s->newton_its,
-                        s->ksp_its, (double)s->residual_norm));
-  PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g, contact force %g, energy %.10g\n", s->active_vertices,
-                        (double)s->max_penetration, (double)s->contact_force, (double)s->energy));
+  PetscCall(PetscPrintf(comm, "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, |F| = %g\n",
+                        SNESConvergedReasons[s->reason], s->newton_its, s->ksp_its, (double)s->residual_norm));
+  PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g, contact force %g, energy %.10g\n",
+                        s->active_vertices, (double)s->max_penetration, (double)s->contact_force, (double)s->energy));
   PetscCall(PetscPrintf(comm, "  time: setup %.3f s, solve %.3f s, total %.3f s\n", s->time_setup, s->time_solve, s->time_total));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -30,7 +32,7 @@ static PetscErrorCode CheckAllOptionsUsed(MPI_Comm comm)
 {
   const char *read_at_finalize[] = {"-options_left", "-malloc_dump", "-memory_view", "-objects_dump"};
   PetscInt    N, nleft;
-  char   **names, **values, list[1024] = "";
+  char      **names, **values, list[1024] = "";
 
   PetscFunctionBeginUser;
   for (size_t i = 0; i < sizeof(read_at_finalize) / sizeof(read_at_finalize[0]); ++i) {
@@ -99,7 +101,8 @@ int main(int argc, char **argv)
   PetscCall(OutputWriteHDF5(dm, &user, u));
   PetscCall(PetscPrintf(comm, "  output: %s\n", user.output));
   if (!user.stats.converged)
-    PetscCall(PetscPrintf(comm, "ERROR: the nonlinear solve failed: %s after %" PetscInt_FMT " Newton steps, residual %g; written with converged = 0\n",
+    PetscCall(PetscPrintf(comm,
+                          "ERROR: the nonlinear solve failed: %s after %" PetscInt_FMT " Newton steps, residual %g; written with converged = 0\n",
                           SNESConvergedReasons[user.stats.reason], user.stats.newton_its, (double)user.stats.residual_norm));
 
   PetscCall(VecDestroy(&u));

@@ -14,11 +14,13 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscOptionsBegin(comm, NULL, "Mesh options (PETSc's names)", "DMPLEX");
-  PetscCall(PetscOptionsString("-dm_plex_filename", "Mesh file (Gmsh, ExodusII, HDF5)", "DMPlexCreateFromFile", filename, filename, sizeof(filename), &has_file));
+  PetscCall(PetscOptionsString("-dm_plex_filename", "Mesh file (Gmsh, ExodusII, HDF5)", "DMPlexCreateFromFile", filename, filename, sizeof(filename),
+                               &has_file));
   dim = 2;
   PetscCall(PetscOptionsRangeInt("-dm_plex_dim", "Dimension of the box mesh", "DMPlexCreateBoxMesh", dim, &dim, NULL, 2, 3));
   simplex = PETSC_TRUE;
-  PetscCall(PetscOptionsBool("-dm_plex_simplex", "Simplices (triangles, tetrahedra) or tensor cells (quads, hexes)", "DMPlexCreateBoxMesh", simplex, &simplex, NULL));
+  PetscCall(PetscOptionsBool("-dm_plex_simplex", "Simplices (triangles, tetrahedra) or tensor cells (quads, hexes)", "DMPlexCreateBoxMesh", simplex,
+                             &simplex, NULL));
   faces[0] = faces[1] = faces[2] = (dim == 2) ? 8 : 4;
   PetscCall(PetscOptionsIntArray("-dm_plex_box_faces", "Number of cells along each side of the box", "DMPlexCreateBoxMesh", faces, &nfaces, NULL));
   PetscCall(PetscOptionsRealArray("-dm_plex_box_lower", "Lower corner of the box", "DMPlexCreateBoxMesh", lower, &nlower, NULL));
@@ -99,7 +101,8 @@ PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id)
 
   PetscFunctionBeginUser;
   PetscCall(DMGetLabel(dm, "Face Sets", &label));
-  PetscCheck(label, comm, PETSC_ERR_USER_INPUT, "The mesh has no \"Face Sets\" label, so it has no contact boundary Gamma_C (Face Sets value %" PetscInt_FMT ")", contact_id);
+  PetscCheck(label, comm, PETSC_ERR_USER_INPUT,
+             "The mesh has no \"Face Sets\" label, so it has no contact boundary Gamma_C (Face Sets value %" PetscInt_FMT ")", contact_id);
   PetscCall(DMPlexGetHeightStratum(dm, 1, &fStart, &fEnd));
   PetscCall(DMLabelGetStratumIS(label, contact_id, &is));
   if (is) {
@@ -113,6 +116,7 @@ PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id)
     PetscCall(ISDestroy(&is));
   }
   PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, comm));
-  PetscCheck(ntotal > 0, comm, PETSC_ERR_USER_INPUT, "The mesh has no contact boundary: no face carries \"Face Sets\" value %" PetscInt_FMT " (Gamma_C)", contact_id);
+  PetscCheck(ntotal > 0, comm, PETSC_ERR_USER_INPUT,
+             "The mesh has no contact boundary: no face carries \"Face Sets\" value %" PetscInt_FMT " (Gamma_C)", contact_id);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -10,7 +10,8 @@ static PetscReal SimplexOrientation(PetscInt dim, const PetscReal coords[], cons
   for (PetscInt i = 0; i < dim; ++i)
     for (PetscInt d = 0; d < dim; ++d) a[i][d] = coords[v[i + 1] * dim + d] - coords[v[0] * dim + d];
   if (dim == 2) return a[0][0] * a[1][1] - a[0][1] * a[1][0];
-  return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
+  return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
+         a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
 }
 
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[], DM *dm)
@@ -18,17 +19,10 @@ PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt 
   /* PETSc's reference triangle is counterclockwise, its reference tetrahedron has negative orientation */
   const PetscReal sign = dim == 2 ? 1.0 : -1.0;
   const PetscInt  nx = faces[0], ny = faces[1], nz = dim == 3 ? faces[2] : 1;
-  const PetscInt  perms[6][3] = {
-    {0, 1, 2},
-    {0, 2, 1},
-    {1, 0, 2},
-    {1, 2, 0},
-    {2, 0, 1},
-    {2, 1, 0}
-  };
-  PetscInt    *cells = NULL, ncells = 0, nverts = 0, nc = dim + 1;
-  PetscReal   *coords = NULL;
-  PetscMPIInt  rank;
+  const PetscInt  perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
+  PetscInt       *cells = NULL, ncells = 0, nverts = 0, nc = dim + 1;
+  PetscReal      *coords = NULL;
+  PetscMPIInt     rank;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
@@ -41,7 +35,7 @@ PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt 
     for (PetscInt k = 0; k < nvz; ++k)
       for (PetscInt j = 0; j < nvy; ++j)
         for (PetscInt i = 0; i < nvx; ++i) {
-          const PetscInt v   = (k * nvy + j) * nvx + i;
+          const PetscInt v      = (k * nvy + j) * nvx + i;
           const PetscInt idx[3] = {i, j, k}, n[3] = {nx, ny, nz};
           for (PetscInt d = 0; d < dim; ++d) coords[v * dim + d] = lower[d] + (upper[d] - lower[d]) * idx[d] / (PetscReal)n[d];
         }
@@ -53,10 +47,7 @@ PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt 
 
           for (PetscInt b = 0; b < (dim == 2 ? 4 : 8); ++b) corner[b] = ((k + ((b >> 2) & 1)) * nvy + j + ((b >> 1) & 1)) * nvx + i + (b & 1);
           if (dim == 2) {
-            const PetscInt tri[2][3] = {
-              {corner[0], corner[1], corner[3]},
-              {corner[0], corner[3], corner[2]}
-            };
+            const PetscInt tri[2][3] = {{corner[0], corner[1], corner[3]}, {corner[0], corner[3], corner[2]}};
             for (PetscInt t = 0; t < 2; ++t, ++ncells)
               for (PetscInt l = 0; l < 3; ++l) cells[ncells * nc + l] = tri[t][l];
           } else {
@@ -86,17 +77,10 @@ PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt 
    3D: bottom z=0 1, top 2, front y=0 3, back 4, right x=1 5, left x=0 6), and "marker" = 1 on the boundary. */
 PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[])
 {
-  const PetscInt ids2[2][2] = {
-    {4, 2},
-    {1, 3}
-  };
-  const PetscInt ids3[3][2] = {
-    {6, 5},
-    {3, 4},
-    {1, 2}
-  };
-  PetscInt dim, fStart, fEnd;
-  DMLabel  face_sets, marker;
+  const PetscInt ids2[2][2] = {{4, 2}, {1, 3}};
+  const PetscInt ids3[3][2] = {{6, 5}, {3, 4}, {1, 2}};
+  PetscInt       dim, fStart, fEnd;
+  DMLabel        face_sets, marker;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));

@@ -12,7 +12,8 @@ PetscErrorCode OutputGetOptions(MPI_Comm comm, AppCtx *user)
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, NULL, "Output", "Signorini");
   PetscCall(PetscSNPrintf(user->output, sizeof(user->output), "output/%s.h5", user->scene_name));
-  PetscCall(PetscOptionsString("-output", "HDF5 output file (default output/<scene>.h5)", NULL, user->output, user->output, sizeof(user->output), &set));
+  PetscCall(
+      PetscOptionsString("-output", "HDF5 output file (default output/<scene>.h5)", NULL, user->output, user->output, sizeof(user->output), &set));
   PetscOptionsEnd();
   PetscCall(PetscStrncpy(dir, user->output, sizeof(dir)));
   PetscCall(PetscStrrchr(dir, '/', &slash));
@@ -267,10 +268,10 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
 /* XDMF for ParaView, pointing into the final .h5 (rank 0 only). */
 static PetscErrorCode WriteXdmf(AppCtx *user, PetscInt dim, PetscInt ncells, PetscInt ncorners, PetscInt nverts)
 {
-  const char *fields[]  = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "exact_displacement", "error"};
-  const PetscInt ncomp[] = {dim, 1, 1, 1, dim, dim};
-  const PetscInt nfields = user->scene.exact ? 6 : 4;
-  const char    *topo = dim == 2 ? (ncorners == 3 ? "Triangle" : "Quadrilateral") : (ncorners == 4 ? "Tetrahedron" : "Hexahedron");
+  const char    *fields[] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "exact_displacement", "error"};
+  const PetscInt ncomp[]  = {dim, 1, 1, 1, dim, dim};
+  const PetscInt nfields  = user->scene.exact ? 6 : 4;
+  const char    *topo     = dim == 2 ? (ncorners == 3 ? "Triangle" : "Quadrilateral") : (ncorners == 4 ? "Tetrahedron" : "Hexahedron");
   char           xdmf[PETSC_MAX_PATH_LEN + 8], part[PETSC_MAX_PATH_LEN + 16], *h5name, *slash;
   FILE          *fp;
 
@@ -289,13 +290,17 @@ static PetscErrorCode WriteXdmf(AppCtx *user, PetscInt dim, PetscInt ncells, Pet
   PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Cannot write %s", part);
   fprintf(fp, "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"2.0\">\n <Domain>\n  <Grid Name=\"mesh\" GridType=\"Uniform\">\n");
   fprintf(fp, "   <Topology TopologyType=\"%s\" NumberOfElements=\"%d\">\n", topo, (int)ncells);
-  fprintf(fp, "    <DataItem Dimensions=\"%d %d\" NumberType=\"Int\" Format=\"HDF\">%s:/viz/topology/cells</DataItem>\n   </Topology>\n", (int)ncells, (int)ncorners, h5name);
+  fprintf(fp, "    <DataItem Dimensions=\"%d %d\" NumberType=\"Int\" Format=\"HDF\">%s:/viz/topology/cells</DataItem>\n   </Topology>\n", (int)ncells,
+          (int)ncorners, h5name);
   fprintf(fp, "   <Geometry GeometryType=\"%s\">\n", dim == 2 ? "XY" : "XYZ");
   fprintf(fp, "    <DataItem Dimensions=\"%d %d\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n   </Geometry>\n", (int)nverts, (int)dim, h5name);
   for (PetscInt f = 0; f < nfields; ++f) {
     fprintf(fp, "   <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", fields[f], ncomp[f] > 1 ? "Vector" : "Scalar");
-    if (ncomp[f] > 1) fprintf(fp, "    <DataItem Dimensions=\"%d %d\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n", (int)nverts, (int)ncomp[f], h5name, fields[f]);
-    else fprintf(fp, "    <DataItem Dimensions=\"%d\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n", (int)nverts, h5name, fields[f]);
+    if (ncomp[f] > 1)
+      fprintf(fp, "    <DataItem Dimensions=\"%d %d\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n", (int)nverts, (int)ncomp[f], h5name,
+              fields[f]);
+    else
+      fprintf(fp, "    <DataItem Dimensions=\"%d\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n", (int)nverts, h5name, fields[f]);
     fprintf(fp, "   </Attribute>\n");
   }
   fprintf(fp, "  </Grid>\n </Domain>\n</Xdmf>\n");

@@ -12,9 +12,10 @@ static inline PetscReal Penetration(PetscInt dim, const PetscScalar u[], const P
   return d;
 }
 
-static void f0_bd_penalty(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[],
-                          const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[],
-                          PetscReal t, const PetscReal x[], const PetscReal n[], PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
+static void f0_bd_penalty(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
+                          const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
+                          const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[], const PetscReal n[],
+                          PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
 {
   const PetscReal d = Penetration(dim, u, x, constants);
   const PetscReal p = d > 0.0 ? PetscRealPart(constants[CONST_PENALTY]) * d : 0.0;
@@ -22,9 +23,10 @@ static void f0_bd_penalty(PetscInt dim, PetscInt Nf, PetscInt NfAux, const Petsc
   for (PetscInt c = 0; c < dim; ++c) f0[c] = p * constants[CONST_NORMAL_X + c];
 }
 
-static void g0_bd_penalty(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[],
-                          const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[],
-                          PetscReal t, PetscReal u_tShift, const PetscReal x[], const PetscReal n[], PetscInt numConstants, const PetscScalar constants[], PetscScalar g0[])
+static void g0_bd_penalty(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
+                          const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
+                          const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, PetscReal u_tShift, const PetscReal x[], const PetscReal n[],
+                          PetscInt numConstants, const PetscScalar constants[], PetscScalar g0[])
 {
   if (Penetration(dim, u, x, constants) <= 0.0) return;
   for (PetscInt c = 0; c < dim; ++c)
@@ -33,9 +35,10 @@ static void g0_bd_penalty(PetscInt dim, PetscInt Nf, PetscInt NfAux, const Petsc
 
 /* (1/2eps) [u_n - g]_+^2, the penalty energy density, in the first component: summed over the
    entries of the local boundary residual it gives the integral (the basis is a partition of unity). */
-static void f0_bd_penalty_energy(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[],
-                                 const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[],
-                                 PetscReal t, const PetscReal x[], const PetscReal n[], PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
+static void f0_bd_penalty_energy(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
+                                 const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[],
+                                 const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[],
+                                 const PetscReal n[], PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
 {
   const PetscReal d = Penetration(dim, u, x, constants);
 
@@ -50,16 +53,21 @@ PetscErrorCode PenaltySetUp(DM dm, AppCtx *user)
   PetscFunctionBeginUser;
   PetscCall(PetscWeakFormCreate(PetscObjectComm((PetscObject)dm), &user->wf_penalty));
   PetscCall(PetscWeakFormSetNumFields(user->wf_penalty, 1));
-  PetscCall(PetscWeakFormSetIndexBdResidual(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, PENALTY_PART_TERM, 0, f0_bd_penalty, 0, NULL));
-  PetscCall(PetscWeakFormSetIndexBdResidual(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, PENALTY_PART_ENERGY, 0, f0_bd_penalty_energy, 0, NULL));
-  PetscCall(PetscWeakFormSetIndexBdJacobian(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, 0, PENALTY_PART_TERM, 0, g0_bd_penalty, 0, NULL, 0, NULL, 0, NULL));
+  PetscCall(
+      PetscWeakFormSetIndexBdResidual(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, PENALTY_PART_TERM, 0, f0_bd_penalty, 0, NULL));
+  PetscCall(PetscWeakFormSetIndexBdResidual(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, PENALTY_PART_ENERGY, 0,
+                                            f0_bd_penalty_energy, 0, NULL));
+  PetscCall(PetscWeakFormSetIndexBdJacobian(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, 0, PENALTY_PART_TERM, 0, g0_bd_penalty, 0,
+                                            NULL, 0, NULL, 0, NULL));
   if (user->contact.quadrature == PENALTY_QUADRATURE_NODAL) {
     PetscInt bad = 0, nbad;
 
     for (PetscInt i = 0; i < user->cset.n; ++i) bad += user->cset.weight[i] <= 0.0;
     PetscCall(MPIU_Allreduce(&bad, &nbad, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
     PetscCheck(!nbad, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT,
-               "-penalty_quadrature nodal needs a positive lumped boundary mass at every node of Gamma_C; %" PetscInt_FMT " nodes have none (use degree 1 or gauss)", nbad);
+               "-penalty_quadrature nodal needs a positive lumped boundary mass at every node of Gamma_C; %" PetscInt_FMT
+               " nodes have none (use degree 1 or gauss)",
+               nbad);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -149,7 +157,8 @@ PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J)
       if (ContactNodePenetration(user, dim, i, x) <= 0.0) continue;
       for (PetscInt c = 0; c < dim; ++c) {
         rows[c] = rstart + user->cset.global_off[i] + c;
-        for (PetscInt e = 0; e < dim; ++e) block[c * dim + e] = kappa * user->cset.weight[i] * user->scene.obstacle_normal[c] * user->scene.obstacle_normal[e];
+        for (PetscInt e = 0; e < dim; ++e)
+          block[c * dim + e] = kappa * user->cset.weight[i] * user->scene.obstacle_normal[c] * user->scene.obstacle_normal[e];
       }
       PetscCall(MatSetValues(J, dim, rows, dim, rows, block, ADD_VALUES));
     }

@@ -22,20 +22,20 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   PetscCall(VecGetArrayRead(u, &x));
   PetscCall(VecGetArrayRead(R, &r));
   for (PetscInt i = 0; i < cs->n; ++i) {
-    const PetscReal d = ContactNodePenetration(user, dim, i, x);
+    const PetscReal d        = ContactNodePenetration(user, dim, i, x);
     PetscReal       reaction = 0.0;
 
     for (PetscInt c = 0; c < dim; ++c) reaction -= PetscRealPart(r[cs->global_off[i] + c]) * user->scene.obstacle_normal[c];
     switch (user->contact.method) {
-    case CONTACT_PENALTY:
-      cs->pressure[i] = d > 0.0 ? d / user->eps : 0.0;
-      break;
-    case CONTACT_VI:
-      cs->pressure[i] = cs->weight[i] > 0.0 ? reaction / cs->weight[i] : 0.0;
-      break;
-    case CONTACT_NONE:
-      cs->pressure[i] = 0.0;
-      break;
+      case CONTACT_PENALTY:
+        cs->pressure[i] = d > 0.0 ? d / user->eps : 0.0;
+        break;
+      case CONTACT_VI:
+        cs->pressure[i] = cs->weight[i] > 0.0 ? reaction / cs->weight[i] : 0.0;
+        break;
+      case CONTACT_NONE:
+        cs->pressure[i] = 0.0;
+        break;
     }
     local[0] = PetscMax(local[0], d);
     local[1] += reaction;

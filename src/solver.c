@@ -99,7 +99,8 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscCall(SNESSetType(*snes, SNESVINEWTONRSLS));
     PetscCall(VICreateBounds(dm, user));
     PetscCall(SNESVISetVariableBounds(*snes, user->xl, user->xu));
-  } else PetscCall(SNESSetType(*snes, SNESNEWTONLS));
+  } else
+    PetscCall(SNESSetType(*snes, SNESNEWTONLS));
   /* default linear solver: a direct solve (MUMPS), robust for the small problems of a first run */
   PetscCall(SNESGetKSP(*snes, &ksp));
   PetscCall(KSPSetType(ksp, KSPPREONLY));
@@ -116,7 +117,8 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &is_gamg));
     PetscCall(PetscObjectTypeCompare((PetscObject)*snes, SNESVINEWTONRSLS, &is_rsls));
     PetscCheck(!(is_gamg && is_rsls), comm, PETSC_ERR_USER_INPUT,
-               "-pc_type gamg cannot follow the reduced system of -snes_type vinewtonrsls (its size changes between steps): use hypre or mumps with -contact_method vi");
+               "-pc_type gamg cannot follow the reduced system of -snes_type vinewtonrsls (its size changes between steps): use hypre or mumps with "
+               "-contact_method vi");
   }
   PetscCheck(is_vi == (user->contact.method == CONTACT_VI), comm, PETSC_ERR_USER_INPUT,
              "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type,

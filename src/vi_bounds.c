@@ -4,7 +4,7 @@
 /* Bounds act on one unknown each, so the foundation normal must be +-e_axis. */
 PetscErrorCode VIAxisOfNormal(const AppCtx *user, PetscInt dim, PetscInt *axis, PetscReal *sign)
 {
-  const PetscReal *n = user->scene.obstacle_normal;
+  const PetscReal *n     = user->scene.obstacle_normal;
   PetscInt         count = 0;
 
   PetscFunctionBeginUser;
@@ -15,9 +15,10 @@ PetscErrorCode VIAxisOfNormal(const AppCtx *user, PetscInt dim, PetscInt *axis, 
       *axis = d;
     }
   }
-  PetscCheck(count == 1 && PetscAbsReal(PetscAbsReal(n[*axis]) - 1.0) < 1e-12, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT,
-             "-contact_method vi needs Gamma_C normal to a coordinate axis (bounds act on one unknown each); scene %s has obstacle normal (%g, %g, %g)", user->scene.name,
-             (double)n[0], (double)n[1], (double)n[2]);
+  PetscCheck(
+      count == 1 && PetscAbsReal(PetscAbsReal(n[*axis]) - 1.0) < 1e-12, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT,
+      "-contact_method vi needs Gamma_C normal to a coordinate axis (bounds act on one unknown each); scene %s has obstacle normal (%g, %g, %g)",
+      user->scene.name, (double)n[0], (double)n[1], (double)n[2]);
   *sign = n[*axis] > 0.0 ? 1.0 : -1.0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -40,8 +41,10 @@ PetscErrorCode VICreateBounds(DM dm, AppCtx *user)
   PetscCall(VecGetArray(user->xu, &xu));
   for (PetscInt i = 0; i < user->cset.n; ++i) {
     const PetscInt k = user->cset.global_off[i] + axis;
-    if (sign > 0.0) xu[k] = user->cset.gap[i];
-    else xl[k] = -user->cset.gap[i];
+    if (sign > 0.0)
+      xu[k] = user->cset.gap[i];
+    else
+      xl[k] = -user->cset.gap[i];
   }
   PetscCall(VecRestoreArray(user->xl, &xl));
   PetscCall(VecRestoreArray(user->xu, &xu));

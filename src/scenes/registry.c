@@ -35,7 +35,8 @@ PetscErrorCode SceneCreate(const char name[], DM dm, const Material *mat, Scene 
 
   PetscFunctionBeginUser;
   PetscCall(PetscFunctionListFind(scene_list, name, &create));
-  PetscCheck(create, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT, "Unknown scene '%s' (-scene); run with -help to list the registered scenes", name);
+  PetscCheck(create, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT,
+             "Unknown scene '%s' (-scene); run with -help to list the registered scenes", name);
   PetscCall(PetscMemzero(scene, sizeof(*scene)));
   PetscCall(PetscStrncpy(scene->name, name, sizeof(scene->name)));
   PetscCall((*create)(dm, mat, scene));

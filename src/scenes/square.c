@@ -6,9 +6,10 @@
 enum { SQUARE_BETA, SQUARE_X0, SQUARE_NUM_CONSTANTS };
 
 /* residual term -f */
-static void f0_body_square(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[], const PetscScalar u_t[],
-                           const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[],
-                           PetscReal t, const PetscReal x[], PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
+static void f0_body_square(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
+                           const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
+                           const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[], PetscInt numConstants,
+                           const PetscScalar constants[], PetscScalar f0[])
 {
   const PetscScalar beta = constants[CONST_SCENE + SQUARE_BETA], x0 = constants[CONST_SCENE + SQUARE_X0];
 
@@ -29,12 +30,12 @@ PetscErrorCode SceneCreate_Square(DM dm, const Material *mat, Scene *scene)
   x0 = 0.6;
   PetscCall(PetscOptionsReal("-square_x0", "Where the body force changes sign", NULL, x0, &x0, NULL));
   PetscOptionsEnd();
-  scene->contact_id       = 1;                /* bottom, x_d = 0, in 2D and 3D */
-  scene->num_dirichlet    = 1;
-  scene->dirichlet_ids[0] = dim == 2 ? 3 : 2; /* top, x_d = 1 */
-  scene->f0_body          = f0_body_square;
-  scene->obstacle_normal[dim - 1] = -1.0;     /* foundation below: u_n = -u_d */
-  scene->obstacle_offset          = 0.0;      /* plane x_d = 0 */
+  scene->contact_id               = 1; /* bottom, x_d = 0, in 2D and 3D */
+  scene->num_dirichlet            = 1;
+  scene->dirichlet_ids[0]         = dim == 2 ? 3 : 2; /* top, x_d = 1 */
+  scene->f0_body                  = f0_body_square;
+  scene->obstacle_normal[dim - 1] = -1.0; /* foundation below: u_n = -u_d */
+  scene->obstacle_offset          = 0.0;  /* plane x_d = 0 */
   scene->num_constants            = SQUARE_NUM_CONSTANTS;
   scene->constants[SQUARE_BETA]   = beta;
   scene->constants[SQUARE_X0]     = x0;
