@@ -7,7 +7,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
 {
   PetscInt    dim, faces[3], nfaces = 3, nlower = 3, nupper = 3;
   PetscReal   lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
-  PetscBool   simplex, has_file;
+  PetscBool   simplex, has_file, faces_set;
   char        filename[PETSC_MAX_PATH_LEN] = "";
   PetscMPIInt size;
 
@@ -22,7 +22,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
   PetscCall(PetscOptionsBool("-dm_plex_simplex", "Simplices (triangles, tetrahedra) or tensor cells (quads, hexes)", "DMPlexCreateBoxMesh", simplex,
                              &simplex, NULL));
   faces[0] = faces[1] = faces[2] = (dim == 2) ? 8 : 4;
-  PetscCall(PetscOptionsIntArray("-dm_plex_box_faces", "Number of cells along each side of the box", "DMPlexCreateBoxMesh", faces, &nfaces, NULL));
+  PetscCall(PetscOptionsIntArray("-dm_plex_box_faces", "Number of cells along each side of the box", "DMPlexCreateBoxMesh", faces, &nfaces, &faces_set));
   PetscCall(PetscOptionsRealArray("-dm_plex_box_lower", "Lower corner of the box", "DMPlexCreateBoxMesh", lower, &nlower, NULL));
   PetscCall(PetscOptionsRealArray("-dm_plex_box_upper", "Upper corner of the box", "DMPlexCreateBoxMesh", upper, &nupper, NULL));
   PetscOptionsEnd();
@@ -50,6 +50,12 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
     }
     PetscCall(DMSetFromOptions(*dm)); /* refinement and the rest of PETSc's mesh options */
   } else {
+    if (!has_file && !faces_set) { /* the same default number of cells for tensor boxes as for simplex boxes */
+      char value[64];
+
+      PetscCall(PetscSNPrintf(value, sizeof(value), dim == 2 ? "%" PetscInt_FMT ",%" PetscInt_FMT : "%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT, faces[0], faces[1], faces[2]));
+      PetscCall(PetscOptionsSetValue(NULL, "-dm_plex_box_faces", value));
+    }
     PetscCall(DMCreate(comm, dm));
     PetscCall(DMSetType(*dm, DMPLEX));
     PetscCall(DMSetFromOptions(*dm));
