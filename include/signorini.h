@@ -61,7 +61,6 @@ typedef struct {
 typedef struct {
   PetscInt   n;
   PetscInt  *point;      /* DMPlex point holding the node */
-  PetscInt  *local_off;  /* offset of its first component in the local vector */
   PetscInt  *global_off; /* offset of its first component in the global vector (ownership start subtracted) */
   PetscBool *is_vertex;
   PetscReal *gap;      /* g = offset - x . n at the node */

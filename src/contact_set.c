@@ -110,7 +110,7 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
   PetscCall(ContactLumpedMass(dm, user, M));
   PetscCall(VecGetOwnershipRange(M, &rstart, NULL));
   PetscCall(VecGetArrayRead(M, &m));
-  PetscCall(PetscMalloc4(npts, &cs->point, npts, &cs->local_off, npts, &cs->global_off, npts, &cs->is_vertex));
+  PetscCall(PetscMalloc3(npts, &cs->point, npts, &cs->global_off, npts, &cs->is_vertex));
   PetscCall(PetscMalloc4(npts, &cs->gap, npts, &cs->weight, npts, &cs->active, npts, &cs->pressure));
   for (PetscInt i = 0; i < npts; ++i) {
     const PetscInt p = pts[i];
@@ -128,8 +128,7 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
     PetscCall(DMPlexGetPointDepth(dm, p, &depth));
     PetscCall(NodePosition(dm, p, x));
     for (PetscInt d = 0; d < dim; ++d) xn += x[d] * user->scene.obstacle_normal[d];
-    cs->point[cs->n] = p;
-    PetscCall(PetscSectionGetOffset(lsec, p, &cs->local_off[cs->n]));
+    cs->point[cs->n]      = p;
     cs->global_off[cs->n] = goff - rstart;
     cs->is_vertex[cs->n]  = (PetscBool)(depth == 0);
     cs->gap[cs->n]        = user->scene.obstacle_offset - xn;
@@ -147,7 +146,7 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
 PetscErrorCode ContactSetDestroy(ContactSet *cs)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscFree4(cs->point, cs->local_off, cs->global_off, cs->is_vertex));
+  PetscCall(PetscFree3(cs->point, cs->global_off, cs->is_vertex));
   PetscCall(PetscFree4(cs->gap, cs->weight, cs->active, cs->pressure));
   cs->n = 0;
   PetscFunctionReturn(PETSC_SUCCESS);

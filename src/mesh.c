@@ -22,7 +22,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
   PetscCall(PetscOptionsBool("-dm_plex_simplex", "Simplices (triangles, tetrahedra) or tensor cells (quads, hexes)", "DMPlexCreateBoxMesh", simplex,
                              &simplex, NULL));
   faces[0] = faces[1] = faces[2] = (dim == 2) ? 8 : 4;
-  PetscCall(PetscOptionsIntArray("-dm_plex_box_faces", "Number of cells along each side of the box", "DMPlexCreateBoxMesh", faces, &nfaces, &faces_set));
+  PetscCall(
+      PetscOptionsIntArray("-dm_plex_box_faces", "Number of cells along each side of the box", "DMPlexCreateBoxMesh", faces, &nfaces, &faces_set));
   PetscCall(PetscOptionsRealArray("-dm_plex_box_lower", "Lower corner of the box", "DMPlexCreateBoxMesh", lower, &nlower, NULL));
   PetscCall(PetscOptionsRealArray("-dm_plex_box_upper", "Upper corner of the box", "DMPlexCreateBoxMesh", upper, &nupper, NULL));
   PetscOptionsEnd();
@@ -53,7 +54,9 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
     if (!has_file && !faces_set) { /* the same default number of cells for tensor boxes as for simplex boxes */
       char value[64];
 
-      PetscCall(PetscSNPrintf(value, sizeof(value), dim == 2 ? "%" PetscInt_FMT ",%" PetscInt_FMT : "%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT, faces[0], faces[1], faces[2]));
+      PetscCall(PetscSNPrintf(value, sizeof(value),
+                              dim == 2 ? "%" PetscInt_FMT ",%" PetscInt_FMT : "%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT, faces[0],
+                              faces[1], faces[2]));
       PetscCall(PetscOptionsSetValue(NULL, "-dm_plex_box_faces", value));
     }
     PetscCall(DMCreate(comm, dm));
