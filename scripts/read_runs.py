@@ -1,15 +1,11 @@
 #!/usr/bin/python3
 """Collect the /run metadata of solver HDF5 output files into a table.
 
-Every HDF5 attribute of the group /run is read generically (byte strings are
-decoded, numpy scalars become Python int/float), so attributes added by newer
-solver versions appear automatically.
+All attributes of /run are read generically (bytes decoded, numpy scalars ->
+int/float). Directories expand to their sorted *.h5 files; an unreadable file or
+one without /run is an error (exit code 2), never skipped.
 
-Usage:
-    read_runs.py FILE_OR_DIR [...] [--format markdown|csv] [--columns a,b,c] [-o OUT]
-
-Directories are expanded to the *.h5 files they contain (sorted). A file that
-cannot be read or lacks /run is an error (exit code 2), never skipped.
+Usage: read_runs.py FILE_OR_DIR [...] [--format markdown|csv] [--columns a,b,c] [-o OUT]
 """
 import argparse
 import csv
@@ -30,11 +26,7 @@ FORMATS = ("markdown", "csv")
 
 
 def to_python(value):
-    """Convert an HDF5 attribute value to a plain Python object.
-
-    Bytes are decoded (UTF-8), numpy scalars become int/float/bool/str, numpy
-    arrays become (nested) lists with their elements converted likewise.
-    """
+    """Convert an HDF5 attribute value to plain Python (bytes -> str, numpy -> int/float/list)."""
     if isinstance(value, (bytes, np.bytes_)):
         return bytes(value).decode("utf-8", errors="replace")
     if isinstance(value, np.ndarray):
@@ -67,11 +59,7 @@ def read_run(path):
 
 
 def expand_paths(paths):
-    """Expand directories into their sorted *.h5 files; keep files as given.
-
-    Raises ValueError for a path that does not exist or a directory without
-    any *.h5 file.
-    """
+    """Expand directories into their sorted *.h5 files; ValueError on a missing path or empty dir."""
     out = []
     for p in paths:
         p = str(p)
