@@ -138,7 +138,6 @@ PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J);
 PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy);
 
 /* vi_bounds.c */
-PetscErrorCode VIAxisOfNormal(const AppCtx *user, PetscInt dim, PetscInt *axis, PetscReal *sign);
 PetscErrorCode VICreateBounds(DM dm, AppCtx *user);
 
 /* solver.c */

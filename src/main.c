@@ -75,13 +75,6 @@ int main(int argc, char **argv)
   PetscCall(DMGetLabel(dm, "Face Sets", &user.face_sets));
   PetscCall(MeshGetMaxCellDiameter(dm, &user.h));
   PetscCall(ContactComputeEps(&user));
-  if (user.contact.method == CONTACT_VI) {
-    PetscInt  dim, axis;
-    PetscReal sign;
-
-    PetscCall(DMGetDimension(dm, &dim));
-    PetscCall(VIAxisOfNormal(&user, dim, &axis, &sign));
-  }
   PetscCall(ElasticitySetUpDiscretization(dm, &user));
   PetscCall(ContactSetCreate(dm, &user, &user.cset));
   if (user.contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, &user));

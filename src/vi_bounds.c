@@ -2,7 +2,7 @@
 #include "signorini.h"
 
 /* Bounds act on one unknown each, so the foundation normal must be +-e_axis. */
-PetscErrorCode VIAxisOfNormal(const AppCtx *user, PetscInt dim, PetscInt *axis, PetscReal *sign)
+static PetscErrorCode VIAxisOfNormal(const AppCtx *user, PetscInt dim, PetscInt *axis, PetscReal *sign)
 {
   const PetscReal *n     = user->scene.obstacle_normal;
   PetscInt         count = 0;
