@@ -19,3 +19,9 @@
 #endif
 
 /* DMPlexSNESComputeResidualFEM/JacobianFEM keep their arguments; DMPlexSetSNESLocalFEM is not used. */
+
+/* PETSC_NAN appeared after 3.18 */
+#if !defined(PETSC_NAN)
+#  include <math.h>
+#  define PETSC_NAN ((PetscReal)NAN)
+#endif

@@ -42,7 +42,12 @@ typedef struct {
   PetscPointFunc f0_body;         /* volume residual term, -f; NULL: no body force */
   PetscReal      obstacle_normal[3];
   PetscReal      obstacle_offset;
-  ScenePointFn   exact;         /* exact solution, NULL if none; called with ctx = constants */
+  ScenePointFn   exact;          /* exact solution, NULL if none; called with ctx = constants */
+  ScenePointFn   exact_gradient; /* its gradient, G[i*dim+j] = du_i/dx_j (Nc = dim*dim); needed for the error norms */
+  PetscBool      weak_data;      /* load from the exact solution: L(v) = a(u_exact, v) - int_Gamma_C sigma_n(u_exact) v_n */
+  PetscBool      has_kink;       /* the exact solution is not smooth across the plane {x . kink_normal = kink_offset}: */
+  PetscReal      kink_normal[3]; /*   the cells it cuts get the refined quadrature rule */
+  PetscReal      kink_offset;
   PetscInt       num_constants; /* scene constants, stored from constants[CONST_SCENE] on */
   PetscScalar    constants[CONST_SCENE_MAX - CONST_SCENE];
 } Scene;
@@ -69,6 +74,22 @@ typedef struct {
   PetscReal *pressure; /* contact pressure -sigma_n at the node, after the solve */
 } ContactSet;
 
+/* Accurate integration for the verification: Gauss points per direction, and how many times the reference
+   cell is refined for the composite rule on the cells cut by a scene's kink. */
+typedef struct {
+  PetscInt  quad_points, quad_refine;
+  char      reference[PETSC_MAX_PATH_LEN]; /* -reference FILE.h5, "" if none */
+  PetscBool dmsnes_check;
+} VerifyOptions;
+
+/* Error norms of a run against the exact solution or a reference solution (NaN: not computed). */
+typedef struct {
+  PetscReal l2, h1_semi, h1, energy;         /* of u - u_h over Omega */
+  PetscReal pressure_l2, pressure_weighted;  /* of R = sigma_n(u) + p_h on Gamma_C; weighted by eps^1/2 (h^1/2 for vi) */
+  PetscReal pressure_dual;                   /* H^-1/2(Gamma_C) dual norm of R, by one elastic solve */
+  PetscReal penetration_l2, penetration_max; /* of [u_h,n - g]_+ on Gamma_C */
+} ErrorNorms;
+
 typedef struct {
   PetscInt            newton_its, ksp_its;
   PetscBool           converged;
@@ -93,7 +114,10 @@ typedef struct {
   Mat            K;          /* bulk elastic operator, assembled once */
   Vec            r0;         /* bulk residual at u = 0 (loads and Dirichlet lifting) */
   Vec            xl, xu;     /* SNESVI bounds */
+  VerifyOptions  verify;
   RunStats       stats;
+  ErrorNorms     errors;     /* against the scene's exact solution */
+  ErrorNorms     ref_errors; /* against the -reference solution */
 } AppCtx;
 
 /* scenes/registry.c */
@@ -103,6 +127,7 @@ PetscErrorCode SceneCreate(const char name[], DM dm, const Material *mat, Scene 
 PetscErrorCode SceneGetOptions(MPI_Comm comm, char name[], size_t len);
 PetscErrorCode SceneCreate_Square(DM, const Material *, Scene *);
 PetscErrorCode SceneCreate_Patch(DM, const Material *, Scene *);
+PetscErrorCode SceneCreate_MMS(DM, const Material *, Scene *);
 
 /* mesh.c, mesh_box_simplex.c */
 PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm);
@@ -110,6 +135,7 @@ PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt 
 PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[]);
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
 PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id);
+PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count);
 
 /* elasticity.c */
 PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat);
@@ -149,6 +175,46 @@ PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
 /* contact_monitor.c */
 PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx);
 PetscErrorCode ContactCountActive(AppCtx *user, Vec X, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left);
+
+/* cell_quadrature.c: basis functions at the points of an accurate rule, cell by cell or on faces */
+typedef struct {
+  PetscInt         dim, Nb, Nc; /* space dimension, basis functions, components */
+  PetscInt         Nq;          /* points of the current cell or face */
+  const PetscReal *x;           /* [Nq][dim] physical points */
+  const PetscReal *w;           /* [Nq] weights times the Jacobian determinant */
+  const PetscReal *B;           /* [Nq][Nb][Nc] basis values */
+  const PetscReal *D;           /* [Nq][Nb][Nc][dim] physical basis gradients (cells only) */
+  PetscInt         cell;        /* the cell whose basis is tabulated (the support cell of a face) */
+  /* private */
+  DM              dm;
+  PetscFE         fe;
+  const Scene    *scene;
+  PetscQuadrature cell_rule[2], face_rule[2]; /* plain and refined */
+  PetscTabulation cell_tab[2], face_tab;
+  PetscReal      *xbuf, *wbuf, *dbuf, *J, *invJ, *detJ, *refbuf;
+} CellQuadrature;
+PetscErrorCode CellQuadratureCreate(DM dm, const Scene *scene, const VerifyOptions *opts, CellQuadrature *cq);
+PetscErrorCode CellQuadratureSetCell(CellQuadrature *cq, PetscInt cell);
+PetscErrorCode CellQuadratureSetFace(CellQuadrature *cq, PetscInt face);
+PetscErrorCode CellQuadratureDestroy(CellQuadrature *cq);
+PetscErrorCode CellQuadratureInterpolate(const CellQuadrature *cq, const PetscScalar closure[], PetscInt q, PetscReal u[], PetscReal grad[]);
+void           ElasticStress(PetscInt dim, const Material *mat, const PetscReal grad[], PetscReal sigma[]);
+
+/* verify_options.c, weak_data.c, error_norms.c, reference.c */
+PetscErrorCode VerifyGetOptions(MPI_Comm comm, VerifyOptions *opts);
+PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0);
+PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal *sn);
+/* What the discrete solution is compared with: the scene's exact solution, or an FE function on the same mesh. */
+typedef struct {
+  const Scene *scene;        /* exact solution and gradient, if not NULL; otherwise */
+  Vec          loc_u;        /*   a displacement (local vector, boundary values inserted) */
+  Vec          loc_pressure; /*   and its contact pressure p, stored as p n at the nodes of Gamma_C */
+} ErrorTarget;
+PetscErrorCode ErrorNormsReset(ErrorNorms *e);
+PetscErrorCode ErrorNormsPressureVector(DM dm, AppCtx *user, Vec loc_p);
+PetscErrorCode ErrorNormsEvaluate(DM dm, AppCtx *user, Mat K, Vec loc_uh, Vec loc_ph, const ErrorTarget *target, ErrorNorms *e);
+PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u);
+PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u);
 
 /* postprocess.c */
 PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u);

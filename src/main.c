@@ -67,6 +67,7 @@ int main(int argc, char **argv)
   PetscCall(SceneGetOptions(comm, user.scene_name, sizeof(user.scene_name)));
   PetscCall(ElasticityGetOptions(comm, &user.material));
   PetscCall(ContactGetOptions(comm, &user.contact));
+  PetscCall(VerifyGetOptions(comm, &user.verify));
   PetscCall(OutputGetOptions(comm, &user));
 
   PetscCall(MeshCreate(comm, &dm));
@@ -79,14 +80,17 @@ int main(int argc, char **argv)
   PetscCall(ContactSetCreate(dm, &user, &user.cset));
   if (user.contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, &user));
   PetscCall(SolverAssembleBulk(dm, &user));
+  PetscCall(WeakDataAddToResidual(dm, &user, user.r0));
   PetscCall(SolverCreateSNES(dm, &user, &snes));
   PetscCall(DMCreateGlobalVector(dm, &u));
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
+  PetscCall(DMSNESCheckFromOptions(snes, u)); /* -dmsnes_check: PETSc's checks against the exact solution */
   PetscCall(PetscTime(&t1));
   user.stats.time_setup = t1 - t0;
 
   PetscCall(SolverSolve(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
+  PetscCall(ErrorNormsCompute(dm, &user, u));
   PetscCall(PetscTime(&t1));
   user.stats.time_total = t1 - t0;
   PetscCall(CheckAllOptionsUsed(comm));

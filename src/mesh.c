@@ -1,4 +1,5 @@
 /* Mesh creation: PETSc's box and file readers, plus the project's simplex box generator. */
+#include <petscsf.h>
 #include "signorini.h"
 
 /* Creates the mesh from PETSc's own options; simplex boxes, which PETSc 3.18 cannot generate
@@ -127,5 +128,22 @@ PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id)
   PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, comm));
   PetscCheck(ntotal > 0, comm, PETSC_ERR_USER_INPUT,
              "The mesh has no contact boundary: no face carries \"Face Sets\" value %" PetscInt_FMT " (Gamma_C)", contact_id);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Number of points of a stratum owned by this rank, summed over ranks. */
+PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count)
+{
+  PetscSF         sf;
+  PetscInt        nleaves, n = 0;
+  const PetscInt *leaves;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetPointSF(dm, &sf));
+  PetscCall(PetscSFGetGraph(sf, NULL, &nleaves, &leaves, NULL));
+  n = pEnd - pStart;
+  if (nleaves > 0 && leaves)
+    for (PetscInt l = 0; l < nleaves; ++l) n -= (leaves[l] >= pStart && leaves[l] < pEnd);
+  PetscCall(MPIU_Allreduce(&n, count, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

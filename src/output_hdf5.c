@@ -53,23 +53,6 @@ static PetscErrorCode CreateVertexFieldDM(DM dm, PetscInt nc, DM *vdm)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Number of points of a stratum owned by this rank, summed over ranks. */
-static PetscErrorCode CountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count)
-{
-  PetscSF         sf;
-  PetscInt        nleaves, n = 0;
-  const PetscInt *leaves;
-
-  PetscFunctionBeginUser;
-  PetscCall(DMGetPointSF(dm, &sf));
-  PetscCall(PetscSFGetGraph(sf, NULL, &nleaves, &leaves, NULL));
-  n = pEnd - pStart;
-  if (nleaves > 0 && leaves)
-    for (PetscInt l = 0; l < nleaves; ++l) n -= (leaves[l] >= pStart && leaves[l] < pEnd);
-  PetscCall(MPIU_Allreduce(&n, count, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* Writes /vertex_fields/<name of v> as an (n_vertices, nc) dataset in the vertex order of /geometry/vertices. */
 static PetscErrorCode ViewVertexField(Vec v, PetscInt nc, PetscViewer viewer)
 {
@@ -223,6 +206,22 @@ static PetscErrorCode WriteIntAttr(PetscViewer v, const char name[], PetscInt va
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* prefix_l2, prefix_h1, ... for the norms that were computed (NaN: not computed, not written). */
+static PetscErrorCode WriteErrorNorms(PetscViewer v, const char prefix[], const ErrorNorms *e)
+{
+  const char *names[]  = {"l2", "h1_semi", "h1", "energy", "pressure_l2", "pressure_weighted", "pressure_dual"};
+  PetscReal   values[] = {e->l2, e->h1_semi, e->h1, e->energy, e->pressure_l2, e->pressure_weighted, e->pressure_dual};
+  char        name[64];
+
+  PetscFunctionBeginUser;
+  for (size_t i = 0; i < sizeof(values) / sizeof(values[0]); ++i) {
+    if (PetscIsNanReal(values[i])) continue;
+    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_%s", prefix, names[i]));
+    PetscCall(WriteRealAttr(v, name, values[i]));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v, PetscInt ncells, PetscInt nverts)
 {
   const RunStats *s = &user->stats;
@@ -262,6 +261,21 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCall(WriteRealAttr(v, "max_penetration", s->max_penetration));
   PetscCall(WriteRealAttr(v, "contact_force", s->contact_force));
   PetscCall(WriteRealAttr(v, "energy", s->energy));
+  PetscCall(WriteRealAttr(v, "penetration_l2", user->errors.penetration_l2));
+  PetscCall(WriteRealAttr(v, "penetration_max", user->errors.penetration_max));
+  PetscCall(WriteErrorNorms(v, "error", &user->errors));
+  PetscCall(WriteErrorNorms(v, "reference_error", &user->ref_errors));
+  if (user->verify.reference[0]) {
+    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "reference", PETSC_STRING, user->verify.reference));
+  }
+  PetscCall(WriteIntAttr(v, "verify_quadrature_points", user->verify.quad_points));
+  PetscCall(WriteIntAttr(v, "verify_quadrature_refine", user->verify.quad_refine));
+  for (PetscInt i = 0; i < user->scene.num_constants; ++i) { /* the scene's parameters, scene_0, scene_1, ... */
+    char name[32];
+
+    PetscCall(PetscSNPrintf(name, sizeof(name), "scene_%" PetscInt_FMT, i));
+    PetscCall(WriteRealAttr(v, name, PetscRealPart(user->scene.constants[i])));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -322,8 +336,8 @@ PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  PetscCall(CountOwned(dm, cStart, cEnd, &ncells));
-  PetscCall(CountOwned(dm, vStart, vEnd, &nverts));
+  PetscCall(MeshCountOwned(dm, cStart, cEnd, &ncells));
+  PetscCall(MeshCountOwned(dm, vStart, vEnd, &nverts));
   if (cEnd > cStart) PetscCall(DMPlexGetConeSize(dm, cStart, &ncorners));
   if (dim == 3 && ncorners == 6) ncorners = 8; /* a hex has 6 faces and 8 corners; a triangle, quad or tet as many corners as faces */
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ncorners, 1, MPIU_INT, MPI_MAX, comm));

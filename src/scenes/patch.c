@@ -17,6 +17,19 @@ static PetscErrorCode PatchExact(PetscInt dim, PetscReal t, const PetscReal x[],
   return PETSC_SUCCESS;
 }
 
+/* G[i*dim+j] = du_i/dx_j */
+static PetscErrorCode PatchExactGradient(PetscInt dim, PetscReal t, const PetscReal x[], PetscInt Nc, PetscScalar G[], void *ctx)
+{
+  const PetscScalar *c = (const PetscScalar *)ctx;
+
+  for (PetscInt k = 0; k < dim * dim; ++k) G[k] = 0.0;
+  G[0] = c[PATCH_STRAIN];
+  for (PetscInt d = 1; d < dim; ++d) G[d * dim + d] = c[PATCH_LATERAL];
+  G[0 * dim + dim - 1] -= c[PATCH_ROTATION];
+  G[(dim - 1) * dim + 0] += c[PATCH_ROTATION];
+  return PETSC_SUCCESS;
+}
+
 PetscErrorCode SceneCreate_Patch(DM dm, const Material *mat, Scene *scene)
 {
   PetscInt  dim;
@@ -37,6 +50,7 @@ PetscErrorCode SceneCreate_Patch(DM dm, const Material *mat, Scene *scene)
   for (PetscInt i = 0; i < scene->num_dirichlet; ++i) scene->dirichlet_ids[i] = i + 2;
   scene->dirichlet_value          = PatchExact;
   scene->exact                    = PatchExact;
+  scene->exact_gradient           = PatchExactGradient;
   scene->obstacle_normal[dim - 1] = -1.0;
   scene->obstacle_offset          = 0.0;
   scene->num_constants            = PATCH_NUM_CONSTANTS;

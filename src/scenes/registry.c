@@ -8,6 +8,7 @@ PetscErrorCode SceneRegisterAll(void)
   PetscFunctionBeginUser;
   PetscCall(PetscFunctionListAdd(&scene_list, "square", SceneCreate_Square));
   PetscCall(PetscFunctionListAdd(&scene_list, "patch", SceneCreate_Patch));
+  PetscCall(PetscFunctionListAdd(&scene_list, "mms", SceneCreate_MMS));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
