@@ -23,7 +23,8 @@ SRC = $(wildcard src/*.c src/scenes/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test format clean
+.PHONY: all deps run test rates format clean
+STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
 deps:
@@ -46,6 +47,15 @@ run: deps
 test: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) tests/run_tests.py
+
+# The paper's convergence studies (README, "Reproducing the paper"): output/studies/<name>/<name>.{csv,md,png}
+rates: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	@for s in $(STUDIES); do $(PYTHON) scripts/study.py options/studies/$$s.yaml --check || exit 1; done
+
+study-%: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) scripts/study.py options/studies/$*.yaml --check
 
 format:
 	clang-format -i src/*.c src/scenes/*.c include/*.h

@@ -197,6 +197,7 @@ PetscErrorCode CellQuadratureCreate(DM dm, const Scene *scene, const VerifyOptio
 PetscErrorCode CellQuadratureSetCell(CellQuadrature *cq, PetscInt cell);
 PetscErrorCode CellQuadratureSetFace(CellQuadrature *cq, PetscInt face);
 PetscErrorCode CellQuadratureDestroy(CellQuadrature *cq);
+PetscErrorCode CellReferenceCoordinates(DM dm, PetscInt c, PetscInt n, const PetscReal x[], PetscReal xi[]);
 PetscErrorCode CellQuadratureInterpolate(const CellQuadrature *cq, const PetscScalar closure[], PetscInt q, PetscReal u[], PetscReal grad[]);
 void           ElasticStress(PetscInt dim, const Material *mat, const PetscReal grad[], PetscReal sigma[]);
 

@@ -52,6 +52,44 @@ static PetscErrorCode RuleCreate(DMPolytopeType ct, PetscInt npoints, PetscInt r
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Reference coordinates xi[n][dim] of the physical points x[n][dim] in cell c, by Newton on the cell map (one step for
+   affine cells). Replaces DMPlexCoordinatesToReference(), which re-sorts a label on every call in PETSc 3.18. */
+PetscErrorCode CellReferenceCoordinates(DM dm, PetscInt c, PetscInt n, const PetscReal x[], PetscReal xi[])
+{
+  PetscInt        dim;
+  PetscQuadrature q;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(PetscQuadratureCreate(PETSC_COMM_SELF, &q));
+  for (PetscInt i = 0; i < n; ++i) {
+    PetscReal *pt, *wt, v[3], J[9], invJ[9], detJ, res = PETSC_MAX_REAL;
+    PetscInt   it;
+
+    for (PetscInt d = 0; d < dim; ++d) xi[i * dim + d] = 0.0;
+    for (it = 0; it < 20 && res > 1e-13; ++it) {
+      PetscCall(PetscMalloc1(dim, &pt)); /* owned by q */
+      PetscCall(PetscMalloc1(1, &wt));
+      for (PetscInt d = 0; d < dim; ++d) pt[d] = xi[i * dim + d];
+      wt[0] = 1.0;
+      PetscCall(PetscQuadratureSetData(q, dim, 1, 1, pt, wt));
+      PetscCall(DMPlexComputeCellGeometryFEM(dm, c, q, v, J, invJ, &detJ));
+      res = 0.0;
+      for (PetscInt d = 0; d < dim; ++d) {
+        PetscReal step = 0.0;
+
+        for (PetscInt e = 0; e < dim; ++e) step += invJ[d * dim + e] * (x[i * dim + e] - v[e]);
+        xi[i * dim + d] += step;
+        res = PetscMax(res, PetscAbsReal(step));
+      }
+    }
+    PetscCheck(res <= 1e-10, PETSC_COMM_SELF, PETSC_ERR_CONV_FAILED,
+               "No reference coordinates for a point of cell %" PetscInt_FMT " (Newton residual %g)", c, (double)res);
+  }
+  PetscCall(PetscQuadratureDestroy(&q));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Is point p (cell or face) cut by the scene's kink plane? */
 static PetscErrorCode IsCutByKink(const CellQuadrature *cq, PetscInt p, PetscBool *cut)
 {
@@ -248,7 +286,7 @@ PetscErrorCode CellQuadratureSetFace(CellQuadrature *cq, PetscInt f)
   for (PetscInt q = 0; q < cq->Nq; ++q) cq->wbuf[q] = qw[q] * cq->detJ[q];
   PetscCall(DMPlexGetSupport(cq->dm, f, &support));
   cq->cell = support[0];
-  PetscCall(DMPlexCoordinatesToReference(cq->dm, cq->cell, cq->Nq, cq->xbuf, cq->refbuf));
+  PetscCall(CellReferenceCoordinates(cq->dm, cq->cell, cq->Nq, cq->xbuf, cq->refbuf));
   PetscCall(PetscTabulationDestroy(&cq->face_tab));
   PetscCall(PetscFECreateTabulation(cq->fe, 1, cq->Nq, cq->refbuf, 0, &cq->face_tab));
   cq->x = cq->xbuf;

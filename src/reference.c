@@ -53,6 +53,38 @@ static PetscErrorCode ReadIntAttribute(PetscViewer v, const char file[], const c
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* (key, index) pairs sorted by key, then index: libc qsort (PETSc 3.18's integer sorts slow down on many equal keys) */
+typedef struct {
+  PetscInt key, index;
+} KeyIndex;
+
+static int CompareKeyIndex(const void *a, const void *b)
+{
+  const KeyIndex *x = (const KeyIndex *)a, *y = (const KeyIndex *)b;
+
+  if (x->key != y->key) return x->key < y->key ? -1 : 1;
+  return x->index < y->index ? -1 : (x->index > y->index);
+}
+
+static PetscErrorCode SortKeysWithIndices(PetscInt n, PetscInt key[], PetscInt index[])
+{
+  KeyIndex *ki;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(PetscMax(n, 1), &ki));
+  for (PetscInt i = 0; i < n; ++i) {
+    ki[i].key   = key[i];
+    ki[i].index = index[i];
+  }
+  qsort(ki, (size_t)n, sizeof(KeyIndex), CompareKeyIndex);
+  for (PetscInt i = 0; i < n; ++i) {
+    key[i]   = ki[i].key;
+    index[i] = ki[i].index;
+  }
+  PetscCall(PetscFree(ki));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static inline PetscInt BucketKey(const Reference *ref, const PetscInt i[])
 {
   return (i[0] * ref->nb[1] + i[1]) * ref->nb[2] + i[2];
@@ -87,14 +119,14 @@ static PetscErrorCode ReferenceIndex(Reference *ref)
     ref->key[i]  = BucketKey(ref, b);
     ref->perm[i] = i;
   }
-  PetscCall(PetscSortIntWithArray(ref->nv, ref->key, ref->perm));
+  PetscCall(SortKeysWithIndices(ref->nv, ref->key, ref->perm));
   PetscCall(PetscMalloc2(ref->ncells, &ref->cell_first, ref->ncells, &ref->cell_perm));
   for (PetscInt c = 0; c < ref->ncells; ++c) {
     PetscCall(PetscSortInt(ref->ncorners, &ref->cells[c * ref->ncorners]));
     ref->cell_first[c] = ref->cells[c * ref->ncorners];
     ref->cell_perm[c]  = c;
   }
-  PetscCall(PetscSortIntWithArray(ref->ncells, ref->cell_first, ref->cell_perm));
+  PetscCall(SortKeysWithIndices(ref->ncells, ref->cell_first, ref->cell_perm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -295,7 +327,7 @@ static PetscErrorCode RefineAndInterpolate(DM dm, PetscInt levels, PetscInt nvec
         PetscCall(PetscSectionGetOffset(csec, verts[i], &off));
         for (PetscInt d = 0; d < dim; ++d) x[i * dim + d] = PetscRealPart(xc[off + d]);
       }
-      PetscCall(DMPlexCoordinatesToReference(dm, parent[c - fcStart], nv, x, xi));
+      PetscCall(CellReferenceCoordinates(dm, parent[c - fcStart], nv, x, xi));
       PetscCall(PetscFECreateTabulation(fe, 1, nv, xi, 0, &T));
       for (PetscInt k = 0; k < nvec; ++k) {
         PetscScalar *cv = NULL;

@@ -8,6 +8,7 @@ import glob
 import math
 import os
 import re
+import shutil
 import subprocess
 import sys
 import time
@@ -17,44 +18,8 @@ import xml.etree.ElementTree as ET
 import h5py
 import numpy as np
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import read_runs  # noqa: E402
-
-BIN = os.path.join(ROOT, "bin", "signorini")
-OUT = os.path.join(ROOT, "tests", "out")
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
-TESTS = []
-
-
-def test(fn):
-    TESTS.append(fn)
-    return fn
-
-
-def run(args, name, np_=1, expect_rc=0):
-    """Runs the solver; returns (combined output, path of the HDF5 file)."""
-    out = os.path.join(OUT, name + ".h5")
-    cmd = ["mpiexec", "-n", str(np_), BIN, "-output", out] + [str(a) for a in args]
-    p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
-    if expect_rc is not None:
-        assert p.returncode == expect_rc, f"exit code {p.returncode}, expected {expect_rc}: {' '.join(cmd)}\n{p.stdout[-3000:]}"
-    return p.stdout, out
-
-
-def load(path):
-    with h5py.File(path, "r") as f:
-        attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f["run"].attrs.items()}
-        fields = {k: f["vertex_fields"][k][:] for k in f["vertex_fields"]}
-        fields["x"] = f["geometry/vertices"][:]
-    return attrs, fields
-
-
-def sorted_by_position(fields, key):
-    """Field values in a rank-independent vertex order (lexicographic in the coordinates)."""
-    order = np.lexsort(np.round(fields["x"], 12).T)
-    return fields[key][order]
-
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from harness import BIN, ENV, OUT, ROOT, TESTS, load, read_runs, run, sorted_by_position, test  # noqa: E402
 
 # ---------------------------------------------------------------- discretization
 PATCH_MESHES = {
@@ -335,10 +300,12 @@ for _name, (_args, _message) in BAD_INPUTS.items():
     test(_bad)
 
 
+import verification  # noqa: E402,F401  (registers the verification tests)
+
+
 def main():
-    os.makedirs(OUT, exist_ok=True)
-    for f in glob.glob(os.path.join(OUT, "*")):
-        os.remove(f)
+    shutil.rmtree(OUT, ignore_errors=True)
+    os.makedirs(OUT)
     selected = [t for t in TESTS if len(sys.argv) < 2 or any(s in t.__name__ for s in sys.argv[1:])]
     passed = failed = 0
     start = time.time()

@@ -1,0 +1,178 @@
+"""Verification tests (make test): the error norms, the mms scene, -reference and the small convergence studies.
+
+Every assertion checks numbers computed by the solver against a tolerance that can fail.
+"""
+import glob
+import os
+import subprocess
+
+import numpy as np
+
+from harness import ENV, OUT, ROOT, load, run, test
+
+STUDY = os.path.join(ROOT, "scripts", "study.py")
+NORMS = ["error_l2", "error_h1_semi", "error_h1", "error_energy", "error_pressure_l2", "error_pressure_weighted", "error_pressure_dual"]
+
+
+def run_study(name):
+    """Runs options/studies/<name>.yaml with --check; returns the combined output (asserts success)."""
+    outdir = os.path.join(OUT, "studies", name)
+    cmd = ["/usr/bin/python3", STUDY, os.path.join(ROOT, "options", "studies", name + ".yaml"), "--check", "--quiet", "--outdir", outdir]
+    p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=900)
+    assert p.returncode == 0, f"study {name} failed its checks:\n{p.stdout[-4000:]}"
+    for ext in (".csv", ".md"):
+        assert os.path.isfile(os.path.join(outdir, name + ext)), f"{name}{ext} not written"
+    return p.stdout
+
+
+@test
+def error_norms_vanish_for_the_patch_test():
+    """The patch test field is in the FE space: every norm must be round-off, on every cell type."""
+    for mesh, args in {"tri": [], "quad": ["-dm_plex_simplex", 0], "tet": ["-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3"]}.items():
+        _, h5 = run(["-scene", "patch"] + args, f"norms_patch_{mesh}")
+        attrs, _ = load(h5)
+        for k in NORMS:
+            assert 0.0 <= attrs[k] <= 1e-12, f"{mesh}: {k} = {attrs[k]:.3e}"
+        assert attrs["penetration_l2"] == 0.0 and attrs["penetration_max"] == 0.0
+
+
+@test
+def mms_norms_are_consistent():
+    """h1^2 = l2^2 + h1_semi^2, the energy norm is at most sqrt(2 mu + d lambda) times the semi-norm,
+    the weighted pressure norm is eps^1/2 times the L2 one, and the dual norm is at most the energy error (Galerkin)."""
+    _, h5 = run(["-options_file", "options/mms.yaml", "-dm_plex_box_faces", "16,16"], "mms_norms")
+    a, f = load(h5)
+    assert a["converged"] == 1
+    assert abs(a["error_h1"] ** 2 - a["error_l2"] ** 2 - a["error_h1_semi"] ** 2) <= 1e-12 * a["error_h1"] ** 2
+    nu, E = a["poisson_ratio"], a["young_modulus"]
+    mu, lam = E / (2 * (1 + nu)), E * nu / ((1 + nu) * (1 - 2 * nu))
+    assert 0.0 < a["error_energy"] <= np.sqrt(2 * mu + 2 * lam) * a["error_h1_semi"] * 1.001
+    assert abs(a["error_pressure_weighted"] - np.sqrt(a["eps"]) * a["error_pressure_l2"]) <= 1e-12
+    assert 0.0 < a["error_pressure_dual"] <= a["error_energy"] * 1.01, (a["error_pressure_dual"], a["error_energy"])
+    # the nodal error field of the HDF5 file agrees with the exact solution of the scene
+    assert np.abs(f["error"] - (f["displacement"] - f["exact_displacement"])).max() <= 1e-14
+    # the scene is a Signorini solution: u_n = -phi <= 0 on Gamma_C, so the exact field never penetrates
+    on_c = f["contact_boundary"] > 0.5
+    assert np.all(f["exact_displacement"][on_c, 1] >= -1e-15)
+
+
+@test
+def mms_quadrature_does_not_pollute_the_error():
+    """Refining the composite rule on the cells cut by x = a from 2 to 4 levels changes the norms by less than 1%."""
+    vals = {}
+    for r in (2, 4):
+        _, h5 = run(["-options_file", "options/mms.yaml", "-mms_nu", 0.25, "-dm_plex_box_faces", "32,32", "-verify_quadrature_refine", r],
+                    f"mms_quad_{r}")
+        vals[r], _ = load(h5)
+    for k in ("error_h1", "error_pressure_l2", "error_pressure_dual"):
+        rel = abs(vals[2][k] - vals[4][k]) / vals[4][k]
+        assert rel < 1e-2, f"{k}: {vals[2][k]:.6e} (refine 2) vs {vals[4][k]:.6e} (refine 4)"
+
+
+@test
+def mms_3d_error_decreases():
+    """3D tetrahedra: halving h must cut the H1 error by at least 2^0.65 (predicted exponent 3/4, minus 0.1)."""
+    errs = []
+    for n in (4, 8):
+        _, h5 = run(["-options_file", "options/mms.yaml", "-dm_plex_dim", 3, "-dm_plex_box_faces", f"{n},{n},{n}"], f"mms_3d_{n}")
+        a, _ = load(h5)
+        assert a["converged"] == 1
+        errs.append(a["error_h1"])
+    assert errs[1] <= errs[0] / 2 ** 0.65, errs
+
+
+@test
+def mms_norms_parallel_match_serial():
+    """The norms computed on 2 ranks equal the serial ones to solver tolerance."""
+    args = ["-options_file", "options/mms.yaml", "-dm_plex_box_faces", "16,16"]
+    a1, _ = load(run(args, "mms_serial")[1])
+    a2, _ = load(run(args, "mms_parallel", np_=2)[1])
+    for k in NORMS + ["penetration_l2", "penetration_max"]:
+        assert abs(a1[k] - a2[k]) <= 1e-9 * max(abs(a1[k]), 1e-14), f"{k}: {a1[k]:.12e} vs {a2[k]:.12e}"
+
+
+@test
+def dmsnes_check_runs_against_the_exact_solution():
+    out, _ = run(["-options_file", "options/mms.yaml", "-dm_plex_box_faces", "8,8", "-dmsnes_check"], "mms_dmsnes_check")
+    err = float(out.split("L_2 Error:")[1].split()[0])
+    assert 0.0 < err < 0.05, f"L_2 error of the interpolated exact solution {err}"
+
+
+@test
+def reference_on_nested_meshes_is_exact_for_the_patch_test():
+    """A P1-exact field compared with its own solution on a twice refined mesh: zero difference, serial and parallel,
+    triangles and tetrahedra (the coarse solution is interpolated to the fine mesh)."""
+    for dim, faces in ((2, "4,4"), (3, "2,2,2")):
+        _, ref = run(["-scene", "patch", "-dm_plex_dim", dim, "-dm_plex_box_faces", faces, "-dm_refine", 2], f"ref_patch_{dim}d_fine")
+        for np_ in (1, 2):
+            _, h5 = run(["-scene", "patch", "-dm_plex_dim", dim, "-dm_plex_box_faces", faces, "-reference", ref], f"ref_patch_{dim}d_{np_}", np_=np_)
+            a, _ = load(h5)
+            for k in NORMS:
+                assert a["reference_" + k] <= 1e-12, f"{dim}D np {np_}: reference_{k} = {a['reference_' + k]:.3e}"
+
+
+@test
+def reference_errors_of_square_converge():
+    """square scene against a VI run refined 3 times: the H1 difference falls with h (rate > 0.7) and vanishes
+    for the reference itself."""
+    base = ["-options_file", "options/square.yaml", "-contact_monitor", "false", "-dm_plex_box_faces", "4,4"]
+    _, ref = run(base + ["-contact_method", "vi", "-dm_refine", 3], "ref_square_fine")
+    e = []
+    for r in (0, 1, 2):
+        _, h5 = run(base + ["-contact_method", "vi", "-dm_refine", r, "-reference", ref], f"ref_square_{r}", np_=2)
+        a, _ = load(h5)
+        e.append(a["reference_error_h1"])
+    assert e[0] / e[1] > 2 ** 0.7 and e[1] / e[2] > 2 ** 0.7, e
+    _, h5 = run(base + ["-contact_method", "vi", "-dm_refine", 3, "-reference", ref], "ref_square_self")
+    a, _ = load(h5)
+    assert a["reference_error_h1"] == 0.0 and a["reference_error_pressure_l2"] == 0.0
+
+
+@test
+def reference_mismatch_is_refused():
+    _, ref = run(["-scene", "patch", "-dm_plex_box_faces", "4,4", "-dm_refine", 1], "ref_mismatch_fine")
+    cases = {
+        "scene": (["-scene", "square", "-dm_plex_box_faces", "4,4"], "is a run of scene patch, this is scene square"),
+        "cells": (["-scene", "patch", "-dm_plex_box_faces", "3,3"], "which is not this mesh (18 cells) uniformly refined"),
+        "vertices": (["-scene", "patch", "-dm_plex_box_faces", "4,4", "-dm_plex_box_upper", "1,2"], "a vertex of this mesh refined is not one"),
+        "degree": (["-scene", "patch", "-dm_plex_box_faces", "4,4", "-displacement_petscspace_degree", 2], "-reference needs degree 1"),
+        "missing": (["-scene", "patch", "-reference", "tests/out/none.h5"], "Reference file 'tests/out/none.h5' (-reference) does not exist"),
+    }
+    for name, (args, message) in cases.items():
+        if "-reference" not in args:
+            args = args + ["-reference", ref]
+        out, h5 = run(args, f"ref_bad_{name}", expect_rc=None)
+        assert message in out, f"{name}: '{message}' not in\n{out[-1500:]}"
+        assert not glob.glob(h5 + "*"), f"{name}: output left behind"
+
+
+@test
+def mms_bad_parameters_are_refused():
+    for args, message in ((["-mms_nu", 0], "-mms_nu must lie in (0, 1]"), (["-mms_nu", 1.5], "-mms_nu must lie in (0, 1]"),
+                          (["-mms_a", 1], "-mms_a must lie in (0, 1)"), (["-mms_amplitude_B", -1], "must be positive")):
+        out, h5 = run(["-scene", "mms"] + args, "mms_bad", expect_rc=None)
+        assert message in out, f"'{message}' not in\n{out[-1500:]}"
+        assert not os.path.exists(h5)
+
+
+@test
+def study_rates_2d_reach_the_predictions():
+    """Small version of study 1 (make rates): eps = h, nu = 0.25 and 0.5, 8x8 to 64x64; study.py --check asserts
+    that the fitted H1 and pressure rates reach the predicted exponents within 0.1."""
+    out = run_study("quick_rates2d")
+    assert out.count("PASS") == 2, out
+
+
+@test
+def study_eps_refinement_is_monotone_until_the_floor():
+    """Small version of study 4: on a 32x32 mesh the error against the exact solution falls with eps until the
+    discretization floor, and the distance to the SNESVI solution falls like eps (rate >= 0.9)."""
+    out = run_study("quick_epsrefine2d")
+    assert out.count("PASS") == 3, out
+
+
+@test
+def study_script_unit_tests():
+    p = subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "tests", "test_study.py")], cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
+                       stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert p.returncode == 0 and " 0 failed" in p.stdout, p.stdout[-3000:]
