@@ -136,6 +136,7 @@ PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
 PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id);
 PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count);
+PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **faces);
 
 /* elasticity.c */
 PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat);

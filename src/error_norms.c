@@ -85,71 +85,58 @@ static PetscErrorCode IntegrateContact(DM dm, AppCtx *user, CellQuadrature *cq, 
 {
   const PetscInt   dim = cq->dim;
   const PetscReal *n   = user->scene.obstacle_normal;
-  IS               faces_is;
-  DMLabel          face_sets;
+  PetscInt        *faces, nf;
   PetscScalar     *elem;
 
   PetscFunctionBeginUser;
-  PetscCall(DMGetLabel(dm, "Face Sets", &face_sets)); /* of this mesh, which may be a refinement of the run's */
-  PetscCall(DMLabelGetStratumIS(face_sets, user->scene.contact_id, &faces_is));
-  if (!faces_is) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscMalloc1(cq->Nb, &elem));
-  {
-    const PetscInt *faces;
-    PetscInt        nf, fStart, fEnd;
+  PetscCall(MeshGetBoundaryFaces(dm, user->scene.contact_id, &nf, &faces)); /* of this mesh, maybe a refinement of the run's */
+  PetscCall(PetscMalloc1(PetscMax(cq->Nb, 1), &elem));
+  for (PetscInt i = 0; i < nf; ++i) {
+    PetscScalar *uh = NULL, *ph = NULL, *pr = NULL;
 
-    PetscCall(DMPlexGetHeightStratum(dm, 1, &fStart, &fEnd));
-    PetscCall(ISGetLocalSize(faces_is, &nf));
-    PetscCall(ISGetIndices(faces_is, &faces));
-    for (PetscInt i = 0; i < nf; ++i) {
-      PetscScalar *uh = NULL, *ph = NULL, *pr = NULL;
+    PetscCall(CellQuadratureSetFace(cq, faces[i]));
+    PetscCall(DMPlexVecGetClosure(dm, NULL, loc_uh, cq->cell, NULL, &uh));
+    if (loc_ph) PetscCall(DMPlexVecGetClosure(dm, NULL, loc_ph, cq->cell, NULL, &ph));
+    if (t && !t->scene) PetscCall(DMPlexVecGetClosure(dm, NULL, t->loc_pressure, cq->cell, NULL, &pr));
+    for (PetscInt b = 0; b < cq->Nb; ++b) elem[b] = 0.0;
+    for (PetscInt q = 0; q < cq->Nq; ++q) {
+      const PetscReal *x = &cq->x[q * dim];
+      PetscReal        u[3], v[3], d = -user->scene.obstacle_offset, p_h = 0.0, p_target = 0.0, R;
 
-      if (faces[i] < fStart || faces[i] >= fEnd) continue;
-      PetscCall(CellQuadratureSetFace(cq, faces[i]));
-      PetscCall(DMPlexVecGetClosure(dm, NULL, loc_uh, cq->cell, NULL, &uh));
-      if (loc_ph) PetscCall(DMPlexVecGetClosure(dm, NULL, loc_ph, cq->cell, NULL, &ph));
-      if (t && !t->scene) PetscCall(DMPlexVecGetClosure(dm, NULL, t->loc_pressure, cq->cell, NULL, &pr));
-      for (PetscInt b = 0; b < cq->Nb; ++b) elem[b] = 0.0;
-      for (PetscInt q = 0; q < cq->Nq; ++q) {
-        const PetscReal *x = &cq->x[q * dim];
-        PetscReal        u[3], v[3], d = -user->scene.obstacle_offset, p_h = 0.0, p_target = 0.0, R;
+      PetscCall(CellQuadratureInterpolate(cq, uh, q, u, NULL));
+      for (PetscInt k = 0; k < dim; ++k) d += (u[k] + x[k]) * n[k];
+      sums[1] += cq->w[q] * PetscSqr(PetscMax(d, 0.0));
+      *dmax = PetscMax(*dmax, d);
+      if (!t) continue;
+      if (ph) { /* the interpolated nodal pressure, stored as p n */
+        PetscCall(CellQuadratureInterpolate(cq, ph, q, v, NULL));
+        for (PetscInt k = 0; k < dim; ++k) p_h += v[k] * n[k];
+      } else
+        p_h = d > 0.0 ? d / user->eps : 0.0;
+      if (t->scene) {
+        PetscReal sn;
 
-        PetscCall(CellQuadratureInterpolate(cq, uh, q, u, NULL));
-        for (PetscInt k = 0; k < dim; ++k) d += (u[k] + x[k]) * n[k];
-        sums[1] += cq->w[q] * PetscSqr(PetscMax(d, 0.0));
-        *dmax = PetscMax(*dmax, d);
-        if (!t) continue;
-        if (ph) { /* the interpolated nodal pressure, stored as p n */
-          PetscCall(CellQuadratureInterpolate(cq, ph, q, v, NULL));
-          for (PetscInt k = 0; k < dim; ++k) p_h += v[k] * n[k];
-        } else
-          p_h = d > 0.0 ? d / user->eps : 0.0;
-        if (t->scene) {
-          PetscReal sn;
-
-          PetscCall(WeakDataExactNormalStress(user, dim, x, &sn));
-          p_target = -sn;
-        } else {
-          PetscCall(CellQuadratureInterpolate(cq, pr, q, v, NULL));
-          for (PetscInt k = 0; k < dim; ++k) p_target += v[k] * n[k];
-        }
-        R = p_h - p_target; /* sigma_n(u) + p_h */
-        sums[0] += cq->w[q] * R * R;
-        for (PetscInt b = 0; b < cq->Nb; ++b) {
-          PetscReal vn = 0.0;
-
-          for (PetscInt k = 0; k < cq->Nc; ++k) vn += cq->B[(q * cq->Nb + b) * cq->Nc + k] * n[k];
-          elem[b] += cq->w[q] * R * vn;
-        }
+        PetscCall(WeakDataExactNormalStress(user, dim, x, &sn));
+        p_target = -sn;
+      } else {
+        PetscCall(CellQuadratureInterpolate(cq, pr, q, v, NULL));
+        for (PetscInt k = 0; k < dim; ++k) p_target += v[k] * n[k];
       }
-      if (t) PetscCall(DMPlexVecSetClosure(dm, NULL, loc_b, cq->cell, elem, ADD_VALUES));
-      PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc_uh, cq->cell, NULL, &uh));
-      if (ph) PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc_ph, cq->cell, NULL, &ph));
-      if (pr) PetscCall(DMPlexVecRestoreClosure(dm, NULL, t->loc_pressure, cq->cell, NULL, &pr));
+      R = p_h - p_target; /* sigma_n(u) + p_h */
+      sums[0] += cq->w[q] * R * R;
+      for (PetscInt b = 0; b < cq->Nb; ++b) {
+        PetscReal vn = 0.0;
+
+        for (PetscInt k = 0; k < cq->Nc; ++k) vn += cq->B[(q * cq->Nb + b) * cq->Nc + k] * n[k];
+        elem[b] += cq->w[q] * R * vn;
+      }
     }
-    PetscCall(ISRestoreIndices(faces_is, &faces));
+    if (t) PetscCall(DMPlexVecSetClosure(dm, NULL, loc_b, cq->cell, elem, ADD_VALUES));
+    PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc_uh, cq->cell, NULL, &uh));
+    if (ph) PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc_ph, cq->cell, NULL, &ph));
+    if (pr) PetscCall(DMPlexVecRestoreClosure(dm, NULL, t->loc_pressure, cq->cell, NULL, &pr));
   }
-  PetscCall(ISDestroy(&faces_is));
+  PetscCall(PetscFree(faces));
   PetscCall(PetscFree(elem));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -147,3 +147,31 @@ PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *c
   PetscCall(MPIU_Allreduce(&n, count, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The faces of dm with "Face Sets" value id (local, height 1), in a new array the caller frees with PetscFree(). */
+PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **faces)
+{
+  DMLabel  label;
+  IS       is = NULL;
+  PetscInt fStart, fEnd;
+
+  PetscFunctionBeginUser;
+  *n = 0;
+  PetscCall(DMGetLabel(dm, "Face Sets", &label));
+  if (label) PetscCall(DMLabelGetStratumIS(label, id, &is));
+  PetscCall(DMPlexGetHeightStratum(dm, 1, &fStart, &fEnd));
+  if (is) {
+    const PetscInt *points;
+    PetscInt        np;
+
+    PetscCall(ISGetLocalSize(is, &np));
+    PetscCall(ISGetIndices(is, &points));
+    PetscCall(PetscMalloc1(np, faces));
+    for (PetscInt i = 0; i < np; ++i)
+      if (points[i] >= fStart && points[i] < fEnd) (*faces)[(*n)++] = points[i];
+    PetscCall(ISRestoreIndices(is, &points));
+    PetscCall(ISDestroy(&is));
+  } else
+    PetscCall(PetscMalloc1(1, faces));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

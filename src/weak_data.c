@@ -25,9 +25,8 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0)
 {
   CellQuadrature cq;
   Vec            locL;
-  PetscInt       dim, cStart, cEnd;
+  PetscInt       dim, cStart, cEnd, nf, *faces;
   PetscScalar   *elem;
-  IS             faces_is;
 
   PetscFunctionBeginUser;
   if (!user->scene.weak_data) PetscFunctionReturn(PETSC_SUCCESS);
@@ -59,34 +58,24 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0)
     }
     PetscCall(DMPlexVecSetClosure(dm, NULL, locL, c, elem, ADD_VALUES));
   }
-  PetscCall(DMLabelGetStratumIS(user->face_sets, user->scene.contact_id, &faces_is));
-  if (faces_is) {
-    const PetscInt *faces;
-    PetscInt        nf, fStart, fEnd;
+  PetscCall(MeshGetBoundaryFaces(dm, user->scene.contact_id, &nf, &faces));
+  for (PetscInt i = 0; i < nf; ++i) {
+    PetscCall(CellQuadratureSetFace(&cq, faces[i]));
+    for (PetscInt b = 0; b < cq.Nb; ++b) elem[b] = 0.0;
+    for (PetscInt q = 0; q < cq.Nq; ++q) {
+      PetscReal sn;
 
-    PetscCall(DMPlexGetHeightStratum(dm, 1, &fStart, &fEnd));
-    PetscCall(ISGetLocalSize(faces_is, &nf));
-    PetscCall(ISGetIndices(faces_is, &faces));
-    for (PetscInt i = 0; i < nf; ++i) {
-      if (faces[i] < fStart || faces[i] >= fEnd) continue;
-      PetscCall(CellQuadratureSetFace(&cq, faces[i]));
-      for (PetscInt b = 0; b < cq.Nb; ++b) elem[b] = 0.0;
-      for (PetscInt q = 0; q < cq.Nq; ++q) {
-        PetscReal sn;
+      PetscCall(WeakDataExactNormalStress(user, dim, &cq.x[q * dim], &sn));
+      for (PetscInt b = 0; b < cq.Nb; ++b) {
+        PetscReal vn = 0.0;
 
-        PetscCall(WeakDataExactNormalStress(user, dim, &cq.x[q * dim], &sn));
-        for (PetscInt b = 0; b < cq.Nb; ++b) {
-          PetscReal vn = 0.0;
-
-          for (PetscInt k = 0; k < cq.Nc; ++k) vn += cq.B[(q * cq.Nb + b) * cq.Nc + k] * user->scene.obstacle_normal[k];
-          elem[b] -= cq.w[q] * sn * vn;
-        }
+        for (PetscInt k = 0; k < cq.Nc; ++k) vn += cq.B[(q * cq.Nb + b) * cq.Nc + k] * user->scene.obstacle_normal[k];
+        elem[b] -= cq.w[q] * sn * vn;
       }
-      PetscCall(DMPlexVecSetClosure(dm, NULL, locL, cq.cell, elem, ADD_VALUES));
     }
-    PetscCall(ISRestoreIndices(faces_is, &faces));
-    PetscCall(ISDestroy(&faces_is));
+    PetscCall(DMPlexVecSetClosure(dm, NULL, locL, cq.cell, elem, ADD_VALUES));
   }
+  PetscCall(PetscFree(faces));
   /* r0 -= L */
   PetscCall(VecScale(locL, -1.0));
   PetscCall(DMLocalToGlobal(dm, locL, ADD_VALUES, r0));
