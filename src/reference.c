@@ -443,8 +443,8 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(ReferenceRead(comm, user, dim, &ref));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(MeshCountOwned(dm, cStart, cEnd, &ncells));
-  while (ncells * (1 << (dim * levels)) < ref.ncells && levels < 8) ++levels;
-  PetscCheck(ncells * (1 << (dim * levels)) == ref.ncells, comm, PETSC_ERR_USER_INPUT,
+  while ((PetscInt64)ncells << (dim * levels) < (PetscInt64)ref.ncells && levels < 8) ++levels;
+  PetscCheck((PetscInt64)ncells << (dim * levels) == (PetscInt64)ref.ncells, comm, PETSC_ERR_USER_INPUT,
              "Reference %s has %" PetscInt_FMT " cells, which is not this mesh (%" PetscInt_FMT " cells) uniformly refined", user->verify.reference,
              ref.ncells, ncells);
 
