@@ -23,6 +23,13 @@ static PetscErrorCode PrintSummary(DM dm, AppCtx *user, Vec u)
                         SNESConvergedReasons[s->reason], s->newton_its, s->ksp_its, (double)s->residual_norm));
   PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g, contact force %g, energy %.10g\n",
                         s->active_vertices, (double)s->max_penetration, (double)s->contact_force, (double)s->energy));
+  if (!PetscIsNanReal(user->errors.h1))
+    PetscCall(PetscPrintf(comm, "  error against the exact solution: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n",
+                          (double)user->errors.h1, (double)user->errors.l2, (double)user->errors.pressure_l2, (double)user->errors.pressure_dual));
+  if (!PetscIsNanReal(user->ref_errors.h1))
+    PetscCall(PetscPrintf(comm, "  error against the reference: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n",
+                          (double)user->ref_errors.h1, (double)user->ref_errors.l2, (double)user->ref_errors.pressure_l2,
+                          (double)user->ref_errors.pressure_dual));
   PetscCall(PetscPrintf(comm, "  time: setup %.3f s, solve %.3f s, total %.3f s\n", s->time_setup, s->time_solve, s->time_total));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
