@@ -60,6 +60,9 @@ typedef struct {
   PenaltyQuadrature quadrature;
   PetscReal         eps0, eps_power, eps_fixed; /* eps = eps0 h^power / E, or eps_fixed when > 0 */
   PetscBool         monitor;
+  PetscBool         continuation;        /* reach an eps below h/E through a sequence of larger ones */
+  PetscReal         continuation_factor; /* ratio of two consecutive eps of the sequence, in (0, 1) */
+  PetscBool         condition_estimate;  /* estimate the 1-norm condition number of the final Jacobian */
 } ContactOptions;
 
 /* The nodes of Gamma_C owned by this rank and free to move: the unknowns the contact acts on. */
@@ -95,6 +98,9 @@ typedef struct {
   PetscBool           converged;
   SNESConvergedReason reason;
   PetscReal           residual_norm;
+  PetscInt            continuation_stages;                  /* solves of the eps sequence before the target eps (0: none) */
+  PetscReal           condition_1norm;                      /* estimate of cond_1 of the final Jacobian, NaN if not computed */
+  PetscReal           peak_memory_mb, peak_memory_total_mb; /* resident set size: maximum over ranks, and summed */
   PetscReal           time_setup, time_solve, time_total;
   PetscInt            active_vertices;
   PetscReal           max_penetration, contact_force, energy;
@@ -172,6 +178,7 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user);
 PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u);
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
+PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
 
 /* contact_monitor.c */
 PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx);

@@ -26,7 +26,18 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   opts->monitor = PETSC_FALSE;
   PetscCall(
       PetscOptionsBool("-contact_monitor", "Print residual and active-set changes at each Newton step", NULL, opts->monitor, &opts->monitor, NULL));
+  opts->continuation = PETSC_TRUE;
+  PetscCall(PetscOptionsBool("-penalty_continuation", "Reach an eps below h/E through the sequence h/E, h/E f, h/E f^2, ... (warm starts)", NULL,
+                             opts->continuation, &opts->continuation, NULL));
+  opts->continuation_factor = 1e-2;
+  PetscCall(PetscOptionsReal("-penalty_continuation_factor", "Ratio f of two consecutive eps of the continuation, in (0, 1)", NULL,
+                             opts->continuation_factor, &opts->continuation_factor, NULL));
+  opts->condition_estimate = PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-contact_condition_estimate", "Estimate the 1-norm condition number of the final Jacobian (a few extra solves)", NULL,
+                             opts->condition_estimate, &opts->condition_estimate, NULL));
   PetscOptionsEnd();
+  PetscCheck(opts->continuation_factor > 0.0 && opts->continuation_factor < 1.0, comm, PETSC_ERR_USER_INPUT,
+             "-penalty_continuation_factor must lie in (0, 1), got %g", (double)opts->continuation_factor);
   PetscCheck(opts->eps0 > 0.0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0 must be positive, got %g", (double)opts->eps0);
   PetscCheck(opts->eps_power >= 0.0 && opts->eps_power <= 4.0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps_power must lie in [0, 4], got %g",
              (double)opts->eps_power);

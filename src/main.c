@@ -2,6 +2,7 @@ static const char help[] =
     "Frictionless Signorini contact in linear elasticity by the penalty method (Chouly & Hild 2013),\n"
     "with SNESVI as the reference for the exact constraint. 2D plane strain and 3D, DMPlex + PetscFE.\n\n";
 
+#include <sys/resource.h>
 #include "signorini.h"
 
 static PetscErrorCode PrintSummary(DM dm, AppCtx *user, Vec u)
@@ -30,7 +31,27 @@ static PetscErrorCode PrintSummary(DM dm, AppCtx *user, Vec u)
     PetscCall(PetscPrintf(comm, "  error against the reference: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n",
                           (double)user->ref_errors.h1, (double)user->ref_errors.l2, (double)user->ref_errors.pressure_l2,
                           (double)user->ref_errors.pressure_dual));
-  PetscCall(PetscPrintf(comm, "  time: setup %.3f s, solve %.3f s, total %.3f s\n", s->time_setup, s->time_solve, s->time_total));
+  if (s->continuation_stages)
+    PetscCall(PetscPrintf(comm, "  eps continuation: %" PetscInt_FMT " solve(s) from eps = h/E before the target eps (counted in the Newton steps)\n",
+                          s->continuation_stages));
+  if (!PetscIsNanReal(s->condition_1norm))
+    PetscCall(PetscPrintf(comm, "  condition number estimate (1-norm) of the Jacobian: %.3e\n", (double)s->condition_1norm));
+  PetscCall(PetscPrintf(comm, "  time: setup %.3f s, solve %.3f s, total %.3f s; peak memory %.1f MB per rank (max), %.1f MB in all\n", s->time_setup,
+                        s->time_solve, s->time_total, (double)s->peak_memory_mb, (double)s->peak_memory_total_mb));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Peak resident set size of each rank (getrusage), its maximum and sum over the ranks, in MB. */
+static PetscErrorCode RecordPeakMemory(MPI_Comm comm, RunStats *s)
+{
+  struct rusage ru;
+  PetscReal     mb;
+
+  PetscFunctionBeginUser;
+  PetscCheck(getrusage(RUSAGE_SELF, &ru) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "getrusage() failed");
+  mb = (PetscReal)ru.ru_maxrss / 1024.0; /* kB on Linux */
+  PetscCall(MPIU_Allreduce(&mb, &s->peak_memory_mb, 1, MPIU_REAL, MPIU_MAX, comm));
+  PetscCall(MPIU_Allreduce(&mb, &s->peak_memory_total_mb, 1, MPIU_REAL, MPIU_SUM, comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -96,10 +117,12 @@ int main(int argc, char **argv)
   user.stats.time_setup = t1 - t0;
 
   PetscCall(SolverSolve(snes, &user, u));
+  PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
   PetscCall(ErrorNormsCompute(dm, &user, u));
   PetscCall(PetscTime(&t1));
   user.stats.time_total = t1 - t0;
+  PetscCall(RecordPeakMemory(comm, &user.stats));
   PetscCall(CheckAllOptionsUsed(comm));
   PetscCall(PrintSummary(dm, &user, u));
   PetscCall(OutputWriteHDF5(dm, &user, u));

@@ -261,6 +261,10 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCall(WriteRealAttr(v, "max_penetration", s->max_penetration));
   PetscCall(WriteRealAttr(v, "contact_force", s->contact_force));
   PetscCall(WriteRealAttr(v, "energy", s->energy));
+  PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));
+  if (!PetscIsNanReal(s->condition_1norm)) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm));
+  PetscCall(WriteRealAttr(v, "peak_memory_mb", s->peak_memory_mb));
+  PetscCall(WriteRealAttr(v, "peak_memory_total_mb", s->peak_memory_total_mb));
   PetscCall(WriteRealAttr(v, "penetration_l2", user->errors.penetration_l2));
   PetscCall(WriteRealAttr(v, "penetration_max", user->errors.penetration_max));
   PetscCall(WriteErrorNorms(v, "error", &user->errors));

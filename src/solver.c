@@ -135,20 +135,121 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Solves from a zero initial guess and records the outcome; a failed solve is recorded, not raised. */
-PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u)
+/* Records the outcome of the last SNESSolve, with the iteration counts of all solves so far. */
+static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, PetscInt *ksp)
 {
-  PetscLogDouble t0, t1;
+  PetscInt its, lits;
 
   PetscFunctionBeginUser;
+  PetscCall(SNESGetConvergedReason(snes, &user->stats.reason));
+  PetscCall(SNESGetIterationNumber(snes, &its));
+  PetscCall(SNESGetLinearSolveIterations(snes, &lits));
+  *newton += its;
+  *ksp += lits;
+  user->stats.newton_its = *newton;
+  user->stats.ksp_its    = *ksp;
+  user->stats.converged  = (PetscBool)(user->stats.reason > 0);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Solves from a zero initial guess and records the outcome; a failed solve is recorded, not raised.
+   An eps below h/E is reached by continuation: the penalty problems for eps = h/E, h/E f, h/E f^2, ... are solved in turn,
+   each from the solution of the previous one, so that Newton starts near the active set and the 1/eps scale of the
+   residual never meets a far-off initial guess (the direct solve at eps = 1e-12 h diverges on the square scene). */
+PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u)
+{
+  const PetscReal eps_target = user->eps, eps_start = user->h / user->material.young_modulus;
+  PetscLogDouble  t0, t1;
+  PetscInt        newton = 0, ksp = 0;
+  DM              dm;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESGetDM(snes, &dm));
   PetscCall(VecZeroEntries(u));
   PetscCall(PetscTime(&t0));
-  PetscCall(SNESSolve(snes, NULL, u));
+  user->stats.continuation_stages = 0;
+  if (user->contact.method == CONTACT_PENALTY && user->contact.continuation && eps_target < eps_start) {
+    for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= user->contact.continuation_factor) {
+      user->eps = eps;
+      PetscCall(ElasticityUpdateConstants(dm, user));
+      PetscCall(SNESSolve(snes, NULL, u));
+      PetscCall(RecordSolve(snes, user, &newton, &ksp));
+      user->stats.continuation_stages++;
+      if (!user->stats.converged) break; /* reported as the failure of the whole solve */
+    }
+    user->eps = eps_target;
+    PetscCall(ElasticityUpdateConstants(dm, user));
+  }
+  if (user->stats.continuation_stages == 0 || user->stats.converged) {
+    PetscCall(SNESSolve(snes, NULL, u));
+    PetscCall(RecordSolve(snes, user, &newton, &ksp));
+  }
   PetscCall(PetscTime(&t1));
   user->stats.time_solve = t1 - t0;
-  PetscCall(SNESGetConvergedReason(snes, &user->stats.reason));
-  PetscCall(SNESGetIterationNumber(snes, &user->stats.newton_its));
-  PetscCall(SNESGetLinearSolveIterations(snes, &user->stats.ksp_its));
-  user->stats.converged = (PetscBool)(user->stats.reason > 0);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Hager's estimate of ||J^-1||_1 (Higham, ACM TOMS 14, 1988), with solves by the SNES's own linear solver, times ||J||_1:
+   the 1-norm condition number of the Jacobian at the solution (for vi: of K). J is symmetric, so J^-T x is a solve with J. */
+PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
+{
+  KSP                ksp;
+  Mat                J;
+  Vec                x, y, z;
+  PetscReal          normJ, est = 0.0;
+  PetscInt           n, last    = -1;
+  KSPConvergedReason reason;
+
+  PetscFunctionBeginUser;
+  user->stats.condition_1norm = PETSC_NAN;
+  if (!user->contact.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(SNESGetKSP(snes, &ksp));
+  PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
+  if (user->contact.method == CONTACT_VI)
+    J = user->K;
+  else
+    PetscCall(SNESComputeJacobian(snes, u, J, J));
+  PetscCall(KSPSetOperators(ksp, J, J));
+  PetscCall(MatNorm(J, NORM_1, &normJ));
+  PetscCall(VecDuplicate(u, &x));
+  PetscCall(VecDuplicate(u, &y));
+  PetscCall(VecDuplicate(u, &z));
+  PetscCall(VecGetSize(u, &n));
+  PetscCall(VecSet(x, 1.0 / n));
+  for (PetscInt it = 0; it < 5; ++it) {
+    PetscScalar *a, ztx;
+    PetscReal    zmax;
+    PetscInt     jmax;
+    PetscInt     nloc;
+
+    PetscCall(KSPSolve(ksp, x, y)); /* y = J^-1 x */
+    PetscCall(KSPGetConvergedReason(ksp, &reason));
+    if (reason <= 0) { /* no estimate without solves: reported as not computed */
+      PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes), "  condition number estimate: the linear solve failed (%s), no estimate\n",
+                            KSPConvergedReasons[reason]));
+      est = PETSC_NAN;
+      break;
+    }
+    PetscCall(VecNorm(y, NORM_1, &est));
+    PetscCall(VecCopy(y, z));
+    PetscCall(VecGetLocalSize(z, &nloc));
+    PetscCall(VecGetArray(z, &a));
+    for (PetscInt i = 0; i < nloc; ++i) a[i] = PetscRealPart(a[i]) >= 0.0 ? 1.0 : -1.0;
+    PetscCall(VecRestoreArray(z, &a));
+    PetscCall(KSPSolve(ksp, z, y)); /* y = J^-T sign(J^-1 x) */
+    PetscCall(VecDot(y, x, &ztx));
+    PetscCall(VecAbs(y));
+    PetscCall(VecMax(y, &jmax, &zmax));
+    if (zmax <= PetscRealPart(ztx) || jmax == last) break;
+    last = jmax;
+    PetscCall(VecSet(x, 0.0));
+    PetscCall(VecSetValue(x, jmax, 1.0, INSERT_VALUES));
+    PetscCall(VecAssemblyBegin(x));
+    PetscCall(VecAssemblyEnd(x));
+  }
+  user->stats.condition_1norm = normJ * est;
+  PetscCall(VecDestroy(&x));
+  PetscCall(VecDestroy(&y));
+  PetscCall(VecDestroy(&z));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
