@@ -20,6 +20,7 @@ typedef enum {
 } ConstantIndex;
 
 typedef enum { CONTACT_PENALTY, CONTACT_VI, CONTACT_NONE } ContactMethod;
+#define CONTACT_HISTORY 256 /* Newton steps whose active sets are kept for the cycle detection */
 extern const char *const ContactMethods[];
 typedef enum { PENALTY_QUADRATURE_GAUSS, PENALTY_QUADRATURE_NODAL } PenaltyQuadrature;
 extern const char *const PenaltyQuadratures[];
@@ -63,6 +64,7 @@ typedef struct {
   PetscBool         continuation;        /* reach an eps below h/E through a sequence of larger ones */
   PetscReal         continuation_factor; /* ratio of two consecutive eps of the sequence, in (0, 1) */
   PetscBool         condition_estimate;  /* estimate the 1-norm condition number of the final Jacobian */
+  PetscBool         cycle_damping;       /* damp the Newton step when the active set cycles */
 } ContactOptions;
 
 /* The nodes of Gamma_C owned by this rank and free to move: the unknowns the contact acts on. */
@@ -99,6 +101,7 @@ typedef struct {
   SNESConvergedReason reason;
   PetscReal           residual_norm;
   PetscInt            continuation_stages;                  /* solves of the eps sequence before the target eps (0: none) */
+  PetscInt            active_set_cycles;                    /* active-set cycles detected (and damped) in the Newton iterations */
   PetscReal           condition_1norm;                      /* estimate of cond_1 of the final Jacobian, NaN if not computed */
   PetscReal           peak_memory_mb, peak_memory_total_mb; /* resident set size: maximum over ranks, and summed */
   PetscReal           time_setup, time_solve, time_total;
@@ -122,8 +125,10 @@ typedef struct {
   Vec            xl, xu;     /* SNESVI bounds */
   VerifyOptions  verify;
   RunStats       stats;
-  ErrorNorms     errors;     /* against the scene's exact solution */
-  ErrorNorms     ref_errors; /* against the -reference solution */
+  PetscInt64     active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
+  PetscReal      fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */
+  ErrorNorms     errors;                          /* against the scene's exact solution */
+  ErrorNorms     ref_errors;                      /* against the -reference solution */
 } AppCtx;
 
 /* scenes/registry.c */

@@ -262,6 +262,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCall(WriteRealAttr(v, "contact_force", s->contact_force));
   PetscCall(WriteRealAttr(v, "energy", s->energy));
   PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));
+  PetscCall(WriteIntAttr(v, "active_set_cycles", s->active_set_cycles));
   if (!PetscIsNanReal(s->condition_1norm)) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm));
   PetscCall(WriteRealAttr(v, "peak_memory_mb", s->peak_memory_mb));
   PetscCall(WriteRealAttr(v, "peak_memory_total_mb", s->peak_memory_total_mb));

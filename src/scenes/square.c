@@ -20,7 +20,7 @@ static void f0_body_square(PetscInt dim, PetscInt Nf, PetscInt NfAux, const Pets
 PetscErrorCode SceneCreate_Square(DM dm, const Material *mat, Scene *scene)
 {
   PetscInt  dim;
-  PetscReal beta, x0;
+  PetscReal beta, x0, tilt;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
@@ -29,13 +29,19 @@ PetscErrorCode SceneCreate_Square(DM dm, const Material *mat, Scene *scene)
   PetscCall(PetscOptionsReal("-square_beta", "Body force f_d = beta (x_1 - x0)", NULL, beta, &beta, NULL));
   x0 = 0.6;
   PetscCall(PetscOptionsReal("-square_x0", "Where the body force changes sign", NULL, x0, &x0, NULL));
+  tilt = 0.0;
+  PetscCall(
+      PetscOptionsReal("-square_tilt", "Angle (degrees) of the foundation plane about the origin, in the (x_1, x_d) plane", NULL, tilt, &tilt, NULL));
   PetscOptionsEnd();
+  PetscCheck(PetscAbsReal(tilt) < 45.0, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT, "-square_tilt must lie in (-45, 45) degrees, got %g",
+             (double)tilt);
   scene->contact_id               = 1; /* bottom, x_d = 0, in 2D and 3D */
   scene->num_dirichlet            = 1;
   scene->dirichlet_ids[0]         = dim == 2 ? 3 : 2; /* top, x_d = 1 */
   scene->f0_body                  = f0_body_square;
-  scene->obstacle_normal[dim - 1] = -1.0; /* foundation below: u_n = -u_d */
-  scene->obstacle_offset          = 0.0;  /* plane x_d = 0 */
+  scene->obstacle_normal[0]       = PetscSinReal(tilt * PETSC_PI / 180.0); /* foundation below: u_n = -u_d when not tilted */
+  scene->obstacle_normal[dim - 1] = -PetscCosReal(tilt * PETSC_PI / 180.0);
+  scene->obstacle_offset          = 0.0; /* plane x_d = 0 */
   scene->num_constants            = SQUARE_NUM_CONSTANTS;
   scene->constants[SQUARE_BETA]   = beta;
   scene->constants[SQUARE_X0]     = x0;
