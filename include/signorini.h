@@ -24,6 +24,8 @@ typedef enum { CONTACT_PENALTY, CONTACT_VI, CONTACT_NONE } ContactMethod;
 extern const char *const ContactMethods[];
 typedef enum { PENALTY_QUADRATURE_GAUSS, PENALTY_QUADRATURE_NODAL } PenaltyQuadrature;
 extern const char *const PenaltyQuadratures[];
+typedef enum { PENALTY_MODULUS_YOUNG, PENALTY_MODULUS_PWAVE } PenaltyModulus; /* the stiffness M of eps = eps0 h^power / M */
+extern const char *const PenaltyModuli[];
 
 typedef struct {
   PetscReal young_modulus, poisson_ratio;
@@ -59,9 +61,10 @@ typedef PetscErrorCode (*SceneCreateFn)(DM dm, const Material *mat, Scene *scene
 typedef struct {
   ContactMethod     method;
   PenaltyQuadrature quadrature;
-  PetscReal         eps0, eps_power, eps_fixed; /* eps = eps0 h^power / E, or eps_fixed when > 0 */
+  PetscReal         eps0, eps_power, eps_fixed; /* eps = eps0 h^power / M, or eps_fixed when > 0 */
+  PenaltyModulus    modulus;                    /* M = E (young) or lambda + 2 mu (pwave) */
   PetscBool         monitor;
-  PetscBool         continuation;        /* reach an eps below h/E through a sequence of larger ones */
+  PetscBool         continuation;        /* reach an eps below h/M through a sequence of larger ones */
   PetscReal         continuation_factor; /* ratio of two consecutive eps of the sequence, in (0, 1) */
   PetscBool         condition_estimate;  /* estimate the 1-norm condition number of the final Jacobian */
   PetscBool         cycle_damping;       /* damp the Newton step when the active set cycles */
@@ -157,6 +160,7 @@ PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user);
 /* contact_options.c, contact_set.c */
 PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts);
 PetscErrorCode ContactComputeEps(AppCtx *user);
+PetscReal      ContactPenaltyModulus(const AppCtx *user);
 PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs);
 PetscErrorCode ContactSetDestroy(ContactSet *cs);
 

@@ -3,6 +3,7 @@
 
 const char *const ContactMethods[]     = {"penalty", "vi", "none", "ContactMethod", "CONTACT_", NULL};
 const char *const PenaltyQuadratures[] = {"gauss", "nodal", "PenaltyQuadrature", "PENALTY_QUADRATURE_", NULL};
+const char *const PenaltyModuli[]      = {"young", "pwave", "PenaltyModulus", "PENALTY_MODULUS_", NULL};
 
 PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
 {
@@ -21,13 +22,17 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   opts->eps_power = 1.0;
   PetscCall(
       PetscOptionsReal("-penalty_eps_power", "eps = eps0 h^power / E: the power of h, in [0, 4]", NULL, opts->eps_power, &opts->eps_power, NULL));
+  opts->modulus = PENALTY_MODULUS_YOUNG;
+  PetscCall(PetscOptionsEnum("-penalty_eps_modulus",
+                             "Stiffness M of eps = eps0 h^power / M: young (E) or pwave (lambda + 2 mu, for nearly incompressible bodies)", NULL,
+                             PenaltyModuli, (PetscEnum)opts->modulus, (PetscEnum *)&opts->modulus, NULL));
   opts->eps_fixed = 0.0;
   PetscCall(PetscOptionsReal("-penalty_eps", "Set eps directly (overrides eps0 and power)", NULL, opts->eps_fixed, &opts->eps_fixed, &eps_set));
   opts->monitor = PETSC_FALSE;
   PetscCall(
       PetscOptionsBool("-contact_monitor", "Print residual and active-set changes at each Newton step", NULL, opts->monitor, &opts->monitor, NULL));
   opts->continuation = PETSC_TRUE;
-  PetscCall(PetscOptionsBool("-penalty_continuation", "Reach an eps below h/E through the sequence h/E, h/E f, h/E f^2, ... (warm starts)", NULL,
+  PetscCall(PetscOptionsBool("-penalty_continuation", "Reach an eps below h/M through the sequence h/M, h/M f, h/M f^2, ... (warm starts)", NULL,
                              opts->continuation, &opts->continuation, NULL));
   opts->continuation_factor = 1e-2;
   PetscCall(PetscOptionsReal("-penalty_continuation_factor", "Ratio f of two consecutive eps of the continuation, in (0, 1)", NULL,
@@ -48,13 +53,19 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* eps = eps0 h^power / E (Corollary 3.3 takes eps = h), or the fixed -penalty_eps. */
+/* M of eps = eps0 h^power / M: E, or the P-wave modulus lambda + 2 mu, which grows without bound as nu -> 1/2. */
+PetscReal ContactPenaltyModulus(const AppCtx *user)
+{
+  return user->contact.modulus == PENALTY_MODULUS_PWAVE ? user->material.lambda + 2.0 * user->material.mu : user->material.young_modulus;
+}
+
+/* eps = eps0 h^power / M (Corollary 3.3 takes eps = h), or the fixed -penalty_eps. */
 PetscErrorCode ContactComputeEps(AppCtx *user)
 {
   PetscFunctionBeginUser;
   if (user->contact.eps_fixed > 0.0)
     user->eps = user->contact.eps_fixed;
   else
-    user->eps = user->contact.eps0 * PetscPowReal(user->h, user->contact.eps_power) / user->material.young_modulus;
+    user->eps = user->contact.eps0 * PetscPowReal(user->h, user->contact.eps_power) / ContactPenaltyModulus(user);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -32,7 +32,7 @@ static PetscErrorCode PrintSummary(DM dm, AppCtx *user, Vec u)
                           (double)user->ref_errors.h1, (double)user->ref_errors.l2, (double)user->ref_errors.pressure_l2,
                           (double)user->ref_errors.pressure_dual));
   if (s->continuation_stages)
-    PetscCall(PetscPrintf(comm, "  eps continuation: %" PetscInt_FMT " solve(s) from eps = h/E before the target eps (counted in the Newton steps)\n",
+    PetscCall(PetscPrintf(comm, "  eps continuation: %" PetscInt_FMT " solve(s) from eps = h/M before the target eps (counted in the Newton steps)\n",
                           s->continuation_stages));
   if (!PetscIsNanReal(s->condition_1norm))
     PetscCall(PetscPrintf(comm, "  condition number estimate (1-norm) of the Jacobian: %.3e\n", (double)s->condition_1norm));

@@ -238,6 +238,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "scene", PETSC_STRING, user->scene.name));
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "method", PETSC_STRING, method));
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_quadrature", PETSC_STRING, PenaltyQuadratures[user->contact.quadrature]));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_eps_modulus", PETSC_STRING, PenaltyModuli[user->contact.modulus]));
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "snes_reason", PETSC_STRING, SNESConvergedReasons[s->reason]));
   PetscCall(WriteIntAttr(v, "dim", dim));
   PetscCall(WriteIntAttr(v, "degree", user->degree));
@@ -263,7 +264,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCall(WriteRealAttr(v, "energy", s->energy));
   PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));
   PetscCall(WriteIntAttr(v, "active_set_cycles", s->active_set_cycles));
-  if (!PetscIsNanReal(s->condition_1norm)) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm));
+  if (user->contact.condition_estimate) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm)); /* NaN: the estimate failed */
   PetscCall(WriteRealAttr(v, "peak_memory_mb", s->peak_memory_mb));
   PetscCall(WriteRealAttr(v, "peak_memory_total_mb", s->peak_memory_total_mb));
   PetscCall(WriteRealAttr(v, "penetration_l2", user->errors.penetration_l2));

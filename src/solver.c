@@ -153,12 +153,12 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
 }
 
 /* Solves from a zero initial guess and records the outcome; a failed solve is recorded, not raised.
-   An eps below h/E is reached by continuation: the penalty problems for eps = h/E, h/E f, h/E f^2, ... are solved in turn,
+   An eps below h/M is reached by continuation: the penalty problems for eps = h/M, h/M f, h/M f^2, ... are solved in turn,
    each from the solution of the previous one, so that Newton starts near the active set and the 1/eps scale of the
    residual never meets a far-off initial guess (the direct solve at eps = 1e-12 h diverges on the square scene). */
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u)
 {
-  const PetscReal eps_target = user->eps, eps_start = user->h / user->material.young_modulus;
+  const PetscReal eps_target = user->eps, eps_start = user->h / ContactPenaltyModulus(user);
   PetscLogDouble  t0, t1;
   PetscInt        newton = 0, ksp = 0;
   DM              dm;

@@ -1,0 +1,141 @@
+"""Robustness tests (make test): eps at the extremes, scaling in E, loads, tiny meshes, active-set cycles, and the
+bad input that must be refused without touching a previous good output.
+
+Every assertion checks numbers computed by the solver against a tolerance that can fail.
+"""
+import hashlib
+import os
+import subprocess
+
+import numpy as np
+
+from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position, test
+
+SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "false", "-dm_plex_box_faces", "16,16"]
+
+
+@test
+def tiny_eps_converges_by_continuation():
+    """eps = 1e-12 h: the continuation from h/E converges, the penetration vanishes with eps, and the solution is the
+    eps = 1e-8 h one to within 1e-6 (both are the SNESVI solution up to O(eps))."""
+    sol, pen = {}, {}
+    for eps0 in ("1e-8", "1e-12"):
+        _, h5 = run(SQUARE + ["-penalty_eps0", eps0], f"tiny_eps_{eps0}")
+        a, f = load(h5)
+        assert a["converged"] == 1, a["snes_reason"]
+        assert a["continuation_stages"] == (4 if eps0 == "1e-8" else 6), a["continuation_stages"]
+        sol[eps0], pen[eps0] = sorted_by_position(f, "displacement"), a["max_penetration"]
+    assert 0.5e-4 <= pen["1e-12"] / pen["1e-8"] <= 2e-4, pen  # penetration = eps p_h: proportional to eps
+    diff = np.abs(sol["1e-12"] - sol["1e-8"]).max() / np.abs(sol["1e-8"]).max()
+    assert diff <= 1e-6, diff
+
+
+@test
+def condition_estimate_grows_like_one_over_eps():
+    """The Hager estimate of cond_1(J) grows by about 1e4 from eps = 1e-2 h to eps = 1e-6 h (the penalty term dominates)."""
+    cond = {}
+    for eps0 in (1e-2, 1e-6):
+        _, h5 = run(SQUARE + ["-penalty_eps0", eps0, "-contact_condition_estimate"], f"cond_{eps0}")
+        a, _ = load(h5)
+        cond[eps0] = a["condition_1norm"]
+        assert cond[eps0] >= 1.0
+    ratio = cond[1e-6] / cond[1e-2]
+    assert 1e3 <= ratio <= 1e5, (cond, ratio)
+
+
+@test
+def iterative_solver_failure_at_small_eps_is_loud():
+    """CG + GAMG cannot solve the Jacobian at eps = 1e-8 h: the run must end with converged = 0, the reason, the
+    residual and exit status 3, never with a result flagged converged."""
+    out, h5 = run(SQUARE + ["-options_file", "options/solvers/gamg.yaml", "-penalty_eps0", "1e-8"], "gamg_small_eps", expect_rc=3)
+    a, _ = load(h5)
+    assert a["converged"] == 0 and a["snes_reason"].startswith("DIVERGED"), a["snes_reason"]
+    assert "ERROR: the nonlinear solve failed" in out and a["residual_norm"] > 0
+
+
+@test
+def young_modulus_scaling_is_exact():
+    """With eps = h/E the problem scales with E: u E is the same for E = 1e-6, 1 and 1e12."""
+    ue = {}
+    for E in ("1e-6", "1", "1e12"):
+        _, h5 = run(SQUARE + ["-young_modulus", E], f"scale_E_{E}")
+        a, f = load(h5)
+        assert a["converged"] == 1
+        ue[E] = sorted_by_position(f, "displacement") * float(E)
+    for E in ("1e-6", "1e12"):
+        rel = np.abs(ue[E] - ue["1"]).max() / np.abs(ue["1"]).max()
+        assert rel <= 1e-8, (E, rel)
+
+
+@test
+def loads_with_no_and_full_contact():
+    """x0 = -1 lifts the body everywhere: no active vertex and an open gap; x0 = 2 presses everywhere: every vertex of
+    Gamma_C is active; a load 500 times larger still converges, with every vertex active."""
+    _, h5 = run(SQUARE + ["-square_x0", -1], "load_none")
+    a, f = load(h5)
+    assert a["converged"] == 1 and a["active_vertices"] == 0 and a["max_penetration"] == 0 and abs(a["contact_force"]) < 1e-12
+    on_c = f["contact_boundary"] > 0.5
+    assert np.all(f["normal_gap"][on_c] > 0), "the gap must be open everywhere on Gamma_C"
+    for name, extra in (("full", []), ("large", ["-square_beta", 1000])):
+        _, h5 = run(SQUARE + ["-square_x0", 2] + extra, f"load_{name}")
+        a, f = load(h5)
+        n_gamma_c = int(round(f["contact_boundary"].sum()))
+        assert a["converged"] == 1 and a["active_vertices"] == n_gamma_c == 17, (a["active_vertices"], n_gamma_c)
+        assert a["contact_force"] > 0
+
+
+@test
+def two_cells_per_side():
+    for args in ([], ["-dm_plex_dim", 3]):
+        _, h5 = run(["-options_file", "options/square.yaml", "-contact_monitor", "false", "-dm_plex_box_faces", "2,2,2" if args else "2,2"] + args,
+                    f"two_cells_{len(args)}")
+        a, _ = load(h5)
+        assert a["converged"] == 1 and a["n_cells"] in (8, 48), a["n_cells"]
+
+
+@test
+def active_set_cycle_is_detected_and_damped():
+    """P2, eps = 1e-6, full Newton steps: Newton step 11 returns to the active set of step 6 with a larger residual;
+    the cycle is reported, counted in /run, the next step is damped, and the solve converges."""
+    args = SQUARE + ["-dm_plex_box_faces", "32,32", "-displacement_petscspace_degree", 2, "-penalty_eps", 1e-6, "-penalty_continuation", "false", "-snes_linesearch_type", "basic",
+                     "-snes_divergence_tolerance", -1]
+    out, h5 = run(args, "cycle")
+    a, _ = load(h5)
+    assert "active-set cycle" in out and "damped by 1/2" in out
+    assert a["active_set_cycles"] >= 1 and a["converged"] == 1
+
+
+def file_digest(path):
+    with open(path, "rb") as fh:
+        return hashlib.sha256(fh.read()).hexdigest()
+
+
+@test
+def bad_input_leaves_a_previous_good_output_untouched():
+    """A good run writes FILE.h5; each bad run aimed at the same FILE.h5 fails with its message and leaves it as it was."""
+    _, good = run(SQUARE, "keep_me")
+    digest = file_digest(good)
+    bad_yaml = os.path.join(OUT, "malformed.yaml")
+    with open(bad_yaml, "w") as fh:
+        fh.write("scene: square\n  bad: [unclosed\n")
+    garbage = os.path.join(OUT, "garbage.msh")
+    with open(garbage, "w") as fh:
+        fh.write("garbage\n")
+    cases = {
+        "malformed_yaml": (["-options_file", bad_yaml], "YAML parser loading error"),
+        "garbage_mesh": (["-dm_plex_filename", garbage], "File is not a valid Gmsh file"),
+        "vi_tilted": (["-contact_method", "vi", "-square_tilt", 5], "-contact_method vi needs Gamma_C normal to a coordinate axis"),
+        "tilt_range": (["-square_tilt", 60], "-square_tilt must lie in (-45, 45) degrees"),
+        "continuation_factor": (["-penalty_continuation_factor", 1.5], "-penalty_continuation_factor must lie in (0, 1)"),
+        "typo": (["-penalty_eps0", 1, "-contact_cycle_dampng", 0], "-contact_cycle_dampng"),
+    }
+    for name, (args, message) in cases.items():
+        cmd = ["mpiexec", "-n", "1", BIN] + SQUARE + [str(x) for x in args] + ["-output", good]
+        p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
+        assert p.returncode != 0, f"{name}: accepted"
+        assert message in p.stdout, f"{name}: '{message}' not in\n{p.stdout[-1500:]}"
+        assert file_digest(good) == digest, f"{name}: the previous output was changed"
+        assert not os.path.exists(good + ".part"), f"{name}: partial file left"
+    out_not_dir = ["-output", "/etc/passwd/x.h5"]
+    out, _ = run(SQUARE + out_not_dir, "not_a_dir", expect_rc=None)
+    assert "Output directory '/etc/passwd'" in out
