@@ -68,8 +68,7 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
   PetscSection       lsec, gsec;
-  IS                 is;
-  PetscInt           dim, fStart, fEnd, npts = 0, *pts = NULL, rstart;
+  PetscInt           dim, npts = 0, *pts = NULL, rstart;
   Vec                M;
   const PetscScalar *m;
 
@@ -78,33 +77,51 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMGetLocalSection(dm, &lsec));
   PetscCall(DMGetGlobalSection(dm, &gsec));
-  PetscCall(DMPlexGetHeightStratum(dm, 1, &fStart, &fEnd));
-  PetscCall(DMLabelGetStratumIS(user->face_sets, user->scene.contact_id, &is));
-  if (is) {
-    const PetscInt *faces;
-    PetscInt        nf;
+  /* A node belongs to Gamma_C if it lies in the closure of a Gamma_C face on some rank; its owner may have no such face
+     (the faces around it can all be on the other rank), so the marks are summed into the global vector first. */
+  {
+    Vec                locI, mark;
+    const PetscScalar *ind;
+    PetscInt          *faces, nf, pStart, pEnd;
 
-    PetscCall(ISGetLocalSize(is, &nf));
-    PetscCall(ISGetIndices(is, &faces));
-    PetscCall(PetscMalloc1(nf * 27, &pts)); /* closure of a face: at most 9 vertices, 12 edges, 1 face (Q2 hex) */
+    PetscCall(DMGetLocalVector(dm, &locI));
+    PetscCall(DMGetGlobalVector(dm, &mark));
+    PetscCall(VecZeroEntries(locI));
+    PetscCall(MeshGetBoundaryFaces(dm, user->scene.contact_id, &nf, &faces));
     for (PetscInt i = 0; i < nf; ++i) {
       PetscInt *closure = NULL, ncl;
 
-      if (faces[i] < fStart || faces[i] >= fEnd) continue;
       PetscCall(DMPlexGetTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
       for (PetscInt j = 0; j < ncl; ++j) {
-        PetscInt dof;
+        PetscInt dof, off;
 
         PetscCall(PetscSectionGetDof(lsec, closure[2 * j], &dof));
-        if (dof > 0) pts[npts++] = closure[2 * j];
+        PetscCall(PetscSectionGetOffset(lsec, closure[2 * j], &off));
+        for (PetscInt d = 0; d < dof; ++d) PetscCall(VecSetValue(locI, off + d, 1.0, INSERT_VALUES));
       }
       PetscCall(DMPlexRestoreTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
     }
-    PetscCall(ISRestoreIndices(is, &faces));
-    PetscCall(ISDestroy(&is));
-  } else
-    PetscCall(PetscMalloc1(1, &pts));
-  PetscCall(PetscSortRemoveDupsInt(&npts, pts));
+    PetscCall(PetscFree(faces));
+    PetscCall(VecAssemblyBegin(locI));
+    PetscCall(VecAssemblyEnd(locI));
+    PetscCall(VecZeroEntries(mark));
+    PetscCall(DMLocalToGlobal(dm, locI, ADD_VALUES, mark));
+    PetscCall(VecGetOwnershipRange(mark, &rstart, NULL));
+    PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+    PetscCall(PetscMalloc1(PetscMax(pEnd - pStart, 1), &pts));
+    PetscCall(VecGetArrayRead(mark, &ind));
+    for (PetscInt p = pStart; p < pEnd; ++p) {
+      PetscInt gdof, goff;
+
+      PetscCall(PetscSectionGetDof(gsec, p, &gdof));
+      if (gdof <= 0) continue; /* not owned, or constrained */
+      PetscCall(PetscSectionGetOffset(gsec, p, &goff));
+      if (PetscRealPart(ind[goff - rstart]) > 0.0) pts[npts++] = p;
+    }
+    PetscCall(VecRestoreArrayRead(mark, &ind));
+    PetscCall(DMRestoreGlobalVector(dm, &mark));
+    PetscCall(DMRestoreLocalVector(dm, &locI));
+  }
 
   PetscCall(DMGetGlobalVector(dm, &M));
   PetscCall(ContactLumpedMass(dm, user, M));

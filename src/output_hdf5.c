@@ -262,6 +262,12 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCall(WriteRealAttr(v, "max_penetration", s->max_penetration));
   PetscCall(WriteRealAttr(v, "contact_force", s->contact_force));
   PetscCall(WriteRealAttr(v, "energy", s->energy));
+  {
+    PetscInt n = user->cset.n, ntotal;
+
+    PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
+    PetscCall(WriteIntAttr(v, "contact_nodes", ntotal)); /* the free nodes of Gamma_C the contact acts on, each counted once */
+  }
   PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));
   PetscCall(WriteIntAttr(v, "active_set_cycles", s->active_set_cycles));
   if (user->contact.condition_estimate) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm)); /* NaN: the estimate failed */
