@@ -111,10 +111,11 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
     PetscCall(PetscMalloc1(PetscMax(pEnd - pStart, 1), &pts));
     PetscCall(VecGetArrayRead(mark, &ind));
     for (PetscInt p = pStart; p < pEnd; ++p) {
-      PetscInt gdof, goff;
+      PetscInt gdof, cdof, goff;
 
       PetscCall(PetscSectionGetDof(gsec, p, &gdof));
-      if (gdof <= 0) continue; /* not owned, or constrained */
+      PetscCall(PetscSectionGetConstraintDof(lsec, p, &cdof));
+      if (gdof <= 0 || cdof > 0) continue; /* not owned, no unknowns, or clamped by Gamma_D */
       PetscCall(PetscSectionGetOffset(gsec, p, &goff));
       if (PetscRealPart(ind[goff - rstart]) > 0.0) pts[npts++] = p;
     }
