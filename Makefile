@@ -61,6 +61,11 @@ extremes: deps
 	$(PYTHON) scripts/study.py options/studies/extremes_material.yaml --check
 	$(PYTHON) scripts/study.py options/studies/extremes_loads.yaml --check
 
+# Speed against accuracy (README, "Choosing eps and the solver"): output/tradeoff/tradeoff/
+tradeoff: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) scripts/tradeoff.py options/studies/tradeoff.yaml
+
 study-%: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/study.py options/studies/$*.yaml --check

@@ -172,6 +172,13 @@ def study_eps_refinement_is_monotone_until_the_floor():
 
 
 @test
+def tradeoff_script_unit_tests():
+    p = subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "tests", "test_tradeoff.py")], cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
+                       stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert p.returncode == 0 and " 0 failed" in p.stdout, p.stdout[-3000:]
+
+
+@test
 def study_script_unit_tests():
     p = subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "tests", "test_study.py")], cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
                        stderr=subprocess.STDOUT, text=True, timeout=600)
