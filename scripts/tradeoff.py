@@ -128,11 +128,7 @@ SCRIPTS = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(SCRIPTS)
 sys.path.insert(0, SCRIPTS)
 import read_runs  # noqa: E402
-from study import StudyError, option_value, safe_label  # noqa: E402
-
-BIN = "bin/signorini"  # relative to ROOT, the working directory of every run
-MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
-           "OMPI_MCA_rmaps_base_oversubscribe": "1"}
+from study import BIN, MPI_ENV, StudyError, option_value, safe_label  # noqa: E402
 LOG_TAIL_LINES = 40
 
 TOP_KEYS = ("name", "description", "np", "timeout", "cost", "error_rtol", "norms", "targets",
