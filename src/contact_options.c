@@ -41,8 +41,9 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscCall(PetscOptionsBool("-contact_condition_estimate", "Estimate the 1-norm condition number of the final Jacobian (a few extra solves)", NULL,
                              opts->condition_estimate, &opts->condition_estimate, NULL));
   opts->cycle_damping = PETSC_TRUE;
-  PetscCall(PetscOptionsBool("-contact_cycle_damping", "Halve the Newton step each time the active set cycles (the cycle is reported either way)",
-                             NULL, opts->cycle_damping, &opts->cycle_damping, NULL));
+  PetscCall(PetscOptionsBool("-contact_cycle_damping",
+                             "Damp the next Newton step by 1/2 when the active set cycles (the cycle is reported either way)", NULL,
+                             opts->cycle_damping, &opts->cycle_damping, NULL));
   PetscOptionsEnd();
   PetscCheck(opts->continuation_factor > 0.0 && opts->continuation_factor < 1.0, comm, PETSC_ERR_USER_INPUT,
              "-penalty_continuation_factor must lie in (0, 1), got %g", (double)opts->continuation_factor);
