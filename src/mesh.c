@@ -104,27 +104,16 @@ PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h)
 /* Refuses a mesh whose "Face Sets" label has no face with the value of Gamma_C. */
 PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id)
 {
-  DMLabel  label;
-  PetscInt n = 0, ntotal, fStart, fEnd;
-  IS       is;
   MPI_Comm comm = PetscObjectComm((PetscObject)dm);
+  DMLabel  label;
+  PetscInt n, ntotal, *faces;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetLabel(dm, "Face Sets", &label));
   PetscCheck(label, comm, PETSC_ERR_USER_INPUT,
              "The mesh has no \"Face Sets\" label, so it has no contact boundary Gamma_C (Face Sets value %" PetscInt_FMT ")", contact_id);
-  PetscCall(DMPlexGetHeightStratum(dm, 1, &fStart, &fEnd));
-  PetscCall(DMLabelGetStratumIS(label, contact_id, &is));
-  if (is) {
-    const PetscInt *points;
-    PetscInt        np;
-
-    PetscCall(ISGetLocalSize(is, &np));
-    PetscCall(ISGetIndices(is, &points));
-    for (PetscInt i = 0; i < np; ++i) n += (points[i] >= fStart && points[i] < fEnd);
-    PetscCall(ISRestoreIndices(is, &points));
-    PetscCall(ISDestroy(&is));
-  }
+  PetscCall(MeshGetBoundaryFaces(dm, contact_id, &n, &faces));
+  PetscCall(PetscFree(faces));
   PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, comm));
   PetscCheck(ntotal > 0, comm, PETSC_ERR_USER_INPUT,
              "The mesh has no contact boundary: no face carries \"Face Sets\" value %" PetscInt_FMT " (Gamma_C)", contact_id);

@@ -244,6 +244,21 @@ static PetscErrorCode ReferenceDestroy(Reference *ref)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The vertices of cell c (at most 8), in closure order. */
+static PetscErrorCode CellVertices(DM dm, PetscInt c, PetscInt verts[], PetscInt *nv)
+{
+  PetscInt *closure = NULL, ncl, vStart, vEnd;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  *nv = 0;
+  PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &closure));
+  for (PetscInt j = 0; j < ncl; ++j)
+    if (closure[2 * j] >= vStart && closure[2 * j] < vEnd && *nv < 8) verts[(*nv)++] = closure[2 * j];
+  PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &closure));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Refines dm `levels` times (regular refinement) into fine, with the run's discretization and boundary conditions, and
    interpolates the local vectors loc[] (boundary values included) to fine_loc[]: every vertex of a fine cell gets the value
    of the run's FE function in the coarse cell that contains it (exact for the nested P1/Q1 spaces). */
@@ -300,13 +315,12 @@ static PetscErrorCode RefineAndInterpolate(DM dm, PetscInt levels, PetscInt nvec
     Vec                coords;
     const PetscScalar *xc;
     PetscScalar       *fv[2];
-    PetscInt           vStart, vEnd, fcStart, fcEnd;
+    PetscInt           fcStart, fcEnd;
 
     PetscCall(DMGetLocalSection(*fine, &fsec));
     PetscCall(DMGetCoordinateDM(*fine, &cdm));
     PetscCall(DMGetLocalSection(cdm, &csec));
     PetscCall(DMGetCoordinatesLocal(*fine, &coords));
-    PetscCall(DMPlexGetDepthStratum(*fine, 0, &vStart, &vEnd));
     PetscCall(DMPlexGetHeightStratum(*fine, 0, &fcStart, &fcEnd));
     for (PetscInt k = 0; k < nvec; ++k) {
       PetscCall(DMCreateLocalVector(*fine, &fine_loc[k]));
@@ -315,14 +329,11 @@ static PetscErrorCode RefineAndInterpolate(DM dm, PetscInt levels, PetscInt nvec
     }
     PetscCall(VecGetArrayRead(coords, &xc));
     for (PetscInt c = fcStart; c < fcEnd; ++c) {
-      PetscInt       *closure = NULL, ncl, nv = 0, verts[8], off;
+      PetscInt        nv, verts[8], off;
       PetscReal       x[8 * 3], xi[8 * 3];
       PetscTabulation T;
 
-      PetscCall(DMPlexGetTransitiveClosure(*fine, c, PETSC_TRUE, &ncl, &closure));
-      for (PetscInt j = 0; j < ncl; ++j)
-        if (closure[2 * j] >= vStart && closure[2 * j] < vEnd && nv < 8) verts[nv++] = closure[2 * j];
-      PetscCall(DMPlexRestoreTransitiveClosure(*fine, c, PETSC_TRUE, &ncl, &closure));
+      PetscCall(CellVertices(*fine, c, verts, &nv));
       for (PetscInt i = 0; i < nv; ++i) {
         PetscCall(PetscSectionGetOffset(csec, verts[i], &off));
         for (PetscInt d = 0; d < dim; ++d) x[i * dim + d] = PetscRealPart(xc[off + d]);
@@ -401,12 +412,10 @@ static PetscErrorCode MatchReference(DM fine, const AppCtx *user, const Referenc
   PetscCall(VecRestoreArray(loc_u, &u));
   PetscCall(VecRestoreArrayRead(coords, &xc));
   for (PetscInt c = cStart; c < cEnd && bad_vertex < 0; ++c) {
-    PetscInt *closure = NULL, ncl, nv = 0, verts[8];
+    PetscInt nv, verts[8];
 
-    PetscCall(DMPlexGetTransitiveClosure(fine, c, PETSC_TRUE, &ncl, &closure));
-    for (PetscInt j = 0; j < ncl; ++j)
-      if (closure[2 * j] >= vStart && closure[2 * j] < vEnd && nv < 8) verts[nv++] = vmap[closure[2 * j] - vStart];
-    PetscCall(DMPlexRestoreTransitiveClosure(fine, c, PETSC_TRUE, &ncl, &closure));
+    PetscCall(CellVertices(fine, c, verts, &nv));
+    for (PetscInt i = 0; i < nv; ++i) verts[i] = vmap[verts[i] - vStart];
     PetscCall(PetscSortInt(nv, verts));
     if (nv != ref->ncorners || !ReferenceHasCell(ref, verts)) {
       bad_cell = c;
