@@ -123,6 +123,7 @@ typedef struct {
   ContactSet     cset;
   DMLabel        face_sets;
   PetscWeakForm  wf_penalty; /* the penalty term on Gamma_C, kept out of the bulk weak form */
+  Vec            loc_bc;     /* local vector holding the Dirichlet values, zero elsewhere (penalty only) */
   Mat            K;          /* bulk elastic operator, assembled once */
   Vec            r0;         /* bulk residual at u = 0 (loads and Dirichlet lifting) */
   Vec            xl, xu;     /* SNESVI bounds */

@@ -139,6 +139,7 @@ int main(int argc, char **argv)
   PetscCall(VecDestroy(&user.xl));
   PetscCall(VecDestroy(&user.xu));
   PetscCall(PetscWeakFormDestroy(&user.wf_penalty));
+  PetscCall(VecDestroy(&user.loc_bc));
   PetscCall(ContactSetDestroy(&user.cset));
   PetscCall(DMDestroy(&dm));
   PetscCall(SceneFinalize());
