@@ -68,7 +68,19 @@ typedef struct {
   PetscReal         continuation_factor; /* ratio of two consecutive eps of the sequence, in (0, 1) */
   PetscBool         condition_estimate;  /* estimate the 1-norm condition number of the final Jacobian */
   PetscBool         cycle_damping;       /* damp the Newton step when the active set cycles */
+  PetscBool         pc_reuse;            /* reuse the preconditioner/factorization while few contact nodes change */
+  PetscInt          pc_reuse_changes;    /*   at most this many changed nodes since the build */
 } ContactOptions;
+
+/* State of the preconditioner reuse (pc_reuse.c). */
+typedef struct {
+  PetscBool enabled;         /* penalty method with a Krylov method around the preconditioner */
+  PetscInt  max_changes;     /* rebuild when more contact nodes changed state since the build */
+  PetscBool built;           /* a build exists */
+  PetscReal eps;             /* eps of the build */
+  PetscInt  its_after_build; /* Krylov iterations of the first solve after the build (-1: not yet known) */
+  PetscInt  builds;          /* builds so far */
+} PcReuse;
 
 /* The nodes of Gamma_C owned by this rank and free to move: the unknowns the contact acts on. */
 typedef struct {
@@ -76,10 +88,11 @@ typedef struct {
   PetscInt  *point;      /* DMPlex point holding the node */
   PetscInt  *global_off; /* offset of its first component in the global vector (ownership start subtracted) */
   PetscBool *is_vertex;
-  PetscReal *gap;      /* g = offset - x . n at the node */
-  PetscReal *weight;   /* lumped boundary mass, the integral of the node's basis function over Gamma_C */
-  PetscBool *active;   /* active set at the last monitor call */
-  PetscReal *pressure; /* contact pressure -sigma_n at the node, after the solve */
+  PetscReal *gap;          /* g = offset - x . n at the node */
+  PetscReal *weight;       /* lumped boundary mass, the integral of the node's basis function over Gamma_C */
+  PetscBool *active;       /* active set at the last monitor call */
+  PetscBool *built_active; /* active set when the preconditioner was last built */
+  PetscReal *pressure;     /* contact pressure -sigma_n at the node, after the solve */
 } ContactSet;
 
 /* Accurate integration for the verification: Gauss points per direction, and how many times the reference
@@ -105,6 +118,7 @@ typedef struct {
   PetscReal           residual_norm;
   PetscInt            continuation_stages;                  /* solves of the eps sequence before the target eps (0: none) */
   PetscInt            active_set_cycles;                    /* active-set cycles detected (and damped) in the Newton iterations */
+  PetscInt            pc_builds;                            /* preconditioner (factorization) builds of the Newton steps */
   PetscReal           condition_1norm;                      /* estimate of cond_1 of the final Jacobian, NaN if not computed */
   PetscReal           peak_memory_mb, peak_memory_total_mb; /* resident set size: maximum over ranks, and summed */
   PetscReal           time_setup, time_solve, time_total;
@@ -127,6 +141,7 @@ typedef struct {
   Mat            K;          /* bulk elastic operator, assembled once */
   Vec            r0;         /* bulk residual at u = 0 (loads and Dirichlet lifting) */
   Vec            xl, xu;     /* SNESVI bounds */
+  PcReuse        pc_reuse;
   VerifyOptions  verify;
   RunStats       stats;
   PetscInt64     active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
@@ -189,6 +204,9 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u);
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
 PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
+
+/* pc_reuse.c */
+PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X);
 
 /* contact_monitor.c */
 PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx);

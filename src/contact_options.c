@@ -44,7 +44,17 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscCall(PetscOptionsBool("-contact_cycle_damping",
                              "Damp the next Newton step by 1/2 when the active set cycles (the cycle is reported either way)", NULL,
                              opts->cycle_damping, &opts->cycle_damping, NULL));
+  opts->pc_reuse = PETSC_TRUE;
+  PetscCall(PetscOptionsBool("-contact_pc_reuse",
+                             "Penalty: reuse the preconditioner (or factorization) of an earlier Newton step while few contact nodes changed "
+                             "state (needs a Krylov method, not -ksp_type preonly)",
+                             NULL, opts->pc_reuse, &opts->pc_reuse, NULL));
+  opts->pc_reuse_changes = 20;
+  PetscCall(PetscOptionsInt("-contact_pc_reuse_changes", "Rebuild when more contact nodes than this changed state since the last build", NULL,
+                            opts->pc_reuse_changes, &opts->pc_reuse_changes, NULL));
   PetscOptionsEnd();
+  PetscCheck(opts->pc_reuse_changes >= 0, comm, PETSC_ERR_USER_INPUT, "-contact_pc_reuse_changes must be >= 0, got %" PetscInt_FMT,
+             opts->pc_reuse_changes);
   PetscCheck(opts->continuation_factor > 0.0 && opts->continuation_factor < 1.0, comm, PETSC_ERR_USER_INPUT,
              "-penalty_continuation_factor must lie in (0, 1), got %g", (double)opts->continuation_factor);
   PetscCheck(opts->eps0 > 0.0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0 must be positive, got %g", (double)opts->eps0);

@@ -130,6 +130,7 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
   PetscCall(VecGetArrayRead(M, &m));
   PetscCall(PetscMalloc3(npts, &cs->point, npts, &cs->global_off, npts, &cs->is_vertex));
   PetscCall(PetscMalloc4(npts, &cs->gap, npts, &cs->weight, npts, &cs->active, npts, &cs->pressure));
+  PetscCall(PetscCalloc1(npts, &cs->built_active));
   for (PetscInt i = 0; i < npts; ++i) {
     const PetscInt p = pts[i];
     PetscInt       dof, cdof, gdof, goff, depth;
@@ -166,6 +167,7 @@ PetscErrorCode ContactSetDestroy(ContactSet *cs)
   PetscFunctionBeginUser;
   PetscCall(PetscFree3(cs->point, cs->global_off, cs->is_vertex));
   PetscCall(PetscFree4(cs->gap, cs->weight, cs->active, cs->pressure));
+  PetscCall(PetscFree(cs->built_active));
   cs->n = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -20,8 +20,9 @@ static PetscErrorCode PrintSummary(DM dm, AppCtx *user, Vec u)
   if (user->contact.method == CONTACT_PENALTY)
     PetscCall(PetscPrintf(comm, " (%s quadrature, eps = %g)", PenaltyQuadratures[user->contact.quadrature], (double)user->eps));
   PetscCall(PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, h = %g, %d rank(s)\n", user->degree, ndofs, (double)user->h, size));
-  PetscCall(PetscPrintf(comm, "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, |F| = %g\n",
-                        SNESConvergedReasons[s->reason], s->newton_its, s->ksp_its, (double)s->residual_norm));
+  PetscCall(PetscPrintf(
+      comm, "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, %" PetscInt_FMT " preconditioner builds, |F| = %g\n",
+      SNESConvergedReasons[s->reason], s->newton_its, s->ksp_its, s->pc_builds, (double)s->residual_norm));
   PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g, contact force %g, energy %.10g\n",
                         s->active_vertices, (double)s->max_penetration, (double)s->contact_force, (double)s->energy));
   if (!PetscIsNanReal(user->errors.h1))

@@ -58,6 +58,7 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
   PetscFunctionBeginUser;
   PetscCall(SNESGetDM(snes, &dm));
   if (user->contact.method == CONTACT_PENALTY) {
+    PetscCall(PcReuseDecide(snes, dm, user, X));
     PetscCall(MatCopy(user->K, P, SAME_NONZERO_PATTERN));
     PetscCall(PenaltyAddJacobian(dm, user, X, P));
     PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
@@ -110,9 +111,12 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     /* no convergence on a small step: with eps = 1e-7 (128x128 mms) it stopped Newton at |F| = 3e-4, far from the solution */
     PetscCall(SNESSetTolerances(*snes, PETSC_DEFAULT, PETSC_DEFAULT, 0.0, PETSC_DEFAULT, PETSC_DEFAULT));
   }
-  /* default linear solver: a direct solve (MUMPS), robust for the small problems of a first run */
+  /* default linear solver: a direct solve (MUMPS), robust for the small problems of a first run; for the penalty method
+     inside CG, so that a factorization can serve as the preconditioner of later Newton steps (pc_reuse.c) */
   PetscCall(SNESGetKSP(*snes, &ksp));
-  PetscCall(KSPSetType(ksp, KSPPREONLY));
+  PetscCall(KSPSetType(ksp, user->contact.method == CONTACT_PENALTY && user->contact.pc_reuse ? KSPCG : KSPPREONLY));
+  /* Newton steps as accurate as with a fresh factorization, also when it is reused */
+  PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCSetType(pc, PCLU));
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
@@ -128,6 +132,13 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscCheck(!(is_gamg && is_rsls), comm, PETSC_ERR_USER_INPUT,
                "-pc_type gamg cannot follow the reduced system of -snes_type vinewtonrsls (its size changes between steps): use hypre or mumps with "
                "-contact_method vi");
+  }
+  {
+    PetscBool is_preonly;
+
+    PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &is_preonly));
+    user->pc_reuse.enabled     = (PetscBool)(user->contact.method == CONTACT_PENALTY && user->contact.pc_reuse && !is_preonly);
+    user->pc_reuse.max_changes = user->contact.pc_reuse_changes;
   }
   PetscCheck(is_vi == (user->contact.method == CONTACT_VI), comm, PETSC_ERR_USER_INPUT,
              "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type,
@@ -149,6 +160,7 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   user->stats.newton_its = *newton;
   user->stats.ksp_its    = *ksp;
   user->stats.converged  = (PetscBool)(user->stats.reason > 0);
+  user->stats.pc_builds  = user->pc_reuse.enabled ? user->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -209,6 +221,7 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
     J = user->K;
   else
     PetscCall(SNESComputeJacobian(snes, u, J, J));
+  PetscCall(KSPSetReusePreconditioner(ksp, PETSC_FALSE)); /* a preconditioner built for this very J */
   PetscCall(KSPSetOperators(ksp, J, J));
   PetscCall(MatNorm(J, NORM_1, &normJ));
   PetscCall(VecDuplicate(u, &x));
