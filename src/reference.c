@@ -244,122 +244,16 @@ static PetscErrorCode ReferenceDestroy(Reference *ref)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The vertices of cell c (at most 8), in closure order. */
-static PetscErrorCode CellVertices(DM dm, PetscInt c, PetscInt verts[], PetscInt *nv)
-{
-  PetscInt *closure = NULL, ncl, vStart, vEnd;
-
-  PetscFunctionBeginUser;
-  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  *nv = 0;
-  PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &closure));
-  for (PetscInt j = 0; j < ncl; ++j)
-    if (closure[2 * j] >= vStart && closure[2 * j] < vEnd && *nv < 8) verts[(*nv)++] = closure[2 * j];
-  PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &closure));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* Refines dm `levels` times (regular refinement) into fine, with the run's discretization and boundary conditions, and
-   interpolates the local vectors loc[] (boundary values included) to fine_loc[]: every vertex of a fine cell gets the value
-   of the run's FE function in the coarse cell that contains it (exact for the nested P1/Q1 spaces). */
+   interpolates the local vectors loc[] (boundary values included) to fine_loc[]. */
 static PetscErrorCode RefineAndInterpolate(DM dm, PetscInt levels, PetscInt nvec, Vec loc[], DM *fine, Vec fine_loc[])
 {
-  MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
-  DM        cur  = dm;
-  PetscInt *parent, cStart, cEnd, dim, Nb, Nc;
-  PetscFE   fe;
+  PetscInt *parent;
 
   PetscFunctionBeginUser;
-  PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
-  PetscCall(PetscMalloc1(cEnd - cStart, &parent));
-  for (PetscInt c = cStart; c < cEnd; ++c) parent[c - cStart] = c;
-  for (PetscInt l = 0; l < levels; ++l) {
-    DMPlexTransform tr;
-    DM              next;
-    PetscInt        nStart, nEnd, *np;
-
-    PetscCall(DMPlexTransformCreate(comm, &tr));
-    PetscCall(DMPlexTransformSetType(tr, DMPLEXREFINEREGULAR));
-    PetscCall(DMPlexTransformSetDM(tr, cur));
-    PetscCall(DMPlexTransformSetUp(tr));
-    PetscCall(DMPlexTransformApply(tr, cur, &next));
-    PetscCall(DMPlexGetHeightStratum(next, 0, &nStart, &nEnd));
-    PetscCall(PetscMalloc1(nEnd - nStart, &np));
-    for (PetscInt c = nStart; c < nEnd; ++c) {
-      DMPolytopeType ct, ctn;
-      PetscInt       src, r;
-
-      PetscCall(DMPlexTransformGetSourcePoint(tr, c, &ct, &ctn, &src, &r));
-      np[c - nStart] = parent[src - cStart];
-    }
-    PetscCall(PetscFree(parent));
-    parent = np;
-    cStart = nStart;
-    PetscCall(DMPlexTransformDestroy(&tr));
-    if (cur != dm) PetscCall(DMDestroy(&cur));
-    cur = next;
-  }
-  if (cur == dm)
-    PetscCall(DMClone(dm, fine));
-  else
-    *fine = cur;
+  PetscCall(MeshRefineRegular(dm, levels, fine, &parent));
   PetscCall(DMCopyDisc(dm, *fine)); /* the run's field, weak form and boundary conditions */
-
-  PetscCall(DMGetField(dm, 0, NULL, (PetscObject *)&fe));
-  PetscCall(PetscFEGetDimension(fe, &Nb));
-  PetscCall(PetscFEGetNumComponents(fe, &Nc));
-  {
-    DM                 cdm;
-    PetscSection       fsec, csec;
-    Vec                coords;
-    const PetscScalar *xc;
-    PetscScalar       *fv[2];
-    PetscInt           fcStart, fcEnd;
-
-    PetscCall(DMGetLocalSection(*fine, &fsec));
-    PetscCall(DMGetCoordinateDM(*fine, &cdm));
-    PetscCall(DMGetLocalSection(cdm, &csec));
-    PetscCall(DMGetCoordinatesLocal(*fine, &coords));
-    PetscCall(DMPlexGetHeightStratum(*fine, 0, &fcStart, &fcEnd));
-    for (PetscInt k = 0; k < nvec; ++k) {
-      PetscCall(DMCreateLocalVector(*fine, &fine_loc[k]));
-      PetscCall(VecZeroEntries(fine_loc[k]));
-      PetscCall(VecGetArray(fine_loc[k], &fv[k]));
-    }
-    PetscCall(VecGetArrayRead(coords, &xc));
-    for (PetscInt c = fcStart; c < fcEnd; ++c) {
-      PetscInt        nv, verts[8], off;
-      PetscReal       x[8 * 3], xi[8 * 3];
-      PetscTabulation T;
-
-      PetscCall(CellVertices(*fine, c, verts, &nv));
-      for (PetscInt i = 0; i < nv; ++i) {
-        PetscCall(PetscSectionGetOffset(csec, verts[i], &off));
-        for (PetscInt d = 0; d < dim; ++d) x[i * dim + d] = PetscRealPart(xc[off + d]);
-      }
-      PetscCall(CellReferenceCoordinates(dm, parent[c - fcStart], nv, x, xi));
-      PetscCall(PetscFECreateTabulation(fe, 1, nv, xi, 0, &T));
-      for (PetscInt k = 0; k < nvec; ++k) {
-        PetscScalar *cv = NULL;
-
-        PetscCall(DMPlexVecGetClosure(dm, NULL, loc[k], parent[c - fcStart], NULL, &cv));
-        for (PetscInt i = 0; i < nv; ++i) {
-          PetscCall(PetscSectionGetOffset(fsec, verts[i], &off));
-          for (PetscInt comp = 0; comp < Nc; ++comp) {
-            PetscScalar val = 0.0;
-
-            for (PetscInt b = 0; b < Nb; ++b) val += cv[b] * T->T[0][(i * Nb + b) * Nc + comp];
-            fv[k][off + comp] = val;
-          }
-        }
-        PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc[k], parent[c - fcStart], NULL, &cv));
-      }
-      PetscCall(PetscTabulationDestroy(&T));
-    }
-    PetscCall(VecRestoreArrayRead(coords, &xc));
-    for (PetscInt k = 0; k < nvec; ++k) PetscCall(VecRestoreArray(fine_loc[k], &fv[k]));
-  }
+  PetscCall(MeshInterpolateFromParents(dm, *fine, parent, nvec, loc, fine_loc));
   PetscCall(PetscFree(parent));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -414,7 +308,7 @@ static PetscErrorCode MatchReference(DM fine, const AppCtx *user, const Referenc
   for (PetscInt c = cStart; c < cEnd && bad_vertex < 0; ++c) {
     PetscInt nv, verts[8];
 
-    PetscCall(CellVertices(fine, c, verts, &nv));
+    PetscCall(MeshCellVertices(fine, c, verts, &nv));
     for (PetscInt i = 0; i < nv; ++i) verts[i] = vmap[verts[i] - vStart];
     PetscCall(PetscSortInt(nv, verts));
     if (nv != ref->ncorners || !ReferenceHasCell(ref, verts)) {
