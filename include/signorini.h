@@ -70,6 +70,9 @@ typedef struct {
   PetscBool         cycle_damping;       /* damp the Newton step when the active set cycles */
   PetscBool         pc_reuse;            /* reuse the preconditioner/factorization while few contact nodes change */
   PetscInt          pc_reuse_changes;    /*   at most this many changed nodes since the build */
+  PetscInt          grid_sequence;       /* solve on the mesh and on this many uniform refinements of it, each from the last */
+  PetscReal         eps0_sweep[32];      /* eps0 values solved in turn on the final mesh, each from the last solution */
+  PetscInt          n_sweep;
 } ContactOptions;
 
 /* State of the preconditioner reuse (pc_reuse.c). */
@@ -112,7 +115,8 @@ typedef struct {
 } ErrorNorms;
 
 typedef struct {
-  PetscInt            newton_its, ksp_its;
+  PetscInt            newton_its, ksp_its;             /* of the last solve (the finest mesh, the last eps) */
+  PetscInt            newton_its_total, ksp_its_total; /* of all solves: grid sequence levels, continuation, eps sweep */
   PetscBool           converged;
   SNESConvergedReason reason;
   PetscReal           residual_norm;
@@ -125,6 +129,17 @@ typedef struct {
   PetscInt            active_vertices;
   PetscReal           max_penetration, contact_force, energy;
 } RunStats;
+
+/* One solve of a run: a level of the grid sequence or an eps of the sweep (/solves in the output). */
+typedef struct {
+  PetscInt  level, n_dofs;
+  PetscReal h, eps;
+  PetscInt  newton_its, ksp_its, pc_builds;
+  PetscBool converged;
+  PetscReal time_setup, time_solve; /* set-up of the mesh's problem (first solve on it only), and the solve */
+  PetscReal max_penetration;
+} SolveRecord;
+#define SOLVE_RECORDS_MAX 64
 
 typedef struct {
   char           scene_name[64];
@@ -148,6 +163,10 @@ typedef struct {
   PetscReal      fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */
   ErrorNorms     errors;                          /* against the scene's exact solution */
   ErrorNorms     ref_errors;                      /* against the -reference solution */
+  PetscInt       level;                           /* grid sequence level of the current mesh (0: the mesh of the options) */
+  PetscReal      level_setup_time;                /* set-up time of the current mesh's problem, until its first solve */
+  SolveRecord    records[SOLVE_RECORDS_MAX];
+  PetscInt       nrecords;
 } AppCtx;
 
 /* scenes/registry.c */
@@ -206,9 +225,15 @@ PetscErrorCode VICreateBounds(DM dm, AppCtx *user);
 /* solver.c */
 PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user);
 PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
-PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u);
+PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm);
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
 PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
+
+/* problem.c, grid_sequence.c, eps_sweep.c */
+PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes);
+PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
+PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
+PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 
 /* pc_reuse.c */
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X);

@@ -7,7 +7,7 @@ const char *const PenaltyModuli[]      = {"young", "pwave", "PenaltyModulus", "P
 
 PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
 {
-  PetscBool eps_set;
+  PetscBool eps_set, sweep_set;
 
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, NULL, "Contact on Gamma_C", "Signorini");
@@ -52,7 +52,24 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   opts->pc_reuse_changes = 20;
   PetscCall(PetscOptionsInt("-contact_pc_reuse_changes", "Rebuild when more contact nodes than this changed state since the last build", NULL,
                             opts->pc_reuse_changes, &opts->pc_reuse_changes, NULL));
+  opts->grid_sequence = 0;
+  PetscCall(PetscOptionsInt("-contact_grid_sequence",
+                            "Nested iteration: solve on the mesh, then on N uniform refinements of it, each from the interpolated last solution",
+                            NULL, opts->grid_sequence, &opts->grid_sequence, NULL));
+  opts->n_sweep = 32;
+  PetscCall(PetscOptionsRealArray("-penalty_eps0_sweep", "eps0 values solved in turn on the final mesh, each from the last solution", NULL,
+                                  opts->eps0_sweep, &opts->n_sweep, &sweep_set));
+  if (!sweep_set) opts->n_sweep = 0;
   PetscOptionsEnd();
+  PetscCheck(opts->grid_sequence >= 0 && opts->grid_sequence <= 8, comm, PETSC_ERR_USER_INPUT,
+             "-contact_grid_sequence must lie in [0, 8], got %" PetscInt_FMT, opts->grid_sequence);
+  PetscCheck(!sweep_set || opts->n_sweep > 0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep needs a comma-separated list of values");
+  for (PetscInt k = 0; k < opts->n_sweep; ++k)
+    PetscCheck(opts->eps0_sweep[k] > 0.0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep: every value must be positive, got %g",
+               (double)opts->eps0_sweep[k]);
+  PetscCheck(!(sweep_set && eps_set), comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep cannot be given together with -penalty_eps");
+  PetscCheck(!sweep_set || opts->method == CONTACT_PENALTY, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep needs -contact_method penalty");
+  if (opts->n_sweep) opts->eps0 = opts->eps0_sweep[0]; /* the sweep starts with its first value, in place of -penalty_eps0 */
   PetscCheck(opts->pc_reuse_changes >= 0, comm, PETSC_ERR_USER_INPUT, "-contact_pc_reuse_changes must be >= 0, got %" PetscInt_FMT,
              opts->pc_reuse_changes);
   PetscCheck(opts->continuation_factor > 0.0 && opts->continuation_factor < 1.0, comm, PETSC_ERR_USER_INPUT,

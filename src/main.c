@@ -32,6 +32,18 @@ static PetscErrorCode PrintSummary(DM dm, AppCtx *user, Vec u)
     PetscCall(PetscPrintf(comm, "  error against the reference: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n",
                           (double)user->ref_errors.h1, (double)user->ref_errors.l2, (double)user->ref_errors.pressure_l2,
                           (double)user->ref_errors.pressure_dual));
+  if (user->nrecords > 1) {
+    PetscCall(PetscPrintf(comm, "  solves: level   dofs        h           eps         Newton  Krylov  PC builds  setup s   solve s\n"));
+    for (PetscInt i = 0; i < user->nrecords; ++i) {
+      const SolveRecord *r = &user->records[i];
+
+      PetscCall(PetscPrintf(comm,
+                            "          %5" PetscInt_FMT "  %9" PetscInt_FMT "  %.4e  %.4e  %6" PetscInt_FMT "  %6" PetscInt_FMT "  %9" PetscInt_FMT
+                            "  %8.3f  %8.3f%s\n",
+                            r->level, r->n_dofs, (double)r->h, (double)r->eps, r->newton_its, r->ksp_its, r->pc_builds, (double)r->time_setup,
+                            (double)r->time_solve, r->converged ? "" : "  FAILED"));
+    }
+  }
   if (s->continuation_stages)
     PetscCall(PetscPrintf(comm, "  eps continuation: %" PetscInt_FMT " solve(s) from eps = h/M before the target eps (counted in the Newton steps)\n",
                           s->continuation_stages));
@@ -100,24 +112,15 @@ int main(int argc, char **argv)
   PetscCall(OutputGetOptions(comm, &user));
 
   PetscCall(MeshCreate(comm, &dm));
-  PetscCall(SceneCreate(user.scene_name, dm, &user.material, &user.scene));
-  PetscCall(MeshCheckContactBoundary(dm, user.scene.contact_id));
-  PetscCall(DMGetLabel(dm, "Face Sets", &user.face_sets));
-  PetscCall(MeshGetMaxCellDiameter(dm, &user.h));
-  PetscCall(ContactComputeEps(&user));
-  PetscCall(ElasticitySetUpDiscretization(dm, &user));
-  PetscCall(ContactSetCreate(dm, &user, &user.cset));
-  if (user.contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, &user));
-  PetscCall(SolverAssembleBulk(dm, &user));
-  PetscCall(WeakDataAddToResidual(dm, &user, user.r0));
-  PetscCall(SolverCreateSNES(dm, &user, &snes));
+  PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(DMCreateGlobalVector(dm, &u));
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
   PetscCall(DMSNESCheckFromOptions(snes, u)); /* -dmsnes_check: PETSc's checks against the exact solution */
   PetscCall(PetscTime(&t1));
   user.stats.time_setup = t1 - t0;
 
-  PetscCall(SolverSolve(snes, &user, u));
+  PetscCall(GridSequenceSolve(&dm, &user, &snes, &u)); /* one solve without -contact_grid_sequence */
+  PetscCall(EpsSweepSolve(dm, &user, snes, u));
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
   PetscCall(ErrorNormsCompute(dm, &user, u));
@@ -134,14 +137,7 @@ int main(int argc, char **argv)
                           SNESConvergedReasons[user.stats.reason], user.stats.newton_its, (double)user.stats.residual_norm));
 
   PetscCall(VecDestroy(&u));
-  PetscCall(SNESDestroy(&snes));
-  PetscCall(MatDestroy(&user.K));
-  PetscCall(VecDestroy(&user.r0));
-  PetscCall(VecDestroy(&user.xl));
-  PetscCall(VecDestroy(&user.xu));
-  PetscCall(PetscWeakFormDestroy(&user.wf_penalty));
-  PetscCall(VecDestroy(&user.loc_bc));
-  PetscCall(ContactSetDestroy(&user.cset));
+  PetscCall(ProblemDestroy(&user, &snes));
   PetscCall(DMDestroy(&dm));
   PetscCall(SceneFinalize());
   {

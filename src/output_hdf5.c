@@ -254,6 +254,10 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCall(WriteIntAttr(v, "snes_reason_code", (PetscInt)s->reason));
   PetscCall(WriteIntAttr(v, "newton_its", s->newton_its));
   PetscCall(WriteIntAttr(v, "ksp_its", s->ksp_its));
+  PetscCall(WriteIntAttr(v, "newton_its_total", s->newton_its_total));
+  PetscCall(WriteIntAttr(v, "ksp_its_total", s->ksp_its_total));
+  PetscCall(WriteIntAttr(v, "grid_sequence", user->contact.grid_sequence));
+  PetscCall(WriteIntAttr(v, "n_solves", user->nrecords));
   PetscCall(WriteRealAttr(v, "residual_norm", s->residual_norm));
   PetscCall(WriteRealAttr(v, "time_setup", s->time_setup));
   PetscCall(WriteRealAttr(v, "time_solve", s->time_solve));
@@ -289,6 +293,39 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
     PetscCall(PetscSNPrintf(name, sizeof(name), "scene_%" PetscInt_FMT, i));
     PetscCall(WriteRealAttr(v, name, PetscRealPart(user->scene.constants[i])));
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* /solves/<column>: one row per solve of the run (grid sequence levels, eps sweep values), as datasets of length n. */
+static PetscErrorCode WriteSolves(MPI_Comm comm, const AppCtx *user, PetscViewer v)
+{
+  const char    *columns[] = {"level",     "n_dofs",    "h",          "eps",        "newton_its",     "ksp_its",
+                              "pc_builds", "converged", "time_setup", "time_solve", "max_penetration"};
+  const PetscInt ncol = (PetscInt)(sizeof(columns) / sizeof(columns[0])), n = user->nrecords;
+  PetscMPIInt    rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCall(PetscViewerHDF5PushGroup(v, "/solves"));
+  for (PetscInt j = 0; j < ncol; ++j) {
+    Vec          col;
+    PetscScalar *a;
+
+    PetscCall(VecCreateMPI(comm, rank == 0 ? n : 0, n, &col));
+    PetscCall(PetscObjectSetName((PetscObject)col, columns[j]));
+    PetscCall(VecGetArray(col, &a));
+    for (PetscInt i = 0; rank == 0 && i < n; ++i) {
+      const SolveRecord *r      = &user->records[i];
+      const PetscReal    vals[] = {
+             (PetscReal)r->level,     (PetscReal)r->n_dofs,     r->h,          r->eps,        (PetscReal)r->newton_its, (PetscReal)r->ksp_its,
+             (PetscReal)r->pc_builds, r->converged ? 1.0 : 0.0, r->time_setup, r->time_solve, r->max_penetration};
+      a[i] = vals[j];
+    }
+    PetscCall(VecRestoreArray(col, &a));
+    PetscCall(VecView(col, v));
+    PetscCall(VecDestroy(&col));
+  }
+  PetscCall(PetscViewerHDF5PopGroup(v));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -362,6 +399,7 @@ PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
   PetscCall(WriteVertexFields(dm, user, u, viewer));
   PetscCall(PetscViewerPopFormat(viewer));
   PetscCall(WriteRunMetadata(dm, user, u, viewer, ncells, nverts));
+  PetscCall(WriteSolves(comm, user, viewer));
   PetscCall(PetscViewerDestroy(&viewer));
   PetscCallMPI(MPI_Barrier(comm));
   if (rank == 0) {

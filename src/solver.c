@@ -164,11 +164,44 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Solves from a zero initial guess and records the outcome; a failed solve is recorded, not raised.
+/* Appends the outcome of the last SolverSolve() to the table of solves (/solves in the output). */
+static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal time_solve)
+{
+  SolveRecord       *r;
+  const PetscScalar *x;
+  PetscInt           dim;
+  PetscReal          pen = 0.0;
+  DM                 dm;
+
+  PetscFunctionBeginUser;
+  if (user->nrecords >= SOLVE_RECORDS_MAX) PetscFunctionReturn(PETSC_SUCCESS);
+  r = &user->records[user->nrecords++];
+  PetscCall(SNESGetDM(snes, &dm));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(VecGetArrayRead(u, &x));
+  for (PetscInt i = 0; i < user->cset.n; ++i) pen = PetscMax(pen, ContactNodePenetration(user, dim, i, x));
+  PetscCall(VecRestoreArrayRead(u, &x));
+  PetscCall(MPIU_Allreduce(&pen, &r->max_penetration, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
+  PetscCall(VecGetSize(u, &r->n_dofs));
+  r->level               = user->level;
+  r->h                   = user->h;
+  r->eps                 = user->contact.method == CONTACT_PENALTY ? user->eps : 0.0;
+  r->newton_its          = user->stats.newton_its;
+  r->ksp_its             = user->stats.ksp_its;
+  r->pc_builds           = user->stats.pc_builds;
+  r->converged           = user->stats.converged;
+  r->time_setup          = user->level_setup_time;
+  r->time_solve          = time_solve;
+  user->level_setup_time = 0.0; /* counted once, with the first solve on the mesh */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Solves from a zero initial guess (warm: from u) and records the outcome; a failed solve is recorded, not raised.
    An eps below h/M is reached by continuation: the penalty problems for eps = h/M, h/M f, h/M f^2, ... are solved in turn,
    each from the solution of the previous one, so that Newton starts near the active set and the 1/eps scale of the
-   residual never meets a far-off initial guess (the direct solve at eps = 1e-12 h diverges on the square scene). */
-PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u)
+   residual never meets a far-off initial guess (the direct solve at eps = 1e-12 h diverges on the square scene).
+   A warm start needs no continuation: it starts from the solution for a nearby eps or a coarser mesh. */
+PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm)
 {
   const PetscReal eps_target = user->eps, eps_start = user->h / ContactPenaltyModulus(user);
   PetscLogDouble  t0, t1;
@@ -177,10 +210,11 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u)
 
   PetscFunctionBeginUser;
   PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(VecZeroEntries(u));
+  if (!warm) PetscCall(VecZeroEntries(u));
   PetscCall(PetscTime(&t0));
+  user->pc_reuse.builds           = 0; /* counted per solve */
   user->stats.continuation_stages = 0;
-  if (user->contact.method == CONTACT_PENALTY && user->contact.continuation && eps_target < eps_start) {
+  if (!warm && user->contact.method == CONTACT_PENALTY && user->contact.continuation && eps_target < eps_start) {
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= user->contact.continuation_factor) {
       user->eps = eps;
       PetscCall(ElasticityUpdateConstants(dm, user));
@@ -197,7 +231,10 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u)
     PetscCall(RecordSolve(snes, user, &newton, &ksp));
   }
   PetscCall(PetscTime(&t1));
-  user->stats.time_solve = t1 - t0;
+  user->stats.time_solve += t1 - t0;
+  user->stats.newton_its_total += newton;
+  user->stats.ksp_its_total += ksp;
+  PetscCall(SolverAddRecord(snes, user, u, t1 - t0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
