@@ -1,0 +1,113 @@
+"""Tests of the performance features: grid sequencing, the eps sweep, the reuse of the preconditioner, GAMG at
+small eps, and make bench (scripts/bench.py). Each compares solutions computed two ways, never timings."""
+import csv
+import os
+import subprocess
+
+import h5py
+import numpy as np
+
+from harness import ENV, OUT, ROOT, load, run, sorted_by_position, test
+
+SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "0"]
+
+
+def solves(h5):
+    with h5py.File(h5, "r") as f:
+        return {k: np.asarray(f["solves"][k][:]).ravel() for k in f["solves"]}
+
+
+def max_diff(h5a, h5b):
+    _, fa = load(h5a)
+    _, fb = load(h5b)
+    ua, ub = sorted_by_position(fa, "displacement"), sorted_by_position(fb, "displacement")
+    assert ua.shape == ub.shape, f"different meshes: {ua.shape} against {ub.shape}"
+    return np.abs(ua - ub).max() / np.abs(ub).max()
+
+
+@test
+def grid_sequence_gives_the_direct_solution_with_few_newton_steps():
+    """4x4 refined 3 times by the sequence = 32x32 solved directly; the finest level needs <= 3 Newton steps."""
+    _, direct = run(SQUARE + ["-dm_plex_box_faces", "4,4", "-dm_refine", "3"], "gs_direct")
+    _, seq = run(SQUARE + ["-dm_plex_box_faces", "4,4", "-contact_grid_sequence", "3"], "gs_sequence")
+    assert max_diff(seq, direct) < 1e-8
+    a, _ = load(seq)
+    s = solves(seq)
+    assert list(s["level"]) == [0, 1, 2, 3] and np.all(np.diff(s["n_dofs"]) > 0)
+    assert np.all(s["converged"] == 1) and a["grid_sequence"] == 3 and a["newton_its"] == s["newton_its"][-1]
+    assert a["newton_its"] <= 3, f"{a['newton_its']} Newton steps on the finest level"
+    assert a["newton_its_total"] == s["newton_its"].sum()
+
+
+@test
+def grid_sequence_in_parallel_and_3d_equals_serial():
+    args = SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3", "-contact_grid_sequence", "1"]
+    _, one = run(args, "gs3d_np1")
+    _, two = run(args, "gs3d_np2", np_=2)
+    _, direct = run(SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3", "-dm_refine", "1"], "gs3d_direct")
+    assert max_diff(two, one) < 1e-8 and max_diff(one, direct) < 1e-8
+
+
+@test
+def eps_sweep_ends_at_the_direct_solution_for_its_last_eps():
+    sweep = [100, 10, 1, 0.1, 0.01, 1e-3, 1e-4, 1e-6]
+    _, h5 = run(SQUARE + ["-dm_plex_box_faces", "32,32", "-penalty_eps0_sweep", ",".join(map(str, sweep))], "sweep")
+    _, direct = run(SQUARE + ["-dm_plex_box_faces", "32,32", "-penalty_eps0", "1e-6"], "sweep_direct")
+    assert max_diff(h5, direct) < 1e-7
+    a, _ = load(h5)
+    s = solves(h5)
+    np.testing.assert_allclose(s["eps"], np.array(sweep) * a["h"], rtol=1e-12)
+    assert np.all(s["converged"] == 1) and abs(a["eps"] - 1e-6 * a["h"]) < 1e-12 * a["h"]
+    assert np.all(np.diff(s["max_penetration"]) < 0), "penetration must fall with eps"
+
+
+@test
+def preconditioner_reuse_changes_the_cost_not_the_answer():
+    args = SQUARE + ["-dm_plex_box_faces", "64,64"]
+    _, reuse = run(args, "reuse_on")
+    _, fresh = run(args + ["-contact_pc_reuse", "0"], "reuse_off")
+    a, _ = load(reuse)
+    b, _ = load(fresh)
+    assert max_diff(reuse, fresh) < 1e-9
+    assert b["pc_builds"] == b["newton_its"] and a["pc_builds"] < a["newton_its"], (a["pc_builds"], a["newton_its"])
+
+
+@test
+def gamg_converges_at_small_eps_and_agrees_with_mumps():
+    args = SQUARE + ["-dm_plex_box_faces", "32,32", "-penalty_eps0", "1e-6"]
+    _, gamg = run(args + ["-options_file", "options/solvers/gamg.yaml"], "gamg_eps1e-6")
+    _, mumps = run(args, "mumps_eps1e-6")
+    assert max_diff(gamg, mumps) < 1e-7
+
+
+@test
+def bad_sequence_and_sweep_options_are_refused():
+    for args, message in ((["-contact_grid_sequence", "-1"], "-contact_grid_sequence must lie in [0, 8]"),
+                          (["-penalty_eps0_sweep", "1,0,0.1"], "-penalty_eps0_sweep: every value must be positive"),
+                          (["-penalty_eps0_sweep", "1,0.1", "-penalty_eps", "1e-3"], "cannot be given together with -penalty_eps"),
+                          (["-penalty_eps0_sweep", "1,0.1", "-contact_method", "vi"], "needs -contact_method penalty")):
+        out, h5 = run(SQUARE + args, "bad_perf", expect_rc=None)
+        assert message in out, f"'{message}' not in the output of {args}:\n{out[-1500:]}"
+        assert not os.path.exists(h5)
+
+
+@test
+def bench_script_tables_come_from_its_runs():
+    """scripts/bench.py on a tiny bench: every run is listed, VI + GAMG skipped with its reason, and each ratio
+    of the Markdown table is the ratio of the times in the CSV."""
+    outdir = os.path.join(OUT, "bench")
+    p = subprocess.run(["/usr/bin/python3", "scripts/bench.py", "options/bench/test.yaml", "--outdir", os.path.relpath(outdir, ROOT)],
+                       cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert p.returncode == 0, p.stdout[-3000:]
+    with open(os.path.join(outdir, "test.csv")) as fh:
+        rows = list(csv.DictReader(fh))
+    assert len(rows) == 2 * 5, [r["kind"] for r in rows]
+    skipped = [r for r in rows if r["note"].startswith("skipped")]
+    assert [(r["solver"], r["kind"]) for r in skipped] == [("gamg", "vi")]
+    t = {(r["solver"], r["kind"]): float(r["time"]) for r in rows if not r["note"]}
+    assert all(r["converged"] == "1" for r in rows if not r["note"])
+    md = open(os.path.join(outdir, "test.md")).read()
+    line = next(x for x in md.splitlines() if x.startswith("| square2d | mumps | 1 |"))
+    cells = [c.strip() for c in line.strip("|").split("|")]
+    assert abs(float(cells[3]) - t[("mumps", "penalty")] / t[("mumps", "elastic")]) <= 5e-3 * float(cells[3])  # printed to 3 digits
+    assert abs(float(cells[5]) - t[("mumps", "sweep")] / t[("mumps", "penalty_gs")]) <= 5e-3 * float(cells[5])
