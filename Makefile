@@ -23,7 +23,7 @@ SRC = $(wildcard src/*.c src/scenes/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test rates extremes tradeoff format clean
+.PHONY: all deps run test rates extremes tradeoff bench format clean
 STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
@@ -65,6 +65,11 @@ extremes: deps
 tradeoff: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/tradeoff.py options/studies/tradeoff.yaml
+
+# Performance (README, "Performance"): bench/bench.{md,csv}, runs under bench/runs/
+bench: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) scripts/bench.py options/bench/bench.yaml
 
 study-%: deps
 	@$(MAKE) --no-print-directory $(BIN)
