@@ -24,6 +24,8 @@ typedef enum { CONTACT_PENALTY, CONTACT_VI, CONTACT_NONE } ContactMethod;
 extern const char *const ContactMethods[];
 typedef enum { PENALTY_QUADRATURE_GAUSS, PENALTY_QUADRATURE_NODAL } PenaltyQuadrature;
 extern const char *const PenaltyQuadratures[];
+typedef enum { ASSEMBLY_AUTO, ASSEMBLY_FE, ASSEMBLY_P1 } AssemblyType; /* -assembly: how the bulk matrix K is assembled */
+extern const char *const AssemblyTypes[];
 typedef enum { PENALTY_MODULUS_YOUNG, PENALTY_MODULUS_PWAVE } PenaltyModulus; /* the stiffness M of eps = eps0 h^power / M */
 extern const char *const PenaltyModuli[];
 
@@ -124,8 +126,10 @@ typedef struct {
   DMLabel        face_sets;
   PetscWeakForm  wf_penalty; /* the penalty term on Gamma_C, kept out of the bulk weak form */
   Mat            K;          /* bulk elastic operator, assembled once */
-  Vec            r0;         /* bulk residual at u = 0 (loads and Dirichlet lifting) */
-  Vec            xl, xu;     /* SNESVI bounds */
+  AssemblyType   assembly;   /* how K was assembled: fe or p1 (auto resolved) */
+  PetscBool      assembly_check;
+  Vec            r0;     /* bulk residual at u = 0 (loads and Dirichlet lifting) */
+  Vec            xl, xu; /* SNESVI bounds */
   VerifyOptions  verify;
   RunStats       stats;
   PetscInt64     active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
@@ -188,6 +192,11 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u);
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
 PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
+
+/* assembly_p1.c */
+PetscErrorCode AssemblyGetOptions(DM dm, AppCtx *user);
+PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K);
+PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX);
 
 /* contact_monitor.c */
 PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx);
