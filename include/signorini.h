@@ -126,16 +126,16 @@ typedef struct {
   DMLabel        face_sets;
   PetscWeakForm  wf_penalty; /* the penalty term on Gamma_C, kept out of the bulk weak form */
   Mat            K;          /* bulk elastic operator, assembled once */
-  AssemblyType   assembly;   /* how K was assembled: fe or p1 (auto resolved) */
-  PetscBool      assembly_check;
-  Vec            r0;     /* bulk residual at u = 0 (loads and Dirichlet lifting) */
-  Vec            xl, xu; /* SNESVI bounds */
+  Vec            r0;         /* bulk residual at u = 0 (loads and Dirichlet lifting) */
+  Vec            xl, xu;     /* SNESVI bounds */
   VerifyOptions  verify;
   RunStats       stats;
   PetscInt64     active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
   PetscReal      fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */
   ErrorNorms     errors;                          /* against the scene's exact solution */
   ErrorNorms     ref_errors;                      /* against the -reference solution */
+  AssemblyType   assembly;                        /* how K is assembled: fe or p1 (-assembly auto resolved) */
+  PetscBool      assembly_check;                  /* -assembly_check: assemble K both ways and compare */
 } AppCtx;
 
 /* scenes/registry.c */
