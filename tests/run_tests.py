@@ -300,6 +300,7 @@ for _name, (_args, _message) in BAD_INPUTS.items():
     test(_bad)
 
 
+import assembly  # noqa: E402,F401  (registers the assembly tests)
 import robustness  # noqa: E402,F401  (registers the robustness tests)
 import verification  # noqa: E402,F401  (registers the verification tests)
 
