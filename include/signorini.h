@@ -24,6 +24,8 @@ typedef enum { CONTACT_PENALTY, CONTACT_VI, CONTACT_NONE } ContactMethod;
 extern const char *const ContactMethods[];
 typedef enum { PENALTY_QUADRATURE_GAUSS, PENALTY_QUADRATURE_NODAL } PenaltyQuadrature;
 extern const char *const PenaltyQuadratures[];
+typedef enum { ASSEMBLY_AUTO, ASSEMBLY_FE, ASSEMBLY_P1 } AssemblyType; /* -assembly: how the bulk matrix K is assembled */
+extern const char *const AssemblyTypes[];
 typedef enum { PENALTY_MODULUS_YOUNG, PENALTY_MODULUS_PWAVE } PenaltyModulus; /* the stiffness M of eps = eps0 h^power / M */
 extern const char *const PenaltyModuli[];
 
@@ -167,6 +169,8 @@ typedef struct {
   PetscReal      level_setup_time;                /* set-up time of the current mesh's problem, until its first solve */
   SolveRecord    records[SOLVE_RECORDS_MAX];
   PetscInt       nrecords;
+  AssemblyType   assembly;                        /* how K is assembled: fe or p1 (-assembly auto resolved) */
+  PetscBool      assembly_check;                  /* -assembly_check: assemble K both ways and compare */
 } AppCtx;
 
 /* scenes/registry.c */
@@ -237,6 +241,11 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 
 /* pc_reuse.c */
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X);
+
+/* assembly_p1.c */
+PetscErrorCode AssemblyGetOptions(DM dm, AppCtx *user);
+PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K);
+PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX);
 
 /* contact_monitor.c */
 PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx);

@@ -8,14 +8,19 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   MatNullSpace rigid;
 
   PetscFunctionBeginUser;
-  PetscCall(DMCreateMatrix(dm, &user->K));
+  PetscCall(AssemblyGetOptions(dm, user)); /* -assembly fe|p1 */
+  if (user->assembly == ASSEMBLY_P1)
+    PetscCall(AssemblyP1CreateMatrix(dm, user, &user->K));
+  else
+    PetscCall(DMCreateMatrix(dm, &user->K));
   PetscCall(DMCreateGlobalVector(dm, &user->r0));
   PetscCall(DMGetLocalVector(dm, &locX));
   PetscCall(DMGetLocalVector(dm, &locF));
   PetscCall(VecZeroEntries(locX));
   PetscCall(VecZeroEntries(locF));
   PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, locX, 0.0, NULL, NULL, NULL));
-  PetscCall(DMPlexSNESComputeJacobianFEM(dm, locX, user->K, user->K, user));
+  if (user->assembly == ASSEMBLY_FE) PetscCall(DMPlexSNESComputeJacobianFEM(dm, locX, user->K, user->K, user));
+  if (user->assembly_check) PetscCall(AssemblyP1Check(dm, user, locX));
   PetscCall(MatAssemblyBegin(user->K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(user->K, MAT_FINAL_ASSEMBLY));
   PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));

@@ -301,6 +301,7 @@ for _name, (_args, _message) in BAD_INPUTS.items():
 
 
 import performance  # noqa: E402,F401  (registers the performance tests)
+import assembly  # noqa: E402,F401  (registers the assembly tests)
 import robustness  # noqa: E402,F401  (registers the robustness tests)
 import verification  # noqa: E402,F401  (registers the verification tests)
 
