@@ -169,8 +169,8 @@ typedef struct {
   PetscReal      level_setup_time;                /* set-up time of the current mesh's problem, until its first solve */
   SolveRecord    records[SOLVE_RECORDS_MAX];
   PetscInt       nrecords;
-  AssemblyType   assembly;                        /* how K is assembled: fe or p1 (-assembly auto resolved) */
-  PetscBool      assembly_check;                  /* -assembly_check: assemble K both ways and compare */
+  AssemblyType   assembly;       /* how K is assembled: fe or p1 (-assembly auto resolved) */
+  PetscBool      assembly_check; /* -assembly_check: assemble K both ways and compare */
 } AppCtx;
 
 /* scenes/registry.c */
@@ -200,6 +200,7 @@ PetscErrorCode MeshInterpolateFromParents(DM dm, DM fine, const PetscInt parent[
 PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat);
 PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user);
 PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user);
+PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace);
 
 /* contact_options.c, contact_set.c */
 PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts);

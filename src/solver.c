@@ -28,7 +28,10 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, user->r0));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscCall(DMRestoreLocalVector(dm, &locF));
-  PetscCall(DMPlexCreateRigidBody(dm, 0, &rigid));
+  if (user->degree == 1)
+    PetscCall(ElasticityRigidBodyModesP1(dm, &rigid)); /* unknowns at the vertices only */
+  else
+    PetscCall(DMPlexCreateRigidBody(dm, 0, &rigid));
   PetscCall(MatSetNearNullSpace(user->K, rigid));
   PetscCall(MatNullSpaceDestroy(&rigid));
   PetscFunctionReturn(PETSC_SUCCESS);
