@@ -193,7 +193,8 @@ PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **
 
 /* mesh_refine.c */
 PetscErrorCode MeshCellVertices(DM dm, PetscInt c, PetscInt verts[], PetscInt *nv);
-PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **parent);
+PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **parent, PetscInt **vertex_source);
+PetscErrorCode MeshInterpolateVertexSources(DM dm, DM fine, const PetscInt vertex_source[], Vec loc, Vec *fine_loc);
 PetscErrorCode MeshInterpolateFromParents(DM dm, DM fine, const PetscInt parent[], PetscInt nvec, Vec loc[], Vec fine_loc[]);
 
 /* elasticity.c */

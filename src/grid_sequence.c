@@ -9,7 +9,7 @@
 static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u)
 {
   DM        fine;
-  PetscInt *parent;
+  PetscInt *parent, *vertex_source = NULL;
   Vec       loc, fine_loc;
 
   PetscFunctionBeginUser;
@@ -19,11 +19,15 @@ static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *
   PetscCall(DMGlobalToLocal(*dm, *u, INSERT_VALUES, loc));
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
-  PetscCall(MeshRefineRegular(*dm, 1, &fine, &parent));
+  PetscCall(MeshRefineRegular(*dm, 1, &fine, &parent, &vertex_source));
   user->level++;
   PetscCall(ProblemSetUp(fine, user, snes));
-  PetscCall(MeshInterpolateFromParents(*dm, fine, parent, 1, &loc, &fine_loc));
+  if (user->degree == 1)
+    PetscCall(MeshInterpolateVertexSources(*dm, fine, vertex_source, loc, &fine_loc)); /* exact and fast */
+  else
+    PetscCall(MeshInterpolateFromParents(*dm, fine, parent, 1, &loc, &fine_loc));
   PetscCall(PetscFree(parent));
+  PetscCall(PetscFree(vertex_source));
   PetscCall(VecDestroy(&loc));
   PetscCall(DMDestroy(dm));
   *dm = fine;

@@ -19,8 +19,10 @@ PetscErrorCode MeshCellVertices(DM dm, PetscInt c, PetscInt verts[], PetscInt *n
 }
 
 /* Refines dm `levels` times (regular refinement, labels kept) into fine, without a discretization; parent[c - cStart]
-   is the cell of dm that holds fine cell c (an array the caller frees with PetscFree()). */
-PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **parent)
+   is the cell of dm that holds fine cell c (an array the caller frees with PetscFree()). With one level and
+   vertex_source not NULL, vertex_source[v - vStart] is the point of dm (vertex, edge, face or cell) whose centre fine
+   vertex v is. */
+PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **parent, PetscInt **vertex_source)
 {
   MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
   DM        cur  = dm;
@@ -50,6 +52,18 @@ PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **pa
       PetscCall(DMPlexTransformGetSourcePoint(tr, c, &ct, &ctn, &src, &r));
       np[c - nStart] = par[src - cStart];
     }
+    if (vertex_source && levels == 1) {
+      PetscInt vStart, vEnd;
+
+      PetscCall(DMPlexGetDepthStratum(next, 0, &vStart, &vEnd));
+      PetscCall(PetscMalloc1(vEnd - vStart, vertex_source));
+      for (PetscInt v = vStart; v < vEnd; ++v) {
+        DMPolytopeType ct, ctn;
+        PetscInt       r;
+
+        PetscCall(DMPlexTransformGetSourcePoint(tr, v, &ct, &ctn, &(*vertex_source)[v - vStart], &r));
+      }
+    }
     PetscCall(PetscFree(par));
     par    = np;
     cStart = nStart;
@@ -65,6 +79,55 @@ PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **pa
   PetscCall(DMSetMatType(*fine, mtype));
   PetscCall(PetscObjectSetName((PetscObject)*fine, "mesh"));
   *parent = par;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The interpolation of a local vector of dm with its unknowns at the vertices (P1, Q1) to fine, refined once by
+   MeshRefineRegular(): every fine vertex is the centre of its source point (a vertex, an edge midpoint, the centre of
+   a quad or a hex) and gets the mean of the values at the source point's vertices, which is exact for nested P1/Q1.
+   A vertex-by-vertex loop, with none of the cell-by-cell geometry of MeshInterpolateFromParents(). */
+PetscErrorCode MeshInterpolateVertexSources(DM dm, DM fine, const PetscInt vertex_source[], Vec loc, Vec *fine_loc)
+{
+  PetscSection       csec, fsec;
+  PetscInt           vStart, vEnd, cvStart, cvEnd, nc;
+  const PetscScalar *cv;
+  PetscScalar       *fv;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetLocalSection(dm, &csec));
+  PetscCall(DMGetLocalSection(fine, &fsec));
+  PetscCall(DMPlexGetDepthStratum(fine, 0, &vStart, &vEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &cvStart, &cvEnd));
+  PetscCall(DMCreateLocalVector(fine, fine_loc));
+  PetscCall(VecZeroEntries(*fine_loc));
+  PetscCall(VecGetArrayRead(loc, &cv));
+  PetscCall(VecGetArray(*fine_loc, &fv));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    const PetscInt src = vertex_source[v - vStart];
+    PetscInt       verts[8], nv = 0, foff;
+
+    PetscCall(PetscSectionGetDof(fsec, v, &nc));
+    if (!nc) continue;
+    PetscCall(PetscSectionGetOffset(fsec, v, &foff));
+    if (src >= cvStart && src < cvEnd)
+      verts[nv++] = src;
+    else {
+      PetscInt *closure = NULL, ncl;
+
+      PetscCall(DMPlexGetTransitiveClosure(dm, src, PETSC_TRUE, &ncl, &closure));
+      for (PetscInt j = 0; j < ncl; ++j)
+        if (closure[2 * j] >= cvStart && closure[2 * j] < cvEnd && nv < 8) verts[nv++] = closure[2 * j];
+      PetscCall(DMPlexRestoreTransitiveClosure(dm, src, PETSC_TRUE, &ncl, &closure));
+    }
+    for (PetscInt i = 0; i < nv; ++i) {
+      PetscInt coff;
+
+      PetscCall(PetscSectionGetOffset(csec, verts[i], &coff));
+      for (PetscInt c = 0; c < nc; ++c) fv[foff + c] += cv[coff + c] / nv;
+    }
+  }
+  PetscCall(VecRestoreArray(*fine_loc, &fv));
+  PetscCall(VecRestoreArrayRead(loc, &cv));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

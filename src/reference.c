@@ -251,7 +251,7 @@ static PetscErrorCode RefineAndInterpolate(DM dm, PetscInt levels, PetscInt nvec
   PetscInt *parent;
 
   PetscFunctionBeginUser;
-  PetscCall(MeshRefineRegular(dm, levels, fine, &parent));
+  PetscCall(MeshRefineRegular(dm, levels, fine, &parent, NULL));
   PetscCall(DMCopyDisc(dm, *fine)); /* the run's field, weak form and boundary conditions */
   PetscCall(MeshInterpolateFromParents(dm, *fine, parent, nvec, loc, fine_loc));
   PetscCall(PetscFree(parent));

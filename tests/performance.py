@@ -49,6 +49,17 @@ def grid_sequence_in_parallel_and_3d_equals_serial():
 
 
 @test
+def grid_sequence_on_quads_and_hexes_equals_the_direct_solution():
+    """Q1: the new vertices are edge midpoints and face or cell centres, interpolated as means of their corners."""
+    for dim, faces in ((2, "4,4"), (3, "2,2,2")):
+        base = SQUARE + ["-dm_plex_simplex", 0, "-dm_plex_dim", dim, "-dm_plex_box_faces", faces]
+        _, seq = run(base + ["-contact_grid_sequence", 2], f"gs_q1_{dim}d")
+        _, direct = run(base + ["-dm_refine", 2], f"gs_q1_{dim}d_direct")
+        assert max_diff(seq, direct) < 1e-8
+        assert load(seq)[0]["newton_its"] <= 3
+
+
+@test
 def eps_sweep_ends_at_the_direct_solution_for_its_last_eps():
     sweep = [100, 10, 1, 0.1, 0.01, 1e-3, 1e-4, 1e-6]
     _, h5 = run(SQUARE + ["-dm_plex_box_faces", "32,32", "-penalty_eps0_sweep", ",".join(map(str, sweep))], "sweep")
