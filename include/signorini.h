@@ -98,6 +98,16 @@ typedef struct {
   PetscReal penetration_l2, penetration_max; /* of [u_h,n - g]_+ on Gamma_C */
 } ErrorNorms;
 
+/* How the mesh is distributed over the ranks (-partitioner), and the quality of the partition. */
+typedef enum { MESH_PARTITIONER_PTSCOTCH, MESH_PARTITIONER_METIS, MESH_PARTITIONER_SIMPLE } MeshPartitionerType;
+extern const char *const MeshPartitionerTypes[];
+typedef struct {
+  MeshPartitionerType partitioner;
+  PetscInt            edge_cut;  /* interior faces whose two cells are on different ranks (-1: uninterpolated mesh) */
+  PetscReal           imbalance; /* max cells per rank / mean cells per rank (1: perfect, and on one rank) */
+  PetscInt            cells_max; /* cells on the most loaded rank */
+} MeshPartitionStats;
+
 typedef struct {
   PetscInt            newton_its, ksp_its;
   PetscBool           converged;
@@ -110,6 +120,7 @@ typedef struct {
   PetscReal           time_setup, time_solve, time_total;
   PetscInt            active_vertices;
   PetscReal           max_penetration, contact_force, energy;
+  MeshPartitionStats  partition; /* from MeshPartitionGetStats() */
 } RunStats;
 
 typedef struct {
@@ -151,6 +162,10 @@ PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
 PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id);
 PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count);
 PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **faces);
+
+/* mesh_partition.c */
+PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm);
+PetscErrorCode MeshPartitionGetStats(DM dm, MeshPartitionStats *stats);
 
 /* elasticity.c */
 PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat);
