@@ -8,7 +8,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
 {
   PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3;
   PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
-  PetscBool           simplex, has_file, faces_set;
+  PetscBool           simplex, has_file, faces_set, parallel_read = PETSC_FALSE;
   char                filename[PETSC_MAX_PATH_LEN] = "";
   MeshPartitionerType partitioner;
 
@@ -56,8 +56,10 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
     PetscCall(DMSetType(*dm, DMPLEX));
   }
   /* The serial mesh on rank 0: PETSc creates tensor boxes and file meshes here, and refines; MeshPartitionDistribute()
-     alone distributes, for every kind of mesh, with the partitioner of -partitioner. */
-  PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
+     distributes, for every kind of mesh, with the partitioner of -partitioner. PETSc reads HDF5 meshes in parallel, in
+     pieces that are only consistent after its own distribution (without it the solution is wrong): they get both. */
+  if (has_file) PetscCall(PetscStrendswith(filename, ".h5", &parallel_read));
+  if (!parallel_read) PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
   PetscCall(DMSetFromOptions(*dm));
   PetscCall(MeshPartitionDistribute(partitioner, dm));
   PetscCall(PetscObjectSetName((PetscObject)*dm, "mesh"));

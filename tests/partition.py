@@ -1,5 +1,5 @@
 """Mesh partitioning tests (make test): -partitioner metis|ptscotch|simple gives the serial answer on 2 and 3 ranks, for
-every kind of mesh (simplex box, tensor box, Gmsh file), and the recorded edge cut and load imbalance are right.
+every kind of mesh (simplex box, tensor box, Gmsh and HDF5 files), and the recorded edge cut and load imbalance are right.
 
 Every assertion checks numbers computed by the solver against a bound or an independent count that can fail.
 """
@@ -82,6 +82,19 @@ def metis_gmsh_file_matches_serial():
     msh = os.path.join(OUT, "part_square16.msh")
     write_gmsh_square(msh, 16)
     check_same_as_serial(SQUARE + ["-dm_plex_filename", msh], "part_msh", nranks=(2,))
+
+
+@test
+def metis_hdf5_mesh_matches_serial():
+    """PETSc reads an HDF5 mesh in parallel, in pieces: METIS (on the mesh gathered to rank 0) on 2 and 3 ranks gives the
+    serial answer. Without PETSc's own distribution first, this gave a wrong solution (ptscotch, simple) or an error (metis)."""
+    mesh = os.path.join(OUT, "part_square32_mesh.h5")
+    run(SQUARE + ["-dm_view", f"hdf5:{mesh}"], "part_write_mesh")
+    check_same_as_serial(SQUARE + ["-dm_plex_filename", mesh], "part_h5mesh")
+    _, ref = load(os.path.join(OUT, "part_h5mesh_serial.h5"))
+    for p in ("ptscotch", "simple"):
+        a, f = load(run(SQUARE + ["-dm_plex_filename", mesh, "-partitioner", p], f"part_h5mesh_{p}", np_=2)[1])
+        assert a["partitioner"] == p and displacement_difference(f, ref) <= 1e-8, (p, displacement_difference(f, ref))
 
 
 @test
