@@ -116,6 +116,16 @@ typedef struct {
   PetscReal penetration_l2, penetration_max; /* of [u_h,n - g]_+ on Gamma_C */
 } ErrorNorms;
 
+/* How the mesh is distributed over the ranks (-partitioner), and the quality of the partition. */
+typedef enum { MESH_PARTITIONER_PTSCOTCH, MESH_PARTITIONER_METIS, MESH_PARTITIONER_SIMPLE } MeshPartitionerType;
+extern const char *const MeshPartitionerTypes[];
+typedef struct {
+  MeshPartitionerType partitioner;
+  PetscInt            edge_cut;  /* interior faces whose two cells are on different ranks (-1: uninterpolated mesh) */
+  PetscReal           imbalance; /* max cells per rank / mean cells per rank (1: perfect, and on one rank) */
+  PetscInt            cells_max; /* cells on the most loaded rank */
+} MeshPartitionStats;
+
 typedef struct {
   PetscInt            newton_its, ksp_its;             /* of the last solve (the finest mesh, the last eps) */
   PetscInt            newton_its_total, ksp_its_total; /* of all solves: grid sequence levels, continuation, eps sweep */
@@ -130,6 +140,7 @@ typedef struct {
   PetscReal           time_setup, time_solve, time_total;
   PetscInt            active_vertices;
   PetscReal           max_penetration, contact_force, energy;
+  MeshPartitionStats  partition; /* from MeshPartitionGetStats() */
 } RunStats;
 
 /* One solve of a run: a level of the grid sequence or an eps of the sweep (/solves in the output). */
@@ -196,6 +207,10 @@ PetscErrorCode MeshCellVertices(DM dm, PetscInt c, PetscInt verts[], PetscInt *n
 PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **parent, PetscInt **vertex_source);
 PetscErrorCode MeshInterpolateVertexSources(DM dm, DM fine, const PetscInt vertex_source[], Vec loc, Vec *fine_loc);
 PetscErrorCode MeshInterpolateFromParents(DM dm, DM fine, const PetscInt parent[], PetscInt nvec, Vec loc[], Vec fine_loc[]);
+
+/* mesh_partition.c */
+PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm);
+PetscErrorCode MeshPartitionGetStats(DM dm, MeshPartitionStats *stats);
 
 /* elasticity.c */
 PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat);

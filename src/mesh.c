@@ -6,15 +6,14 @@
    without Triangle/CTetGen, come from MeshCreateSimplexBox(). */
 PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
 {
-  PetscInt    dim, faces[3], nfaces = 3, nlower = 3, nupper = 3;
-  PetscReal   lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
-  PetscBool   simplex, has_file, faces_set;
-  char        filename[PETSC_MAX_PATH_LEN] = "";
-  PetscMPIInt size;
+  PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3;
+  PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
+  PetscBool           simplex, has_file, faces_set, parallel_read = PETSC_FALSE;
+  char                filename[PETSC_MAX_PATH_LEN] = "";
+  MeshPartitionerType partitioner;
 
   PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscOptionsBegin(comm, NULL, "Mesh options (PETSc's names)", "DMPLEX");
+  PetscOptionsBegin(comm, NULL, "Mesh options (PETSc's names, and -partitioner)", "DMPLEX");
   PetscCall(PetscOptionsString("-dm_plex_filename", "Mesh file (Gmsh, ExodusII, HDF5)", "DMPlexCreateFromFile", filename, filename, sizeof(filename),
                                &has_file));
   dim = 2;
@@ -27,6 +26,9 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
       PetscOptionsIntArray("-dm_plex_box_faces", "Number of cells along each side of the box", "DMPlexCreateBoxMesh", faces, &nfaces, &faces_set));
   PetscCall(PetscOptionsRealArray("-dm_plex_box_lower", "Lower corner of the box", "DMPlexCreateBoxMesh", lower, &nlower, NULL));
   PetscCall(PetscOptionsRealArray("-dm_plex_box_upper", "Upper corner of the box", "DMPlexCreateBoxMesh", upper, &nupper, NULL));
+  partitioner = MESH_PARTITIONER_PTSCOTCH; /* PETSc 3.18's default where it has PTScotch and no ParMETIS */
+  PetscCall(PetscOptionsEnum("-partitioner", "How the cells are distributed over the ranks", "MeshPartitionDistribute", MeshPartitionerTypes,
+                             (PetscEnum)partitioner, (PetscEnum *)&partitioner, NULL));
   PetscOptionsEnd();
   for (PetscInt d = 0; d < dim; ++d) {
     PetscCheck(faces[d] >= 1, comm, PETSC_ERR_USER_INPUT, "-dm_plex_box_faces: need at least one cell per side, got %" PetscInt_FMT, faces[d]);
@@ -39,19 +41,9 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
     PetscCall(PetscTestFile(filename, 'r', &exists));
     PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "Mesh file '%s' (-dm_plex_filename) does not exist or cannot be read", filename);
   }
-  if (simplex && !has_file) {
+  if (simplex && !has_file)
     PetscCall(MeshCreateSimplexBox(comm, dim, faces, lower, upper, dm));
-    if (size > 1) {
-      DM dist = NULL;
-
-      PetscCall(DMPlexDistribute(*dm, 0, NULL, &dist));
-      if (dist) {
-        PetscCall(DMDestroy(dm));
-        *dm = dist;
-      }
-    }
-    PetscCall(DMSetFromOptions(*dm)); /* refinement and the rest of PETSc's mesh options */
-  } else {
+  else {
     if (!has_file && !faces_set) { /* the same default number of cells for tensor boxes as for simplex boxes */
       char value[64];
 
@@ -62,8 +54,14 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
     }
     PetscCall(DMCreate(comm, dm));
     PetscCall(DMSetType(*dm, DMPLEX));
-    PetscCall(DMSetFromOptions(*dm));
   }
+  /* The serial mesh on rank 0: PETSc creates tensor boxes and file meshes here, and refines; MeshPartitionDistribute()
+     distributes, for every kind of mesh, with the partitioner of -partitioner. PETSc reads HDF5 meshes in parallel, in
+     pieces that are only consistent after its own distribution (without it the solution is wrong): they get both. */
+  if (has_file) PetscCall(PetscStrendswith(filename, ".h5", &parallel_read));
+  if (!parallel_read) PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
+  PetscCall(DMSetFromOptions(*dm));
+  PetscCall(MeshPartitionDistribute(partitioner, dm));
   PetscCall(PetscObjectSetName((PetscObject)*dm, "mesh"));
   PetscCall(DMViewFromOptions(*dm, NULL, "-dm_view"));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -276,6 +276,10 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));
   PetscCall(WriteIntAttr(v, "active_set_cycles", s->active_set_cycles));
   PetscCall(WriteIntAttr(v, "pc_builds", s->pc_builds));
+  PetscCall(MeshPartitionGetStats(dm, &user->stats.partition));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "partitioner", PETSC_STRING, MeshPartitionerTypes[s->partition.partitioner]));
+  PetscCall(WriteIntAttr(v, "partition_edge_cut", s->partition.edge_cut));
+  PetscCall(WriteRealAttr(v, "partition_imbalance", s->partition.imbalance));
   if (user->contact.condition_estimate) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm)); /* NaN: the estimate failed */
   PetscCall(WriteRealAttr(v, "peak_memory_mb", s->peak_memory_mb));
   PetscCall(WriteRealAttr(v, "peak_memory_total_mb", s->peak_memory_total_mb));

@@ -303,6 +303,7 @@ for _name, (_args, _message) in BAD_INPUTS.items():
 import performance  # noqa: E402,F401  (registers the performance tests)
 import assembly  # noqa: E402,F401  (registers the assembly tests)
 import robustness  # noqa: E402,F401  (registers the robustness tests)
+import partition  # noqa: E402,F401  (registers the partitioning tests)
 import verification  # noqa: E402,F401  (registers the verification tests)
 
 

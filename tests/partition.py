@@ -1,0 +1,127 @@
+"""Mesh partitioning tests (make test): -partitioner metis|ptscotch|simple gives the serial answer on 2 and 3 ranks, for
+every kind of mesh (simplex box, tensor box, Gmsh and HDF5 files), and the recorded edge cut and load imbalance are right.
+
+Every assertion checks numbers computed by the solver against a bound or an independent count that can fail.
+"""
+import os
+import re
+import subprocess
+
+import numpy as np
+
+from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position, test
+
+SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "false"]  # 32x32, default solver (MUMPS)
+MMS3D = ["-options_file", "options/mms.yaml", "-dm_plex_dim", 3, "-dm_plex_box_faces", "6,6,6"]
+
+
+def displacement_difference(a, b):
+    """max |u_a - u_b| / max |u_b| over the vertices, matched by position."""
+    ua, ub = sorted_by_position(a, "displacement"), sorted_by_position(b, "displacement")
+    assert ua.shape == ub.shape, (ua.shape, ub.shape)
+    return np.abs(ua - ub).max() / np.abs(ub).max()
+
+
+def metis_edge_cut(log):
+    """The edge cut METIS reports for its own partition of the serial cell graph (-info :dm), an independent count."""
+    m = re.findall(r"METIS: (\d+) cells, (\d+) parts, edge cut (\d+)", log)
+    assert len(m) == 1, f"no METIS line in the log:\n{log[-2000:]}"
+    return int(m[0][2])
+
+
+def check_same_as_serial(args, name, nranks=(2, 3)):
+    ref_attrs, ref = load(run(args, f"{name}_serial")[1])
+    assert ref_attrs["converged"] == 1
+    assert ref_attrs["partition_edge_cut"] == 0 and ref_attrs["partition_imbalance"] == 1.0, "one rank: no cut, no imbalance"
+    for n in nranks:
+        log, h5 = run(args + ["-partitioner", "metis", "-info", ":dm"], f"{name}_metis_{n}", np_=n)
+        a, f = load(h5)
+        assert a["converged"] == 1 and a["nprocs"] == n and a["partitioner"] == "metis", (a["converged"], a["nprocs"], a["partitioner"])
+        assert a["n_cells"] == ref_attrs["n_cells"]
+        assert a["partition_edge_cut"] == metis_edge_cut(log) > 0, (a["partition_edge_cut"], metis_edge_cut(log))
+        diff = displacement_difference(f, ref)
+        assert diff <= 1e-8, (n, diff)
+
+
+@test
+def metis_2d_square_matches_serial():
+    """The 2D square on 2 and 3 ranks partitioned by METIS: the serial displacement to 1e-8 (MUMPS, Newton to 1e-14)."""
+    check_same_as_serial(SQUARE, "part_square")
+
+
+@test
+def metis_3d_mms_matches_serial():
+    """The 3D manufactured solution on 2 and 3 ranks partitioned by METIS: the serial displacement to 1e-8."""
+    check_same_as_serial(MMS3D, "part_mms3d")
+
+
+@test
+def metis_tensor_box_matches_serial():
+    """Quadrilaterals come from DMSetFromOptions, not the project's generator: METIS must partition them too."""
+    check_same_as_serial(SQUARE + ["-dm_plex_simplex", 0], "part_quads", nranks=(2,))
+
+
+def write_gmsh_square(path, n):
+    """A Gmsh 2.2 file of the unit square in n x n quadrilaterals, physical lines 1-4 numbered as PETSc's box."""
+    vid = lambda i, j: j * (n + 1) + i + 1  # noqa: E731
+    sides = {1: [(vid(i, 0), vid(i + 1, 0)) for i in range(n)], 2: [(vid(n, j), vid(n, j + 1)) for j in range(n)],
+             3: [(vid(i, n), vid(i + 1, n)) for i in range(n)], 4: [(vid(0, j), vid(0, j + 1)) for j in range(n)]}
+    elems = [f"1 2 {tag} {tag} {a} {b}" for tag, segs in sides.items() for a, b in segs]
+    elems += [f"3 2 10 10 {vid(i, j)} {vid(i + 1, j)} {vid(i + 1, j + 1)} {vid(i, j + 1)}" for j in range(n) for i in range(n)]
+    with open(path, "w") as fp:
+        fp.write("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n%d\n" % (n + 1) ** 2)
+        fp.writelines(f"{vid(i, j)} {i / n!r} {j / n!r} 0\n" for j in range(n + 1) for i in range(n + 1))
+        fp.write("$EndNodes\n$Elements\n%d\n" % len(elems))
+        fp.writelines(f"{k + 1} {e}\n" for k, e in enumerate(elems))
+        fp.write("$EndElements\n")
+
+
+@test
+def metis_gmsh_file_matches_serial():
+    """A mesh read from a Gmsh file goes through the same distribution: METIS on 2 ranks, the serial answer."""
+    msh = os.path.join(OUT, "part_square16.msh")
+    write_gmsh_square(msh, 16)
+    check_same_as_serial(SQUARE + ["-dm_plex_filename", msh], "part_msh", nranks=(2,))
+
+
+@test
+def metis_hdf5_mesh_matches_serial():
+    """PETSc reads an HDF5 mesh in parallel, in pieces: METIS (on the mesh gathered to rank 0) on 2 and 3 ranks gives the
+    serial answer. Without PETSc's own distribution first, this gave a wrong solution (ptscotch, simple) or an error (metis)."""
+    mesh = os.path.join(OUT, "part_square32_mesh.h5")
+    run(SQUARE + ["-dm_view", f"hdf5:{mesh}"], "part_write_mesh")
+    check_same_as_serial(SQUARE + ["-dm_plex_filename", mesh], "part_h5mesh")
+    _, ref = load(os.path.join(OUT, "part_h5mesh_serial.h5"))
+    for p in ("ptscotch", "simple"):
+        a, f = load(run(SQUARE + ["-dm_plex_filename", mesh, "-partitioner", p], f"part_h5mesh_{p}", np_=2)[1])
+        assert a["partitioner"] == p and displacement_difference(f, ref) <= 1e-8, (p, displacement_difference(f, ref))
+
+
+@test
+def partition_quality_is_recorded():
+    """METIS on the 32x32 square (2048 triangles): imbalance in [1, 1.1], edge cut above 0 and below twice a straight cut
+    (32 faces per straight line across the square). The simple partitioner splits the row-by-row cell numbering in
+    halves, so on 2 ranks it cuts exactly the 32 faces of the line y = 1/2 with 1024 cells each, for triangles and quads."""
+    for n, straight in ((2, 32), (3, 64)):
+        a, _ = load(run(SQUARE + ["-partitioner", "metis"], f"quality_metis_{n}", np_=n)[1])
+        assert 1.0 <= a["partition_imbalance"] <= 1.1, a["partition_imbalance"]
+        assert 0 < a["partition_edge_cut"] < 2 * straight, a["partition_edge_cut"]
+    for extra in ([], ["-dm_plex_simplex", 0]):
+        a, _ = load(run(SQUARE + extra + ["-partitioner", "simple"], f"quality_simple{len(extra)}", np_=2)[1])
+        assert a["partitioner"] == "simple" and a["partition_edge_cut"] == 32 and a["partition_imbalance"] == 1.0, (
+            a["partition_edge_cut"], a["partition_imbalance"])
+    a, _ = load(run(SQUARE, "quality_default", np_=2)[1])
+    assert a["partitioner"] == "ptscotch" and 0 < a["partition_edge_cut"] < 64 and 1.0 <= a["partition_imbalance"] <= 1.1
+
+
+@test
+def bad_partitioner_is_refused():
+    """-partitioner bogus: non-zero exit, a message naming the choices, and no output file."""
+    for n in (1, 2):
+        out = os.path.join(OUT, f"bad_partitioner_{n}.h5")
+        cmd = ["mpiexec", "-n", str(n), BIN, "-output", out] + SQUARE + ["-partitioner", "bogus"]
+        p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
+        assert p.returncode != 0, "bad -partitioner accepted"
+        message = "Unknown option bogus for -partitioner. Available options: ptscotch metis simple"
+        assert message in p.stdout, f"'{message}' not in:\n{p.stdout[-2000:]}"
+        assert not os.path.exists(out) and not os.path.exists(out + ".part"), "output left behind"
