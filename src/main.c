@@ -112,6 +112,7 @@ int main(int argc, char **argv)
   PetscCall(OutputGetOptions(comm, &user));
 
   PetscCall(MeshCreate(comm, &dm));
+  PetscCall(MeshPartitionGetStats(dm, &user.stats.partition)); /* the partitioner; the final mesh's cut is taken at output */
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(DMCreateGlobalVector(dm, &u));
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));

@@ -6,7 +6,7 @@
    without Triangle/CTetGen, come from MeshCreateSimplexBox(). */
 PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
 {
-  PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3;
+  PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
   PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
   PetscBool           simplex, has_file, faces_set, parallel_read = PETSC_FALSE;
   char                filename[PETSC_MAX_PATH_LEN] = "";
@@ -29,7 +29,13 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
   partitioner = MESH_PARTITIONER_PTSCOTCH; /* PETSc 3.18's default where it has PTScotch and no ParMETIS */
   PetscCall(PetscOptionsEnum("-partitioner", "How the cells are distributed over the ranks", "MeshPartitionDistribute", MeshPartitionerTypes,
                              (PetscEnum)partitioner, (PetscEnum *)&partitioner, NULL));
+  refine = 0;
+  PetscCall(PetscOptionsRangeInt("-dm_refine", "Uniform refinements, after the distribution", "DMRefine", refine, &refine, NULL, 0, 12));
   PetscOptionsEnd();
+  /* PETSc's DMSetFromOptions() would refine the serial mesh on rank 0, before the distribution: the project refines the
+     distributed mesh instead, on all ranks (at 1M unknowns the serial refinement and distribution cost more than the
+     whole elastic solve on 2 ranks) */
+  PetscCall(PetscOptionsClearValue(NULL, "-dm_refine"));
   for (PetscInt d = 0; d < dim; ++d) {
     PetscCheck(faces[d] >= 1, comm, PETSC_ERR_USER_INPUT, "-dm_plex_box_faces: need at least one cell per side, got %" PetscInt_FMT, faces[d]);
     PetscCheck(upper[d] > lower[d], comm, PETSC_ERR_USER_INPUT, "-dm_plex_box_upper must exceed -dm_plex_box_lower in every direction");
@@ -55,13 +61,20 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
     PetscCall(DMCreate(comm, dm));
     PetscCall(DMSetType(*dm, DMPLEX));
   }
-  /* The serial mesh on rank 0: PETSc creates tensor boxes and file meshes here, and refines; MeshPartitionDistribute()
+  /* The serial mesh on rank 0: PETSc creates tensor boxes and file meshes here; MeshPartitionDistribute()
      distributes, for every kind of mesh, with the partitioner of -partitioner. PETSc reads HDF5 meshes in parallel, in
      pieces that are only consistent after its own distribution (without it the solution is wrong): they get both. */
   if (has_file) PetscCall(PetscStrendswith(filename, ".h5", &parallel_read));
   if (!parallel_read) PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
   PetscCall(DMSetFromOptions(*dm));
   PetscCall(MeshPartitionDistribute(partitioner, dm));
+  for (PetscInt r = 0; r < refine; ++r) {
+    DM fine;
+
+    PetscCall(DMRefine(*dm, comm, &fine));
+    PetscCall(DMDestroy(dm));
+    *dm = fine;
+  }
   PetscCall(PetscObjectSetName((PetscObject)*dm, "mesh"));
   PetscCall(DMViewFromOptions(*dm, NULL, "-dm_view"));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -176,16 +176,20 @@ PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The partitioner, edge cut and imbalance recorded by MeshPartitionDistribute() on a mesh from MeshCreate(). */
+/* The edge cut and imbalance of dm as it is now (after refinements too), and the partitioner recorded by
+   MeshPartitionDistribute() when dm is the mesh it distributed (otherwise stats->partitioner is left as it is). */
 PetscErrorCode MeshPartitionGetStats(DM dm, MeshPartitionStats *stats)
 {
-  PetscContainer      container;
-  MeshPartitionStats *s;
+  PetscContainer container;
 
   PetscFunctionBeginUser;
   PetscCall(PetscObjectQuery((PetscObject)dm, MESH_PARTITION_STATS_KEY, (PetscObject *)&container));
-  PetscCheck(container, PetscObjectComm((PetscObject)dm), PETSC_ERR_ARG_WRONG, "The mesh was not distributed by MeshPartitionDistribute()");
-  PetscCall(PetscContainerGetPointer(container, (void **)&s));
-  *stats = *s;
+  if (container) {
+    MeshPartitionStats *s;
+
+    PetscCall(PetscContainerGetPointer(container, (void **)&s));
+    stats->partitioner = s->partitioner;
+  }
+  PetscCall(MeshPartitionComputeStats(dm, stats));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
