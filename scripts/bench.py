@@ -156,7 +156,7 @@ def summarize(rows, bench):
     """One line per (problem, solver, ranks): the ratios of the issue's targets."""
     out = []
     for p in bench["problems"]:
-        for solver in bench["solvers"]:
+        for solver in p.get("solvers", bench["solvers"]):
             for ranks in bench["ranks"]:
                 g = {k: find(rows, p["name"], solver, ranks, k) for k in KINDS}
                 one = {k: find(rows, p["name"], solver, bench["ranks"][0], k) for k in KINDS}

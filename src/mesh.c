@@ -11,6 +11,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
   PetscBool           simplex, has_file, faces_set, parallel_read = PETSC_FALSE;
   char                filename[PETSC_MAX_PATH_LEN] = "";
   MeshPartitionerType partitioner;
+  MatType             mtype;
+  char               *mtype_copy;
 
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, NULL, "Mesh options (PETSc's names, and -partitioner)", "DMPLEX");
@@ -67,6 +69,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
   if (has_file) PetscCall(PetscStrendswith(filename, ".h5", &parallel_read));
   if (!parallel_read) PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
   PetscCall(DMSetFromOptions(*dm));
+  PetscCall(DMGetMatType(*dm, &mtype));
+  PetscCall(PetscStrallocpy(mtype, &mtype_copy)); /* -dm_mat_type, which the distributed mesh does not inherit */
   PetscCall(MeshPartitionDistribute(partitioner, dm));
   for (PetscInt r = 0; r < refine; ++r) {
     DM fine;
@@ -75,6 +79,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
     PetscCall(DMDestroy(dm));
     *dm = fine;
   }
+  PetscCall(DMSetMatType(*dm, mtype_copy));
+  PetscCall(PetscFree(mtype_copy));
   PetscCall(PetscObjectSetName((PetscObject)*dm, "mesh"));
   PetscCall(DMViewFromOptions(*dm, NULL, "-dm_view"));
   PetscFunctionReturn(PETSC_SUCCESS);
