@@ -13,7 +13,8 @@ The time of a run is the solver's own set-up + solve time (/run time_setup + tim
 not MPI start-up, post-processing or output). The tables go to bench/<name>.md and bench/<name>.csv, the runs
 (HDF5 and console output) to bench/runs/<name>/.
 
-Usage: scripts/bench.py [options/bench/bench.yaml] [--only SUBSTRING ...]
+A run longer than the bench file's `timeout` (seconds, default 3600) is stopped and listed as failed.
+Usage: scripts/bench.py [options/bench/bench.yaml] [--outdir DIR] [--resume]
 """
 import argparse
 import csv
@@ -99,25 +100,47 @@ def read_solves(f):
     return {k: np.asarray(f["solves"][k][:]).ravel() for k in f["solves"]}
 
 
-def run_case(problem, solver, ranks, kind, bench, outdir):
+def run_case(problem, solver, ranks, kind, bench, outdir, resume=False):
+    """Runs one case, or with resume reads the output an earlier invocation left (its log holds its exit status)."""
     row = {"problem": problem["name"], "solver": solver, "ranks": ranks, "kind": kind, "note": ""}
     if (kind, solver) in SKIP:
         row["note"] = "skipped: " + SKIP[(kind, solver)]
         return row
     name = f"{problem['name']}_{solver}_np{ranks}_{kind}"
     h5 = os.path.join(outdir, name + ".h5")
+    log = h5[:-3] + ".log"
+    cmd = command(problem, solver, ranks, kind, bench, os.path.relpath(h5, ROOT))
+    limit = bench.get("timeout", 3600)
+    if resume and os.path.exists(h5) and os.path.exists(log):
+        with open(log) as fh:
+            first = fh.readline().rstrip("\n")
+        if first.startswith("exit ") and first.split(" ", 2)[2] == shlex.join(cmd):
+            returncode = int(first.split(" ", 2)[1])
+            return read_case(row, name, h5, cmd, returncode, "", problem, kind)
     if os.path.exists(h5):
         os.remove(h5)
-    cmd = command(problem, solver, ranks, kind, bench, os.path.relpath(h5, ROOT))
     env = {**os.environ, **MPI_ENV, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
     t0 = time.time()
-    proc = subprocess.run(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        proc = subprocess.run(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=limit)
+        returncode, output = proc.returncode, proc.stdout
+    except subprocess.TimeoutExpired as exc:
+        out = exc.stdout or ""
+        returncode, output = None, out.decode() if isinstance(out, bytes) else out
     row["wall"] = time.time() - t0
-    with open(h5[:-3] + ".log", "w") as fh:
-        fh.write(shlex.join(cmd) + "\n" + proc.stdout)
+    with open(log, "w") as fh:
+        fh.write(f"exit {returncode} {shlex.join(cmd)}\n" + output)
+    if returncode is None:
+        row["note"] = f"FAILED: stopped after the bench's time limit of {limit} s"
+        return row
+    return read_case(row, name, h5, cmd, returncode, output, problem, kind)
+
+
+def read_case(row, name, h5, cmd, returncode, output, problem, kind):
+    """Fills row from the output file of one run."""
     if not os.path.exists(h5):
-        tail = "\n".join(proc.stdout.rstrip().splitlines()[-15:])
-        raise StudyError(f"{name}: exit status {proc.returncode}, no output; command:\n  {shlex.join(cmd)}\n{tail}")
+        tail = "\n".join(output.rstrip().splitlines()[-15:])
+        raise StudyError(f"{name}: exit status {returncode}, no output; command:\n  {shlex.join(cmd)}\n{tail}")
     with h5py.File(h5, "r") as f:
         a = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f["run"].attrs.items()}
         solves = read_solves(f)
@@ -136,8 +159,8 @@ def run_case(problem, solver, ranks, kind, bench, outdir):
         per = [solves["ksp_its"][i] / max(solves["newton_its"][i], 1) for i in range(first, len(solves["eps"]))]
         row["sweep_ksp_per_newton"] = "/".join(f"{p:.0f}" for p in per)
         row["sweep_solved"] = len(per)
-    if proc.returncode != 0 or a["converged"] != 1:
-        row["note"] = f"FAILED: exit {proc.returncode}, {a['snes_reason']}"
+    if returncode != 0 or a["converged"] != 1:
+        row["note"] = f"FAILED: exit {returncode}, {a['snes_reason']}"
     return row
 
 
@@ -235,6 +258,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("bench", nargs="?", default="options/bench/bench.yaml")
     ap.add_argument("--outdir", default="bench", help="directory of the tables (default bench/)")
+    ap.add_argument("--resume", action="store_true", help="reuse the outputs of an earlier invocation with the same commands")
     args = ap.parse_args(argv)
     try:
         bench = load_bench(os.path.join(ROOT, args.bench) if not os.path.isabs(args.bench) else args.bench)
@@ -246,7 +270,7 @@ def main(argv=None):
             for solver in p.get("solvers", bench["solvers"]):
                 for ranks in bench["ranks"]:
                     for kind in KINDS:
-                        r = run_case(p, solver, ranks, kind, bench, rundir)
+                        r = run_case(p, solver, ranks, kind, bench, rundir, args.resume)
                         rows.append(r)
                         print(f"{p['name']:10s} {solver:6s} np={ranks} {kind:10s} time {fmt(r.get('time'))} s, "
                               f"Newton {fmt(r.get('newton_its'))}, Krylov {fmt(r.get('ksp_its'))} {r.get('note', '')}",
