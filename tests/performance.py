@@ -40,6 +40,16 @@ def grid_sequence_gives_the_direct_solution_with_few_newton_steps():
 
 
 @test
+def grid_sequence_with_snesvi_equals_the_direct_solution():
+    base = SQUARE + ["-contact_method", "vi", "-dm_plex_box_faces", "8,8"]
+    _, seq = run(base + ["-contact_grid_sequence", 2], "gs_vi")
+    _, direct = run(base + ["-dm_refine", 2], "gs_vi_direct")
+    assert max_diff(seq, direct) < 1e-10
+    a, _ = load(seq)
+    assert a["newton_its"] <= 3 and a["max_penetration"] <= 0.0
+
+
+@test
 def grid_sequence_in_parallel_and_3d_equals_serial():
     args = SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3", "-contact_grid_sequence", "1"]
     _, one = run(args, "gs3d_np1")
@@ -77,10 +87,13 @@ def preconditioner_reuse_changes_the_cost_not_the_answer():
     args = SQUARE + ["-dm_plex_box_faces", "64,64"]
     _, reuse = run(args, "reuse_on")
     _, fresh = run(args + ["-contact_pc_reuse", "0"], "reuse_off")
+    _, strict = run(args + ["-contact_pc_reuse_changes", 0], "reuse_strict")
     a, _ = load(reuse)
     b, _ = load(fresh)
-    assert max_diff(reuse, fresh) < 1e-9
+    c, _ = load(strict)
+    assert max_diff(reuse, fresh) < 1e-9 and max_diff(strict, fresh) < 1e-9
     assert b["pc_builds"] == b["newton_its"] and a["pc_builds"] < a["newton_its"], (a["pc_builds"], a["newton_its"])
+    assert a["pc_builds"] <= c["pc_builds"] <= c["newton_its"], (a["pc_builds"], c["pc_builds"])
 
 
 @test
