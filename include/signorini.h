@@ -80,7 +80,6 @@ typedef struct {
 /* State of the preconditioner reuse (pc_reuse.c). */
 typedef struct {
   PetscBool enabled;         /* penalty method with a Krylov method around the preconditioner */
-  PetscInt  max_changes;     /* rebuild when more contact nodes changed state since the build */
   PetscBool built;           /* a build exists */
   PetscReal eps;             /* eps of the build */
   PetscInt  its_after_build; /* Krylov iterations of the first solve after the build (-1: not yet known) */

@@ -43,7 +43,7 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
     PetscCall(KSPGetIterationNumber(ksp, &its));
     PetscCall(KSPGetConvergedReason(ksp, &reason));
     /* rebuild after a failed solve, or when the last solve needed twice the iterations of the first after the build */
-    rebuild = (PetscBool)(changes > r->max_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
+    rebuild = (PetscBool)(changes > user->contact.pc_reuse_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
   }
   if (rebuild) {
     PetscCall(CountChanges(user, dim, x, PETSC_TRUE, &changes));

@@ -145,8 +145,7 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscBool is_preonly;
 
     PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &is_preonly));
-    user->pc_reuse.enabled     = (PetscBool)(user->contact.method == CONTACT_PENALTY && user->contact.pc_reuse && !is_preonly);
-    user->pc_reuse.max_changes = user->contact.pc_reuse_changes;
+    user->pc_reuse.enabled = (PetscBool)(user->contact.method == CONTACT_PENALTY && user->contact.pc_reuse && !is_preonly);
   }
   PetscCheck(is_vi == (user->contact.method == CONTACT_VI), comm, PETSC_ERR_USER_INPUT,
              "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type,
