@@ -73,8 +73,9 @@ typedef struct {
   PetscBool         pc_reuse;            /* reuse the preconditioner/factorization while few contact nodes change */
   PetscInt          pc_reuse_changes;    /*   at most this many changed nodes since the build */
   PetscInt          grid_sequence;       /* solve on the mesh and on this many uniform refinements of it, each from the last */
-  PetscReal         eps0_sweep[32];      /* eps0 values solved in turn on the final mesh, each from the last solution */
+  PetscReal        *eps0_sweep;          /* eps0 values solved in turn on the final mesh, each from the last solution (any number) */
   PetscInt          n_sweep;
+  PetscReal         load_rtol; /* Newton also stops when |F| <= load_rtol ||F(0)||: the residual is at round-off for the load */
 } ContactOptions;
 
 /* State of the preconditioner reuse (pc_reuse.c). */
@@ -128,7 +129,8 @@ typedef struct {
 typedef struct {
   PetscInt            newton_its, ksp_its;             /* of the last solve (the finest mesh, the last eps) */
   PetscInt            newton_its_total, ksp_its_total; /* of all solves: grid sequence levels, continuation, eps sweep */
-  PetscBool           converged;
+  PetscBool           converged;        /* PETSc's reason is a convergence and the residual fell as asked (residual_reduced) */
+  PetscBool           residual_reduced; /* |F| <= rtol |F0|, or at round-off for the load, or below -snes_atol */
   SNESConvergedReason reason;
   PetscReal           residual_norm;
   PetscInt            continuation_stages;                  /* solves of the eps sequence before the target eps (0: none) */
@@ -151,7 +153,6 @@ typedef struct {
   PetscReal time_setup, time_solve; /* set-up of the mesh's problem (first solve on it only), and the solve */
   PetscReal max_penetration;
 } SolveRecord;
-#define SOLVE_RECORDS_MAX 64
 
 typedef struct {
   char           scene_name[64];
@@ -177,11 +178,21 @@ typedef struct {
   ErrorNorms     ref_errors;                      /* against the -reference solution */
   PetscInt       level;                           /* grid sequence level of the current mesh (0: the mesh of the options) */
   PetscReal      level_setup_time;                /* set-up time of the current mesh's problem, until its first solve */
-  SolveRecord    records[SOLVE_RECORDS_MAX];
-  PetscInt       nrecords;
+  SolveRecord   *records; /* one per solve, any number */
+  PetscInt       nrecords, maxrecords;
+  PetscReal      load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
+  PetscReal      displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */
+  PetscReal      snes_scale;         /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
+  PetscReal      fnorm0;             /* |F| at the start of the last SNESSolve, in the user's units */
+  Vec            work;               /* U x~: the displacement of the SNES iterate x~ */
   AssemblyType   assembly;       /* how K is assembled: fe or p1 (-assembly auto resolved) */
   PetscBool      assembly_check; /* -assembly_check: assemble K both ways and compare */
 } AppCtx;
+
+/* options_check.c */
+PetscErrorCode OptionsCheckFinite(MPI_Comm comm, const char name[], PetscReal value);
+PetscErrorCode OptionsCheckFiniteArray(MPI_Comm comm, const char name[], PetscInt n, const PetscReal values[]);
+PetscErrorCode OptionsCountListValues(const char name[], PetscInt *n);
 
 /* scenes/registry.c */
 PetscErrorCode SceneRegisterAll(void);
@@ -219,6 +230,7 @@ PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace);
 
 /* contact_options.c, contact_set.c */
 PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts);
+PetscErrorCode ContactOptionsDestroy(ContactOptions *opts);
 PetscErrorCode ContactComputeEps(AppCtx *user);
 PetscReal      ContactPenaltyModulus(const AppCtx *user);
 PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs);
@@ -245,6 +257,7 @@ PetscErrorCode VICreateBounds(DM dm, AppCtx *user);
 /* solver.c */
 PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user);
 PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
+PetscErrorCode SolverComputeScales(DM dm, AppCtx *user);
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm);
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
 PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);

@@ -5,7 +5,7 @@
    With update, the active flags are stored and the vertices that entered and left are counted. */
 PetscErrorCode ContactCountActive(AppCtx *user, Vec X, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left)
 {
-  const PetscReal    tol = user->contact.method == CONTACT_VI ? 1e-10 * user->h : 0.0;
+  const PetscReal    tol = user->contact.method == CONTACT_VI ? 1e-10 * user->displacement_scale : 0.0; /* on the bound, for vi */
   const PetscScalar *x;
   PetscInt           dim, local[3] = {0, 0, 0}, global[3];
   DM                 dm;
@@ -86,15 +86,23 @@ static PetscErrorCode DetectActiveSetCycle(SNES snes, AppCtx *user, PetscInt it,
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx)
+/* The SNES iterates on x~ = u/U with the residual F/U (solver.c): the monitor reports u and |F| in the user's units. */
+PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm_scaled, void *ctx)
 {
-  AppCtx  *user = (AppCtx *)ctx;
-  Vec      X;
-  PetscInt active, entered, left;
+  AppCtx         *user  = (AppCtx *)ctx;
+  const PetscReal fnorm = fnorm_scaled * user->snes_scale;
+  Vec             X, Xs;
+  PetscInt        active, entered, left;
 
   PetscFunctionBeginUser;
   user->stats.residual_norm = fnorm;
-  PetscCall(SNESGetSolution(snes, &X));
+  PetscCall(SNESGetSolution(snes, &Xs));
+  X = Xs;
+  if (user->snes_scale != 1.0) {
+    PetscCall(VecCopy(Xs, user->work));
+    PetscCall(VecScale(user->work, user->snes_scale));
+    X = user->work;
+  }
   if (user->contact.method == CONTACT_PENALTY) PetscCall(DetectActiveSetCycle(snes, user, it, fnorm, X));
   if (!user->contact.monitor) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactCountActive(user, X, PETSC_TRUE, &active, &entered, &left));

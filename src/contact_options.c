@@ -56,11 +56,25 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscCall(PetscOptionsInt("-contact_grid_sequence",
                             "Nested iteration: solve on the mesh, then on N uniform refinements of it, each from the interpolated last solution",
                             NULL, opts->grid_sequence, &opts->grid_sequence, NULL));
-  opts->n_sweep = 32;
+  PetscCall(OptionsCountListValues("-penalty_eps0_sweep", &opts->n_sweep));
+  PetscCall(PetscMalloc1(opts->n_sweep + 1, &opts->eps0_sweep));
   PetscCall(PetscOptionsRealArray("-penalty_eps0_sweep", "eps0 values solved in turn on the final mesh, each from the last solution", NULL,
                                   opts->eps0_sweep, &opts->n_sweep, &sweep_set));
   if (!sweep_set) opts->n_sweep = 0;
+  opts->load_rtol = 1e-12;
+  PetscCall(PetscOptionsReal("-contact_load_rtol",
+                             "Newton also stops, converged, when |F| <= this times ||F(0)|| (the load): the residual is at round-off", NULL,
+                             opts->load_rtol, &opts->load_rtol, NULL));
   PetscOptionsEnd();
+  {
+    const char *names[]  = {"-penalty_eps0", "-penalty_eps_power", "-penalty_eps", "-penalty_continuation_factor", "-contact_load_rtol"};
+    PetscReal   values[] = {opts->eps0, opts->eps_power, opts->eps_fixed, opts->continuation_factor, opts->load_rtol};
+
+    for (size_t i = 0; i < sizeof(values) / sizeof(values[0]); ++i) PetscCall(OptionsCheckFinite(comm, names[i], values[i]));
+    PetscCall(OptionsCheckFiniteArray(comm, "-penalty_eps0_sweep", opts->n_sweep, opts->eps0_sweep));
+  }
+  PetscCheck(opts->load_rtol >= 0.0 && opts->load_rtol < 1.0, comm, PETSC_ERR_USER_INPUT, "-contact_load_rtol must lie in [0, 1), got %g",
+             (double)opts->load_rtol);
   PetscCheck(opts->grid_sequence >= 0 && opts->grid_sequence <= 8, comm, PETSC_ERR_USER_INPUT,
              "-contact_grid_sequence must lie in [0, 8], got %" PetscInt_FMT, opts->grid_sequence);
   PetscCheck(!sweep_set || opts->n_sweep > 0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep needs a comma-separated list of values");
@@ -78,6 +92,13 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscCheck(opts->eps_power >= 0.0 && opts->eps_power <= 4.0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps_power must lie in [0, 4], got %g",
              (double)opts->eps_power);
   PetscCheck(!eps_set || opts->eps_fixed > 0.0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps must be positive, got %g", (double)opts->eps_fixed);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode ContactOptionsDestroy(ContactOptions *opts)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(opts->eps0_sweep));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -140,6 +140,8 @@ int main(int argc, char **argv)
   PetscCall(VecDestroy(&u));
   PetscCall(ProblemDestroy(&user, &snes));
   PetscCall(DMDestroy(&dm));
+  PetscCall(ContactOptionsDestroy(&user.contact));
+  PetscCall(PetscFree(user.records));
   PetscCall(SceneFinalize());
   {
     const PetscBool converged = user.stats.converged;

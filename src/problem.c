@@ -18,6 +18,7 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   if (user->contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, user));
   PetscCall(SolverAssembleBulk(dm, user));
   PetscCall(WeakDataAddToResidual(dm, user, user->r0));
+  PetscCall(SolverComputeScales(dm, user));
   PetscCall(PetscMemzero(&user->pc_reuse, sizeof(user->pc_reuse)));
   PetscCall(SolverCreateSNES(dm, user, snes));
   PetscCall(PetscTime(&t1));
@@ -34,6 +35,7 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes)
   PetscCall(VecDestroy(&user->xl));
   PetscCall(VecDestroy(&user->xu));
   PetscCall(VecDestroy(&user->loc_bc));
+  PetscCall(VecDestroy(&user->work));
   PetscCall(PetscWeakFormDestroy(&user->wf_penalty));
   PetscCall(ContactSetDestroy(&user->cset));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -1,5 +1,6 @@
 /* The nonlinear solve. The bulk operator is linear: K and r0 = F_bulk(0) are assembled once,
    the residual is K u + r0 + (contact terms) and the Jacobian K + (contact Jacobian). */
+#include <math.h>
 #include "signorini.h"
 
 PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
@@ -46,15 +47,41 @@ PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The SNES works on x~ = u/U with the residual F~(x~) = F(U x~)/U, U = user->snes_scale a power of 2 (exact in floating
+   point): F~ has the Jacobian of F, so Newton's iterates are U times smaller and the same, while the absolute tolerances
+   inside PETSc (SNESVI's bound tolerance, the line searches' maximal step) see a displacement of size one in any units.
+   The displacement of the iterate, U x~, goes to user->work. */
+static PetscErrorCode SolverIterateDisplacement(AppCtx *user, Vec X, Vec *u)
+{
+  PetscFunctionBeginUser;
+  *u = X;
+  if (user->snes_scale == 1.0) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(VecCopy(X, user->work));
+  PetscCall(VecScale(user->work, user->snes_scale));
+  *u = user->work;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The residual K u + r0 + (penalty term) at the displacement u, in the user's units. */
+static PetscErrorCode SolverResidual(DM dm, AppCtx *user, Vec u, Vec F)
+{
+  PetscFunctionBeginUser;
+  PetscCall(SolverBulkResidual(user, u, F));
+  if (user->contact.method == CONTACT_PENALTY) PetscCall(PenaltyAddResidual(dm, user, u, F));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode FormFunction(SNES snes, Vec X, Vec F, void *ctx)
 {
   AppCtx *user = (AppCtx *)ctx;
   DM      dm;
+  Vec     u;
 
   PetscFunctionBeginUser;
   PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(SolverBulkResidual(user, X, F));
-  if (user->contact.method == CONTACT_PENALTY) PetscCall(PenaltyAddResidual(dm, user, X, F));
+  PetscCall(SolverIterateDisplacement(user, X, &u));
+  PetscCall(SolverResidual(dm, user, u, F));
+  if (user->snes_scale != 1.0) PetscCall(VecScale(F, 1.0 / user->snes_scale));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -62,13 +89,15 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
 {
   AppCtx *user = (AppCtx *)ctx;
   DM      dm;
+  Vec     u;
 
   PetscFunctionBeginUser;
   PetscCall(SNESGetDM(snes, &dm));
+  PetscCall(SolverIterateDisplacement(user, X, &u));
   if (user->contact.method == CONTACT_PENALTY) {
-    PetscCall(PcReuseDecide(snes, dm, user, X));
+    PetscCall(PcReuseDecide(snes, dm, user, u));
     PetscCall(MatCopy(user->K, P, SAME_NONZERO_PATTERN));
-    PetscCall(PenaltyAddJacobian(dm, user, X, P));
+    PetscCall(PenaltyAddJacobian(dm, user, u, P));
     PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
   }
@@ -76,6 +105,73 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
     PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Newton stops, converged, when PETSc's tests say so (|F| fell by -snes_rtol, ...) or when |F| <= -contact_load_rtol
+   ||F(0)||: at round-off for the load, which a warm start (eps sweep, grid sequence) may reach before any reduction
+   by -snes_rtol. Every norm here is relative, so the test is the same in any units. */
+static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm, SNESConvergedReason *reason,
+                                      void *ctx)
+{
+  AppCtx         *user = (AppCtx *)ctx;
+  const PetscReal f    = fnorm * user->snes_scale; /* |F| in the user's units */
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, NULL));
+  if (it == 0) user->fnorm0 = f;
+  if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->contact.load_rtol * user->load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The scales of the problem on this mesh: the load ||F(0)||_2, and the displacement scale U, the largest entry of
+   the best displacement along F(0) (one steepest-descent step of the energy from u = 0: alpha F(0) with
+   alpha = |F(0)|^2 / F(0).K F(0)), rounded to a power of 2. Only U's order of magnitude matters. */
+PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
+{
+  MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
+  Vec         zero, F, KF;
+  PetscScalar fkf;
+  PetscReal   finf, U = 1.0;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMCreateGlobalVector(dm, &user->work));
+  PetscCall(DMGetGlobalVector(dm, &zero));
+  PetscCall(DMGetGlobalVector(dm, &F));
+  PetscCall(DMGetGlobalVector(dm, &KF));
+  PetscCall(VecZeroEntries(zero));
+  PetscCall(SolverResidual(dm, user, zero, F));
+  PetscCall(VecNorm(F, NORM_2, &user->load_norm));
+  PetscCheck(!PetscIsInfOrNanReal(user->load_norm), comm, PETSC_ERR_USER_INPUT,
+             "The load of the problem is not finite (||F(0)|| = %g): check the loads, the material and the mesh coordinates", (double)user->load_norm);
+  if (user->load_norm > 0.0) {
+    PetscCall(VecNorm(F, NORM_INFINITY, &finf));
+    PetscCall(MatMult(user->K, F, KF));
+    PetscCall(VecDot(F, KF, &fkf));
+    if (PetscRealPart(fkf) > 0.0) U = PetscSqr(user->load_norm) / PetscRealPart(fkf) * finf;
+    if (!(U > 0.0) || PetscIsInfOrNanReal(U)) U = 1.0;
+  }
+  user->displacement_scale = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
+  user->snes_scale         = 1.0;
+  PetscCall(DMRestoreGlobalVector(dm, &zero));
+  PetscCall(DMRestoreGlobalVector(dm, &F));
+  PetscCall(DMRestoreGlobalVector(dm, &KF));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The default linear solver: a direct solve (MUMPS), robust for the small problems of a first run; for the penalty
+   method inside CG, so that a factorization can serve as the preconditioner of later Newton steps (pc_reuse.c).
+   The Newton steps are as accurate as with a fresh factorization, also when it is reused. */
+static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
+{
+  PC pc;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPSetType(ksp, user->contact.method == CONTACT_PENALTY && user->contact.pc_reuse ? KSPCG : KSPPREONLY));
+  PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCLU));
+  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -119,15 +215,18 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     /* no convergence on a small step: with eps = 1e-7 (128x128 mms) it stopped Newton at |F| = 3e-4, far from the solution */
     PetscCall(SNESSetTolerances(*snes, PETSC_DEFAULT, PETSC_DEFAULT, 0.0, PETSC_DEFAULT, PETSC_DEFAULT));
   }
-  /* default linear solver: a direct solve (MUMPS), robust for the small problems of a first run; for the penalty method
-     inside CG, so that a factorization can serve as the preconditioner of later Newton steps (pc_reuse.c) */
+  {
+    SNESLineSearch ls;
+
+    /* no absolute test in the line search: the critical-point search would stop at the initial point, and report
+       CONVERGED_FNORM_ABS, wherever |F . dx| < 1e-15, that is for any problem whose loads are small in absolute terms */
+    PetscCall(SNESGetLineSearch(*snes, &ls));
+    PetscCall(SNESLineSearchSetTolerances(ls, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, 0.0, PETSC_DEFAULT, PETSC_DEFAULT));
+  }
+  PetscCall(SNESSetConvergenceTest(*snes, SolverConverged, user, NULL));
   PetscCall(SNESGetKSP(*snes, &ksp));
-  PetscCall(KSPSetType(ksp, user->contact.method == CONTACT_PENALTY && user->contact.pc_reuse ? KSPCG : KSPPREONLY));
-  /* Newton steps as accurate as with a fresh factorization, also when it is reused */
-  PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
+  PetscCall(SolverSetDefaultLinearSolver(ksp, user));
   PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, PCLU));
-  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   PetscCall(SNESMonitorSet(*snes, ContactMonitor, user, NULL));
   PetscCall(SNESSetFromOptions(*snes));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)*snes, &is_vi, SNESVINEWTONRSLS, SNESVINEWTONSSLS, ""));
@@ -153,20 +252,28 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Records the outcome of the last SNESSolve, with the iteration counts of all solves so far. */
+/* Records the outcome of the last SNESSolve, with the iteration counts of all solves so far. A solve counts as
+   converged only if PETSc says so and the residual fell by -snes_rtol or reached round-off for the load (or the
+   user's -snes_atol): a stop on a small step or in the line search with a large residual is a failure. */
 static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, PetscInt *ksp)
 {
-  PetscInt its, lits;
+  PetscInt  its, lits, maxit, maxf;
+  PetscReal fnorm, atol, rtol, stol;
 
   PetscFunctionBeginUser;
   PetscCall(SNESGetConvergedReason(snes, &user->stats.reason));
   PetscCall(SNESGetIterationNumber(snes, &its));
   PetscCall(SNESGetLinearSolveIterations(snes, &lits));
+  PetscCall(SNESGetFunctionNorm(snes, &fnorm));
+  PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
   *newton += its;
   *ksp += lits;
-  user->stats.newton_its = *newton;
-  user->stats.ksp_its    = *ksp;
-  user->stats.converged  = (PetscBool)(user->stats.reason > 0);
+  user->stats.newton_its       = *newton;
+  user->stats.ksp_its          = *ksp;
+  user->stats.residual_norm    = fnorm * user->displacement_scale; /* the SNES saw F/U */
+  user->stats.residual_reduced = (PetscBool)(user->stats.residual_norm <= rtol * user->fnorm0 ||
+                                             user->stats.residual_norm <= user->contact.load_rtol * user->load_norm || fnorm <= atol);
+  user->stats.converged        = (PetscBool)(user->stats.reason > 0 && user->stats.residual_reduced);
   user->stats.pc_builds  = user->pc_reuse.enabled ? user->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -181,7 +288,15 @@ static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal 
   DM                 dm;
 
   PetscFunctionBeginUser;
-  if (user->nrecords >= SOLVE_RECORDS_MAX) PetscFunctionReturn(PETSC_SUCCESS);
+  if (user->nrecords == user->maxrecords) { /* grow */
+    SolveRecord *grown;
+
+    user->maxrecords = PetscMax(16, 2 * user->maxrecords);
+    PetscCall(PetscMalloc1(user->maxrecords, &grown));
+    if (user->nrecords) PetscCall(PetscArraycpy(grown, user->records, user->nrecords));
+    PetscCall(PetscFree(user->records));
+    user->records = grown;
+  }
   r = &user->records[user->nrecords++];
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(DMGetDimension(dm, &dim));
@@ -200,6 +315,24 @@ static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal 
   r->time_setup          = user->level_setup_time;
   r->time_solve          = time_solve;
   user->level_setup_time = 0.0; /* counted once, with the first solve on the mesh */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* SNESSolve on x~ = u/U (and the bounds of SNESVI divided by U): see SolverIterateDisplacement(). */
+static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
+{
+  const PetscReal U = user->displacement_scale;
+
+  PetscFunctionBeginUser;
+  user->snes_scale = U;
+  PetscCall(VecScale(u, 1.0 / U));
+  if (user->xl) PetscCall(VecScale(user->xl, 1.0 / U));
+  if (user->xu) PetscCall(VecScale(user->xu, 1.0 / U));
+  PetscCall(SNESSolve(snes, NULL, u));
+  PetscCall(VecScale(u, U));
+  if (user->xl) PetscCall(VecScale(user->xl, U));
+  if (user->xu) PetscCall(VecScale(user->xu, U));
+  user->snes_scale = 1.0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -225,7 +358,7 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm)
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= user->contact.continuation_factor) {
       user->eps = eps;
       PetscCall(ElasticityUpdateConstants(dm, user));
-      PetscCall(SNESSolve(snes, NULL, u));
+      PetscCall(SolverSNESSolve(snes, user, u));
       PetscCall(RecordSolve(snes, user, &newton, &ksp));
       user->stats.continuation_stages++;
       if (!user->stats.converged) break; /* reported as the failure of the whole solve */
@@ -234,7 +367,7 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm)
     PetscCall(ElasticityUpdateConstants(dm, user));
   }
   if (user->stats.continuation_stages == 0 || user->stats.converged) {
-    PetscCall(SNESSolve(snes, NULL, u));
+    PetscCall(SolverSNESSolve(snes, user, u));
     PetscCall(RecordSolve(snes, user, &newton, &ksp));
   }
   PetscCall(PetscTime(&t1));
