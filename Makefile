@@ -12,7 +12,7 @@ ifdef PETSC_DIR
   CC           = $(PCC)
 else
   PETSC_CFLAGS = $(shell pkg-config --cflags petsc hdf5-openmpi)
-  PETSC_LIBS   = $(shell pkg-config --libs petsc)
+  PETSC_LIBS   = $(shell pkg-config --libs petsc hdf5-openmpi)
   CC           = mpicc
 endif
 CFLAGS  ?= -O2 -g

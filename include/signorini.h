@@ -324,6 +324,15 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u);
 /* postprocess.c */
 PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u);
 
+/* output_file.c */
+PetscErrorCode OutputFileInstallCleanup(void);
+PetscErrorCode OutputFileSplitPath(const char path[], char dir[], size_t dlen, char base[], size_t blen);
+PetscErrorCode OutputFileXdmfName(const char h5[], char xdmf[], size_t len);
+PetscErrorCode OutputFileCheckTarget(MPI_Comm comm, const char path[], PetscBool create_dir);
+PetscErrorCode OutputFileCreateTemps(MPI_Comm comm, const char dir[], PetscInt n, char temps[][PETSC_MAX_PATH_LEN]);
+PetscErrorCode OutputFileDiscardTemps(MPI_Comm comm);
+PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, char temps[][PETSC_MAX_PATH_LEN], const char *targets[]);
+
 /* output_hdf5.c */
 PetscErrorCode OutputGetOptions(MPI_Comm comm, AppCtx *user);
 PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u);

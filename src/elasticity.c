@@ -130,6 +130,8 @@ PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat)
   mat->poisson_ratio = 0.3;
   PetscCall(PetscOptionsReal("-poisson_ratio", "Poisson ratio nu, in (-1, 0.5)", NULL, mat->poisson_ratio, &mat->poisson_ratio, NULL));
   PetscOptionsEnd();
+  PetscCall(OptionsCheckFinite(comm, "-young_modulus", mat->young_modulus));
+  PetscCall(OptionsCheckFinite(comm, "-poisson_ratio", mat->poisson_ratio));
   PetscCheck(mat->young_modulus > 0.0, comm, PETSC_ERR_USER_INPUT, "-young_modulus must be positive, got %g", (double)mat->young_modulus);
   PetscCheck(mat->poisson_ratio > -1.0 && mat->poisson_ratio < 0.5, comm, PETSC_ERR_USER_INPUT, "-poisson_ratio must lie in (-1, 0.5), got %g",
              (double)mat->poisson_ratio);

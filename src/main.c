@@ -104,6 +104,7 @@ int main(int argc, char **argv)
   comm = PETSC_COMM_WORLD;
   PetscCall(PetscTime(&t0));
   PetscCall(PetscMemzero(&user, sizeof(user)));
+  PetscCall(OutputFileInstallCleanup());
   PetscCall(SceneRegisterAll());
   PetscCall(SceneGetOptions(comm, user.scene_name, sizeof(user.scene_name)));
   PetscCall(ElasticityGetOptions(comm, &user.material));
@@ -132,7 +133,14 @@ int main(int argc, char **argv)
   PetscCall(PrintSummary(dm, &user, u));
   PetscCall(OutputWriteHDF5(dm, &user, u));
   PetscCall(PetscPrintf(comm, "  output: %s\n", user.output));
-  if (!user.stats.converged)
+  if (!user.stats.converged && user.stats.reason > 0)
+    PetscCall(PetscPrintf(comm,
+                          "ERROR: the nonlinear solve failed: it stopped with %s after %" PetscInt_FMT
+                          " Newton steps at residual %g, which fell neither by -snes_rtol from %g nor to round-off for the load %g; written with "
+                          "converged = 0\n",
+                          SNESConvergedReasons[user.stats.reason], user.stats.newton_its, (double)user.stats.residual_norm, (double)user.fnorm0,
+                          (double)user.load_norm));
+  else if (!user.stats.converged)
     PetscCall(PetscPrintf(comm,
                           "ERROR: the nonlinear solve failed: %s after %" PetscInt_FMT " Newton steps, residual %g; written with converged = 0\n",
                           SNESConvergedReasons[user.stats.reason], user.stats.newton_its, (double)user.stats.residual_norm));

@@ -38,6 +38,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
      distributed mesh instead, on all ranks (at 1M unknowns the serial refinement and distribution cost more than the
      whole elastic solve on 2 ranks) */
   PetscCall(PetscOptionsClearValue(NULL, "-dm_refine"));
+  PetscCall(OptionsCheckFiniteArray(comm, "-dm_plex_box_lower", dim, lower));
+  PetscCall(OptionsCheckFiniteArray(comm, "-dm_plex_box_upper", dim, upper));
   for (PetscInt d = 0; d < dim; ++d) {
     PetscCheck(faces[d] >= 1, comm, PETSC_ERR_USER_INPUT, "-dm_plex_box_faces: need at least one cell per side, got %" PetscInt_FMT, faces[d]);
     PetscCheck(upper[d] > lower[d], comm, PETSC_ERR_USER_INPUT, "-dm_plex_box_upper must exceed -dm_plex_box_lower in every direction");

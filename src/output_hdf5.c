@@ -1,13 +1,18 @@
 /* HDF5 writer: mesh and vertex fields in PETSc's layout (petsc_gen_xdmf.py reads it), run metadata
-   as attributes of /run, an .xdmf beside it. Written under FILE.part and renamed when complete. */
+   as attributes of /run, an .xdmf beside it. Written under temporary names and renamed when complete (output_file.c). */
+#define _DEFAULT_SOURCE /* POSIX and BSD calls (mkstemp, lstat, sigaction, flock) under -std=c99 */
+#include <errno.h>
+#include <fcntl.h>
+#include <string.h>
+#include <sys/statvfs.h>
+#include <unistd.h>
 #include <petscsf.h>
 #include <petscviewerhdf5.h>
 #include "signorini.h"
 
 PetscErrorCode OutputGetOptions(MPI_Comm comm, AppCtx *user)
 {
-  char      dir[PETSC_MAX_PATH_LEN], *slash;
-  PetscBool set, exists;
+  PetscBool set;
 
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, NULL, "Output", "Signorini");
@@ -15,17 +20,7 @@ PetscErrorCode OutputGetOptions(MPI_Comm comm, AppCtx *user)
   PetscCall(
       PetscOptionsString("-output", "HDF5 output file (default output/<scene>.h5)", NULL, user->output, user->output, sizeof(user->output), &set));
   PetscOptionsEnd();
-  PetscCall(PetscStrncpy(dir, user->output, sizeof(dir)));
-  PetscCall(PetscStrrchr(dir, '/', &slash));
-  if (slash != dir) {
-    slash[-1] = '\0';
-    PetscCall(PetscTestDirectory(dir, 'w', &exists));
-    if (!exists && !set) { /* the default directory is created; a user's directory must exist */
-      PetscCall(PetscMkdir(dir));
-      PetscCall(PetscTestDirectory(dir, 'w', &exists));
-    }
-    PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "Output directory '%s' (-output %s) does not exist or is not writable", dir, user->output);
-  }
+  PetscCall(OutputFileCheckTarget(comm, user->output, (PetscBool)!set)); /* the default directory is created; a user's must exist */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -260,6 +255,9 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCall(WriteIntAttr(v, "grid_sequence", user->contact.grid_sequence));
   PetscCall(WriteIntAttr(v, "n_solves", user->nrecords));
   PetscCall(WriteRealAttr(v, "residual_norm", s->residual_norm));
+  PetscCall(WriteIntAttr(v, "residual_reduced", s->residual_reduced ? 1 : 0));
+  PetscCall(WriteRealAttr(v, "load_norm", user->load_norm));
+  PetscCall(WriteRealAttr(v, "displacement_scale", user->displacement_scale));
   PetscCall(WriteRealAttr(v, "time_setup", s->time_setup));
   PetscCall(WriteRealAttr(v, "time_solve", s->time_solve));
   PetscCall(WriteRealAttr(v, "time_total", s->time_total));
@@ -334,29 +332,20 @@ static PetscErrorCode WriteSolves(MPI_Comm comm, const AppCtx *user, PetscViewer
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* XDMF for ParaView, pointing into the final .h5 (rank 0 only). */
-static PetscErrorCode WriteXdmf(AppCtx *user, PetscInt dim, PetscInt ncells, PetscInt ncorners, PetscInt nverts)
+/* XDMF for ParaView into the file xdmf, pointing into h5name, the final .h5 beside it (rank 0 only). */
+static PetscErrorCode WriteXdmf(AppCtx *user, const char xdmf[], const char h5name[], PetscInt dim, PetscInt ncells, PetscInt ncorners,
+                                PetscInt nverts)
 {
   const char    *fields[] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "exact_displacement", "error"};
   const PetscInt ncomp[]  = {dim, 1, 1, 1, dim, dim};
   const PetscInt nfields  = user->scene.exact ? 6 : 4;
   const char    *topo     = dim == 2 ? (ncorners == 3 ? "Triangle" : "Quadrilateral") : (ncorners == 4 ? "Tetrahedron" : "Hexahedron");
-  char           xdmf[PETSC_MAX_PATH_LEN + 8], part[PETSC_MAX_PATH_LEN + 16], *h5name, *slash;
   FILE          *fp;
+  int            bad;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscStrrchr(user->output, '/', &slash));
-  h5name = slash;
-  PetscCall(PetscStrncpy(xdmf, user->output, sizeof(xdmf)));
-  {
-    size_t len;
-    PetscCall(PetscStrlen(xdmf, &len));
-    if (len > 3 && !strcmp(xdmf + len - 3, ".h5")) xdmf[len - 3] = '\0';
-    PetscCall(PetscStrlcat(xdmf, ".xdmf", sizeof(xdmf)));
-  }
-  PetscCall(PetscSNPrintf(part, sizeof(part), "%s.part", xdmf));
-  fp = fopen(part, "w");
-  PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Cannot write %s", part);
+  fp = fopen(xdmf, "w");
+  PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "%s", strerror(errno));
   fprintf(fp, "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"2.0\">\n <Domain>\n  <Grid Name=\"mesh\" GridType=\"Uniform\">\n");
   fprintf(fp, "   <Topology TopologyType=\"%s\" NumberOfElements=\"%d\">\n", topo, (int)ncells);
   fprintf(fp, "    <DataItem Dimensions=\"%d %d\" NumberType=\"Int\" Format=\"HDF\">%s:/viz/topology/cells</DataItem>\n   </Topology>\n", (int)ncells,
@@ -373,15 +362,16 @@ static PetscErrorCode WriteXdmf(AppCtx *user, PetscInt dim, PetscInt ncells, Pet
     fprintf(fp, "   </Attribute>\n");
   }
   fprintf(fp, "  </Grid>\n </Domain>\n</Xdmf>\n");
-  PetscCheck(fclose(fp) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot write %s", part);
-  PetscCheck(rename(part, xdmf) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot rename %s to %s", part, xdmf);
+  bad = fflush(fp) != 0 || ferror(fp);
+  bad = (fclose(fp) != 0) || bad;
+  PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "%s", strerror(errno));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
+/* The HDF5 file, written into the temporary h5tmp of the current directory, and the XDMF file into xdmftmp. */
+static PetscErrorCode WriteFiles(DM dm, AppCtx *user, Vec u, const char h5tmp[], const char xdmftmp[], const char h5name[])
 {
   MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
-  char        part[PETSC_MAX_PATH_LEN + 8];
   PetscViewer viewer;
   PetscInt    dim, cStart, cEnd, vStart, vEnd, ncells, nverts, ncorners = 0;
   PetscMPIInt rank;
@@ -397,8 +387,7 @@ PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
   if (dim == 3 && ncorners == 6) ncorners = 8; /* a hex has 6 faces and 8 corners; a triangle, quad or tet as many corners as faces */
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ncorners, 1, MPIU_INT, MPI_MAX, comm));
 
-  PetscCall(PetscSNPrintf(part, sizeof(part), "%s.part", user->output));
-  PetscCall(PetscViewerHDF5Open(comm, part, FILE_MODE_WRITE, &viewer));
+  PetscCall(PetscViewerHDF5Open(comm, h5tmp, FILE_MODE_WRITE, &viewer));
   PetscCall(PetscViewerPushFormat(viewer, PETSC_VIEWER_HDF5_VIZ));
   PetscCall(DMView(dm, viewer));
   PetscCall(WriteVertexFields(dm, user, u, viewer));
@@ -406,11 +395,56 @@ PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
   PetscCall(WriteRunMetadata(dm, user, u, viewer, ncells, nverts));
   PetscCall(WriteSolves(comm, user, viewer));
   PetscCall(PetscViewerDestroy(&viewer));
-  PetscCallMPI(MPI_Barrier(comm));
-  if (rank == 0) {
-    PetscCheck(rename(part, user->output) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot rename %s to %s", part, user->output);
-    PetscCall(WriteXdmf(user, dim, ncells, ncorners, nverts));
+  if (rank == 0) PetscCall(WriteXdmf(user, xdmftmp, h5name, dim, ncells, ncorners, nverts));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Writes FILE.h5 and FILE.xdmf (output_file.c: temporaries renamed when complete). The HDF5 file is written from
+   inside its directory under a short relative name: Open MPI 4.1's MPI-IO copies the file name into a 256-byte
+   buffer (a longer path crashed it). An I/O error is reported in one sentence naming the file and the cause. */
+PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
+{
+  MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
+  char           dir[PETSC_MAX_PATH_LEN], base[PETSC_MAX_PATH_LEN], xdmf[PETSC_MAX_PATH_LEN], temps[2][PETSC_MAX_PATH_LEN];
+  char           tdir[PETSC_MAX_PATH_LEN], h5tmp[PETSC_MAX_PATH_LEN];
+  const char    *targets[2] = {xdmf, user->output};
+  PetscErrorCode ierr;
+  int            cwd, err = 0, local_failed, failed;
+  H5E_auto2_t    h5_func;
+  void          *h5_data;
+
+  PetscFunctionBeginUser;
+  PetscCall(OutputFileSplitPath(user->output, dir, sizeof(dir), base, sizeof(base)));
+  PetscCall(OutputFileXdmfName(user->output, xdmf, sizeof(xdmf)));
+  PetscCall(OutputFileCreateTemps(comm, dir, 2, temps)); /* [0] the XDMF file, [1] the HDF5 file */
+  PetscCall(OutputFileSplitPath(temps[1], tdir, sizeof(tdir), h5tmp, sizeof(h5tmp)));
+  cwd = open(".", O_RDONLY | O_DIRECTORY);
+  PetscCheck(cwd >= 0 && chdir(dir) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Cannot enter the output directory '%s': %s", dir, strerror(errno));
+  (void)H5Eget_auto2(H5E_DEFAULT, &h5_func, &h5_data);
+  (void)H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* HDF5's own error stack: replaced by the sentence below */
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  errno = 0;
+  ierr  = WriteFiles(dm, user, u, h5tmp, temps[0], base);
+  err   = errno;
+  PetscCall(PetscPopErrorHandler());
+  (void)H5Eset_auto2(H5E_DEFAULT, h5_func, h5_data);
+  PetscCheck(fchdir(cwd) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "Cannot return to the working directory: %s", strerror(errno));
+  (void)close(cwd);
+  local_failed = ierr != 0;
+  PetscCallMPI(MPI_Allreduce(&local_failed, &failed, 1, MPI_INT, MPI_MAX, comm));
+  if (failed) {
+    const char    *text = NULL;
+    char          *specific = NULL, cause[256] = "the write failed on another rank";
+    struct statvfs fs;
+
+    PetscCall(OutputFileDiscardTemps(comm));
+    if (ierr) PetscCall(PetscErrorMessage(ierr, &text, &specific));
+    if (statvfs(dir, &fs) == 0 && fs.f_bavail == 0) PetscCall(PetscSNPrintf(cause, sizeof(cause), "no space left on the device of '%s'", dir));
+    else if (err == ENOSPC || err == EDQUOT || err == EFBIG || err == EIO || err == EROFS || err == EACCES)
+      PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", strerror(err)));
+    else if (ierr) PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", specific && specific[0] ? specific : text));
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot write the output file %s: %s", user->output, cause);
   }
-  PetscCallMPI(MPI_Barrier(comm));
+  PetscCall(OutputFileCommit(comm, dir, 2, temps, targets));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -379,10 +379,12 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm)
 }
 
 /* Hager's estimate of ||J^-1||_1 (Higham, ACM TOMS 14, 1988), with solves by the SNES's own linear solver, times ||J||_1:
-   the 1-norm condition number of the Jacobian at the solution (for vi: of K). J is symmetric, so J^-T x is a solve with J. */
+   the 1-norm condition number of the Jacobian at the solution (for vi: of K). J is symmetric, so J^-T x is a solve with J.
+   SNESVI's linear solver holds the reduced system of the last active set, so vi gets a linear solver of its own for K,
+   set up as the SNES's (the same defaults and options). */
 PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
 {
-  KSP                ksp;
+  KSP                ksp, ksp_vi = NULL;
   Mat                J;
   Vec                x, y, z;
   PetscReal          normJ, est = 0.0;
@@ -394,10 +396,13 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
   if (!user->contact.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
-  if (user->contact.method == CONTACT_VI)
+  if (user->contact.method == CONTACT_VI) {
     J = user->K;
-  else
-    PetscCall(SNESComputeJacobian(snes, u, J, J));
+    PetscCall(KSPCreate(PetscObjectComm((PetscObject)snes), &ksp_vi));
+    PetscCall(SolverSetDefaultLinearSolver(ksp_vi, user));
+    PetscCall(KSPSetFromOptions(ksp_vi));
+    ksp = ksp_vi;
+  } else PetscCall(SNESComputeJacobian(snes, u, J, J));
   PetscCall(KSPSetReusePreconditioner(ksp, PETSC_FALSE)); /* a preconditioner built for this very J */
   PetscCall(KSPSetOperators(ksp, J, J));
   PetscCall(MatNorm(J, NORM_1, &normJ));
@@ -440,6 +445,7 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
   user->stats.condition_1norm = normJ * est;
   PetscCall(VecDestroy(&x));
   PetscCall(VecDestroy(&y));
+  PetscCall(KSPDestroy(&ksp_vi));
   PetscCall(VecDestroy(&z));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

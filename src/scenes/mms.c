@@ -72,6 +72,10 @@ PetscErrorCode SceneCreate_MMS(DM dm, const Material *mat, Scene *scene)
   amp_b = 1.0;
   PetscCall(PetscOptionsReal("-mms_amplitude_B", "Amplitude B of the contact profile psi", NULL, amp_b, &amp_b, NULL));
   PetscOptionsEnd();
+  PetscCall(OptionsCheckFinite(comm, "-mms_nu", nu));
+  PetscCall(OptionsCheckFinite(comm, "-mms_a", a));
+  PetscCall(OptionsCheckFinite(comm, "-mms_amplitude_A", amp_a));
+  PetscCall(OptionsCheckFinite(comm, "-mms_amplitude_B", amp_b));
   PetscCheck(nu > 0.0 && nu <= 1.0, comm, PETSC_ERR_USER_INPUT, "-mms_nu must lie in (0, 1], got %g", (double)nu);
   PetscCheck(a > 0.0 && a < 1.0, comm, PETSC_ERR_USER_INPUT, "-mms_a must lie in (0, 1), got %g", (double)a);
   PetscCheck(amp_a > 0.0 && amp_b > 0.0, comm, PETSC_ERR_USER_INPUT, "-mms_amplitude_A and -mms_amplitude_B must be positive, got %g and %g",

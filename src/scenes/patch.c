@@ -45,6 +45,9 @@ PetscErrorCode SceneCreate_Patch(DM dm, const Material *mat, Scene *scene)
   rotation = 1e-2;
   PetscCall(PetscOptionsReal("-patch_rotation", "Rigid rotation angle in the (x_1, x_d) plane", NULL, rotation, &rotation, NULL));
   PetscOptionsEnd();
+  PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-patch_strain", strain));
+  PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-patch_lift", lift));
+  PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-patch_rotation", rotation));
   scene->contact_id    = 1;
   scene->num_dirichlet = 2 * dim - 1; /* every box face but the bottom */
   for (PetscInt i = 0; i < scene->num_dirichlet; ++i) scene->dirichlet_ids[i] = i + 2;

@@ -33,6 +33,9 @@ PetscErrorCode SceneCreate_Square(DM dm, const Material *mat, Scene *scene)
   PetscCall(
       PetscOptionsReal("-square_tilt", "Angle (degrees) of the foundation plane about the origin, in the (x_1, x_d) plane", NULL, tilt, &tilt, NULL));
   PetscOptionsEnd();
+  PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-square_beta", beta));
+  PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-square_x0", x0));
+  PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-square_tilt", tilt));
   PetscCheck(PetscAbsReal(tilt) < 45.0, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT, "-square_tilt must lie in (-45, 45) degrees, got %g",
              (double)tilt);
   scene->contact_id               = 1; /* bottom, x_d = 0, in 2D and 3D */
