@@ -204,7 +204,9 @@ PetscErrorCode SceneCreate_Patch(DM, const Material *, Scene *);
 PetscErrorCode SceneCreate_MMS(DM, const Material *, Scene *);
 
 /* mesh.c, mesh_box_simplex.c */
-PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm);
+PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm);
+PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[]);
+PetscErrorCode MeshCheckFaceSets(DM dm, const char scene[], const char what[], PetscInt n, const PetscInt ids[]);
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[], DM *dm);
 PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[]);
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
@@ -320,6 +322,7 @@ PetscErrorCode ErrorNormsPressureVector(DM dm, AppCtx *user, Vec loc_p);
 PetscErrorCode ErrorNormsEvaluate(DM dm, AppCtx *user, Mat K, Vec loc_uh, Vec loc_ph, const ErrorTarget *target, ErrorNorms *e);
 PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u);
 PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u);
+PetscErrorCode ReferenceCheckFile(DM dm, const AppCtx *user);
 
 /* postprocess.c */
 PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u);

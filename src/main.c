@@ -112,9 +112,10 @@ int main(int argc, char **argv)
   PetscCall(VerifyGetOptions(comm, &user.verify));
   PetscCall(OutputGetOptions(comm, &user));
 
-  PetscCall(MeshCreate(comm, &dm));
+  PetscCall(MeshCreate(comm, user.contact.grid_sequence, &dm));
   PetscCall(MeshPartitionGetStats(dm, &user.stats.partition)); /* the partitioner; the final mesh's cut is taken at output */
   PetscCall(ProblemSetUp(dm, &user, &snes));
+  PetscCall(ReferenceCheckFile(dm, &user)); /* before the solve, not after it */
   PetscCall(DMCreateGlobalVector(dm, &u));
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
   PetscCall(DMSNESCheckFromOptions(snes, u)); /* -dmsnes_check: PETSc's checks against the exact solution */

@@ -1,14 +1,62 @@
 /* Mesh creation: PETSc's box and file readers, plus the project's simplex box generator. */
+#define _DEFAULT_SOURCE /* sysconf(_SC_PHYS_PAGES) */
+#include <unistd.h>
 #include <petscsf.h>
 #include "signorini.h"
 
+/* Refuses, before anything is allocated, a mesh of ncells cells (after all refinements) that 32-bit PETSc indices
+   cannot number or that needs more memory than the machines of the run have: at least 1 kB per cell (the cheapest
+   measured run, linear elasticity with GAMG in 2D, needs 1.5 kB per cell), against the physical memory of the nodes. */
+PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[])
+{
+  const PetscReal bytes_per_cell = 1000.0, points_per_cell = dim == 2 ? 3.0 : 4.5; /* cells, faces, edges, vertices */
+  PetscReal       memory = 0.0, local;
+  MPI_Comm        node;
+  PetscMPIInt     node_rank;
+
+  PetscFunctionBeginUser;
+  PetscCheck(ncells * points_per_cell < (PetscReal)PETSC_MAX_INT, comm, PETSC_ERR_USER_INPUT,
+             "%s: the mesh would have %.3g cells, more mesh points than PETSc's %d-bit indices can number", what, (double)ncells,
+             (int)(8 * sizeof(PetscInt)));
+  PetscCallMPI(MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node));
+  PetscCallMPI(MPI_Comm_rank(node, &node_rank));
+  PetscCallMPI(MPI_Comm_free(&node));
+  local = node_rank == 0 ? (PetscReal)sysconf(_SC_PHYS_PAGES) * (PetscReal)sysconf(_SC_PAGE_SIZE) : 0.0; /* once per node */
+  PetscCall(MPIU_Allreduce(&local, &memory, 1, MPIU_REAL, MPIU_SUM, comm));
+  PetscCheck(memory <= 0.0 || ncells * bytes_per_cell <= memory, comm, PETSC_ERR_USER_INPUT,
+             "%s: the mesh would have %.3g cells and need at least %.3g GB of memory, more than the %.3g GB of the machine(s) of this run", what,
+             (double)ncells, (double)(ncells * bytes_per_cell / 1e9), (double)(memory / 1e9));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Reads the mesh file (DMSetFromOptions), with an error that names the file and the reader's complaint. */
+static PetscErrorCode MeshReadFile(MPI_Comm comm, const char filename[], DM dm)
+{
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  ierr = DMSetFromOptions(dm);
+  PetscCall(PetscPopErrorHandler());
+  if (ierr) {
+    const char *text     = NULL;
+    char       *specific = NULL;
+
+    PetscCall(PetscErrorMessage(ierr, &text, &specific));
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "Cannot read the mesh file '%s' (-dm_plex_filename): %s", filename,
+            specific && specific[0] ? specific : text);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Creates the mesh from PETSc's own options; simplex boxes, which PETSc 3.18 cannot generate
-   without Triangle/CTetGen, come from MeshCreateSimplexBox(). */
-PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
+   without Triangle/CTetGen, come from MeshCreateSimplexBox(). later_refinements: uniform refinements the run will
+   still make (grid sequencing), counted in the size check. */
+PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
 {
   PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
   PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
-  PetscBool           simplex, has_file, faces_set, parallel_read = PETSC_FALSE;
+  PetscBool           simplex, has_file, faces_set, dim_set, parallel_read = PETSC_FALSE;
   char                filename[PETSC_MAX_PATH_LEN] = "";
   MeshPartitionerType partitioner;
   MatType             mtype;
@@ -19,7 +67,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
   PetscCall(PetscOptionsString("-dm_plex_filename", "Mesh file (Gmsh, ExodusII, HDF5)", "DMPlexCreateFromFile", filename, filename, sizeof(filename),
                                &has_file));
   dim = 2;
-  PetscCall(PetscOptionsRangeInt("-dm_plex_dim", "Dimension of the box mesh", "DMPlexCreateBoxMesh", dim, &dim, NULL, 2, 3));
+  PetscCall(PetscOptionsRangeInt("-dm_plex_dim", "Dimension of the box mesh", "DMPlexCreateBoxMesh", dim, &dim, &dim_set, 2, 3));
   simplex = PETSC_TRUE;
   PetscCall(PetscOptionsBool("-dm_plex_simplex", "Simplices (triangles, tetrahedra) or tensor cells (quads, hexes)", "DMPlexCreateBoxMesh", simplex,
                              &simplex, NULL));
@@ -51,6 +99,14 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
     PetscCall(PetscTestFile(filename, 'r', &exists));
     PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "Mesh file '%s' (-dm_plex_filename) does not exist or cannot be read", filename);
   }
+  if (!has_file) {
+    char      what[64];
+    PetscReal ncells = (simplex ? (dim == 2 ? 2.0 : 6.0) : 1.0) * PetscPowReal(2.0, (PetscReal)(dim * (refine + later_refinements)));
+
+    for (PetscInt d = 0; d < dim; ++d) ncells *= (PetscReal)faces[d];
+    PetscCall(PetscSNPrintf(what, sizeof(what), "-dm_plex_box_faces with %" PetscInt_FMT " refinement(s)", refine + later_refinements));
+    PetscCall(MeshCheckSize(comm, dim, ncells, what));
+  }
   if (simplex && !has_file)
     PetscCall(MeshCreateSimplexBox(comm, dim, faces, lower, upper, dm));
   else {
@@ -70,7 +126,22 @@ PetscErrorCode MeshCreate(MPI_Comm comm, DM *dm)
      pieces that are only consistent after its own distribution (without it the solution is wrong): they get both. */
   if (has_file) PetscCall(PetscStrendswith(filename, ".h5", &parallel_read));
   if (!parallel_read) PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
-  PetscCall(DMSetFromOptions(*dm));
+  if (has_file) {
+    PetscInt  fdim, cStart, cEnd, n;
+    PetscReal ncells;
+    char      what[PETSC_MAX_PATH_LEN + 64];
+
+    PetscCall(MeshReadFile(comm, filename, *dm));
+    PetscCall(DMGetDimension(*dm, &fdim));
+    PetscCheck(!dim_set || fdim == dim, comm, PETSC_ERR_USER_INPUT,
+               "The mesh file '%s' holds a %" PetscInt_FMT "D mesh, but -dm_plex_dim %" PetscInt_FMT " was given", filename, fdim, dim);
+    PetscCall(DMPlexGetHeightStratum(*dm, 0, &cStart, &cEnd));
+    n = cEnd - cStart;
+    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &n, 1, MPIU_INT, MPI_SUM, comm)); /* the cells of the file (before the distribution) */
+    ncells = (PetscReal)n * PetscPowReal(2.0, (PetscReal)(fdim * (refine + later_refinements)));
+    PetscCall(PetscSNPrintf(what, sizeof(what), "%s with %" PetscInt_FMT " refinement(s)", filename, refine + later_refinements));
+    PetscCall(MeshCheckSize(comm, fdim, ncells, what));
+  } else PetscCall(DMSetFromOptions(*dm));
   PetscCall(DMGetMatType(*dm, &mtype));
   PetscCall(PetscStrallocpy(mtype, &mtype_copy)); /* -dm_mat_type, which the distributed mesh does not inherit */
   PetscCall(MeshPartitionDistribute(partitioner, dm));
@@ -136,6 +207,24 @@ PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id)
   PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, comm));
   PetscCheck(ntotal > 0, comm, PETSC_ERR_USER_INPUT,
              "The mesh has no contact boundary: no face carries \"Face Sets\" value %" PetscInt_FMT " (Gamma_C)", contact_id);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Refuses a mesh on which a face set the scene names (what: its role) is carried by no face. */
+PetscErrorCode MeshCheckFaceSets(DM dm, const char scene[], const char what[], PetscInt n, const PetscInt ids[])
+{
+  MPI_Comm comm = PetscObjectComm((PetscObject)dm);
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < n; ++i) {
+    PetscInt nf, total, *faces;
+
+    PetscCall(MeshGetBoundaryFaces(dm, ids[i], &nf, &faces));
+    PetscCall(PetscFree(faces));
+    PetscCall(MPIU_Allreduce(&nf, &total, 1, MPIU_INT, MPI_SUM, comm));
+    PetscCheck(total > 0, comm, PETSC_ERR_USER_INPUT, "No face of the mesh carries \"Face Sets\" value %" PetscInt_FMT ", which scene %s uses for %s",
+               ids[i], scene, what);
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -186,32 +186,72 @@ static PetscBool ReferenceHasCell(const Reference *ref, const PetscInt v[])
 }
 
 /* Every rank reads the whole reference: mesh, displacement and contact pressure at the vertices. */
-static PetscErrorCode ReferenceRead(MPI_Comm comm, const AppCtx *user, PetscInt dim, Reference *ref)
+/* The checks of the reference's /run against this run: same scene and dimension, converged, degree 1. */
+static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, PetscInt dim, PetscViewer v, PetscInt *ref_dim, PetscInt *ncells)
 {
   const char *file = user->verify.reference;
-  PetscViewer v;
-  PetscInt    converged, degree, n;
-  PetscReal  *cells;
+  const char *datasets[] = {"/geometry/vertices", "/vertex_fields/displacement", "/vertex_fields/contact_pressure", "/viz/topology/cells"};
+  PetscInt    converged, degree;
   char       *scene = NULL;
-  PetscBool   same;
+  PetscBool   same, has;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMemzero(ref, sizeof(*ref)));
-  PetscCall(PetscViewerHDF5Open(PETSC_COMM_SELF, file, FILE_MODE_READ, &v));
-  PetscCall(ReadIntAttribute(v, file, "dim", &ref->dim));
+  PetscCall(PetscViewerHDF5HasGroup(v, "/run", &has));
+  PetscCheck(has, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "Reference file %s has no /run group: not an output of this solver", file);
+  PetscCall(ReadIntAttribute(v, file, "dim", ref_dim));
   PetscCall(ReadIntAttribute(v, file, "degree", &degree));
   PetscCall(ReadIntAttribute(v, file, "converged", &converged));
-  PetscCall(ReadIntAttribute(v, file, "n_cells", &ref->ncells));
+  PetscCall(ReadIntAttribute(v, file, "n_cells", ncells));
+  PetscCall(PetscViewerHDF5HasAttribute(v, "/run", "scene", &has));
+  PetscCheck(has, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "Reference file %s has no /run attribute scene: not an output of this solver", file);
   PetscCall(PetscViewerHDF5ReadAttribute(v, "/run", "scene", PETSC_STRING, NULL, &scene));
   PetscCall(PetscStrcmp(scene, user->scene.name, &same));
   PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "Reference %s is a run of scene %s, this is scene %s", file, scene, user->scene.name);
   PetscCall(PetscFree(scene));
-  PetscCheck(ref->dim == dim, comm, PETSC_ERR_USER_INPUT, "Reference %s is %" PetscInt_FMT "D, this run is %" PetscInt_FMT "D", file, ref->dim, dim);
+  PetscCheck(*ref_dim == dim, comm, PETSC_ERR_USER_INPUT, "Reference %s is %" PetscInt_FMT "D, this run is %" PetscInt_FMT "D", file, *ref_dim, dim);
   PetscCheck(converged == 1, comm, PETSC_ERR_USER_INPUT, "Reference %s did not converge (/run converged = 0)", file);
   PetscCheck(degree == 1 && user->degree == 1, comm, PETSC_ERR_USER_INPUT,
              "-reference needs degree 1 in the run and the reference (they are compared through vertex values); got %" PetscInt_FMT
              " and %" PetscInt_FMT,
              user->degree, degree);
+  for (size_t i = 0; i < sizeof(datasets) / sizeof(datasets[0]); ++i) {
+    PetscCall(PetscViewerHDF5HasDataset(v, datasets[i], &has));
+    PetscCheck(has, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "Reference file %s has no dataset %s: not an output of this solver", file, datasets[i]);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Before the solve: the -reference file (if any) opens as HDF5 and fits this run (ReferenceCheckHeader()). */
+PetscErrorCode ReferenceCheckFile(DM dm, const AppCtx *user)
+{
+  const char    *file = user->verify.reference;
+  PetscViewer    v;
+  PetscInt       dim, ref_dim, ncells;
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  if (!file[0]) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  ierr = PetscViewerHDF5Open(PETSC_COMM_SELF, file, FILE_MODE_READ, &v);
+  PetscCall(PetscPopErrorHandler());
+  PetscCheck(!ierr, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Reference file '%s' (-reference) cannot be opened as an HDF5 file", file);
+  PetscCall(ReferenceCheckHeader(PetscObjectComm((PetscObject)dm), user, dim, v, &ref_dim, &ncells));
+  PetscCall(PetscViewerDestroy(&v));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode ReferenceRead(MPI_Comm comm, const AppCtx *user, PetscInt dim, Reference *ref)
+{
+  const char *file = user->verify.reference;
+  PetscViewer v;
+  PetscInt    n;
+  PetscReal  *cells;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(ref, sizeof(*ref)));
+  PetscCall(PetscViewerHDF5Open(PETSC_COMM_SELF, file, FILE_MODE_READ, &v));
+  PetscCall(ReferenceCheckHeader(comm, user, dim, v, &ref->dim, &ref->ncells));
   PetscCall(ReadArray(v, file, "/geometry", "vertices", &n, &ref->x));
   ref->nv = n / dim;
   PetscCall(ReadArray(v, file, "/vertex_fields", "displacement", &n, &ref->u));

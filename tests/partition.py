@@ -9,7 +9,7 @@ import subprocess
 
 import numpy as np
 
-from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position, test
+from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position, test, write_gmsh_square
 
 SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "false"]  # 32x32, default solver (MUMPS)
 MMS3D = ["-options_file", "options/mms.yaml", "-dm_plex_dim", 3, "-dm_plex_box_faces", "6,6,6"]
@@ -61,26 +61,11 @@ def metis_tensor_box_matches_serial():
     check_same_as_serial(SQUARE + ["-dm_plex_simplex", 0], "part_quads", nranks=(2,))
 
 
-def write_gmsh_square(path, n):
-    """A Gmsh 2.2 file of the unit square in n x n quadrilaterals, physical lines 1-4 numbered as PETSc's box."""
-    vid = lambda i, j: j * (n + 1) + i + 1  # noqa: E731
-    sides = {1: [(vid(i, 0), vid(i + 1, 0)) for i in range(n)], 2: [(vid(n, j), vid(n, j + 1)) for j in range(n)],
-             3: [(vid(i, n), vid(i + 1, n)) for i in range(n)], 4: [(vid(0, j), vid(0, j + 1)) for j in range(n)]}
-    elems = [f"1 2 {tag} {tag} {a} {b}" for tag, segs in sides.items() for a, b in segs]
-    elems += [f"3 2 10 10 {vid(i, j)} {vid(i + 1, j)} {vid(i + 1, j + 1)} {vid(i, j + 1)}" for j in range(n) for i in range(n)]
-    with open(path, "w") as fp:
-        fp.write("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n%d\n" % (n + 1) ** 2)
-        fp.writelines(f"{vid(i, j)} {i / n!r} {j / n!r} 0\n" for j in range(n + 1) for i in range(n + 1))
-        fp.write("$EndNodes\n$Elements\n%d\n" % len(elems))
-        fp.writelines(f"{k + 1} {e}\n" for k, e in enumerate(elems))
-        fp.write("$EndElements\n")
-
-
 @test
 def metis_gmsh_file_matches_serial():
     """A mesh read from a Gmsh file goes through the same distribution: METIS on 2 ranks, the serial answer."""
     msh = os.path.join(OUT, "part_square16.msh")
-    write_gmsh_square(msh, 16)
+    write_gmsh_square(msh, 16, quads=True)
     check_same_as_serial(SQUARE + ["-dm_plex_filename", msh], "part_msh", nranks=(2,))
 
 

@@ -19,7 +19,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from harness import BIN, ENV, OUT, ROOT, TESTS, load, read_runs, run, sorted_by_position, test  # noqa: E402
+from harness import BIN, ENV, OUT, ROOT, TESTS, load, read_runs, run, sorted_by_position, test, write_gmsh_square  # noqa: E402
 
 # ---------------------------------------------------------------- discretization
 PATCH_MESHES = {
@@ -224,28 +224,6 @@ def yaml_options_file():
     log, h5 = run(["-options_file", "options/square.yaml", "-dm_plex_box_faces", "8,8", "-options_file", "options/solvers/hypre.yaml"], "yaml")
     attrs, _ = load(h5)
     assert attrs["converged"] == 1 and attrs["scene"] == "square" and attrs["n_cells"] == 128 and attrs["ksp_its"] > attrs["newton_its"]
-
-
-def write_gmsh_square(path, n, with_contact=True):
-    """A Gmsh 2.2 file of the unit square split like the built-in simplex box; physical lines 1-4 as PETSc's box."""
-    nodes = [(i / n, j / n) for j in range(n + 1) for i in range(n + 1)]
-    vid = lambda i, j: j * (n + 1) + i + 1  # noqa: E731
-    elems = []
-    sides = {1: [(vid(i, 0), vid(i + 1, 0)) for i in range(n)], 2: [(vid(n, j), vid(n, j + 1)) for j in range(n)],
-             3: [(vid(i, n), vid(i + 1, n)) for i in range(n)], 4: [(vid(0, j), vid(0, j + 1)) for j in range(n)]}
-    for tag, segs in sides.items():
-        if tag == 1 and not with_contact:
-            continue
-        elems += [f"1 2 {tag} {tag} {a} {b}" for a, b in segs]
-    for j in range(n):
-        for i in range(n):
-            elems += [f"2 2 10 10 {vid(i, j)} {vid(i + 1, j)} {vid(i + 1, j + 1)}", f"2 2 10 10 {vid(i, j)} {vid(i + 1, j + 1)} {vid(i, j + 1)}"]
-    with open(path, "w") as fp:
-        fp.write("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n$Nodes\n%d\n" % len(nodes))
-        fp.writelines(f"{k + 1} {x!r} {y!r} 0\n" for k, (x, y) in enumerate(nodes))
-        fp.write("$EndNodes\n$Elements\n%d\n" % len(elems))
-        fp.writelines(f"{k + 1} {e}\n" for k, e in enumerate(elems))
-        fp.write("$EndElements\n")
 
 
 @test
