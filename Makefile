@@ -17,7 +17,7 @@ else
 endif
 CFLAGS  ?= -O2 -g
 CFLAGS  += -std=c99 -Wall -Wextra -Wno-unused-parameter -Iinclude
-LDLIBS  += $(PETSC_LIBS) -lmetis -lm
+LDLIBS  += $(PETSC_LIBS) -lyaml -lmetis -lm
 
 SRC = $(wildcard src/*.c src/scenes/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
@@ -28,7 +28,7 @@ STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
 deps:
-	@pkg-config --exists petsc && [ -f /usr/include/metis.h ] && command -v mpicc >/dev/null && command -v mpiexec >/dev/null && \
+	@pkg-config --exists petsc && [ -f /usr/include/metis.h ] && [ -f /usr/include/yaml.h ] && command -v mpicc >/dev/null && command -v mpiexec >/dev/null && \
 	  $(PYTHON) -c "import h5py, numpy, matplotlib, yaml" 2>/dev/null || sh scripts/install-deps.sh
 
 build/%.o: src/%.c include/signorini.h include/compat.h

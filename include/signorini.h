@@ -189,6 +189,9 @@ typedef struct {
   PetscBool      assembly_check; /* -assembly_check: assemble K both ways and compare */
 } AppCtx;
 
+/* options_files.c (before PetscInitialize(): plain C, returns 1 after printing the problem) */
+int OptionsFilesCheckYAML(int argc, char **argv);
+
 /* options_check.c */
 PetscErrorCode OptionsCheckFinite(MPI_Comm comm, const char name[], PetscReal value);
 PetscErrorCode OptionsCheckFiniteArray(MPI_Comm comm, const char name[], PetscInt n, const PetscReal values[]);

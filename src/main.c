@@ -100,6 +100,7 @@ int main(int argc, char **argv)
   MPI_Comm       comm;
   PetscLogDouble t0, t1;
 
+  if (OptionsFilesCheckYAML(argc, argv)) return 1; /* PETSc's own message would not name the file */
   PetscCall(PetscInitialize(&argc, &argv, NULL, help));
   comm = PETSC_COMM_WORLD;
   PetscCall(PetscTime(&t0));

@@ -368,7 +368,7 @@ static PetscErrorCode WriteXdmf(AppCtx *user, const char xdmf[], const char h5na
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The HDF5 file, written into the temporary h5tmp of the current directory, and the XDMF file into xdmftmp. */
+/* The HDF5 file, written into the temporary h5tmp, and the XDMF file into xdmftmp, both in the current directory. */
 static PetscErrorCode WriteFiles(DM dm, AppCtx *user, Vec u, const char h5tmp[], const char xdmftmp[], const char h5name[])
 {
   MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
@@ -406,7 +406,7 @@ PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
 {
   MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
   char           dir[PETSC_MAX_PATH_LEN], base[PETSC_MAX_PATH_LEN], xdmf[PETSC_MAX_PATH_LEN], temps[2][PETSC_MAX_PATH_LEN];
-  char           tdir[PETSC_MAX_PATH_LEN], h5tmp[PETSC_MAX_PATH_LEN];
+  char           tdir[PETSC_MAX_PATH_LEN], h5tmp[PETSC_MAX_PATH_LEN], xdmftmp[PETSC_MAX_PATH_LEN];
   const char    *targets[2] = {xdmf, user->output};
   PetscErrorCode ierr;
   int            cwd, err = 0, local_failed, failed;
@@ -417,6 +417,7 @@ PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
   PetscCall(OutputFileSplitPath(user->output, dir, sizeof(dir), base, sizeof(base)));
   PetscCall(OutputFileXdmfName(user->output, xdmf, sizeof(xdmf)));
   PetscCall(OutputFileCreateTemps(comm, dir, 2, temps)); /* [0] the XDMF file, [1] the HDF5 file */
+  PetscCall(OutputFileSplitPath(temps[0], tdir, sizeof(tdir), xdmftmp, sizeof(xdmftmp))); /* names inside dir */
   PetscCall(OutputFileSplitPath(temps[1], tdir, sizeof(tdir), h5tmp, sizeof(h5tmp)));
   cwd = open(".", O_RDONLY | O_DIRECTORY);
   PetscCheck(cwd >= 0 && chdir(dir) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Cannot enter the output directory '%s': %s", dir, strerror(errno));
@@ -424,7 +425,7 @@ PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
   (void)H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* HDF5's own error stack: replaced by the sentence below */
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
   errno = 0;
-  ierr  = WriteFiles(dm, user, u, h5tmp, temps[0], base);
+  ierr  = WriteFiles(dm, user, u, h5tmp, xdmftmp, base);
   err   = errno;
   PetscCall(PetscPopErrorHandler());
   (void)H5Eset_auto2(H5E_DEFAULT, h5_func, h5_data);

@@ -125,7 +125,7 @@ def bad_input_leaves_a_previous_good_output_untouched():
     with open(garbage, "w") as fh:
         fh.write("garbage\n")
     cases = {
-        "malformed_yaml": (["-options_file", bad_yaml], "YAML parser loading error"),
+        "malformed_yaml": (["-options_file", bad_yaml], f"the options file '{bad_yaml}' is not valid YAML"),
         "garbage_mesh": (["-dm_plex_filename", garbage], "File is not a valid Gmsh file"),
         "vi_tilted": (["-contact_method", "vi", "-square_tilt", 5], "-contact_method vi needs Gamma_C normal to a coordinate axis"),
         "tilt_range": (["-square_tilt", 60], "-square_tilt must lie in (-45, 45) degrees"),
