@@ -23,7 +23,7 @@ SRC = $(wildcard src/*.c src/scenes/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test rates extremes tradeoff bench format clean
+.PHONY: all deps run test asan rates extremes tradeoff bench format clean
 STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
@@ -38,6 +38,20 @@ build/%.o: src/%.c include/signorini.h include/compat.h
 $(BIN): $(OBJ)
 	@mkdir -p bin
 	$(CC) $(CFLAGS) -o $@ $(OBJ) $(LDLIBS)
+
+# AddressSanitizer and UndefinedBehaviorSanitizer build of the same sources (tests/sanitize.py runs a few cases with it)
+ASAN_FLAGS = -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer
+ASAN_OBJ   = $(SRC:src/%.c=build-asan/%.o)
+ASAN_BIN   = bin/signorini-asan
+build-asan/%.o: src/%.c include/signorini.h include/compat.h
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS) $(ASAN_FLAGS) $(PETSC_CFLAGS) -c $< -o $@
+
+$(ASAN_BIN): $(ASAN_OBJ)
+	@mkdir -p bin
+	$(CC) $(CFLAGS) $(ASAN_FLAGS) -o $@ $(ASAN_OBJ) $(LDLIBS)
+
+asan: $(ASAN_BIN)
 
 run: deps
 	@$(MAKE) --no-print-directory $(BIN)
@@ -79,4 +93,4 @@ format:
 	clang-format -i src/*.c src/scenes/*.c include/*.h
 
 clean:
-	rm -rf build bin output tests/out
+	rm -rf build build-asan bin output tests/out

@@ -58,21 +58,22 @@ PetscErrorCode CellReferenceCoordinates(DM dm, PetscInt c, PetscInt n, const Pet
 {
   PetscInt        dim;
   PetscQuadrature q;
+  PetscReal      *pt, *wt;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(PetscQuadratureCreate(PETSC_COMM_SELF, &q));
+  PetscCall(PetscMalloc1(dim, &pt)); /* owned by q, which reads the point at each geometry call */
+  PetscCall(PetscMalloc1(1, &wt));
+  wt[0] = 1.0;
+  PetscCall(PetscQuadratureSetData(q, dim, 1, 1, pt, wt));
   for (PetscInt i = 0; i < n; ++i) {
-    PetscReal *pt, *wt, v[3], J[9], invJ[9], detJ, res = PETSC_MAX_REAL;
-    PetscInt   it;
+    PetscReal v[3], J[9], invJ[9], detJ, res = PETSC_MAX_REAL;
+    PetscInt  it;
 
     for (PetscInt d = 0; d < dim; ++d) xi[i * dim + d] = 0.0;
     for (it = 0; it < 20 && res > 1e-13; ++it) {
-      PetscCall(PetscMalloc1(dim, &pt)); /* owned by q */
-      PetscCall(PetscMalloc1(1, &wt));
       for (PetscInt d = 0; d < dim; ++d) pt[d] = xi[i * dim + d];
-      wt[0] = 1.0;
-      PetscCall(PetscQuadratureSetData(q, dim, 1, 1, pt, wt));
       PetscCall(DMPlexComputeCellGeometryFEM(dm, c, q, v, J, invJ, &detJ));
       res = 0.0;
       for (PetscInt d = 0; d < dim; ++d) {

@@ -283,6 +283,10 @@ import assembly  # noqa: E402,F401  (registers the assembly tests)
 import robustness  # noqa: E402,F401  (registers the robustness tests)
 import partition  # noqa: E402,F401  (registers the partitioning tests)
 import verification  # noqa: E402,F401  (registers the verification tests)
+import hostile  # noqa: E402,F401  (registers the hostile-input catalogue)
+import units  # noqa: E402,F401  (registers the unit-invariance tests)
+import safety  # noqa: E402,F401  (registers the signal and concurrency tests of the output)
+import sanitize  # noqa: E402,F401  (registers the sanitizer runs)
 
 
 def main():

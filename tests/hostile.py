@@ -1,0 +1,334 @@
+"""Hostile input (make test): every case is refused with a non-zero exit and a message that names the option or the
+file, and leaves the previous good output at the same path byte for byte as it was, with no temporary file beside it.
+
+Each case runs in a directory of its own holding a copy of a good run's result.h5 and result.xdmf; the bad run is
+aimed at result.h5 (or at the hostile -output path of the case, next to it).
+"""
+import hashlib
+import os
+import shutil
+import stat
+import subprocess
+
+from harness import BIN, ENV, OUT, ROOT, run, test, write_gmsh_cube, write_gmsh_square
+
+HOSTILE = os.path.join(OUT, "hostile")
+SMALL = ["-dm_plex_box_faces", "4,4"]
+_GOOD = {}
+
+
+def good_output():
+    """A good run's FILE.h5 and FILE.xdmf, made once and copied into each case's directory."""
+    if not _GOOD:
+        os.makedirs(HOSTILE, exist_ok=True)
+        _, h5 = run(SMALL, "hostile/good")
+        _GOOD["h5"], _GOOD["xdmf"] = h5, h5[:-3] + ".xdmf"
+    return _GOOD
+
+
+def digest(path):
+    with open(path, "rb") as fh:
+        return hashlib.sha256(fh.read()).hexdigest()
+
+
+def snapshot(directory):
+    """Every entry of the directory: kind and, for a regular file, its digest (symbolic links are not followed)."""
+    state = {}
+    for name in sorted(os.listdir(directory)):
+        path = os.path.join(directory, name)
+        mode = os.lstat(path).st_mode
+        if stat.S_ISREG(mode):
+            state[name] = ("file", digest(path))
+        elif stat.S_ISLNK(mode):
+            state[name] = ("link", os.readlink(path))
+        else:
+            state[name] = ("dir" if stat.S_ISDIR(mode) else "fifo" if stat.S_ISFIFO(mode) else "other", None)
+    return state
+
+
+def case_dir(name):
+    d = os.path.join(HOSTILE, name)
+    shutil.rmtree(d, ignore_errors=True)
+    os.makedirs(d)
+    good = good_output()
+    shutil.copy2(good["h5"], os.path.join(d, "result.h5"))
+    shutil.copy2(good["xdmf"], os.path.join(d, "result.xdmf"))
+    return d
+
+
+def refuse(d, args, message, output=None, np_=1):
+    """Runs the bad case in directory d; returns its output. Asserts the refusal, the message, and that d is as it was."""
+    before = snapshot(d)
+    target = output if output is not None else os.path.join(d, "result.h5")
+    cmd = ["mpiexec", "-n", str(np_), BIN] + [str(a) for a in args] + ["-output", target]
+    p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=300)
+    assert p.returncode != 0, f"bad input accepted (exit 0): {' '.join(cmd)}"
+    assert message in p.stdout, f"message '{message}' not in:\n{p.stdout[-2500:]}"
+    after = snapshot(d)
+    assert after == before, f"the directory changed: {before} -> {after}"
+    return p.stdout
+
+
+# (name, args, message): options and values. Messages name the option.
+OPTION_CASES = [
+    ("unknown_scene", ["-scene", "nosuch"], "Unknown scene 'nosuch' (-scene)"),
+    ("eps_zero", ["-penalty_eps", 0], "-penalty_eps must be positive"),
+    ("eps_negative", ["-penalty_eps", -1e-3], "-penalty_eps must be positive"),
+    ("eps_inf", ["-penalty_eps", "inf"], "-penalty_eps must be a finite number"),
+    ("eps_nan", ["-penalty_eps", "nan"], "-penalty_eps must be a finite number"),
+    ("eps0_inf", ["-penalty_eps0", "inf"], "-penalty_eps0 must be a finite number"),
+    ("eps0_zero", ["-penalty_eps0", 0], "-penalty_eps0 must be positive"),
+    ("eps_power", ["-penalty_eps_power", 5], "-penalty_eps_power must lie in [0, 4]"),
+    ("sweep_inf", ["-penalty_eps0_sweep", "1,inf"], "-penalty_eps0_sweep must be a list of finite numbers, got inf"),
+    ("sweep_negative", ["-penalty_eps0_sweep", "1,-1"], "-penalty_eps0_sweep: every value must be positive"),
+    ("sweep_with_eps", ["-penalty_eps0_sweep", "1,0.1", "-penalty_eps", 1e-3], "-penalty_eps0_sweep cannot be given together with -penalty_eps"),
+    ("sweep_with_vi", ["-penalty_eps0_sweep", "1,0.1", "-contact_method", "vi"], "-penalty_eps0_sweep needs -contact_method penalty"),
+    ("young_inf", ["-young_modulus", "inf"], "-young_modulus must be a finite number"),
+    ("young_nan", ["-young_modulus", "nan"], "-young_modulus must be a finite number"),
+    ("young_zero", ["-young_modulus", 0], "-young_modulus must be positive"),
+    ("poisson_half", ["-poisson_ratio", 0.5], "-poisson_ratio must lie in (-1, 0.5)"),
+    ("poisson_nan", ["-poisson_ratio", "nan"], "-poisson_ratio must be a finite number"),
+    ("beta_inf", ["-square_beta", "inf"], "-square_beta must be a finite number"),
+    ("beta_nan", ["-square_beta", "nan"], "-square_beta must be a finite number"),
+    ("x0_inf", ["-square_x0", "-inf"], "-square_x0 must be a finite number"),
+    ("tilt_range", ["-square_tilt", 60], "-square_tilt must lie in (-45, 45) degrees"),
+    ("vi_tilted", ["-contact_method", "vi", "-square_tilt", 5], "-contact_method vi needs Gamma_C normal to a coordinate axis"),
+    ("mms_amplitude_inf", ["-scene", "mms", "-mms_amplitude_A", "inf"], "-mms_amplitude_A must be a finite number"),
+    ("mms_nu_zero", ["-scene", "mms", "-mms_nu", 0], "-mms_nu must lie in (0, 1]"),
+    ("mms_a_outside", ["-scene", "mms", "-mms_a", 1.5], "-mms_a must lie in (0, 1)"),
+    ("patch_lift_nan", ["-scene", "patch", "-patch_lift", "nan"], "-patch_lift must be a finite number"),
+    ("box_upper_inf", ["-dm_plex_box_upper", "inf,1"], "-dm_plex_box_upper must be a list of finite numbers, got inf"),
+    ("box_upper_below_lower", ["-dm_plex_box_upper", "0,1"], "-dm_plex_box_upper must exceed -dm_plex_box_lower"),
+    ("box_faces_zero", ["-dm_plex_box_faces", "0,4"], "-dm_plex_box_faces: need at least one cell per side"),
+    ("box_faces_overflow", ["-dm_plex_box_faces", "100000,100000"], "-dm_plex_box_faces with 0 refinement(s): the mesh would have 2e+10 cells, more mesh points than"),
+    ("box_faces_memory", ["-dm_plex_box_faces", "5000,5000"], "the mesh would have 5e+07 cells and need at least 50 GB of memory"),
+    ("refine_memory", ["-dm_plex_box_faces", "64,64", "-dm_refine", 10], "-dm_plex_box_faces with 10 refinement(s): the mesh would have"),
+    ("grid_sequence_memory", ["-dm_plex_box_faces", "64,64", "-contact_grid_sequence", 8], "-dm_plex_box_faces with 8 refinement(s)"),
+    ("grid_sequence_range", ["-contact_grid_sequence", 9], "-contact_grid_sequence must lie in [0, 8]"),
+    ("continuation_factor", ["-penalty_continuation_factor", 1.5], "-penalty_continuation_factor must lie in (0, 1)"),
+    ("load_rtol", ["-contact_load_rtol", 2], "-contact_load_rtol must lie in [0, 1)"),
+    ("unknown_method", ["-contact_method", "bogus"], "Unknown option bogus for -contact_method"),
+    ("unknown_partitioner", ["-partitioner", "bogus"], "Unknown option bogus for -partitioner"),
+    ("option_typo", ["-penalty_esp", 1], "never used (misspelled? see -help): -penalty_esp"),
+    ("vi_with_newtonls", ["-contact_method", "vi", "-snes_type", "newtonls"], "-snes_type newtonls does not fit -contact_method vi"),
+    ("vi_with_gamg", ["-contact_method", "vi", "-pc_type", "gamg"], "-pc_type gamg cannot follow the reduced system"),
+    ("p1_assembly_on_p2", ["-displacement_petscspace_degree", 2, "-assembly", "p1"], "-assembly p1 needs P1 displacements"),
+]
+for _name, _args, _message in OPTION_CASES:
+    def _case(name=_name, args=_args, message=_message):
+        refuse(case_dir(name), SMALL + args, message)
+    _case.__name__ = f"hostile_{_name}"
+    test(_case)
+
+
+@test
+def hostile_parallel_runs_refuse_alike():
+    """On 2 ranks too: an infinite modulus and a missing mesh are named, and the output is left alone."""
+    refuse(case_dir("parallel_young_inf"), SMALL + ["-young_modulus", "inf"], "-young_modulus must be a finite number", np_=2)
+    d = case_dir("parallel_missing_mesh")
+    refuse(d, ["-dm_plex_filename", os.path.join(d, "missing.msh")], f"Mesh file '{os.path.join(d, 'missing.msh')}' (-dm_plex_filename) does not exist", np_=2)
+
+
+# ---------------------------------------------------------------- files: every message names the file
+@test
+def hostile_missing_mesh_file():
+    d = case_dir("missing_mesh")
+    msh = os.path.join(d, "missing.msh")
+    refuse(d, ["-dm_plex_filename", msh], f"Mesh file '{msh}' (-dm_plex_filename) does not exist or cannot be read")
+
+
+@test
+def hostile_truncated_mesh_file():
+    d = case_dir("truncated_mesh")
+    msh = os.path.join(d, "truncated.msh")
+    write_gmsh_square(msh, 4)
+    text = open(msh).read()
+    with open(msh, "w") as fh:
+        fh.write(text[: len(text) // 2])
+    refuse(d, ["-dm_plex_filename", msh], f"Cannot read the mesh file '{msh}' (-dm_plex_filename): ")
+
+
+@test
+def hostile_garbage_mesh_file():
+    d = case_dir("garbage_mesh")
+    msh = os.path.join(d, "garbage.msh")
+    with open(msh, "w") as fh:
+        fh.write("garbage\n")
+    refuse(d, ["-dm_plex_filename", msh], f"Cannot read the mesh file '{msh}' (-dm_plex_filename): File is not a valid Gmsh file")
+
+
+@test
+def hostile_mesh_without_contact_boundary():
+    d = case_dir("no_contact")
+    msh = os.path.join(d, "no_contact.msh")
+    write_gmsh_square(msh, 4, with_contact=False)
+    refuse(d, ["-dm_plex_filename", msh], 'The mesh has no contact boundary: no face carries "Face Sets" value 1 (Gamma_C)')
+
+
+@test
+def hostile_mesh_with_nothing_to_clamp():
+    """A Gmsh mesh with no face of Gamma_D was a DIVERGED_LINEAR_SOLVE; now it is refused before the solve."""
+    d = case_dir("no_clamp")
+    msh = os.path.join(d, "no_clamp.msh")
+    write_gmsh_square(msh, 4, with_clamp=False)
+    refuse(d, ["-dm_plex_filename", msh], 'No face of the mesh carries "Face Sets" value 3, which scene square uses for the Dirichlet boundary Gamma_D')
+
+
+@test
+def hostile_tetrahedra_with_dim_2():
+    d = case_dir("tets_dim2")
+    msh = os.path.join(d, "cube.msh")
+    write_gmsh_cube(msh, 2)
+    refuse(d, ["-dm_plex_filename", msh, "-dm_plex_dim", 2], f"The mesh file '{msh}' holds a 3D mesh, but -dm_plex_dim 2 was given")
+
+
+@test
+def hostile_missing_options_file():
+    d = case_dir("missing_options")
+    f = os.path.join(d, "missing.yaml")
+    refuse(d, ["-options_file", f], f"Unable to open YAML option file: {f}")
+
+
+@test
+def hostile_malformed_yaml_options_file():
+    d = case_dir("malformed_yaml")
+    f = os.path.join(d, "malformed.yaml")
+    with open(f, "w") as fh:
+        fh.write("scene: square\n  bad: [unclosed\n")
+    refuse(d, ["-options_file", f], f"the options file '{f}' is not valid YAML: mapping values are not allowed in this context at line 2")
+
+
+@test
+def hostile_reference_files():
+    """-reference: missing, not HDF5, of another scene, without its displacement; all refused before the solve."""
+    d = case_dir("reference")
+    missing, not_h5 = os.path.join(d, "missing.h5"), os.path.join(d, "mesh.msh")
+    write_gmsh_square(not_h5, 2)
+    refuse(d, SMALL + ["-reference", missing], f"Reference file '{missing}' (-reference) does not exist or cannot be read")
+    refuse(d, SMALL + ["-reference", not_h5], f"Reference file '{not_h5}' (-reference) is not an HDF5 file")
+    good = os.path.join(d, "result.h5")
+    out = refuse(d, SMALL + ["-scene", "mms", "-reference", good], f"Reference {good} is a run of scene square, this is scene mms")
+    assert "SNES" not in out, "refused only after the solve"
+    import h5py
+    crippled = os.path.join(HOSTILE, "crippled_reference.h5")
+    shutil.copy2(good, crippled)
+    with h5py.File(crippled, "a") as f:
+        del f["vertex_fields/displacement"]
+    refuse(d, SMALL + ["-reference", crippled], f"Reference file {crippled} has no dataset /vertex_fields/displacement")
+
+
+# ---------------------------------------------------------------- -output itself
+@test
+def hostile_output_is_a_directory():
+    d = case_dir("output_dir")
+    os.mkdir(os.path.join(d, "adir.h5"))
+    out = refuse(d, SMALL, f"-output {d}/adir.h5 is a directory", output=os.path.join(d, "adir.h5"))
+    assert "SNES" not in out, "found only after the solve"
+    refuse(d, SMALL, f"-output {d}/ names a directory, not a file", output=d + "/")
+
+
+@test
+def hostile_output_is_a_fifo():
+    d = case_dir("output_fifo")
+    os.mkfifo(os.path.join(d, "fifo.h5"))
+    refuse(d, SMALL, f"-output {d}/fifo.h5 is a FIFO", output=os.path.join(d, "fifo.h5"))
+
+
+@test
+def hostile_output_is_a_symlink():
+    """The link (to the good output) is neither replaced nor followed."""
+    d = case_dir("output_link")
+    os.symlink("result.h5", os.path.join(d, "link.h5"))
+    refuse(d, SMALL, f"-output {d}/link.h5 is a symbolic link", output=os.path.join(d, "link.h5"))
+
+
+@test
+def hostile_output_xdmf_is_a_directory():
+    d = case_dir("output_xdmf_dir")
+    os.mkdir(os.path.join(d, "other.xdmf"))
+    refuse(d, SMALL, f"The XDMF file of -output {d}/other.h5, {d}/other.xdmf, is a directory", output=os.path.join(d, "other.h5"))
+
+
+@test
+def hostile_output_directory_missing():
+    d = case_dir("output_nodir")
+    refuse(d, SMALL, f"Output directory '{d}/nope' (-output {d}/nope/x.h5) does not exist or is not writable", output=os.path.join(d, "nope", "x.h5"))
+
+
+@test
+def hostile_output_names_too_long():
+    """A name the file system refuses (256 characters), and a 255-character FILE.h5 whose FILE.xdmf would be 257."""
+    d = case_dir("output_long")
+    refuse(d, SMALL, "has 259 characters, more than the 255 the file system", output=os.path.join(d, "a" * 256 + ".h5"))
+    refuse(d, SMALL, "-output: the XDMF file beside it", output=os.path.join(d, "b" * 252 + ".h5"))
+
+
+@test
+def hostile_disk_full():
+    """A full file system (a 96 kB tmpfs holding a good 4x4 output) during the write: one sentence naming the file and
+    the cause, the good output untouched, no temporary left."""
+    d = case_dir("disk_full")
+    small = os.path.join(d, "small")
+    os.mkdir(small)
+    p = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=96k", "tmpfs", small], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert p.returncode == 0, f"cannot mount a small tmpfs for the disk-full test (the test suite runs as root): {p.stdout}"
+    try:
+        good = good_output()
+        shutil.copy2(good["h5"], os.path.join(small, "result.h5"))
+        shutil.copy2(good["xdmf"], os.path.join(small, "result.xdmf"))
+        target = os.path.join(small, "result.h5")
+        out = refuse(small, ["-dm_plex_box_faces", "24,24"], f"Cannot write the output file {target}: no space left on the device of '{small}'", output=target)
+        assert "H5Dcreate2" not in out and "H5Dwrite" not in out, "raw HDF5 trace"
+    finally:
+        subprocess.run(["umount", small], check=True)
+
+
+# ---------------------------------------------------------------- limits that used to crash or truncate
+@test
+def long_output_file_name_is_written():
+    """A 240-character file name crashed Open MPI's MPI-IO ("buffer overflow detected"); the solver now writes it."""
+    name = "c" * 237 + ".h5"
+    os.makedirs(HOSTILE, exist_ok=True)
+    _, h5 = run(SMALL, "hostile/" + name)
+    assert os.path.getsize(h5) > 0 and os.path.getsize(h5[:-3] + ".xdmf") > 0
+    assert not [n for n in os.listdir(HOSTILE) if n.startswith(".signorini-")]
+
+
+@test
+def eps_sweep_of_any_length():
+    """40 values (the sweep used to drop all past the 32nd silently): 40 solves, and the output is the 40th value's."""
+    import h5py
+    values = [10.0 ** (-k / 8.0) for k in range(40)]
+    os.makedirs(HOSTILE, exist_ok=True)
+    _, h5 = run(["-dm_plex_box_faces", "8,8", "-penalty_eps0_sweep", ",".join(f"{v:.17g}" for v in values)], "hostile/sweep40")
+    with h5py.File(h5, "r") as f:
+        eps = f["solves/eps"][:]
+        assert f["run"].attrs["n_solves"] == 40 and len(eps) == 40 and f["run"].attrs["converged"] == 1
+        h = f["run"].attrs["h"]
+        assert abs(f["run"].attrs["eps"] - values[-1] * h) <= 1e-12 * values[-1] * h
+        assert abs(eps[-1] - values[-1] * h) <= 1e-12 * values[-1] * h
+
+
+@test
+def condition_estimate_with_vi_is_that_of_k():
+    """With SNESVI the estimate used to fail after converging ("Cannot change local size of Amat"); it is the estimate
+    of K, the same number as the elastic run's (whose Jacobian is K)."""
+    from harness import load
+    os.makedirs(HOSTILE, exist_ok=True)
+    a_vi, _ = load(run(SMALL + ["-contact_method", "vi", "-contact_condition_estimate"], "hostile/cond_vi")[1])
+    a_none, _ = load(run(SMALL + ["-contact_method", "none", "-contact_condition_estimate"], "hostile/cond_none")[1])
+    assert a_vi["converged"] == 1 and a_vi["condition_1norm"] > 1.0
+    assert abs(a_vi["condition_1norm"] - a_none["condition_1norm"]) <= 1e-8 * a_none["condition_1norm"]
+
+
+@test
+def stop_with_a_large_residual_is_a_failure():
+    """PETSc's step-length test (-snes_stol) stops Newton with CONVERGED_SNORM_RELATIVE far from the solution: the run
+    reports it as a failure (exit 3, converged = 0), never as a converged result."""
+    from harness import load
+    os.makedirs(HOSTILE, exist_ok=True)
+    out, h5 = run(["-dm_plex_box_faces", "32,32", "-penalty_eps0", 1e-6, "-penalty_continuation", "false", "-snes_stol", 0.9], "hostile/stol", expect_rc=3)
+    a, _ = load(h5)
+    assert a["snes_reason"] == "CONVERGED_SNORM_RELATIVE" and a["converged"] == 0 and a["residual_reduced"] == 0, (a["snes_reason"], a["converged"])
+    assert a["residual_norm"] > 1e-8 * a["load_norm"]
+    assert "ERROR: the nonlinear solve failed: it stopped with CONVERGED_SNORM_RELATIVE" in out

@@ -1,0 +1,39 @@
+"""Memory errors (make test): a few runs covering every module under AddressSanitizer and UndefinedBehaviorSanitizer
+(`make asan`, bin/signorini-asan), with PETSc's own allocation tracking (-malloc_debug -malloc_dump) for leaks of
+PETSc-allocated memory. Open MPI's and HDF5's own allocations at exit are not ours, so ASan's leak checker is off
+(ASAN_OPTIONS=detect_leaks=0) and -malloc_dump stands in for it.
+"""
+import os
+import re
+import subprocess
+
+from harness import ENV, OUT, ROOT, test
+
+ASAN_BIN = os.path.join(ROOT, "bin", "signorini-asan")
+CASES = {
+    "square_penalty": (1, ["-dm_plex_box_faces", "8,8"], 0),
+    "vi_condition_np2": (2, ["-dm_plex_box_faces", "8,8", "-contact_method", "vi", "-contact_condition_estimate"], 0),
+    "nodal_3d_grid_sequence": (1, ["-dm_plex_dim", 3, "-dm_plex_box_faces", "2,2,2", "-penalty_quadrature", "nodal", "-contact_grid_sequence", 1], 0),
+    "mms_sweep_metis_np2": (2, ["-scene", "mms", "-dm_plex_box_faces", "8,8", "-penalty_eps0_sweep", "1,0.01", "-partitioner", "metis"], 0),
+    "quads_p2_fe_assembly": (1, ["-dm_plex_simplex", 0, "-dm_plex_box_faces", "4,4", "-displacement_petscspace_degree", 2], 0),
+    "failed_solve": (1, ["-dm_plex_box_faces", "8,8", "-snes_max_it", 1], 3),
+    "bad_input": (1, ["-dm_plex_box_faces", "8,8", "-young_modulus", "nan"], None),
+}
+
+
+@test
+def sanitizers_report_nothing():
+    p = subprocess.run(["make", "--no-print-directory", "asan"], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert p.returncode == 0, p.stdout[-3000:]
+    env = dict(ENV, ASAN_OPTIONS="detect_leaks=0", UBSAN_OPTIONS="print_stacktrace=1")
+    os.makedirs(os.path.join(OUT, "asan"), exist_ok=True)
+    for name, (np_, args, rc) in CASES.items():
+        cmd = ["mpiexec", "-n", str(np_), ASAN_BIN, "-malloc_debug", "-malloc_dump", "-output", os.path.join(OUT, "asan", name + ".h5")]
+        p = subprocess.run(cmd + [str(a) for a in args], cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=300)
+        if rc is None:
+            assert p.returncode != 0, f"{name}: bad input accepted"
+        else:
+            assert p.returncode == rc, f"{name}: exit status {p.returncode}, expected {rc}\n{p.stdout[-3000:]}"
+        assert "AddressSanitizer" not in p.stdout and "runtime error:" not in p.stdout, f"{name}:\n{p.stdout[-5000:]}"
+        leaks = re.findall(r"^\[\s*\d+\]\s*\d+ bytes .*$", p.stdout, re.M)
+        assert not leaks, f"{name}: PETSc memory not freed:\n" + "\n".join(leaks[:20])
