@@ -129,8 +129,8 @@ typedef struct {
 typedef struct {
   PetscInt            newton_its, ksp_its;             /* of the last solve (the finest mesh, the last eps) */
   PetscInt            newton_its_total, ksp_its_total; /* of all solves: grid sequence levels, continuation, eps sweep */
-  PetscBool           converged;        /* PETSc's reason is a convergence and the residual fell as asked (residual_reduced) */
-  PetscBool           residual_reduced; /* |F| <= rtol |F0|, or at round-off for the load, or below -snes_atol */
+  PetscBool           converged;                       /* PETSc's reason is a convergence and the residual fell as asked (residual_reduced) */
+  PetscBool           residual_reduced;                /* |F| <= rtol |F0|, or at round-off for the load, or below -snes_atol */
   SNESConvergedReason reason;
   PetscReal           residual_norm;
   PetscInt            continuation_stages;                  /* solves of the eps sequence before the target eps (0: none) */
@@ -178,15 +178,15 @@ typedef struct {
   ErrorNorms     ref_errors;                      /* against the -reference solution */
   PetscInt       level;                           /* grid sequence level of the current mesh (0: the mesh of the options) */
   PetscReal      level_setup_time;                /* set-up time of the current mesh's problem, until its first solve */
-  SolveRecord   *records; /* one per solve, any number */
+  SolveRecord   *records;                         /* one per solve, any number */
   PetscInt       nrecords, maxrecords;
   PetscReal      load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
   PetscReal      displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */
   PetscReal      snes_scale;         /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
   PetscReal      fnorm0;             /* |F| at the start of the last SNESSolve, in the user's units */
   Vec            work;               /* U x~: the displacement of the SNES iterate x~ */
-  AssemblyType   assembly;       /* how K is assembled: fe or p1 (-assembly auto resolved) */
-  PetscBool      assembly_check; /* -assembly_check: assemble K both ways and compare */
+  AssemblyType   assembly;           /* how K is assembled: fe or p1 (-assembly auto resolved) */
+  PetscBool      assembly_check;     /* -assembly_check: assemble K both ways and compare */
 } AppCtx;
 
 /* options_files.c (before PetscInitialize(): plain C, returns 1 after printing the problem) */
@@ -337,6 +337,8 @@ PetscErrorCode OutputFileXdmfName(const char h5[], char xdmf[], size_t len);
 PetscErrorCode OutputFileCheckTarget(MPI_Comm comm, const char path[], PetscBool create_dir);
 PetscErrorCode OutputFileCreateTemps(MPI_Comm comm, const char dir[], PetscInt n, char temps[][PETSC_MAX_PATH_LEN]);
 PetscErrorCode OutputFileDiscardTemps(MPI_Comm comm);
+PetscErrorCode OutputFileEnterDirectory(const char path[], int *cwd, char base[], size_t len);
+PetscErrorCode OutputFileLeaveDirectory(int cwd);
 PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, char temps[][PETSC_MAX_PATH_LEN], const char *targets[]);
 
 /* output_hdf5.c */

@@ -125,6 +125,10 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
      distributes, for every kind of mesh, with the partitioner of -partitioner. PETSc reads HDF5 meshes in parallel, in
      pieces that are only consistent after its own distribution (without it the solution is wrong): they get both. */
   if (has_file) PetscCall(PetscStrendswith(filename, ".h5", &parallel_read));
+  PetscCheck(!parallel_read || strlen(filename) <= 240, comm, PETSC_ERR_USER_INPUT,
+             "The HDF5 mesh file name '%s' (-dm_plex_filename) has %d characters: PETSc reads it with MPI-IO, which in Open MPI 4.1 crashes on names "
+             "of more than 240; use a shorter (for example relative) path",
+             filename, (int)strlen(filename));
   if (!parallel_read) PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
   if (has_file) {
     PetscInt  fdim, cStart, cEnd, n;
@@ -141,7 +145,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
     ncells = (PetscReal)n * PetscPowReal(2.0, (PetscReal)(fdim * (refine + later_refinements)));
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s with %" PetscInt_FMT " refinement(s)", filename, refine + later_refinements));
     PetscCall(MeshCheckSize(comm, fdim, ncells, what));
-  } else PetscCall(DMSetFromOptions(*dm));
+  } else
+    PetscCall(DMSetFromOptions(*dm));
   PetscCall(DMGetMatType(*dm, &mtype));
   PetscCall(PetscStrallocpy(mtype, &mtype_copy)); /* -dm_mat_type, which the distributed mesh does not inherit */
   PetscCall(MeshPartitionDistribute(partitioner, dm));

@@ -31,7 +31,8 @@ static int CheckYAMLFile(const char file[], int print)
   bad = !yaml_parser_load(&parser, &doc);
   if (bad && print)
     fprintf(stderr, "signorini: the options file '%s' is not valid YAML: %s at line %lu, column %lu\n", file,
-            parser.problem ? parser.problem : "parse error", (unsigned long)parser.problem_mark.line + 1, (unsigned long)parser.problem_mark.column + 1);
+            parser.problem ? parser.problem : "parse error", (unsigned long)parser.problem_mark.line + 1,
+            (unsigned long)parser.problem_mark.column + 1);
   if (!bad) yaml_document_delete(&doc);
   yaml_parser_delete(&parser);
   (void)fclose(fp);

@@ -18,7 +18,7 @@
 
 #define OUTPUT_MAX_TEMPS 2
 static char         output_temps[OUTPUT_MAX_TEMPS][PETSC_MAX_PATH_LEN]; /* temporaries to remove on failure, exit or signal */
-static mode_t       output_mode = 0644;                                 /* mode of a new file under the process's umask */
+static mode_t       output_mode      = 0644;                            /* mode of a new file under the process's umask */
 static const int    output_signals[] = {SIGTERM, SIGINT, SIGHUP, SIGQUIT};
 static const size_t output_nsignals  = sizeof(output_signals) / sizeof(output_signals[0]);
 
@@ -59,7 +59,8 @@ PetscErrorCode OutputFileInstallCleanup(void)
   memset(&sa, 0, sizeof(sa));
   sa.sa_handler = OutputFileSignalHandler;
   sigemptyset(&sa.sa_mask);
-  for (size_t i = 0; i < output_nsignals; ++i) PetscCheck(sigaction(output_signals[i], &sa, NULL) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "sigaction() failed");
+  for (size_t i = 0; i < output_nsignals; ++i)
+    PetscCheck(sigaction(output_signals[i], &sa, NULL) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "sigaction() failed");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -74,7 +75,8 @@ PetscErrorCode OutputFileSplitPath(const char path[], char dir[], size_t dlen, c
     PetscCall(PetscStrncpy(base, path, blen));
   } else {
     PetscCheck((size_t)(slash - path) < dlen, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "Path too long: %s", path);
-    if (slash == path) PetscCall(PetscStrncpy(dir, "/", dlen));
+    if (slash == path)
+      PetscCall(PetscStrncpy(dir, "/", dlen));
     else {
       memcpy(dir, path, (size_t)(slash - path));
       dir[slash - path] = '\0';
@@ -167,7 +169,8 @@ PetscErrorCode OutputFileCreateTemps(MPI_Comm comm, const char dir[], PetscInt n
 
       (void)snprintf(temps[i], PETSC_MAX_PATH_LEN, "%s/.signorini-XXXXXX", dir);
       fd = mkstemp(temps[i]);
-      if (fd < 0) err = errno;
+      if (fd < 0)
+        err = errno;
       else {
         (void)fchmod(fd, output_mode);
         (void)close(fd);
@@ -180,7 +183,8 @@ PetscErrorCode OutputFileCreateTemps(MPI_Comm comm, const char dir[], PetscInt n
   if (err) PetscCall(OutputFileDiscardTemps(comm));
   PetscCheck(!err, comm, PETSC_ERR_FILE_WRITE, "Cannot create a file in the output directory '%s': %s", dir, strerror(err));
   PetscCallMPI(MPI_Bcast(temps, (PetscMPIInt)(n * PETSC_MAX_PATH_LEN), MPI_CHAR, 0, comm));
-  if (rank) for (PetscInt i = 0; i < n; ++i) memcpy(output_temps[i], temps[i], PETSC_MAX_PATH_LEN);
+  if (rank)
+    for (PetscInt i = 0; i < n; ++i) memcpy(output_temps[i], temps[i], PETSC_MAX_PATH_LEN);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -217,7 +221,8 @@ PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, cha
       if (rename(temps[i], targets[i]) != 0) {
         err    = errno;
         failed = (int)i;
-      } else output_temps[i][0] = '\0';
+      } else
+        output_temps[i][0] = '\0';
     }
     if (dfd >= 0) {
       (void)flock(dfd, LOCK_UN);
@@ -227,8 +232,33 @@ PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, cha
   }
   PetscCallMPI(MPI_Bcast(&err, 1, MPI_INT, 0, comm));
   PetscCallMPI(MPI_Bcast(&failed, 1, MPI_INT, 0, comm));
-  if (err) PetscCall(OutputFileDiscardTemps(comm));
-  else memset(output_temps, 0, sizeof(output_temps));
+  if (err)
+    PetscCall(OutputFileDiscardTemps(comm));
+  else
+    memset(output_temps, 0, sizeof(output_temps));
   PetscCheck(!err, comm, PETSC_ERR_FILE_WRITE, "Cannot replace %s: %s", targets[failed], strerror(err));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Makes the directory of path the working directory and gives the file's name in it: an HDF5 file is opened by its
+   short name, because Open MPI 4.1's MPI-IO copies the name into a 256-byte buffer (a longer path crashed it).
+   *cwd keeps the previous working directory for OutputFileLeaveDirectory(). */
+PetscErrorCode OutputFileEnterDirectory(const char path[], int *cwd, char base[], size_t len)
+{
+  char dir[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  PetscCall(OutputFileSplitPath(path, dir, sizeof(dir), base, len));
+  *cwd = open(".", O_RDONLY | O_DIRECTORY);
+  PetscCheck(*cwd >= 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "Cannot open the working directory: %s", strerror(errno));
+  PetscCheck(chdir(dir) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Cannot enter the directory '%s' of %s: %s", dir, path, strerror(errno));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode OutputFileLeaveDirectory(int cwd)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(fchdir(cwd) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "Cannot return to the working directory: %s", strerror(errno));
+  (void)close(cwd);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

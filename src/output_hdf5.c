@@ -399,9 +399,8 @@ static PetscErrorCode WriteFiles(DM dm, AppCtx *user, Vec u, const char h5tmp[],
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Writes FILE.h5 and FILE.xdmf (output_file.c: temporaries renamed when complete). The HDF5 file is written from
-   inside its directory under a short relative name: Open MPI 4.1's MPI-IO copies the file name into a 256-byte
-   buffer (a longer path crashed it). An I/O error is reported in one sentence naming the file and the cause. */
+/* Writes FILE.h5 and FILE.xdmf (output_file.c: temporaries renamed when complete), from inside their directory
+   (OutputFileEnterDirectory()). An I/O error is reported in one sentence naming the file and the cause. */
 PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
 {
   MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
@@ -416,11 +415,10 @@ PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
   PetscFunctionBeginUser;
   PetscCall(OutputFileSplitPath(user->output, dir, sizeof(dir), base, sizeof(base)));
   PetscCall(OutputFileXdmfName(user->output, xdmf, sizeof(xdmf)));
-  PetscCall(OutputFileCreateTemps(comm, dir, 2, temps)); /* [0] the XDMF file, [1] the HDF5 file */
+  PetscCall(OutputFileCreateTemps(comm, dir, 2, temps));                                  /* [0] the XDMF file, [1] the HDF5 file */
   PetscCall(OutputFileSplitPath(temps[0], tdir, sizeof(tdir), xdmftmp, sizeof(xdmftmp))); /* names inside dir */
   PetscCall(OutputFileSplitPath(temps[1], tdir, sizeof(tdir), h5tmp, sizeof(h5tmp)));
-  cwd = open(".", O_RDONLY | O_DIRECTORY);
-  PetscCheck(cwd >= 0 && chdir(dir) == 0, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Cannot enter the output directory '%s': %s", dir, strerror(errno));
+  PetscCall(OutputFileEnterDirectory(temps[1], &cwd, h5tmp, sizeof(h5tmp)));
   (void)H5Eget_auto2(H5E_DEFAULT, &h5_func, &h5_data);
   (void)H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* HDF5's own error stack: replaced by the sentence below */
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
@@ -429,21 +427,22 @@ PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
   err   = errno;
   PetscCall(PetscPopErrorHandler());
   (void)H5Eset_auto2(H5E_DEFAULT, h5_func, h5_data);
-  PetscCheck(fchdir(cwd) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "Cannot return to the working directory: %s", strerror(errno));
-  (void)close(cwd);
+  PetscCall(OutputFileLeaveDirectory(cwd));
   local_failed = ierr != 0;
   PetscCallMPI(MPI_Allreduce(&local_failed, &failed, 1, MPI_INT, MPI_MAX, comm));
   if (failed) {
-    const char    *text = NULL;
+    const char    *text     = NULL;
     char          *specific = NULL, cause[256] = "the write failed on another rank";
     struct statvfs fs;
 
     PetscCall(OutputFileDiscardTemps(comm));
     if (ierr) PetscCall(PetscErrorMessage(ierr, &text, &specific));
-    if (statvfs(dir, &fs) == 0 && fs.f_bavail == 0) PetscCall(PetscSNPrintf(cause, sizeof(cause), "no space left on the device of '%s'", dir));
+    if (statvfs(dir, &fs) == 0 && fs.f_bavail == 0)
+      PetscCall(PetscSNPrintf(cause, sizeof(cause), "no space left on the device of '%s'", dir));
     else if (err == ENOSPC || err == EDQUOT || err == EFBIG || err == EIO || err == EROFS || err == EACCES)
       PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", strerror(err)));
-    else if (ierr) PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", specific && specific[0] ? specific : text));
+    else if (ierr)
+      PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", specific && specific[0] ? specific : text));
     SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot write the output file %s: %s", user->output, cause);
   }
   PetscCall(OutputFileCommit(comm, dir, 2, temps, targets));

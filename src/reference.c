@@ -189,7 +189,7 @@ static PetscBool ReferenceHasCell(const Reference *ref, const PetscInt v[])
 /* The checks of the reference's /run against this run: same scene and dimension, converged, degree 1. */
 static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, PetscInt dim, PetscViewer v, PetscInt *ref_dim, PetscInt *ncells)
 {
-  const char *file = user->verify.reference;
+  const char *file       = user->verify.reference;
   const char *datasets[] = {"/geometry/vertices", "/vertex_fields/displacement", "/vertex_fields/contact_pressure", "/viz/topology/cells"};
   PetscInt    converged, degree;
   char       *scene = NULL;
@@ -228,16 +228,21 @@ PetscErrorCode ReferenceCheckFile(DM dm, const AppCtx *user)
   PetscViewer    v;
   PetscInt       dim, ref_dim, ncells;
   PetscErrorCode ierr;
+  int            cwd;
+  char           base[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
   if (!file[0]) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(OutputFileEnterDirectory(file, &cwd, base, sizeof(base)));
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-  ierr = PetscViewerHDF5Open(PETSC_COMM_SELF, file, FILE_MODE_READ, &v);
+  ierr = PetscViewerHDF5Open(PETSC_COMM_SELF, base, FILE_MODE_READ, &v);
   PetscCall(PetscPopErrorHandler());
+  if (ierr) PetscCall(OutputFileLeaveDirectory(cwd));
   PetscCheck(!ierr, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Reference file '%s' (-reference) cannot be opened as an HDF5 file", file);
   PetscCall(ReferenceCheckHeader(PetscObjectComm((PetscObject)dm), user, dim, v, &ref_dim, &ncells));
   PetscCall(PetscViewerDestroy(&v));
+  PetscCall(OutputFileLeaveDirectory(cwd));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -247,10 +252,13 @@ static PetscErrorCode ReferenceRead(MPI_Comm comm, const AppCtx *user, PetscInt 
   PetscViewer v;
   PetscInt    n;
   PetscReal  *cells;
+  int         cwd;
+  char        base[PETSC_MAX_PATH_LEN];
 
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(ref, sizeof(*ref)));
-  PetscCall(PetscViewerHDF5Open(PETSC_COMM_SELF, file, FILE_MODE_READ, &v));
+  PetscCall(OutputFileEnterDirectory(file, &cwd, base, sizeof(base))); /* read by its short name */
+  PetscCall(PetscViewerHDF5Open(PETSC_COMM_SELF, base, FILE_MODE_READ, &v));
   PetscCall(ReferenceCheckHeader(comm, user, dim, v, &ref->dim, &ref->ncells));
   PetscCall(ReadArray(v, file, "/geometry", "vertices", &n, &ref->x));
   ref->nv = n / dim;
@@ -268,6 +276,7 @@ static PetscErrorCode ReferenceRead(MPI_Comm comm, const AppCtx *user, PetscInt 
   for (PetscInt i = 0; i < n; ++i) ref->cells[i] = (PetscInt)cells[i];
   PetscCall(PetscFree(cells));
   PetscCall(PetscViewerDestroy(&v));
+  PetscCall(OutputFileLeaveDirectory(cwd));
   PetscCall(ReferenceIndex(ref));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

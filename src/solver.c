@@ -143,7 +143,8 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
   PetscCall(SolverResidual(dm, user, zero, F));
   PetscCall(VecNorm(F, NORM_2, &user->load_norm));
   PetscCheck(!PetscIsInfOrNanReal(user->load_norm), comm, PETSC_ERR_USER_INPUT,
-             "The load of the problem is not finite (||F(0)|| = %g): check the loads, the material and the mesh coordinates", (double)user->load_norm);
+             "The load of the problem is not finite (||F(0)|| = %g): check the loads, the material and the mesh coordinates",
+             (double)user->load_norm);
   if (user->load_norm > 0.0) {
     PetscCall(VecNorm(F, NORM_INFINITY, &finf));
     PetscCall(MatMult(user->K, F, KF));
@@ -274,7 +275,7 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   user->stats.residual_reduced = (PetscBool)(user->stats.residual_norm <= rtol * user->fnorm0 ||
                                              user->stats.residual_norm <= user->contact.load_rtol * user->load_norm || fnorm <= atol);
   user->stats.converged        = (PetscBool)(user->stats.reason > 0 && user->stats.residual_reduced);
-  user->stats.pc_builds  = user->pc_reuse.enabled ? user->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
+  user->stats.pc_builds        = user->pc_reuse.enabled ? user->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -402,7 +403,8 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
     PetscCall(SolverSetDefaultLinearSolver(ksp_vi, user));
     PetscCall(KSPSetFromOptions(ksp_vi));
     ksp = ksp_vi;
-  } else PetscCall(SNESComputeJacobian(snes, u, J, J));
+  } else
+    PetscCall(SNESComputeJacobian(snes, u, J, J));
   PetscCall(KSPSetReusePreconditioner(ksp, PETSC_FALSE)); /* a preconditioner built for this very J */
   PetscCall(KSPSetOperators(ksp, J, J));
   PetscCall(MatNorm(J, NORM_1, &normJ));

@@ -21,9 +21,9 @@ def test(fn):
     return fn
 
 
-def run(args, name, np_=1, expect_rc=0):
-    """Runs the solver; returns (combined output, path of the HDF5 file)."""
-    out = os.path.join(OUT, name + ".h5")
+def run(args, name, np_=1, expect_rc=0, output=None):
+    """Runs the solver; returns (combined output, path of the HDF5 file: tests/out/NAME.h5, or output)."""
+    out = output or os.path.join(OUT, name + ".h5")
     cmd = ["mpiexec", "-n", str(np_), BIN, "-output", out] + [str(a) for a in args]
     p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
     if expect_rc is not None:

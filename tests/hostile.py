@@ -295,6 +295,31 @@ def long_output_file_name_is_written():
 
 
 @test
+def long_paths_are_read_and_written():
+    """A 250-character directory: a reference written there, read back by -reference, and a run written there, on 2
+    ranks (reading a long path crashed in Open MPI's MPI-IO as writing did)."""
+    from harness import load
+    long_dir = os.path.join(HOSTILE, "d" * 120, "e" * 120)
+    os.makedirs(long_dir, exist_ok=True)
+    ref, out = os.path.join(long_dir, "ref.h5"), os.path.join(long_dir, "run.h5")
+    run(["-dm_plex_box_faces", "16,16", "-contact_method", "vi"], None, output=ref)
+    a, _ = load(run(["-dm_plex_box_faces", "8,8", "-reference", ref], None, np_=2, output=out)[1])
+    assert a["converged"] == 1 and a["nprocs"] == 2 and 0.0 < a["reference_error_h1"] < 1.0, a.get("reference_error_h1")
+
+
+@test
+def hostile_long_hdf5_mesh_path():
+    """PETSc reads an HDF5 mesh with MPI-IO itself, where the name cannot be shortened: a name over 240 characters is
+    refused with the reason instead of the crash."""
+    d = case_dir("long_h5_mesh")
+    long_dir = os.path.join(d, "f" * 120, "g" * 120)
+    os.makedirs(long_dir)
+    mesh = os.path.join(long_dir, "mesh.h5")
+    open(mesh, "w").close()
+    refuse(d, ["-dm_plex_filename", mesh], f"The HDF5 mesh file name '{mesh}' (-dm_plex_filename) has {len(mesh)} characters")
+
+
+@test
 def eps_sweep_of_any_length():
     """40 values (the sweep used to drop all past the 32nd silently): 40 solves, and the output is the 40th value's."""
     import h5py

@@ -132,7 +132,7 @@ def vi_constraint_and_complementarity():
     assert gap.min() >= -1e-12, f"u_n > g by {-gap.min():.3e}"
     assert p.min() >= -1e-8 * pmax, f"tensile contact pressure {p.min():.3e}"
     assert np.abs(p * gap).max() <= 1e-10 * pmax, f"complementarity violated: {np.abs(p * gap).max():.3e}"
-    assert attrs["active_vertices"] == np.sum(gap <= 1e-10 * attrs["h"])
+    assert attrs["active_vertices"] == np.sum(gap <= 1e-10 * attrs["displacement_scale"])
 
 
 @test
