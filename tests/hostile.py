@@ -130,72 +130,48 @@ def hostile_parallel_runs_refuse_alike():
 
 
 # ---------------------------------------------------------------- files: every message names the file
-@test
-def hostile_missing_mesh_file():
-    d = case_dir("missing_mesh")
-    msh = os.path.join(d, "missing.msh")
-    refuse(d, ["-dm_plex_filename", msh], f"Mesh file '{msh}' (-dm_plex_filename) does not exist or cannot be read")
+def write_text(text):
+    def writer(path):
+        with open(path, "w") as fh:
+            fh.write(text)
+    return writer
 
 
-@test
-def hostile_truncated_mesh_file():
-    d = case_dir("truncated_mesh")
-    msh = os.path.join(d, "truncated.msh")
-    write_gmsh_square(msh, 4)
-    text = open(msh).read()
-    with open(msh, "w") as fh:
+def write_truncated_mesh(path):
+    write_gmsh_square(path, 4)
+    text = open(path).read()
+    with open(path, "w") as fh:
         fh.write(text[: len(text) // 2])
-    refuse(d, ["-dm_plex_filename", msh], f"Cannot read the mesh file '{msh}' (-dm_plex_filename): ")
 
 
-@test
-def hostile_garbage_mesh_file():
-    d = case_dir("garbage_mesh")
-    msh = os.path.join(d, "garbage.msh")
-    with open(msh, "w") as fh:
-        fh.write("garbage\n")
-    refuse(d, ["-dm_plex_filename", msh], f"Cannot read the mesh file '{msh}' (-dm_plex_filename): File is not a valid Gmsh file")
-
-
-@test
-def hostile_mesh_without_contact_boundary():
-    d = case_dir("no_contact")
-    msh = os.path.join(d, "no_contact.msh")
-    write_gmsh_square(msh, 4, with_contact=False)
-    refuse(d, ["-dm_plex_filename", msh], 'The mesh has no contact boundary: no face carries "Face Sets" value 1 (Gamma_C)')
-
-
-@test
-def hostile_mesh_with_nothing_to_clamp():
-    """A Gmsh mesh with no face of Gamma_D was a DIVERGED_LINEAR_SOLVE; now it is refused before the solve."""
-    d = case_dir("no_clamp")
-    msh = os.path.join(d, "no_clamp.msh")
-    write_gmsh_square(msh, 4, with_clamp=False)
-    refuse(d, ["-dm_plex_filename", msh], 'No face of the mesh carries "Face Sets" value 3, which scene square uses for the Dirichlet boundary Gamma_D')
-
-
-@test
-def hostile_tetrahedra_with_dim_2():
-    d = case_dir("tets_dim2")
-    msh = os.path.join(d, "cube.msh")
-    write_gmsh_cube(msh, 2)
-    refuse(d, ["-dm_plex_filename", msh, "-dm_plex_dim", 2], f"The mesh file '{msh}' holds a 3D mesh, but -dm_plex_dim 2 was given")
-
-
-@test
-def hostile_missing_options_file():
-    d = case_dir("missing_options")
-    f = os.path.join(d, "missing.yaml")
-    refuse(d, ["-options_file", f], f"Unable to open YAML option file: {f}")
-
-
-@test
-def hostile_malformed_yaml_options_file():
-    d = case_dir("malformed_yaml")
-    f = os.path.join(d, "malformed.yaml")
-    with open(f, "w") as fh:
-        fh.write("scene: square\n  bad: [unclosed\n")
-    refuse(d, ["-options_file", f], f"the options file '{f}' is not valid YAML: mapping values are not allowed in this context at line 2")
+# (name, file name, writer of the file (None: the file is missing), options given the path, message given the path)
+FILE_CASES = [
+    ("missing_mesh", "missing.msh", None, lambda f: ["-dm_plex_filename", f],
+     lambda f: f"Mesh file '{f}' (-dm_plex_filename) does not exist or cannot be read"),
+    ("truncated_mesh", "truncated.msh", write_truncated_mesh, lambda f: ["-dm_plex_filename", f],
+     lambda f: f"Cannot read the mesh file '{f}' (-dm_plex_filename): "),
+    ("garbage_mesh", "garbage.msh", write_text("garbage\n"), lambda f: ["-dm_plex_filename", f],
+     lambda f: f"Cannot read the mesh file '{f}' (-dm_plex_filename): File is not a valid Gmsh file"),
+    ("no_contact", "no_contact.msh", lambda f: write_gmsh_square(f, 4, with_contact=False), lambda f: ["-dm_plex_filename", f],
+     lambda f: 'The mesh has no contact boundary: no face carries "Face Sets" value 1 (Gamma_C)'),
+    # a Gmsh mesh with no face of Gamma_D was a DIVERGED_LINEAR_SOLVE; now it is refused before the solve
+    ("no_clamp", "no_clamp.msh", lambda f: write_gmsh_square(f, 4, with_clamp=False), lambda f: ["-dm_plex_filename", f],
+     lambda f: 'No face of the mesh carries "Face Sets" value 3, which scene square uses for the Dirichlet boundary Gamma_D'),
+    ("tets_dim2", "cube.msh", lambda f: write_gmsh_cube(f, 2), lambda f: ["-dm_plex_filename", f, "-dm_plex_dim", 2],
+     lambda f: f"The mesh file '{f}' holds a 3D mesh, but -dm_plex_dim 2 was given"),
+    ("missing_options", "missing.yaml", None, lambda f: ["-options_file", f], lambda f: f"Unable to open YAML option file: {f}"),
+    ("malformed_yaml", "malformed.yaml", write_text("scene: square\n  bad: [unclosed\n"), lambda f: ["-options_file", f],
+     lambda f: f"the options file '{f}' is not valid YAML: mapping values are not allowed in this context at line 2"),
+]
+for _name, _file, _writer, _args, _message in FILE_CASES:
+    def _case(name=_name, file=_file, writer=_writer, args=_args, message=_message):
+        d = case_dir(name)
+        path = os.path.join(d, file)
+        if writer:
+            writer(path)
+        refuse(d, args(path), message(path))
+    _case.__name__ = f"hostile_{_name}"
+    test(_case)
 
 
 @test
@@ -227,32 +203,25 @@ def hostile_output_is_a_directory():
     refuse(d, SMALL, f"-output {d}/ names a directory, not a file", output=d + "/")
 
 
-@test
-def hostile_output_is_a_fifo():
-    d = case_dir("output_fifo")
-    os.mkfifo(os.path.join(d, "fifo.h5"))
-    refuse(d, SMALL, f"-output {d}/fifo.h5 is a FIFO", output=os.path.join(d, "fifo.h5"))
-
-
-@test
-def hostile_output_is_a_symlink():
-    """The link (to the good output) is neither replaced nor followed."""
-    d = case_dir("output_link")
-    os.symlink("result.h5", os.path.join(d, "link.h5"))
-    refuse(d, SMALL, f"-output {d}/link.h5 is a symbolic link", output=os.path.join(d, "link.h5"))
-
-
-@test
-def hostile_output_xdmf_is_a_directory():
-    d = case_dir("output_xdmf_dir")
-    os.mkdir(os.path.join(d, "other.xdmf"))
-    refuse(d, SMALL, f"The XDMF file of -output {d}/other.h5, {d}/other.xdmf, is a directory", output=os.path.join(d, "other.h5"))
-
-
-@test
-def hostile_output_directory_missing():
-    d = case_dir("output_nodir")
-    refuse(d, SMALL, f"Output directory '{d}/nope' (-output {d}/nope/x.h5) does not exist or is not writable", output=os.path.join(d, "nope", "x.h5"))
+# (name, what to make in the case's directory d, the -output path, the message), all as functions of d; what was
+# made (a FIFO, a link to the good output, a directory) must be left as it was
+OUTPUT_CASES = [
+    ("output_fifo", lambda d: os.mkfifo(os.path.join(d, "fifo.h5")), lambda d: os.path.join(d, "fifo.h5"),
+     lambda d: f"-output {d}/fifo.h5 is a FIFO"),
+    ("output_link", lambda d: os.symlink("result.h5", os.path.join(d, "link.h5")), lambda d: os.path.join(d, "link.h5"),
+     lambda d: f"-output {d}/link.h5 is a symbolic link"),
+    ("output_xdmf_dir", lambda d: os.mkdir(os.path.join(d, "other.xdmf")), lambda d: os.path.join(d, "other.h5"),
+     lambda d: f"The XDMF file of -output {d}/other.h5, {d}/other.xdmf, is a directory"),
+    ("output_nodir", lambda d: None, lambda d: os.path.join(d, "nope", "x.h5"),
+     lambda d: f"Output directory '{d}/nope' (-output {d}/nope/x.h5) does not exist or is not writable"),
+]
+for _name, _make, _output, _message in OUTPUT_CASES:
+    def _case(name=_name, make=_make, output=_output, message=_message):
+        d = case_dir(name)
+        make(d)
+        refuse(d, SMALL, message(d), output=output(d))
+    _case.__name__ = f"hostile_{_name}"
+    test(_case)
 
 
 @test
