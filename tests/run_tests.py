@@ -287,6 +287,7 @@ import hostile  # noqa: E402,F401  (registers the hostile-input catalogue)
 import units  # noqa: E402,F401  (registers the unit-invariance tests)
 import safety  # noqa: E402,F401  (registers the signal and concurrency tests of the output)
 import sanitize  # noqa: E402,F401  (registers the sanitizer runs)
+import test_regression  # noqa: E402,F401  (registers the test of scripts/regression.py)
 
 
 def main():

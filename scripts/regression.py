@@ -1,0 +1,124 @@
+#!/usr/bin/python3
+"""Record and compare the numbers of a fixed set of runs (options/regression/runs.yaml), so that a change of structure
+can show that it keeps every number.
+
+  regression.py run DIR [--bin PATH] [--runs FILE]   runs them, writing DIR/<name>.h5
+  regression.py compare A B [--rtol R] [--allow-added]
+                                                     /run attributes and vertex fields of A/<name>.h5 and B/<name>.h5:
+                                                     reals to R relative (default 1e-12), integers and strings equal, the
+                                                     final residual (round-off) to 1e-12 of the load; timings, memory and
+                                                     file names are not compared. Exit 1 on a difference.
+"""
+import argparse
+import os
+import shlex
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import yaml
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from read_runs import read_run  # noqa: E402
+
+NOT_COMPARED = ("time_", "peak_memory", "reference")
+ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
+
+
+def load_runs(path):
+    with open(path) as fh:
+        runs = yaml.safe_load(fh)["runs"]
+    for r in runs:
+        if set(r) - {"name", "ranks", "args"} or "name" not in r or "args" not in r:
+            raise ValueError(f"{path}: a run needs name and args (and may have ranks): {r}")
+    return runs
+
+
+def run_all(directory, binary, runs):
+    os.makedirs(directory, exist_ok=True)
+    failed = 0
+    for r in runs:
+        out = os.path.join(os.path.abspath(directory), r["name"] + ".h5")
+        cmd = ["mpiexec", "-n", str(r.get("ranks", 1)), binary] + shlex.split(r["args"]) + ["-output", out]
+        p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+        with open(out[:-3] + ".log", "w") as fh:
+            fh.write(p.stdout)
+        print(f"{r['name']}: exit {p.returncode}")
+        failed += p.returncode != 0
+    return 1 if failed else 0
+
+
+def fields(path):
+    with h5py.File(path, "r") as f:
+        x = f["geometry/vertices"][:]
+        order = np.lexsort(np.round(x, 12).T)  # a vertex order that does not depend on the ranks
+        return {k: f["vertex_fields"][k][:][order] for k in f["vertex_fields"]}
+
+
+def compare_one(a, b, rtol, allow_added=False):
+    diffs = []
+    ra, rb = read_run(a), read_run(b)
+    for key in sorted(set(ra) | set(rb)):
+        if key == "file" or key.startswith(NOT_COMPARED) or (allow_added and key not in ra):
+            continue
+        va, vb = ra.get(key), rb.get(key)
+        if key == "residual_norm" and "load_norm" in rb:  # a converged residual is round-off: compared to the load
+            same = abs(va - vb) <= 1e-12 * rb["load_norm"]
+        elif isinstance(va, float) and isinstance(vb, float):
+            same = va == vb or (np.isnan(va) and np.isnan(vb)) or abs(va - vb) <= rtol * max(abs(va), abs(vb))
+        else:
+            same = va == vb
+        if not same:
+            diffs.append(f"/run {key}: {va} != {vb}")
+    fa, fb = fields(a), fields(b)
+    for key in sorted(set(fa) | set(fb)):
+        if key not in fa or key not in fb or fa[key].shape != fb[key].shape:
+            diffs.append(f"field {key}: missing or of another shape")
+            continue
+        scale = max(np.abs(fa[key]).max(), np.abs(fb[key]).max(), 1e-300)
+        d = np.abs(fa[key] - fb[key]).max() / scale
+        if d > rtol:
+            diffs.append(f"field {key}: relative difference {d:.3e}")
+    return diffs
+
+
+def compare_all(dir_a, dir_b, runs, rtol, allow_added=False):
+    bad = 0
+    for r in runs:
+        a, b = os.path.join(dir_a, r["name"] + ".h5"), os.path.join(dir_b, r["name"] + ".h5")
+        if not (os.path.exists(a) and os.path.exists(b)):
+            print(f"{r['name']}: MISSING ({a if not os.path.exists(a) else b})")
+            bad += 1
+            continue
+        diffs = compare_one(a, b, rtol, allow_added)
+        print(f"{r['name']}: {'same' if not diffs else 'DIFFERENT'}")
+        for d in diffs:
+            print(f"    {d}")
+        bad += bool(diffs)
+    print(f"{len(runs) - bad} same, {bad} different")
+    return 1 if bad else 0
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--runs", default=os.path.join(ROOT, "options", "regression", "runs.yaml"))
+    sub = parser.add_subparsers(dest="command", required=True)
+    p_run = sub.add_parser("run")
+    p_run.add_argument("directory")
+    p_run.add_argument("--bin", default=os.path.join(ROOT, "bin", "signorini"))
+    p_cmp = sub.add_parser("compare")
+    p_cmp.add_argument("a")
+    p_cmp.add_argument("b")
+    p_cmp.add_argument("--rtol", type=float, default=1e-12)
+    p_cmp.add_argument("--allow-added", action="store_true", help="attributes of /run that only B has are not differences")
+    args = parser.parse_args(argv)
+    runs = load_runs(args.runs)
+    if args.command == "run":
+        return run_all(args.directory, os.path.abspath(args.bin), runs)
+    return compare_all(args.a, args.b, runs, args.rtol, args.allow_added)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
