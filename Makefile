@@ -31,9 +31,10 @@ deps:
 	@pkg-config --exists petsc && [ -f /usr/include/metis.h ] && [ -f /usr/include/yaml.h ] && command -v mpicc >/dev/null && command -v mpiexec >/dev/null && \
 	  $(PYTHON) -c "import h5py, numpy, matplotlib, yaml" 2>/dev/null || sh scripts/install-deps.sh
 
-build/%.o: src/%.c include/signorini.h include/compat.h
+# -MMD -MP: each object depends on the headers it includes (build/*.d), and only those
+build/%.o: src/%.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(PETSC_CFLAGS) -c $< -o $@
+	$(CC) $(CFLAGS) -MMD -MP $(PETSC_CFLAGS) -c $< -o $@
 
 $(BIN): $(OBJ)
 	@mkdir -p bin
@@ -43,9 +44,9 @@ $(BIN): $(OBJ)
 ASAN_FLAGS = -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer
 ASAN_OBJ   = $(SRC:src/%.c=build-asan/%.o)
 ASAN_BIN   = bin/signorini-asan
-build-asan/%.o: src/%.c include/signorini.h include/compat.h
+build-asan/%.o: src/%.c
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS) $(ASAN_FLAGS) $(PETSC_CFLAGS) -c $< -o $@
+	$(CC) $(CFLAGS) $(ASAN_FLAGS) -MMD -MP $(PETSC_CFLAGS) -c $< -o $@
 
 $(ASAN_BIN): $(ASAN_OBJ)
 	@mkdir -p bin
@@ -94,3 +95,5 @@ format:
 
 clean:
 	rm -rf build build-asan bin output tests/out
+
+-include $(OBJ:.o=.d) $(ASAN_OBJ:.o=.d)

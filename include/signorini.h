@@ -185,6 +185,7 @@ typedef struct {
   PetscReal      snes_scale;         /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
   PetscReal      fnorm0;             /* |F| at the start of the last SNESSolve, in the user's units */
   Vec            work;               /* U x~: the displacement of the SNES iterate x~ */
+  AssemblyType   assembly_option;    /* -assembly as given (auto, fe, p1) */
   AssemblyType   assembly;           /* how K is assembled: fe or p1 (-assembly auto resolved) */
   PetscBool      assembly_check;     /* -assembly_check: assemble K both ways and compare */
 } AppCtx;
@@ -228,7 +229,7 @@ PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm);
 PetscErrorCode MeshPartitionGetStats(DM dm, MeshPartitionStats *stats);
 
 /* elasticity.c */
-PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat);
+PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degree);
 PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user);
 PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user);
 PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace);
@@ -277,7 +278,8 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X);
 
 /* assembly_p1.c */
-PetscErrorCode AssemblyGetOptions(DM dm, AppCtx *user);
+PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscBool *check);
+PetscErrorCode AssemblyResolve(DM dm, AppCtx *user);
 PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K);
 PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX);
 

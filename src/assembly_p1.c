@@ -62,20 +62,29 @@ static PetscErrorCode AssemblyP1Applies(DM dm, const AppCtx *user, const char **
 }
 
 /* -assembly and -assembly_check; resolves auto into fe or p1. */
-PetscErrorCode AssemblyGetOptions(DM dm, AppCtx *user)
+/* -assembly and -assembly_check, read once before any set-up. */
+PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscBool *check)
+{
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, NULL, "Assembly of the bulk matrix", "Signorini");
+  *requested = ASSEMBLY_AUTO;
+  PetscCall(PetscOptionsEnum("-assembly", "Bulk matrix K: auto (p1 where it applies, else fe), fe (PetscFE) or p1 (P1 simplices, closed form)",
+                             "SolverAssembleBulk", AssemblyTypes, (PetscEnum)*requested, (PetscEnum *)requested, NULL));
+  *check = PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-assembly_check", "Assemble K both ways and print ||K_p1 - K_fe||_F / ||K_fe||_F", "SolverAssembleBulk", *check, check,
+                             NULL));
+  PetscOptionsEnd();
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The assembly of this mesh's K: -assembly, with auto resolved (p1 where it applies, fe otherwise). */
+PetscErrorCode AssemblyResolve(DM dm, AppCtx *user)
 {
   MPI_Comm    comm   = PetscObjectComm((PetscObject)dm);
   const char *reason = NULL;
 
   PetscFunctionBeginUser;
-  PetscOptionsBegin(comm, NULL, "Assembly of the bulk matrix", "Signorini");
-  user->assembly = ASSEMBLY_AUTO;
-  PetscCall(PetscOptionsEnum("-assembly", "Bulk matrix K: auto (p1 where it applies, else fe), fe (PetscFE) or p1 (P1 simplices, closed form)",
-                             "SolverAssembleBulk", AssemblyTypes, (PetscEnum)user->assembly, (PetscEnum *)&user->assembly, NULL));
-  user->assembly_check = PETSC_FALSE;
-  PetscCall(PetscOptionsBool("-assembly_check", "Assemble K both ways and print ||K_p1 - K_fe||_F / ||K_fe||_F", "SolverAssembleBulk",
-                             user->assembly_check, &user->assembly_check, NULL));
-  PetscOptionsEnd();
+  user->assembly = user->assembly_option;
   PetscCall(AssemblyP1Applies(dm, user, &reason));
   PetscCheck(user->assembly != ASSEMBLY_P1 || !reason, comm, PETSC_ERR_USER_INPUT,
              "-assembly p1 needs P1 displacements on triangles or tetrahedra, but %s: use -assembly fe or auto", reason);

@@ -121,10 +121,14 @@ PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat)
+/* The material and the degree of the displacement (-displacement_petscspace_degree, PETSc's name for it, default 1). */
+PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degree)
 {
   PetscFunctionBeginUser;
-  PetscOptionsBegin(comm, NULL, "Linear elastic material", "Signorini");
+  PetscOptionsBegin(comm, NULL, "Linear elastic material and its discretization", "Signorini");
+  *degree = 1;
+  PetscCall(PetscOptionsRangeInt("-displacement_petscspace_degree", "Degree of the Lagrange displacement space (P1/Q1 by default)", NULL, *degree,
+                                 degree, NULL, 1, 8));
   mat->young_modulus = 1.0;
   PetscCall(PetscOptionsReal("-young_modulus", "Young's modulus E", NULL, mat->young_modulus, &mat->young_modulus, NULL));
   mat->poisson_ratio = 0.3;
@@ -166,20 +170,15 @@ PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user)
   MPI_Comm     comm  = PetscObjectComm((PetscObject)dm);
   const Scene *scene = &user->scene;
   PetscFE      fe;
-  PetscSpace   space;
   PetscDS      ds;
   PetscInt     dim;
-  PetscBool    simplex, has_degree;
+  PetscBool    simplex;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(PetscOptionsHasName(NULL, NULL, "-displacement_petscspace_degree", &has_degree));
-  if (!has_degree) PetscCall(PetscOptionsSetValue(NULL, "-displacement_petscspace_degree", "1")); /* P1 by default */
   PetscCall(DMPlexIsSimplex(dm, &simplex));
-  PetscCall(PetscFECreateDefault(comm, dim, dim, simplex, "displacement_", PETSC_DETERMINE, &fe));
+  PetscCall(PetscFECreateLagrange(comm, dim, dim, simplex, user->degree, PETSC_DETERMINE, &fe)); /* the degree of ElasticityGetOptions() */
   PetscCall(PetscObjectSetName((PetscObject)fe, "displacement"));
-  PetscCall(PetscFEGetBasisSpace(fe, &space));
-  PetscCall(PetscSpaceGetDegree(space, &user->degree, NULL));
   PetscCall(DMSetField(dm, 0, NULL, (PetscObject)fe));
   PetscCall(PetscFEDestroy(&fe));
   PetscCall(DMCreateDS(dm));

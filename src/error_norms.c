@@ -226,7 +226,6 @@ PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
 
   PetscFunctionBeginUser;
   PetscCall(ErrorNormsReset(&user->errors));
-  PetscCall(ErrorNormsReset(&user->ref_errors));
   PetscCall(DMGetLocalVector(dm, &loc_uh));
   PetscCall(VecZeroEntries(loc_uh));
   PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, loc_uh, 0.0, NULL, NULL, NULL));
@@ -238,6 +237,5 @@ PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(ErrorNormsEvaluate(dm, user, user->K, loc_uh, loc_ph, user->scene.exact && user->scene.exact_gradient ? &exact : NULL, &user->errors));
   if (loc_ph) PetscCall(DMRestoreLocalVector(dm, &loc_ph));
   PetscCall(DMRestoreLocalVector(dm, &loc_uh));
-  if (user->verify.reference[0]) PetscCall(ReferenceCompute(dm, user, u));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

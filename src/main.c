@@ -108,13 +108,15 @@ int main(int argc, char **argv)
   PetscCall(OutputFileInstallCleanup());
   PetscCall(SceneRegisterAll());
   PetscCall(SceneGetOptions(comm, user.scene_name, sizeof(user.scene_name)));
-  PetscCall(ElasticityGetOptions(comm, &user.material));
+  PetscCall(ElasticityGetOptions(comm, &user.material, &user.degree));
   PetscCall(ContactGetOptions(comm, &user.contact));
   PetscCall(VerifyGetOptions(comm, &user.verify));
+  PetscCall(AssemblyGetOptions(comm, &user.assembly_option, &user.assembly_check));
   PetscCall(OutputGetOptions(comm, &user));
 
   PetscCall(MeshCreate(comm, user.contact.grid_sequence, &dm));
-  PetscCall(MeshPartitionGetStats(dm, &user.stats.partition)); /* the partitioner; the final mesh's cut is taken at output */
+  PetscCall(MeshPartitionGetStats(dm, &user.stats.partition)); /* the partitioner; the final mesh's cut is taken after the solve */
+  PetscCall(SceneCreate(user.scene_name, dm, &user.material, &user.scene)); /* its options, once for every level */
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(ReferenceCheckFile(dm, &user)); /* before the solve, not after it */
   PetscCall(DMCreateGlobalVector(dm, &u));
@@ -128,6 +130,8 @@ int main(int argc, char **argv)
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
   PetscCall(ErrorNormsCompute(dm, &user, u));
+  PetscCall(ReferenceCompute(dm, &user, u)); /* -reference, if given */
+  PetscCall(MeshPartitionGetStats(dm, &user.stats.partition)); /* of the final mesh */
   PetscCall(PetscTime(&t1));
   user.stats.time_total = t1 - t0;
   PetscCall(RecordPeakMemory(comm, &user.stats));

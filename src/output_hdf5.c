@@ -274,7 +274,6 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));
   PetscCall(WriteIntAttr(v, "active_set_cycles", s->active_set_cycles));
   PetscCall(WriteIntAttr(v, "pc_builds", s->pc_builds));
-  PetscCall(MeshPartitionGetStats(dm, &user->stats.partition));
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "partitioner", PETSC_STRING, MeshPartitionerTypes[s->partition.partitioner]));
   PetscCall(WriteIntAttr(v, "partition_edge_cut", s->partition.edge_cut));
   PetscCall(WriteRealAttr(v, "partition_imbalance", s->partition.imbalance));

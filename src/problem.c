@@ -8,7 +8,6 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
 
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
-  PetscCall(SceneCreate(user->scene_name, dm, &user->material, &user->scene));
   PetscCall(MeshCheckContactBoundary(dm, user->scene.contact_id));
   PetscCall(MeshCheckFaceSets(dm, user->scene.name, "the Dirichlet boundary Gamma_D (with none, nothing would fix the body)",
                               user->scene.num_dirichlet, user->scene.dirichlet_ids));

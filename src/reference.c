@@ -391,6 +391,8 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   ErrorTarget target;
 
   PetscFunctionBeginUser;
+  PetscCall(ErrorNormsReset(&user->ref_errors));
+  if (!user->verify.reference[0]) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(ReferenceRead(comm, user, dim, &ref));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));

@@ -9,7 +9,7 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   MatNullSpace rigid;
 
   PetscFunctionBeginUser;
-  PetscCall(AssemblyGetOptions(dm, user)); /* -assembly fe|p1 */
+  PetscCall(AssemblyResolve(dm, user)); /* -assembly auto: fe or p1 for this mesh */
   if (user->assembly == ASSEMBLY_P1)
     PetscCall(AssemblyP1CreateMatrix(dm, user, &user->K));
   else
