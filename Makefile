@@ -19,7 +19,7 @@ CFLAGS  ?= -O2 -g
 CFLAGS  += -std=c99 -Wall -Wextra -Wno-unused-parameter -Iinclude
 LDLIBS  += $(PETSC_LIBS) -lyaml -lmetis -lm
 
-SRC = $(wildcard src/*.c src/scenes/*.c)
+SRC = $(wildcard src/*.c src/*/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
@@ -91,7 +91,7 @@ study-%: deps
 	$(PYTHON) scripts/study.py options/studies/$*.yaml --check
 
 format:
-	clang-format -i src/*.c src/scenes/*.c include/*.h
+	clang-format -i src/*.c src/*/*.c include/*.h
 
 clean:
 	rm -rf build build-asan bin output tests/out

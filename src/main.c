@@ -3,7 +3,13 @@ static const char help[] =
     "with SNESVI as the reference for the exact constraint. 2D plane strain and 3D, DMPlex + PetscFE.\n\n";
 
 #include <sys/resource.h>
-#include "signorini.h"
+#include "app.h"
+#include "scenes.h"
+#include "mesh.h"
+#include "physics.h"
+#include "solver.h"
+#include "verify.h"
+#include "io.h"
 
 static PetscErrorCode PrintSummary(DM dm, AppCtx *user, Vec u)
 {
@@ -115,7 +121,7 @@ int main(int argc, char **argv)
   PetscCall(OutputGetOptions(comm, &user));
 
   PetscCall(MeshCreate(comm, user.contact.grid_sequence, &dm));
-  PetscCall(MeshPartitionGetStats(dm, &user.stats.partition)); /* the partitioner; the final mesh's cut is taken after the solve */
+  PetscCall(MeshPartitionGetStats(dm, &user.stats.partition));              /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(user.scene_name, dm, &user.material, &user.scene)); /* its options, once for every level */
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(ReferenceCheckFile(dm, &user)); /* before the solve, not after it */
@@ -130,7 +136,7 @@ int main(int argc, char **argv)
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
   PetscCall(ErrorNormsCompute(dm, &user, u));
-  PetscCall(ReferenceCompute(dm, &user, u)); /* -reference, if given */
+  PetscCall(ReferenceCompute(dm, &user, u));                   /* -reference, if given */
   PetscCall(MeshPartitionGetStats(dm, &user.stats.partition)); /* of the final mesh */
   PetscCall(PetscTime(&t1));
   user.stats.time_total = t1 - t0;

@@ -5,7 +5,8 @@
      u_1 = -x_d phi'(x_1),  u_d = phi(x_1) + x_d psi(x_1),  the other components 0,
    so that on Gamma_C u_n = -phi <= 0, sigma_n = (lambda + 2 mu) psi <= 0, sigma_t = 0 and sigma_n u_n = 0,
    and u is in H^{3/2 + nu - delta} for every delta > 0. The data enter through the weak form (weak_data.c). */
-#include "signorini.h"
+#include "app.h"
+#include "scenes.h"
 
 enum { MMS_NU, MMS_A, MMS_AMP_A, MMS_AMP_B, MMS_NUM_CONSTANTS };
 

@@ -2,7 +2,8 @@
    (sigma = a E e_1 e_1, so Gamma_C = {x_d = 0} is traction-free), plus a rigid lift c along x_d and a rigid rotation w
    in the (x_1, x_d) plane, prescribed on every face but Gamma_C, f = 0. With c > w and a >= 0 the body leaves the
    foundation, so P1/Q1 elements must reproduce the field to round-off with or without the contact terms. */
-#include "signorini.h"
+#include "app.h"
+#include "scenes.h"
 
 enum { PATCH_STRAIN, PATCH_LATERAL, PATCH_LIFT, PATCH_ROTATION, PATCH_NUM_CONSTANTS };
 

@@ -1,5 +1,5 @@
 /* Scenes are registered by name; -scene NAME picks one. */
-#include "signorini.h"
+#include "scenes.h"
 
 static PetscFunctionList scene_list = NULL;
 

@@ -1,7 +1,8 @@
 /* Scene "square": Omega = (0,1)^d clamped on top (x_d = 1), Gamma_C the bottom (x_d = 0) on a flat
    foundation, other faces traction-free, body force f = (0, ..., 0, beta (x_1 - x0)): the body is
    pressed down where x_1 < x0 and lifted where x_1 > x0, so the contact zone ends inside Gamma_C. */
-#include "signorini.h"
+#include "app.h"
+#include "scenes.h"
 
 enum { SQUARE_BETA, SQUARE_X0, SQUARE_NUM_CONSTANTS };
 

@@ -1,0 +1,12 @@
+/* Helpers of the command line and the options: checks shared by every module's *GetOptions, and the YAML options files checked before PETSc starts
+ * (src/app/). */
+#pragma once
+#include "signorini.h"
+
+/* options_files.c (before PetscInitialize(): plain C, returns 1 after printing the problem) */
+int OptionsFilesCheckYAML(int argc, char **argv);
+
+/* options_check.c */
+PetscErrorCode OptionsCheckFinite(MPI_Comm comm, const char name[], PetscReal value);
+PetscErrorCode OptionsCheckFiniteArray(MPI_Comm comm, const char name[], PetscInt n, const PetscReal values[]);
+PetscErrorCode OptionsCountListValues(const char name[], PetscInt *n);

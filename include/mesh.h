@@ -1,0 +1,25 @@
+/* Meshes: creation, size checks, face sets, refinement with interpolation, distribution (src/mesh/). */
+#pragma once
+#include "signorini.h"
+
+/* mesh.c, mesh_box_simplex.c */
+PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm);
+PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[]);
+PetscErrorCode MeshCheckFaceSets(DM dm, const char scene[], const char what[], PetscInt n, const PetscInt ids[]);
+PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[], DM *dm);
+PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[]);
+PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
+PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id);
+PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count);
+PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **faces);
+
+/* mesh_refine.c */
+PetscErrorCode MeshCellVertices(DM dm, PetscInt c, PetscInt verts[], PetscInt *nv);
+PetscErrorCode MeshCellReferenceCoordinates(DM dm, PetscInt c, PetscInt n, const PetscReal x[], PetscReal xi[]);
+PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **parent, PetscInt **vertex_source);
+PetscErrorCode MeshInterpolateVertexSources(DM dm, DM fine, const PetscInt vertex_source[], Vec loc, Vec *fine_loc);
+PetscErrorCode MeshInterpolateFromParents(DM dm, DM fine, const PetscInt parent[], PetscInt nvec, Vec loc[], Vec fine_loc[]);
+
+/* mesh_partition.c */
+PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm);
+PetscErrorCode MeshPartitionGetStats(DM dm, MeshPartitionStats *stats);

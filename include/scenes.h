@@ -1,0 +1,12 @@
+/* Scenes: problem set-ups registered by name (src/scenes/). */
+#pragma once
+#include "signorini.h"
+
+/* scenes/registry.c */
+PetscErrorCode SceneRegisterAll(void);
+PetscErrorCode SceneFinalize(void);
+PetscErrorCode SceneCreate(const char name[], DM dm, const Material *mat, Scene *scene);
+PetscErrorCode SceneGetOptions(MPI_Comm comm, char name[], size_t len);
+PetscErrorCode SceneCreate_Square(DM, const Material *, Scene *);
+PetscErrorCode SceneCreate_Patch(DM, const Material *, Scene *);
+PetscErrorCode SceneCreate_MMS(DM, const Material *, Scene *);

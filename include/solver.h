@@ -1,0 +1,30 @@
+/* Solver: assembly of the bulk operator, the SNES (residual, Jacobian, scaling, convergence), the problem on one mesh, grid sequencing, eps sweep,
+ * preconditioner reuse, the Newton monitor (src/solver/). */
+#pragma once
+#include "signorini.h"
+
+/* solver.c */
+PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user);
+PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
+PetscErrorCode SolverComputeScales(DM dm, AppCtx *user);
+PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm);
+PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
+PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
+
+/* problem.c, grid_sequence.c, eps_sweep.c */
+PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes);
+PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
+PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
+PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
+
+/* pc_reuse.c */
+PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X);
+
+/* assembly_p1.c */
+PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscBool *check);
+PetscErrorCode AssemblyResolve(DM dm, AppCtx *user);
+PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K);
+PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX);
+
+/* contact_monitor.c */
+PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx);

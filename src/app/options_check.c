@@ -1,0 +1,35 @@
+/* Checks of option values shared by the modules' *GetOptions: every real option must be a finite number
+   (PETSc parses "inf" and "nan" as reals, which would run a whole solve into NaN without naming the option). */
+#include "app.h"
+
+PetscErrorCode OptionsCheckFinite(MPI_Comm comm, const char name[], PetscReal value)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(!PetscIsInfOrNanReal(value), comm, PETSC_ERR_USER_INPUT, "%s must be a finite number, got %g", name, (double)value);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode OptionsCheckFiniteArray(MPI_Comm comm, const char name[], PetscInt n, const PetscReal values[])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < n; ++i)
+    PetscCheck(!PetscIsInfOrNanReal(values[i]), comm, PETSC_ERR_USER_INPUT, "%s must be a list of finite numbers, got %g as value %" PetscInt_FMT,
+               name, (double)values[i], i + 1);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Number of comma-separated values of a list option as given (0 if not given), so that a list of any length is read
+   whole: PetscOptionsRealArray() silently drops the values beyond the array it is given. */
+PetscErrorCode OptionsCountListValues(const char name[], PetscInt *n)
+{
+  const char *value;
+  PetscBool   set;
+
+  PetscFunctionBeginUser;
+  *n = 0;
+  PetscCall(PetscOptionsFindPair(NULL, NULL, name, &value, &set));
+  if (!set || !value) PetscFunctionReturn(PETSC_SUCCESS);
+  *n = 1;
+  for (const char *c = value; *c; ++c) *n += *c == ',';
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

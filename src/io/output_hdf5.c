@@ -1,0 +1,451 @@
+/* HDF5 writer: mesh and vertex fields in PETSc's layout (petsc_gen_xdmf.py reads it), run metadata
+   as attributes of /run, an .xdmf beside it. Written under temporary names and renamed when complete (output_file.c). */
+#define _DEFAULT_SOURCE /* POSIX and BSD calls (mkstemp, lstat, sigaction, flock) under -std=c99 */
+#include <errno.h>
+#include <fcntl.h>
+#include <string.h>
+#include <sys/statvfs.h>
+#include <unistd.h>
+#include <petscsf.h>
+#include <petscviewerhdf5.h>
+#include "mesh.h"
+#include "physics.h"
+#include "io.h"
+
+PetscErrorCode OutputGetOptions(MPI_Comm comm, AppCtx *user)
+{
+  PetscBool set;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, NULL, "Output", "Signorini");
+  PetscCall(PetscSNPrintf(user->output, sizeof(user->output), "output/%s.h5", user->scene_name));
+  PetscCall(
+      PetscOptionsString("-output", "HDF5 output file (default output/<scene>.h5)", NULL, user->output, user->output, sizeof(user->output), &set));
+  PetscOptionsEnd();
+  PetscCall(OutputFileCheckTarget(comm, user->output, (PetscBool)!set)); /* the default directory is created; a user's must exist */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* A DM on the same mesh with nc unknowns at each vertex: the layout of a vertex field. */
+static PetscErrorCode CreateVertexFieldDM(DM dm, PetscInt nc, DM *vdm)
+{
+  PetscSection s;
+  PetscInt     pStart, pEnd, vStart, vEnd;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMClone(dm, vdm));
+  PetscCall(PetscSectionCreate(PetscObjectComm((PetscObject)dm), &s));
+  PetscCall(PetscSectionSetNumFields(s, 1));
+  PetscCall(PetscSectionSetFieldComponents(s, 0, nc));
+  PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(PetscSectionSetChart(s, pStart, pEnd));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    PetscCall(PetscSectionSetDof(s, v, nc));
+    PetscCall(PetscSectionSetFieldDof(s, v, 0, nc));
+  }
+  PetscCall(PetscSectionSetUp(s));
+  PetscCall(DMSetLocalSection(*vdm, s));
+  PetscCall(PetscSectionDestroy(&s));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Writes /vertex_fields/<name of v> as an (n_vertices, nc) dataset in the vertex order of /geometry/vertices. */
+static PetscErrorCode ViewVertexField(Vec v, PetscInt nc, PetscViewer viewer)
+{
+  Vec                plain;
+  PetscInt           n;
+  const PetscScalar *a;
+  const char        *name;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetLocalSize(v, &n));
+  PetscCall(VecGetArrayRead(v, &a));
+  PetscCall(VecCreateMPIWithArray(PetscObjectComm((PetscObject)v), nc, n, PETSC_DECIDE, a, &plain));
+  PetscCall(PetscObjectGetName((PetscObject)v, &name));
+  PetscCall(PetscObjectSetName((PetscObject)plain, name));
+  PetscCall(PetscViewerHDF5PushGroup(viewer, "/vertex_fields"));
+  PetscCall(VecView(plain, viewer));
+  PetscCall(PetscViewerHDF5WriteObjectAttribute(viewer, (PetscObject)plain, "vector_field_type", PETSC_STRING, nc > 1 ? "vector" : "scalar"));
+  PetscCall(PetscViewerHDF5PopGroup(viewer));
+  PetscCall(VecDestroy(&plain));
+  PetscCall(VecRestoreArrayRead(v, &a));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The vertex fields: displacement, contact pressure, normal gap g - u_n, Gamma_C indicator,
+   and the exact solution and error when the scene has one. */
+static PetscErrorCode WriteVertexFields(DM dm, AppCtx *user, Vec u, PetscViewer viewer)
+{
+  const ContactSet  *cs = &user->cset;
+  DM                 vdm, sdm, cdm;
+  Vec                locU, disp, pressure, gap, mask, exact = NULL, error = NULL, coords;
+  PetscSection       usec, vsec, ssec, csec;
+  PetscInt           dim, vStart, vEnd, vrstart, srstart;
+  const PetscScalar *lu, *xc, *x;
+  PetscScalar       *d, *p, *g, *m, *ex = NULL, *er = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(CreateVertexFieldDM(dm, dim, &vdm));
+  PetscCall(CreateVertexFieldDM(dm, 1, &sdm));
+  PetscCall(DMGetLocalSection(dm, &usec));
+  PetscCall(DMGetGlobalSection(vdm, &vsec));
+  PetscCall(DMGetGlobalSection(sdm, &ssec));
+  PetscCall(DMGetCoordinateDM(dm, &cdm));
+  PetscCall(DMGetLocalSection(cdm, &csec));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(DMCreateGlobalVector(vdm, &disp));
+  PetscCall(DMCreateGlobalVector(sdm, &pressure));
+  PetscCall(DMCreateGlobalVector(sdm, &gap));
+  PetscCall(DMCreateGlobalVector(sdm, &mask));
+  PetscCall(PetscObjectSetName((PetscObject)disp, "displacement"));
+  PetscCall(PetscObjectSetName((PetscObject)pressure, "contact_pressure"));
+  PetscCall(PetscObjectSetName((PetscObject)gap, "normal_gap"));
+  PetscCall(PetscObjectSetName((PetscObject)mask, "contact_boundary"));
+  PetscCall(VecZeroEntries(pressure));
+  PetscCall(VecZeroEntries(gap));
+  PetscCall(VecZeroEntries(mask));
+  if (user->scene.exact) {
+    PetscCall(VecDuplicate(disp, &exact));
+    PetscCall(VecDuplicate(disp, &error));
+    PetscCall(PetscObjectSetName((PetscObject)exact, "exact_displacement"));
+    PetscCall(PetscObjectSetName((PetscObject)error, "error"));
+    PetscCall(VecGetArray(exact, &ex));
+    PetscCall(VecGetArray(error, &er));
+  }
+  PetscCall(VecGetOwnershipRange(disp, &vrstart, NULL));
+  PetscCall(VecGetOwnershipRange(pressure, &srstart, NULL));
+
+  PetscCall(DMGetLocalVector(dm, &locU));
+  PetscCall(VecZeroEntries(locU));
+  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, locU, 0.0, NULL, NULL, NULL));
+  PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, locU));
+  PetscCall(VecGetArrayRead(locU, &lu));
+  PetscCall(VecGetArrayRead(coords, &xc));
+  PetscCall(VecGetArray(disp, &d));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    PetscInt goff, uoff, coff;
+
+    PetscCall(PetscSectionGetOffset(vsec, v, &goff));
+    if (goff < 0) continue; /* not owned */
+    goff -= vrstart;
+    PetscCall(PetscSectionGetOffset(usec, v, &uoff));
+    for (PetscInt c = 0; c < dim; ++c) d[goff + c] = lu[uoff + c];
+    if (ex) {
+      PetscReal xv[3];
+
+      PetscCall(PetscSectionGetOffset(csec, v, &coff));
+      for (PetscInt c = 0; c < dim; ++c) xv[c] = PetscRealPart(xc[coff + c]);
+      PetscCall((*user->scene.exact)(dim, 0.0, xv, dim, &ex[goff], (void *)user->scene.constants));
+      for (PetscInt c = 0; c < dim; ++c) er[goff + c] = d[goff + c] - ex[goff + c];
+    }
+  }
+  PetscCall(VecRestoreArray(disp, &d));
+  PetscCall(VecRestoreArrayRead(coords, &xc));
+  PetscCall(VecRestoreArrayRead(locU, &lu));
+  PetscCall(DMRestoreLocalVector(dm, &locU));
+  if (ex) {
+    PetscCall(VecRestoreArray(exact, &ex));
+    PetscCall(VecRestoreArray(error, &er));
+  }
+
+  PetscCall(VecGetArrayRead(u, &x));
+  PetscCall(VecGetArray(pressure, &p));
+  PetscCall(VecGetArray(gap, &g));
+  PetscCall(VecGetArray(mask, &m));
+  for (PetscInt i = 0; i < cs->n; ++i) {
+    PetscInt goff;
+
+    if (!cs->is_vertex[i]) continue;
+    PetscCall(PetscSectionGetOffset(ssec, cs->point[i], &goff));
+    goff -= srstart;
+    p[goff] = cs->pressure[i];
+    g[goff] = -ContactNodePenetration(user, dim, i, x);
+    m[goff] = 1.0;
+  }
+  PetscCall(VecRestoreArray(mask, &m));
+  PetscCall(VecRestoreArray(gap, &g));
+  PetscCall(VecRestoreArray(pressure, &p));
+  PetscCall(VecRestoreArrayRead(u, &x));
+
+  PetscCall(ViewVertexField(disp, dim, viewer));
+  PetscCall(ViewVertexField(pressure, 1, viewer));
+  PetscCall(ViewVertexField(gap, 1, viewer));
+  PetscCall(ViewVertexField(mask, 1, viewer));
+  if (exact) {
+    PetscCall(ViewVertexField(exact, dim, viewer));
+    PetscCall(ViewVertexField(error, dim, viewer));
+  }
+  PetscCall(VecDestroy(&exact));
+  PetscCall(VecDestroy(&error));
+  PetscCall(VecDestroy(&disp));
+  PetscCall(VecDestroy(&pressure));
+  PetscCall(VecDestroy(&gap));
+  PetscCall(VecDestroy(&mask));
+  PetscCall(DMDestroy(&vdm));
+  PetscCall(DMDestroy(&sdm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode WriteRealAttr(PetscViewer v, const char name[], PetscReal value)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", name, PETSC_REAL, &value));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode WriteIntAttr(PetscViewer v, const char name[], PetscInt value)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", name, PETSC_INT, &value));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* prefix_l2, prefix_h1, ... for the norms that were computed (NaN: not computed, not written). */
+static PetscErrorCode WriteErrorNorms(PetscViewer v, const char prefix[], const ErrorNorms *e)
+{
+  const char *names[]  = {"l2", "h1_semi", "h1", "energy", "pressure_l2", "pressure_weighted", "pressure_dual"};
+  PetscReal   values[] = {e->l2, e->h1_semi, e->h1, e->energy, e->pressure_l2, e->pressure_weighted, e->pressure_dual};
+  char        name[64];
+
+  PetscFunctionBeginUser;
+  for (size_t i = 0; i < sizeof(values) / sizeof(values[0]); ++i) {
+    if (PetscIsNanReal(values[i])) continue;
+    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_%s", prefix, names[i]));
+    PetscCall(WriteRealAttr(v, name, values[i]));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v, PetscInt ncells, PetscInt nverts)
+{
+  const RunStats *s = &user->stats;
+  PetscMPIInt     size;
+  PetscInt        dim, ndofs;
+  char            method[64];
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)dm), &size));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(VecGetSize(u, &ndofs));
+  PetscCall(PetscStrncpy(method, ContactMethods[user->contact.method], sizeof(method)));
+  PetscCall(PetscViewerHDF5WriteGroup(v, "/run"));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "scene", PETSC_STRING, user->scene.name));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "method", PETSC_STRING, method));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_quadrature", PETSC_STRING, PenaltyQuadratures[user->contact.quadrature]));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_eps_modulus", PETSC_STRING, PenaltyModuli[user->contact.modulus]));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "assembly", PETSC_STRING, AssemblyTypes[user->assembly]));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "snes_reason", PETSC_STRING, SNESConvergedReasons[s->reason]));
+  PetscCall(WriteIntAttr(v, "dim", dim));
+  PetscCall(WriteIntAttr(v, "degree", user->degree));
+  PetscCall(WriteIntAttr(v, "nprocs", size));
+  PetscCall(WriteIntAttr(v, "n_cells", ncells));
+  PetscCall(WriteIntAttr(v, "n_vertices", nverts));
+  PetscCall(WriteIntAttr(v, "n_dofs", ndofs));
+  PetscCall(WriteRealAttr(v, "h", user->h));
+  PetscCall(WriteRealAttr(v, "eps", user->contact.method == CONTACT_PENALTY ? user->eps : 0.0));
+  PetscCall(WriteRealAttr(v, "young_modulus", user->material.young_modulus));
+  PetscCall(WriteRealAttr(v, "poisson_ratio", user->material.poisson_ratio));
+  PetscCall(WriteIntAttr(v, "converged", s->converged ? 1 : 0));
+  PetscCall(WriteIntAttr(v, "snes_reason_code", (PetscInt)s->reason));
+  PetscCall(WriteIntAttr(v, "newton_its", s->newton_its));
+  PetscCall(WriteIntAttr(v, "ksp_its", s->ksp_its));
+  PetscCall(WriteIntAttr(v, "newton_its_total", s->newton_its_total));
+  PetscCall(WriteIntAttr(v, "ksp_its_total", s->ksp_its_total));
+  PetscCall(WriteIntAttr(v, "grid_sequence", user->contact.grid_sequence));
+  PetscCall(WriteIntAttr(v, "n_solves", user->nrecords));
+  PetscCall(WriteRealAttr(v, "residual_norm", s->residual_norm));
+  PetscCall(WriteIntAttr(v, "residual_reduced", s->residual_reduced ? 1 : 0));
+  PetscCall(WriteRealAttr(v, "load_norm", user->load_norm));
+  PetscCall(WriteRealAttr(v, "displacement_scale", user->displacement_scale));
+  PetscCall(WriteRealAttr(v, "time_setup", s->time_setup));
+  PetscCall(WriteRealAttr(v, "time_solve", s->time_solve));
+  PetscCall(WriteRealAttr(v, "time_total", s->time_total));
+  PetscCall(WriteIntAttr(v, "active_vertices", s->active_vertices));
+  PetscCall(WriteRealAttr(v, "max_penetration", s->max_penetration));
+  PetscCall(WriteRealAttr(v, "contact_force", s->contact_force));
+  PetscCall(WriteRealAttr(v, "energy", s->energy));
+  {
+    PetscInt n = user->cset.n, ntotal;
+
+    PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
+    PetscCall(WriteIntAttr(v, "contact_nodes", ntotal)); /* the free nodes of Gamma_C the contact acts on, each counted once */
+  }
+  PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));
+  PetscCall(WriteIntAttr(v, "active_set_cycles", s->active_set_cycles));
+  PetscCall(WriteIntAttr(v, "pc_builds", s->pc_builds));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "partitioner", PETSC_STRING, MeshPartitionerTypes[s->partition.partitioner]));
+  PetscCall(WriteIntAttr(v, "partition_edge_cut", s->partition.edge_cut));
+  PetscCall(WriteRealAttr(v, "partition_imbalance", s->partition.imbalance));
+  if (user->contact.condition_estimate) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm)); /* NaN: the estimate failed */
+  PetscCall(WriteRealAttr(v, "peak_memory_mb", s->peak_memory_mb));
+  PetscCall(WriteRealAttr(v, "peak_memory_total_mb", s->peak_memory_total_mb));
+  PetscCall(WriteRealAttr(v, "penetration_l2", user->errors.penetration_l2));
+  PetscCall(WriteRealAttr(v, "penetration_max", user->errors.penetration_max));
+  PetscCall(WriteErrorNorms(v, "error", &user->errors));
+  PetscCall(WriteErrorNorms(v, "reference_error", &user->ref_errors));
+  if (user->verify.reference[0]) {
+    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "reference", PETSC_STRING, user->verify.reference));
+  }
+  PetscCall(WriteIntAttr(v, "verify_quadrature_points", user->verify.quad_points));
+  PetscCall(WriteIntAttr(v, "verify_quadrature_refine", user->verify.quad_refine));
+  for (PetscInt i = 0; i < user->scene.num_constants; ++i) { /* the scene's parameters, scene_0, scene_1, ... */
+    char name[32];
+
+    PetscCall(PetscSNPrintf(name, sizeof(name), "scene_%" PetscInt_FMT, i));
+    PetscCall(WriteRealAttr(v, name, PetscRealPart(user->scene.constants[i])));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* /solves/<column>: one row per solve of the run (grid sequence levels, eps sweep values), as datasets of length n. */
+static PetscErrorCode WriteSolves(MPI_Comm comm, const AppCtx *user, PetscViewer v)
+{
+  const char    *columns[] = {"level",     "n_dofs",    "h",          "eps",        "newton_its",     "ksp_its",
+                              "pc_builds", "converged", "time_setup", "time_solve", "max_penetration"};
+  const PetscInt ncol = (PetscInt)(sizeof(columns) / sizeof(columns[0])), n = user->nrecords;
+  PetscMPIInt    rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCall(PetscViewerHDF5PushGroup(v, "/solves"));
+  for (PetscInt j = 0; j < ncol; ++j) {
+    Vec          col;
+    PetscScalar *a;
+
+    PetscCall(VecCreateMPI(comm, rank == 0 ? n : 0, n, &col));
+    PetscCall(PetscObjectSetName((PetscObject)col, columns[j]));
+    PetscCall(VecGetArray(col, &a));
+    for (PetscInt i = 0; rank == 0 && i < n; ++i) {
+      const SolveRecord *r      = &user->records[i];
+      const PetscReal    vals[] = {
+             (PetscReal)r->level,     (PetscReal)r->n_dofs,     r->h,          r->eps,        (PetscReal)r->newton_its, (PetscReal)r->ksp_its,
+             (PetscReal)r->pc_builds, r->converged ? 1.0 : 0.0, r->time_setup, r->time_solve, r->max_penetration};
+      a[i] = vals[j];
+    }
+    PetscCall(VecRestoreArray(col, &a));
+    PetscCall(VecView(col, v));
+    PetscCall(VecDestroy(&col));
+  }
+  PetscCall(PetscViewerHDF5PopGroup(v));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* XDMF for ParaView into the file xdmf, pointing into h5name, the final .h5 beside it (rank 0 only). */
+static PetscErrorCode WriteXdmf(AppCtx *user, const char xdmf[], const char h5name[], PetscInt dim, PetscInt ncells, PetscInt ncorners,
+                                PetscInt nverts)
+{
+  const char    *fields[] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "exact_displacement", "error"};
+  const PetscInt ncomp[]  = {dim, 1, 1, 1, dim, dim};
+  const PetscInt nfields  = user->scene.exact ? 6 : 4;
+  const char    *topo     = dim == 2 ? (ncorners == 3 ? "Triangle" : "Quadrilateral") : (ncorners == 4 ? "Tetrahedron" : "Hexahedron");
+  FILE          *fp;
+  int            bad;
+
+  PetscFunctionBeginUser;
+  fp = fopen(xdmf, "w");
+  PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "%s", strerror(errno));
+  fprintf(fp, "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"2.0\">\n <Domain>\n  <Grid Name=\"mesh\" GridType=\"Uniform\">\n");
+  fprintf(fp, "   <Topology TopologyType=\"%s\" NumberOfElements=\"%d\">\n", topo, (int)ncells);
+  fprintf(fp, "    <DataItem Dimensions=\"%d %d\" NumberType=\"Int\" Format=\"HDF\">%s:/viz/topology/cells</DataItem>\n   </Topology>\n", (int)ncells,
+          (int)ncorners, h5name);
+  fprintf(fp, "   <Geometry GeometryType=\"%s\">\n", dim == 2 ? "XY" : "XYZ");
+  fprintf(fp, "    <DataItem Dimensions=\"%d %d\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n   </Geometry>\n", (int)nverts, (int)dim, h5name);
+  for (PetscInt f = 0; f < nfields; ++f) {
+    fprintf(fp, "   <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", fields[f], ncomp[f] > 1 ? "Vector" : "Scalar");
+    if (ncomp[f] > 1)
+      fprintf(fp, "    <DataItem Dimensions=\"%d %d\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n", (int)nverts, (int)ncomp[f], h5name,
+              fields[f]);
+    else
+      fprintf(fp, "    <DataItem Dimensions=\"%d\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n", (int)nverts, h5name, fields[f]);
+    fprintf(fp, "   </Attribute>\n");
+  }
+  fprintf(fp, "  </Grid>\n </Domain>\n</Xdmf>\n");
+  bad = fflush(fp) != 0 || ferror(fp);
+  bad = (fclose(fp) != 0) || bad;
+  PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "%s", strerror(errno));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The HDF5 file, written into the temporary h5tmp, and the XDMF file into xdmftmp, both in the current directory. */
+static PetscErrorCode WriteFiles(DM dm, AppCtx *user, Vec u, const char h5tmp[], const char xdmftmp[], const char h5name[])
+{
+  MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
+  PetscViewer viewer;
+  PetscInt    dim, cStart, cEnd, vStart, vEnd, ncells, nverts, ncorners = 0;
+  PetscMPIInt rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(MeshCountOwned(dm, cStart, cEnd, &ncells));
+  PetscCall(MeshCountOwned(dm, vStart, vEnd, &nverts));
+  if (cEnd > cStart) PetscCall(DMPlexGetConeSize(dm, cStart, &ncorners));
+  if (dim == 3 && ncorners == 6) ncorners = 8; /* a hex has 6 faces and 8 corners; a triangle, quad or tet as many corners as faces */
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ncorners, 1, MPIU_INT, MPI_MAX, comm));
+
+  PetscCall(PetscViewerHDF5Open(comm, h5tmp, FILE_MODE_WRITE, &viewer));
+  PetscCall(PetscViewerPushFormat(viewer, PETSC_VIEWER_HDF5_VIZ));
+  PetscCall(DMView(dm, viewer));
+  PetscCall(WriteVertexFields(dm, user, u, viewer));
+  PetscCall(PetscViewerPopFormat(viewer));
+  PetscCall(WriteRunMetadata(dm, user, u, viewer, ncells, nverts));
+  PetscCall(WriteSolves(comm, user, viewer));
+  PetscCall(PetscViewerDestroy(&viewer));
+  if (rank == 0) PetscCall(WriteXdmf(user, xdmftmp, h5name, dim, ncells, ncorners, nverts));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Writes FILE.h5 and FILE.xdmf (output_file.c: temporaries renamed when complete), from inside their directory
+   (OutputFileEnterDirectory()). An I/O error is reported in one sentence naming the file and the cause. */
+PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
+{
+  MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
+  char           dir[PETSC_MAX_PATH_LEN], base[PETSC_MAX_PATH_LEN], xdmf[PETSC_MAX_PATH_LEN], temps[2][PETSC_MAX_PATH_LEN];
+  char           tdir[PETSC_MAX_PATH_LEN], h5tmp[PETSC_MAX_PATH_LEN], xdmftmp[PETSC_MAX_PATH_LEN];
+  const char    *targets[2] = {xdmf, user->output};
+  PetscErrorCode ierr;
+  int            cwd, err = 0, local_failed, failed;
+  H5E_auto2_t    h5_func;
+  void          *h5_data;
+
+  PetscFunctionBeginUser;
+  PetscCall(OutputFileSplitPath(user->output, dir, sizeof(dir), base, sizeof(base)));
+  PetscCall(OutputFileXdmfName(user->output, xdmf, sizeof(xdmf)));
+  PetscCall(OutputFileCreateTemps(comm, dir, 2, temps));                                  /* [0] the XDMF file, [1] the HDF5 file */
+  PetscCall(OutputFileSplitPath(temps[0], tdir, sizeof(tdir), xdmftmp, sizeof(xdmftmp))); /* names inside dir */
+  PetscCall(OutputFileSplitPath(temps[1], tdir, sizeof(tdir), h5tmp, sizeof(h5tmp)));
+  PetscCall(OutputFileEnterDirectory(temps[1], &cwd, h5tmp, sizeof(h5tmp)));
+  (void)H5Eget_auto2(H5E_DEFAULT, &h5_func, &h5_data);
+  (void)H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* HDF5's own error stack: replaced by the sentence below */
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  errno = 0;
+  ierr  = WriteFiles(dm, user, u, h5tmp, xdmftmp, base);
+  err   = errno;
+  PetscCall(PetscPopErrorHandler());
+  (void)H5Eset_auto2(H5E_DEFAULT, h5_func, h5_data);
+  PetscCall(OutputFileLeaveDirectory(cwd));
+  local_failed = ierr != 0;
+  PetscCallMPI(MPI_Allreduce(&local_failed, &failed, 1, MPI_INT, MPI_MAX, comm));
+  if (failed) {
+    const char    *text     = NULL;
+    char          *specific = NULL, cause[256] = "the write failed on another rank";
+    struct statvfs fs;
+
+    PetscCall(OutputFileDiscardTemps(comm));
+    if (ierr) PetscCall(PetscErrorMessage(ierr, &text, &specific));
+    if (statvfs(dir, &fs) == 0 && fs.f_bavail == 0)
+      PetscCall(PetscSNPrintf(cause, sizeof(cause), "no space left on the device of '%s'", dir));
+    else if (err == ENOSPC || err == EDQUOT || err == EFBIG || err == EIO || err == EROFS || err == EACCES)
+      PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", strerror(err)));
+    else if (ierr)
+      PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", specific && specific[0] ? specific : text));
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot write the output file %s: %s", user->output, cause);
+  }
+  PetscCall(OutputFileCommit(comm, dir, 2, temps, targets));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,280 @@
+/* Mesh creation: PETSc's box and file readers, plus the project's simplex box generator. */
+#define _DEFAULT_SOURCE /* sysconf(_SC_PHYS_PAGES) */
+#include <unistd.h>
+#include <petscsf.h>
+#include "app.h"
+#include "mesh.h"
+
+/* Refuses, before anything is allocated, a mesh of ncells cells (after all refinements) that 32-bit PETSc indices
+   cannot number or that needs more memory than the machines of the run have: at least 1 kB per cell (the cheapest
+   measured run, linear elasticity with GAMG in 2D, needs 1.5 kB per cell), against the physical memory of the nodes. */
+PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[])
+{
+  const PetscReal bytes_per_cell = 1000.0, points_per_cell = dim == 2 ? 3.0 : 4.5; /* cells, faces, edges, vertices */
+  PetscReal       memory = 0.0, local;
+  MPI_Comm        node;
+  PetscMPIInt     node_rank;
+
+  PetscFunctionBeginUser;
+  PetscCheck(ncells * points_per_cell < (PetscReal)PETSC_MAX_INT, comm, PETSC_ERR_USER_INPUT,
+             "%s: the mesh would have %.3g cells, more mesh points than PETSc's %d-bit indices can number", what, (double)ncells,
+             (int)(8 * sizeof(PetscInt)));
+  PetscCallMPI(MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node));
+  PetscCallMPI(MPI_Comm_rank(node, &node_rank));
+  PetscCallMPI(MPI_Comm_free(&node));
+  local = node_rank == 0 ? (PetscReal)sysconf(_SC_PHYS_PAGES) * (PetscReal)sysconf(_SC_PAGE_SIZE) : 0.0; /* once per node */
+  PetscCall(MPIU_Allreduce(&local, &memory, 1, MPIU_REAL, MPIU_SUM, comm));
+  PetscCheck(memory <= 0.0 || ncells * bytes_per_cell <= memory, comm, PETSC_ERR_USER_INPUT,
+             "%s: the mesh would have %.3g cells and need at least %.3g GB of memory, more than the %.3g GB of the machine(s) of this run", what,
+             (double)ncells, (double)(ncells * bytes_per_cell / 1e9), (double)(memory / 1e9));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Reads the mesh file (DMSetFromOptions), with an error that names the file and the reader's complaint. */
+static PetscErrorCode MeshReadFile(MPI_Comm comm, const char filename[], DM dm)
+{
+  PetscErrorCode ierr;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  ierr = DMSetFromOptions(dm);
+  PetscCall(PetscPopErrorHandler());
+  if (ierr) {
+    const char *text     = NULL;
+    char       *specific = NULL;
+
+    PetscCall(PetscErrorMessage(ierr, &text, &specific));
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "Cannot read the mesh file '%s' (-dm_plex_filename): %s", filename,
+            specific && specific[0] ? specific : text);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Creates the mesh from PETSc's own options; simplex boxes, which PETSc 3.18 cannot generate
+   without Triangle/CTetGen, come from MeshCreateSimplexBox(). later_refinements: uniform refinements the run will
+   still make (grid sequencing), counted in the size check. */
+PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
+{
+  PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
+  PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
+  PetscBool           simplex, has_file, faces_set, dim_set, parallel_read = PETSC_FALSE;
+  char                filename[PETSC_MAX_PATH_LEN] = "";
+  MeshPartitionerType partitioner;
+  MatType             mtype;
+  char               *mtype_copy;
+
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, NULL, "Mesh options (PETSc's names, and -partitioner)", "DMPLEX");
+  PetscCall(PetscOptionsString("-dm_plex_filename", "Mesh file (Gmsh, ExodusII, HDF5)", "DMPlexCreateFromFile", filename, filename, sizeof(filename),
+                               &has_file));
+  dim = 2;
+  PetscCall(PetscOptionsRangeInt("-dm_plex_dim", "Dimension of the box mesh", "DMPlexCreateBoxMesh", dim, &dim, &dim_set, 2, 3));
+  simplex = PETSC_TRUE;
+  PetscCall(PetscOptionsBool("-dm_plex_simplex", "Simplices (triangles, tetrahedra) or tensor cells (quads, hexes)", "DMPlexCreateBoxMesh", simplex,
+                             &simplex, NULL));
+  faces[0] = faces[1] = faces[2] = (dim == 2) ? 8 : 4;
+  PetscCall(
+      PetscOptionsIntArray("-dm_plex_box_faces", "Number of cells along each side of the box", "DMPlexCreateBoxMesh", faces, &nfaces, &faces_set));
+  PetscCall(PetscOptionsRealArray("-dm_plex_box_lower", "Lower corner of the box", "DMPlexCreateBoxMesh", lower, &nlower, NULL));
+  PetscCall(PetscOptionsRealArray("-dm_plex_box_upper", "Upper corner of the box", "DMPlexCreateBoxMesh", upper, &nupper, NULL));
+  partitioner = MESH_PARTITIONER_PTSCOTCH; /* PETSc 3.18's default where it has PTScotch and no ParMETIS */
+  PetscCall(PetscOptionsEnum("-partitioner", "How the cells are distributed over the ranks", "MeshPartitionDistribute", MeshPartitionerTypes,
+                             (PetscEnum)partitioner, (PetscEnum *)&partitioner, NULL));
+  refine = 0;
+  PetscCall(PetscOptionsRangeInt("-dm_refine", "Uniform refinements, after the distribution", "DMRefine", refine, &refine, NULL, 0, 12));
+  PetscOptionsEnd();
+  /* PETSc's DMSetFromOptions() would refine the serial mesh on rank 0, before the distribution: the project refines the
+     distributed mesh instead, on all ranks (at 1M unknowns the serial refinement and distribution cost more than the
+     whole elastic solve on 2 ranks) */
+  PetscCall(PetscOptionsClearValue(NULL, "-dm_refine"));
+  PetscCall(OptionsCheckFiniteArray(comm, "-dm_plex_box_lower", dim, lower));
+  PetscCall(OptionsCheckFiniteArray(comm, "-dm_plex_box_upper", dim, upper));
+  for (PetscInt d = 0; d < dim; ++d) {
+    PetscCheck(faces[d] >= 1, comm, PETSC_ERR_USER_INPUT, "-dm_plex_box_faces: need at least one cell per side, got %" PetscInt_FMT, faces[d]);
+    PetscCheck(upper[d] > lower[d], comm, PETSC_ERR_USER_INPUT, "-dm_plex_box_upper must exceed -dm_plex_box_lower in every direction");
+  }
+
+  if (has_file) {
+    PetscBool exists;
+
+    PetscCall(PetscTestFile(filename, 'r', &exists));
+    PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "Mesh file '%s' (-dm_plex_filename) does not exist or cannot be read", filename);
+  }
+  if (!has_file) {
+    char      what[64];
+    PetscReal ncells = (simplex ? (dim == 2 ? 2.0 : 6.0) : 1.0) * PetscPowReal(2.0, (PetscReal)(dim * (refine + later_refinements)));
+
+    for (PetscInt d = 0; d < dim; ++d) ncells *= (PetscReal)faces[d];
+    PetscCall(PetscSNPrintf(what, sizeof(what), "-dm_plex_box_faces with %" PetscInt_FMT " refinement(s)", refine + later_refinements));
+    PetscCall(MeshCheckSize(comm, dim, ncells, what));
+  }
+  if (simplex && !has_file)
+    PetscCall(MeshCreateSimplexBox(comm, dim, faces, lower, upper, dm));
+  else {
+    if (!has_file && !faces_set) { /* the same default number of cells for tensor boxes as for simplex boxes */
+      char value[64];
+
+      PetscCall(PetscSNPrintf(value, sizeof(value),
+                              dim == 2 ? "%" PetscInt_FMT ",%" PetscInt_FMT : "%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT, faces[0],
+                              faces[1], faces[2]));
+      PetscCall(PetscOptionsSetValue(NULL, "-dm_plex_box_faces", value));
+    }
+    PetscCall(DMCreate(comm, dm));
+    PetscCall(DMSetType(*dm, DMPLEX));
+  }
+  /* The serial mesh on rank 0: PETSc creates tensor boxes and file meshes here; MeshPartitionDistribute()
+     distributes, for every kind of mesh, with the partitioner of -partitioner. PETSc reads HDF5 meshes in parallel, in
+     pieces that are only consistent after its own distribution (without it the solution is wrong): they get both. */
+  if (has_file) PetscCall(PetscStrendswith(filename, ".h5", &parallel_read));
+  PetscCheck(!parallel_read || strlen(filename) <= 240, comm, PETSC_ERR_USER_INPUT,
+             "The HDF5 mesh file name '%s' (-dm_plex_filename) has %d characters: PETSc reads it with MPI-IO, which in Open MPI 4.1 crashes on names "
+             "of more than 240; use a shorter (for example relative) path",
+             filename, (int)strlen(filename));
+  if (!parallel_read) PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
+  if (has_file) {
+    PetscInt  fdim, cStart, cEnd, n;
+    PetscReal ncells;
+    char      what[PETSC_MAX_PATH_LEN + 64];
+
+    PetscCall(MeshReadFile(comm, filename, *dm));
+    PetscCall(DMGetDimension(*dm, &fdim));
+    PetscCheck(!dim_set || fdim == dim, comm, PETSC_ERR_USER_INPUT,
+               "The mesh file '%s' holds a %" PetscInt_FMT "D mesh, but -dm_plex_dim %" PetscInt_FMT " was given", filename, fdim, dim);
+    PetscCall(DMPlexGetHeightStratum(*dm, 0, &cStart, &cEnd));
+    n = cEnd - cStart;
+    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &n, 1, MPIU_INT, MPI_SUM, comm)); /* the cells of the file (before the distribution) */
+    ncells = (PetscReal)n * PetscPowReal(2.0, (PetscReal)(fdim * (refine + later_refinements)));
+    PetscCall(PetscSNPrintf(what, sizeof(what), "%s with %" PetscInt_FMT " refinement(s)", filename, refine + later_refinements));
+    PetscCall(MeshCheckSize(comm, fdim, ncells, what));
+  } else
+    PetscCall(DMSetFromOptions(*dm));
+  PetscCall(DMGetMatType(*dm, &mtype));
+  PetscCall(PetscStrallocpy(mtype, &mtype_copy)); /* -dm_mat_type, which the distributed mesh does not inherit */
+  PetscCall(MeshPartitionDistribute(partitioner, dm));
+  for (PetscInt r = 0; r < refine; ++r) {
+    DM fine;
+
+    PetscCall(DMRefine(*dm, comm, &fine));
+    PetscCall(DMDestroy(dm));
+    *dm = fine;
+  }
+  PetscCall(DMSetMatType(*dm, mtype_copy));
+  PetscCall(PetscFree(mtype_copy));
+  PetscCall(PetscObjectSetName((PetscObject)*dm, "mesh"));
+  PetscCall(DMViewFromOptions(*dm, NULL, "-dm_view"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* h: the largest cell diameter (largest distance between two vertices of a cell) over all ranks. */
+PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h)
+{
+  DM           cdm;
+  PetscSection csection;
+  Vec          coords;
+  PetscInt     cStart, cEnd, cdim;
+  PetscReal    hmax = 0.0;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetCoordinateDim(dm, &cdim));
+  PetscCall(DMGetCoordinateDM(dm, &cdm));
+  PetscCall(DMGetLocalSection(cdm, &csection));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    PetscScalar *x = NULL;
+    PetscInt     n;
+
+    PetscCall(DMPlexVecGetClosure(cdm, csection, coords, c, &n, &x));
+    for (PetscInt i = 0; i < n / cdim; ++i)
+      for (PetscInt j = i + 1; j < n / cdim; ++j) {
+        PetscReal d2 = 0.0;
+        for (PetscInt d = 0; d < cdim; ++d) d2 += PetscSqr(PetscRealPart(x[i * cdim + d] - x[j * cdim + d]));
+        hmax = PetscMax(hmax, PetscSqrtReal(d2));
+      }
+    PetscCall(DMPlexVecRestoreClosure(cdm, csection, coords, c, &n, &x));
+  }
+  PetscCall(MPIU_Allreduce(&hmax, h, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Refuses a mesh whose "Face Sets" label has no face with the value of Gamma_C. */
+PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id)
+{
+  MPI_Comm comm = PetscObjectComm((PetscObject)dm);
+  DMLabel  label;
+  PetscInt n, ntotal, *faces;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetLabel(dm, "Face Sets", &label));
+  PetscCheck(label, comm, PETSC_ERR_USER_INPUT,
+             "The mesh has no \"Face Sets\" label, so it has no contact boundary Gamma_C (Face Sets value %" PetscInt_FMT ")", contact_id);
+  PetscCall(MeshGetBoundaryFaces(dm, contact_id, &n, &faces));
+  PetscCall(PetscFree(faces));
+  PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, comm));
+  PetscCheck(ntotal > 0, comm, PETSC_ERR_USER_INPUT,
+             "The mesh has no contact boundary: no face carries \"Face Sets\" value %" PetscInt_FMT " (Gamma_C)", contact_id);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Refuses a mesh on which a face set the scene names (what: its role) is carried by no face. */
+PetscErrorCode MeshCheckFaceSets(DM dm, const char scene[], const char what[], PetscInt n, const PetscInt ids[])
+{
+  MPI_Comm comm = PetscObjectComm((PetscObject)dm);
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < n; ++i) {
+    PetscInt nf, total, *faces;
+
+    PetscCall(MeshGetBoundaryFaces(dm, ids[i], &nf, &faces));
+    PetscCall(PetscFree(faces));
+    PetscCall(MPIU_Allreduce(&nf, &total, 1, MPIU_INT, MPI_SUM, comm));
+    PetscCheck(total > 0, comm, PETSC_ERR_USER_INPUT, "No face of the mesh carries \"Face Sets\" value %" PetscInt_FMT ", which scene %s uses for %s",
+               ids[i], scene, what);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Number of points of a stratum owned by this rank, summed over ranks. */
+PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count)
+{
+  PetscSF         sf;
+  PetscInt        nleaves, n = 0;
+  const PetscInt *leaves;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetPointSF(dm, &sf));
+  PetscCall(PetscSFGetGraph(sf, NULL, &nleaves, &leaves, NULL));
+  n = pEnd - pStart;
+  if (nleaves > 0 && leaves)
+    for (PetscInt l = 0; l < nleaves; ++l) n -= (leaves[l] >= pStart && leaves[l] < pEnd);
+  PetscCall(MPIU_Allreduce(&n, count, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The faces of dm with "Face Sets" value id (local, height 1), in a new array the caller frees with PetscFree(). */
+PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **faces)
+{
+  DMLabel  label;
+  IS       is = NULL;
+  PetscInt fStart, fEnd;
+
+  PetscFunctionBeginUser;
+  *n = 0;
+  PetscCall(DMGetLabel(dm, "Face Sets", &label));
+  if (label) PetscCall(DMLabelGetStratumIS(label, id, &is));
+  PetscCall(DMPlexGetHeightStratum(dm, 1, &fStart, &fEnd));
+  if (is) {
+    const PetscInt *points;
+    PetscInt        np;
+
+    PetscCall(ISGetLocalSize(is, &np));
+    PetscCall(ISGetIndices(is, &points));
+    PetscCall(PetscMalloc1(np, faces));
+    for (PetscInt i = 0; i < np; ++i)
+      if (points[i] >= fStart && points[i] < fEnd) (*faces)[(*n)++] = points[i];
+    PetscCall(ISRestoreIndices(is, &points));
+    PetscCall(ISDestroy(&is));
+  } else
+    PetscCall(PetscMalloc1(1, faces));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

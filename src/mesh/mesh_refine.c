@@ -1,0 +1,235 @@
+/* Uniform refinement with the parent of every fine cell, and the interpolation of FE functions from the coarse mesh
+   to the fine one: used by the grid sequencing (grid_sequence.c) and by -reference (reference.c). */
+#include <petscdmplextransform.h>
+#include "mesh.h"
+
+/* Reference coordinates xi[n][dim] of the physical points x[n][dim] in cell c, by Newton on the cell map (one step for
+   affine cells). Replaces DMPlexCoordinatesToReference(), which re-sorts a label on every call in PETSc 3.18. */
+PetscErrorCode MeshCellReferenceCoordinates(DM dm, PetscInt c, PetscInt n, const PetscReal x[], PetscReal xi[])
+{
+  PetscInt        dim;
+  PetscQuadrature q;
+  PetscReal      *pt, *wt;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(PetscQuadratureCreate(PETSC_COMM_SELF, &q));
+  PetscCall(PetscMalloc1(dim, &pt)); /* owned by q, which reads the point at each geometry call */
+  PetscCall(PetscMalloc1(1, &wt));
+  wt[0] = 1.0;
+  PetscCall(PetscQuadratureSetData(q, dim, 1, 1, pt, wt));
+  for (PetscInt i = 0; i < n; ++i) {
+    PetscReal v[3], J[9], invJ[9], detJ, res = PETSC_MAX_REAL;
+    PetscInt  it;
+
+    for (PetscInt d = 0; d < dim; ++d) xi[i * dim + d] = 0.0;
+    for (it = 0; it < 20 && res > 1e-13; ++it) {
+      for (PetscInt d = 0; d < dim; ++d) pt[d] = xi[i * dim + d];
+      PetscCall(DMPlexComputeCellGeometryFEM(dm, c, q, v, J, invJ, &detJ));
+      res = 0.0;
+      for (PetscInt d = 0; d < dim; ++d) {
+        PetscReal step = 0.0;
+
+        for (PetscInt e = 0; e < dim; ++e) step += invJ[d * dim + e] * (x[i * dim + e] - v[e]);
+        xi[i * dim + d] += step;
+        res = PetscMax(res, PetscAbsReal(step));
+      }
+    }
+    PetscCheck(res <= 1e-10, PETSC_COMM_SELF, PETSC_ERR_CONV_FAILED,
+               "No reference coordinates for a point of cell %" PetscInt_FMT " (Newton residual %g)", c, (double)res);
+  }
+  PetscCall(PetscQuadratureDestroy(&q));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The vertices of cell c (at most 8), in closure order. */
+PetscErrorCode MeshCellVertices(DM dm, PetscInt c, PetscInt verts[], PetscInt *nv)
+{
+  PetscInt *closure = NULL, ncl, vStart, vEnd;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  *nv = 0;
+  PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &closure));
+  for (PetscInt j = 0; j < ncl; ++j)
+    if (closure[2 * j] >= vStart && closure[2 * j] < vEnd && *nv < 8) verts[(*nv)++] = closure[2 * j];
+  PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &closure));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Refines dm `levels` times (regular refinement, labels kept) into fine, without a discretization; parent[c - cStart]
+   is the cell of dm that holds fine cell c (an array the caller frees with PetscFree()). With one level and
+   vertex_source not NULL, vertex_source[v - vStart] is the point of dm (vertex, edge, face or cell) whose centre fine
+   vertex v is. */
+PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **parent, PetscInt **vertex_source)
+{
+  MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
+  DM        cur  = dm;
+  PetscInt *par, cStart, cEnd;
+  MatType   mtype;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(PetscMalloc1(cEnd - cStart, &par));
+  for (PetscInt c = cStart; c < cEnd; ++c) par[c - cStart] = c;
+  for (PetscInt l = 0; l < levels; ++l) {
+    DMPlexTransform tr;
+    DM              next;
+    PetscInt        nStart, nEnd, *np;
+
+    PetscCall(DMPlexTransformCreate(comm, &tr));
+    PetscCall(DMPlexTransformSetType(tr, DMPLEXREFINEREGULAR));
+    PetscCall(DMPlexTransformSetDM(tr, cur));
+    PetscCall(DMPlexTransformSetUp(tr));
+    PetscCall(DMPlexTransformApply(tr, cur, &next));
+    PetscCall(DMPlexGetHeightStratum(next, 0, &nStart, &nEnd));
+    PetscCall(PetscMalloc1(nEnd - nStart, &np));
+    for (PetscInt c = nStart; c < nEnd; ++c) {
+      DMPolytopeType ct, ctn;
+      PetscInt       src, r;
+
+      PetscCall(DMPlexTransformGetSourcePoint(tr, c, &ct, &ctn, &src, &r));
+      np[c - nStart] = par[src - cStart];
+    }
+    if (vertex_source && levels == 1) {
+      PetscInt vStart, vEnd;
+
+      PetscCall(DMPlexGetDepthStratum(next, 0, &vStart, &vEnd));
+      PetscCall(PetscMalloc1(vEnd - vStart, vertex_source));
+      for (PetscInt v = vStart; v < vEnd; ++v) {
+        DMPolytopeType ct, ctn;
+        PetscInt       r;
+
+        PetscCall(DMPlexTransformGetSourcePoint(tr, v, &ct, &ctn, &(*vertex_source)[v - vStart], &r));
+      }
+    }
+    PetscCall(PetscFree(par));
+    par    = np;
+    cStart = nStart;
+    PetscCall(DMPlexTransformDestroy(&tr));
+    if (cur != dm) PetscCall(DMDestroy(&cur));
+    cur = next;
+  }
+  if (cur == dm)
+    PetscCall(DMClone(dm, fine));
+  else
+    *fine = cur;
+  PetscCall(DMGetMatType(dm, &mtype));
+  PetscCall(DMSetMatType(*fine, mtype));
+  PetscCall(PetscObjectSetName((PetscObject)*fine, "mesh"));
+  *parent = par;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The interpolation of a local vector of dm with its unknowns at the vertices (P1, Q1) to fine, refined once by
+   MeshRefineRegular(): every fine vertex is the centre of its source point (a vertex, an edge midpoint, the centre of
+   a quad or a hex) and gets the mean of the values at the source point's vertices, which is exact for nested P1/Q1.
+   A vertex-by-vertex loop, with none of the cell-by-cell geometry of MeshInterpolateFromParents(). */
+PetscErrorCode MeshInterpolateVertexSources(DM dm, DM fine, const PetscInt vertex_source[], Vec loc, Vec *fine_loc)
+{
+  PetscSection       csec, fsec;
+  PetscInt           vStart, vEnd, cvStart, cvEnd, nc;
+  const PetscScalar *cv;
+  PetscScalar       *fv;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetLocalSection(dm, &csec));
+  PetscCall(DMGetLocalSection(fine, &fsec));
+  PetscCall(DMPlexGetDepthStratum(fine, 0, &vStart, &vEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &cvStart, &cvEnd));
+  PetscCall(DMCreateLocalVector(fine, fine_loc));
+  PetscCall(VecZeroEntries(*fine_loc));
+  PetscCall(VecGetArrayRead(loc, &cv));
+  PetscCall(VecGetArray(*fine_loc, &fv));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    const PetscInt src = vertex_source[v - vStart];
+    PetscInt       verts[8], nv = 0, foff;
+
+    PetscCall(PetscSectionGetDof(fsec, v, &nc));
+    if (!nc) continue;
+    PetscCall(PetscSectionGetOffset(fsec, v, &foff));
+    if (src >= cvStart && src < cvEnd)
+      verts[nv++] = src;
+    else {
+      PetscInt *closure = NULL, ncl;
+
+      PetscCall(DMPlexGetTransitiveClosure(dm, src, PETSC_TRUE, &ncl, &closure));
+      for (PetscInt j = 0; j < ncl; ++j)
+        if (closure[2 * j] >= cvStart && closure[2 * j] < cvEnd && nv < 8) verts[nv++] = closure[2 * j];
+      PetscCall(DMPlexRestoreTransitiveClosure(dm, src, PETSC_TRUE, &ncl, &closure));
+    }
+    for (PetscInt i = 0; i < nv; ++i) {
+      PetscInt coff;
+
+      PetscCall(PetscSectionGetOffset(csec, verts[i], &coff));
+      for (PetscInt c = 0; c < nc; ++c) fv[foff + c] += cv[coff + c] / nv;
+    }
+  }
+  PetscCall(VecRestoreArray(*fine_loc, &fv));
+  PetscCall(VecRestoreArrayRead(loc, &cv));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Interpolates the local vectors loc[] of dm (boundary values included) into new local vectors fine_loc[] of fine, which
+   has the same discretization: every vertex of a fine cell gets the value of the FE function in its parent cell
+   (exact for the nested P1/Q1 spaces). */
+PetscErrorCode MeshInterpolateFromParents(DM dm, DM fine, const PetscInt parent[], PetscInt nvec, Vec loc[], Vec fine_loc[])
+{
+  PetscInt           dim, Nb, Nc, fcStart, fcEnd;
+  PetscFE            fe;
+  DM                 cdm;
+  PetscSection       fsec, csec;
+  Vec                coords;
+  const PetscScalar *xc;
+  PetscScalar       *fv[2];
+
+  PetscFunctionBeginUser;
+  PetscCheck(nvec <= 2, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "At most 2 vectors at a time");
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMGetField(dm, 0, NULL, (PetscObject *)&fe));
+  PetscCall(PetscFEGetDimension(fe, &Nb));
+  PetscCall(PetscFEGetNumComponents(fe, &Nc));
+  PetscCall(DMGetLocalSection(fine, &fsec));
+  PetscCall(DMGetCoordinateDM(fine, &cdm));
+  PetscCall(DMGetLocalSection(cdm, &csec));
+  PetscCall(DMGetCoordinatesLocal(fine, &coords));
+  PetscCall(DMPlexGetHeightStratum(fine, 0, &fcStart, &fcEnd));
+  for (PetscInt k = 0; k < nvec; ++k) {
+    PetscCall(DMCreateLocalVector(fine, &fine_loc[k]));
+    PetscCall(VecZeroEntries(fine_loc[k]));
+    PetscCall(VecGetArray(fine_loc[k], &fv[k]));
+  }
+  PetscCall(VecGetArrayRead(coords, &xc));
+  for (PetscInt c = fcStart; c < fcEnd; ++c) {
+    PetscInt        nv, verts[8], off;
+    PetscReal       x[8 * 3], xi[8 * 3];
+    PetscTabulation T;
+
+    PetscCall(MeshCellVertices(fine, c, verts, &nv));
+    for (PetscInt i = 0; i < nv; ++i) {
+      PetscCall(PetscSectionGetOffset(csec, verts[i], &off));
+      for (PetscInt d = 0; d < dim; ++d) x[i * dim + d] = PetscRealPart(xc[off + d]);
+    }
+    PetscCall(MeshCellReferenceCoordinates(dm, parent[c - fcStart], nv, x, xi));
+    PetscCall(PetscFECreateTabulation(fe, 1, nv, xi, 0, &T));
+    for (PetscInt k = 0; k < nvec; ++k) {
+      PetscScalar *cv = NULL;
+
+      PetscCall(DMPlexVecGetClosure(dm, NULL, loc[k], parent[c - fcStart], NULL, &cv));
+      for (PetscInt i = 0; i < nv; ++i) {
+        PetscCall(PetscSectionGetOffset(fsec, verts[i], &off));
+        for (PetscInt comp = 0; comp < Nc; ++comp) {
+          PetscScalar val = 0.0;
+
+          for (PetscInt b = 0; b < Nb; ++b) val += cv[b] * T->T[0][(i * Nb + b) * Nc + comp];
+          fv[k][off + comp] = val;
+        }
+      }
+      PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc[k], parent[c - fcStart], NULL, &cv));
+    }
+    PetscCall(PetscTabulationDestroy(&T));
+  }
+  PetscCall(VecRestoreArrayRead(coords, &xc));
+  for (PetscInt k = 0; k < nvec; ++k) PetscCall(VecRestoreArray(fine_loc[k], &fv[k]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

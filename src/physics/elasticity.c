@@ -1,0 +1,205 @@
+/* Isotropic linear elasticity (plane strain in 2D): material options, pointwise kernels, discretization. */
+#include "app.h"
+#include "physics.h"
+
+/* sigma(u) = 2 mu eps(u) + lambda tr(eps(u)) I */
+static void f1_u(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
+                 const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
+                 const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[], PetscInt numConstants,
+                 const PetscScalar constants[], PetscScalar f1[])
+{
+  const PetscReal lambda = PetscRealPart(constants[CONST_LAMBDA]), mu = PetscRealPart(constants[CONST_MU]);
+  PetscScalar     trace = 0.0;
+
+  for (PetscInt c = 0; c < dim; ++c) trace += u_x[c * dim + c];
+  for (PetscInt c = 0; c < dim; ++c) {
+    for (PetscInt d = 0; d < dim; ++d) f1[c * dim + d] = mu * (u_x[c * dim + d] + u_x[d * dim + c]);
+    f1[c * dim + c] += lambda * trace;
+  }
+}
+
+/* d sigma_{cd} / d (du_e/dx_f) */
+static void g3_uu(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
+                  const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
+                  const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, PetscReal u_tShift, const PetscReal x[], PetscInt numConstants,
+                  const PetscScalar constants[], PetscScalar g3[])
+{
+  const PetscReal lambda = PetscRealPart(constants[CONST_LAMBDA]), mu = PetscRealPart(constants[CONST_MU]);
+
+  for (PetscInt c = 0; c < dim; ++c)
+    for (PetscInt d = 0; d < dim; ++d) {
+      g3[((c * dim + c) * dim + d) * dim + d] += mu;
+      g3[((c * dim + d) * dim + d) * dim + c] += mu;
+      g3[((c * dim + d) * dim + c) * dim + d] += lambda;
+    }
+}
+
+static PetscErrorCode ZeroVector(PetscInt dim, PetscReal t, const PetscReal x[], PetscInt Nc, PetscScalar u[], void *ctx)
+{
+  for (PetscInt c = 0; c < Nc; ++c) u[c] = 0.0;
+  return PETSC_SUCCESS;
+}
+
+static PetscErrorCode CreateRigidBodyModes(DM dm, PetscInt origField, PetscInt field, MatNullSpace *nullspace)
+{
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexCreateRigidBody(dm, origField, nullspace));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The rigid-body modes (the near-null space of GAMG) of a field whose unknowns all sit at the vertices (P1, Q1),
+   directly from the vertex coordinates: DMPlexCreateRigidBody projects them through PetscFE, which took 2 of the
+   5.5 s of set-up at 250k unknowns. Constrained (Dirichlet) unknowns drop out in the local-to-global map, as there. */
+PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace)
+{
+  const PetscInt nmodes[4] = {0, 1, 3, 6};
+  PetscInt       dim, vStart, vEnd, n;
+  PetscSection   sec, csec;
+  Vec            coords, mode[6], loc;
+  DM             cdm;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  n = nmodes[dim];
+  PetscCall(DMGetLocalSection(dm, &sec));
+  PetscCall(DMGetCoordinateDM(dm, &cdm));
+  PetscCall(DMGetLocalSection(cdm, &csec));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(DMGetLocalVector(dm, &loc));
+  for (PetscInt m = 0; m < n; ++m) {
+    const PetscScalar *x;
+    PetscScalar       *a;
+
+    PetscCall(VecZeroEntries(loc));
+    PetscCall(VecGetArrayRead(coords, &x));
+    PetscCall(VecGetArray(loc, &a));
+    for (PetscInt v = vStart; v < vEnd; ++v) {
+      PetscInt  off, coff, ndof;
+      PetscReal p[3] = {0.0, 0.0, 0.0}, r[3] = {0.0, 0.0, 0.0};
+
+      PetscCall(PetscSectionGetDof(sec, v, &ndof));
+      if (ndof < dim) continue;
+      PetscCall(PetscSectionGetOffset(sec, v, &off));
+      PetscCall(PetscSectionGetOffset(csec, v, &coff));
+      for (PetscInt d = 0; d < dim; ++d) p[d] = PetscRealPart(x[coff + d]);
+      if (m < dim)
+        r[m] = 1.0; /* translations */
+      else if (dim == 2) {
+        r[0] = -p[1];
+        r[1] = p[0];
+      } /* rotation about z */
+      else if (m == 3) {
+        r[0] = -p[1];
+        r[1] = p[0];
+      } else if (m == 4) {
+        r[1] = -p[2];
+        r[2] = p[1];
+      } else {
+        r[0] = p[2];
+        r[2] = -p[0];
+      }
+      for (PetscInt d = 0; d < dim; ++d) a[off + d] = r[d];
+    }
+    PetscCall(VecRestoreArray(loc, &a));
+    PetscCall(VecRestoreArrayRead(coords, &x));
+    PetscCall(DMCreateGlobalVector(dm, &mode[m]));
+    PetscCall(DMLocalToGlobal(dm, loc, INSERT_VALUES, mode[m]));
+  }
+  PetscCall(DMRestoreLocalVector(dm, &loc));
+  for (PetscInt m = 0; m < n; ++m) { /* modified Gram-Schmidt: MatNullSpaceCreate wants an orthonormal basis */
+    PetscScalar dots[6];
+
+    if (m > 0) {
+      PetscCall(VecMDot(mode[m], m, mode, dots));
+      for (PetscInt k = 0; k < m; ++k) dots[k] = -dots[k];
+      PetscCall(VecMAXPY(mode[m], m, dots, mode));
+    }
+    PetscCall(VecNormalize(mode[m], NULL));
+  }
+  PetscCall(MatNullSpaceCreate(PetscObjectComm((PetscObject)dm), PETSC_FALSE, n, mode, nullspace));
+  for (PetscInt m = 0; m < n; ++m) PetscCall(VecDestroy(&mode[m]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The material and the degree of the displacement (-displacement_petscspace_degree, PETSc's name for it, default 1). */
+PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degree)
+{
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, NULL, "Linear elastic material and its discretization", "Signorini");
+  *degree = 1;
+  PetscCall(PetscOptionsRangeInt("-displacement_petscspace_degree", "Degree of the Lagrange displacement space (P1/Q1 by default)", NULL, *degree,
+                                 degree, NULL, 1, 8));
+  mat->young_modulus = 1.0;
+  PetscCall(PetscOptionsReal("-young_modulus", "Young's modulus E", NULL, mat->young_modulus, &mat->young_modulus, NULL));
+  mat->poisson_ratio = 0.3;
+  PetscCall(PetscOptionsReal("-poisson_ratio", "Poisson ratio nu, in (-1, 0.5)", NULL, mat->poisson_ratio, &mat->poisson_ratio, NULL));
+  PetscOptionsEnd();
+  PetscCall(OptionsCheckFinite(comm, "-young_modulus", mat->young_modulus));
+  PetscCall(OptionsCheckFinite(comm, "-poisson_ratio", mat->poisson_ratio));
+  PetscCheck(mat->young_modulus > 0.0, comm, PETSC_ERR_USER_INPUT, "-young_modulus must be positive, got %g", (double)mat->young_modulus);
+  PetscCheck(mat->poisson_ratio > -1.0 && mat->poisson_ratio < 0.5, comm, PETSC_ERR_USER_INPUT, "-poisson_ratio must lie in (-1, 0.5), got %g",
+             (double)mat->poisson_ratio);
+  mat->lambda = mat->young_modulus * mat->poisson_ratio / ((1.0 + mat->poisson_ratio) * (1.0 - 2.0 * mat->poisson_ratio));
+  mat->mu     = mat->young_modulus / (2.0 * (1.0 + mat->poisson_ratio));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Writes the material, penalty, obstacle and scene parameters into the constants[] of the kernels. */
+PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user)
+{
+  PetscDS     ds;
+  PetscScalar c[CONST_SCENE_MAX];
+
+  PetscFunctionBeginUser;
+  c[CONST_LAMBDA]          = user->material.lambda;
+  c[CONST_MU]              = user->material.mu;
+  c[CONST_PENALTY]         = (user->contact.method == CONTACT_PENALTY) ? 1.0 / user->eps : 0.0;
+  c[CONST_NORMAL_X]        = user->scene.obstacle_normal[0];
+  c[CONST_NORMAL_Y]        = user->scene.obstacle_normal[1];
+  c[CONST_NORMAL_Z]        = user->scene.obstacle_normal[2];
+  c[CONST_OBSTACLE_OFFSET] = user->scene.obstacle_offset;
+  for (PetscInt i = 0; i < user->scene.num_constants; ++i) c[CONST_SCENE + i] = user->scene.constants[i];
+  PetscCall(DMGetDS(dm, &ds));
+  PetscCall(PetscDSSetConstants(ds, CONST_SCENE + user->scene.num_constants, c));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The displacement field (PetscFE, prefix displacement_), the bulk weak form and Gamma_D. */
+PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user)
+{
+  MPI_Comm     comm  = PetscObjectComm((PetscObject)dm);
+  const Scene *scene = &user->scene;
+  PetscFE      fe;
+  PetscDS      ds;
+  PetscInt     dim;
+  PetscBool    simplex;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexIsSimplex(dm, &simplex));
+  PetscCall(PetscFECreateLagrange(comm, dim, dim, simplex, user->degree, PETSC_DETERMINE, &fe)); /* the degree of ElasticityGetOptions() */
+  PetscCall(PetscObjectSetName((PetscObject)fe, "displacement"));
+  PetscCall(DMSetField(dm, 0, NULL, (PetscObject)fe));
+  PetscCall(PetscFEDestroy(&fe));
+  PetscCall(DMCreateDS(dm));
+  PetscCall(DMGetDS(dm, &ds));
+  PetscCall(PetscDSSetResidual(ds, 0, scene->f0_body, f1_u));
+  PetscCall(PetscDSSetJacobian(ds, 0, 0, NULL, NULL, NULL, g3_uu));
+  if (scene->exact) PetscCall(PetscDSSetExactSolution(ds, 0, scene->exact, (void *)scene->constants));
+  PetscCall(DMAddBoundary(dm, DM_BC_ESSENTIAL, "Gamma_D", user->face_sets, scene->num_dirichlet, scene->dirichlet_ids, 0, 0, NULL,
+                          (void (*)(void))(scene->dirichlet_value ? scene->dirichlet_value : ZeroVector), NULL, (void *)scene->constants, NULL));
+  PetscCall(DMSetNearNullSpaceConstructor(dm, 0, CreateRigidBodyModes));
+  PetscCall(ElasticityUpdateConstants(dm, user));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* sigma = lambda tr(G) I + mu (G + G^T) for the displacement gradient G[i*dim+j] = du_i/dx_j. */
+void ElasticStress(PetscInt dim, const Material *mat, const PetscReal grad[], PetscReal sigma[])
+{
+  PetscReal trace = 0.0;
+
+  for (PetscInt i = 0; i < dim; ++i) trace += grad[i * dim + i];
+  for (PetscInt i = 0; i < dim; ++i)
+    for (PetscInt j = 0; j < dim; ++j) sigma[i * dim + j] = mat->mu * (grad[i * dim + j] + grad[j * dim + i]) + (i == j ? mat->lambda * trace : 0.0);
+}

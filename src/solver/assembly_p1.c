@@ -1,0 +1,436 @@
+/* The bulk elastic matrix K for P1 on simplices, without PetscFE: the preallocation by a MATPREALLOCATOR dry run of
+   the cell loop (DMPlex's adjacency-based preallocation is slow in 3.18) and closed-form element matrices B^T D B |T|.
+   The result is the matrix of DMCreateMatrix() + DMPlexSNESComputeJacobianFEM(): same type, sizes, block size,
+   local-to-global mapping, nonzero pattern and values; the rows and columns of constrained dofs are absent. */
+#include "solver.h"
+
+const char *const AssemblyTypes[] = {"auto", "fe", "p1", "AssemblyType", "ASSEMBLY_", NULL};
+
+static PetscLogEvent ASSEMBLY_P1_Preallocate, ASSEMBLY_P1_Fill;
+
+/* Why the P1 path does not apply to dm, NULL when it does; the same answer on every rank. */
+static PetscErrorCode AssemblyP1Applies(DM dm, const AppCtx *user, const char **reason)
+{
+  static const char *const reasons[] = {NULL,
+                                        "the mesh dimension is not 2 or 3",
+                                        "the cells are not all triangles (2D) or tetrahedra (3D)",
+                                        "the displacement is not of degree 1",
+                                        "the discretization is not one field with dim components",
+                                        "the coordinates are not one vector of dim components per vertex (embedded, periodic or high-order mesh)",
+                                        "the matrix type is not aij, baij or sbaij (-dm_mat_type)"};
+  const char *const        types[]   = {MATAIJ, MATSEQAIJ, MATMPIAIJ, MATBAIJ, MATSEQBAIJ, MATMPIBAIJ, MATSBAIJ, MATSEQSBAIJ, MATMPISBAIJ};
+  PetscInt                 dim, cdim, cStart, cEnd, vStart, vEnd, nf, nc, size, csize;
+  PetscMPIInt              code = 0, gcode;
+  PetscSection             section, csection;
+  PetscBool                localized, known = PETSC_FALSE;
+  MatType                  mtype;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMGetCoordinateDim(dm, &cdim));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(DMGetNumFields(dm, &nf));
+  PetscCall(DMGetLocalSection(dm, &section));
+  PetscCall(PetscSectionGetStorageSize(section, &size));
+  PetscCall(DMGetCoordinatesLocalized(dm, &localized));
+  PetscCall(DMGetCoordinateSection(dm, &csection));
+  PetscCall(PetscSectionGetStorageSize(csection, &csize));
+  PetscCall(DMGetMatType(dm, &mtype));
+  for (size_t i = 0; i < sizeof(types) / sizeof(types[0]); ++i) {
+    PetscBool same;
+
+    PetscCall(PetscStrcmp(mtype, types[i], &same));
+    known = (PetscBool)(known || same);
+  }
+  nc = 0;
+  if (nf == 1) PetscCall(PetscSectionGetFieldComponents(section, 0, &nc));
+  if (dim != 2 && dim != 3) code = 1;
+  for (PetscInt c = cStart; c < cEnd && !code; ++c) {
+    DMPolytopeType ct;
+
+    PetscCall(DMPlexGetCellType(dm, c, &ct));
+    if (ct != (dim == 2 ? DM_POLYTOPE_TRIANGLE : DM_POLYTOPE_TETRAHEDRON)) code = 2;
+  }
+  if (!code && user->degree != 1) code = 3;
+  if (!code && (nf != 1 || nc != dim || size != (vEnd - vStart) * dim)) code = 4;
+  if (!code && (cdim != dim || localized || csize != (vEnd - vStart) * dim)) code = 5;
+  if (!code && !known) code = 6;
+  PetscCallMPI(MPI_Allreduce(&code, &gcode, 1, MPI_INT, MPI_MAX, PetscObjectComm((PetscObject)dm)));
+  *reason = reasons[gcode];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -assembly and -assembly_check; resolves auto into fe or p1. */
+/* -assembly and -assembly_check, read once before any set-up. */
+PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscBool *check)
+{
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, NULL, "Assembly of the bulk matrix", "Signorini");
+  *requested = ASSEMBLY_AUTO;
+  PetscCall(PetscOptionsEnum("-assembly", "Bulk matrix K: auto (p1 where it applies, else fe), fe (PetscFE) or p1 (P1 simplices, closed form)",
+                             "SolverAssembleBulk", AssemblyTypes, (PetscEnum)*requested, (PetscEnum *)requested, NULL));
+  *check = PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-assembly_check", "Assemble K both ways and print ||K_p1 - K_fe||_F / ||K_fe||_F", "SolverAssembleBulk", *check, check,
+                             NULL));
+  PetscOptionsEnd();
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The assembly of this mesh's K: -assembly, with auto resolved (p1 where it applies, fe otherwise). */
+PetscErrorCode AssemblyResolve(DM dm, AppCtx *user)
+{
+  MPI_Comm    comm   = PetscObjectComm((PetscObject)dm);
+  const char *reason = NULL;
+
+  PetscFunctionBeginUser;
+  user->assembly = user->assembly_option;
+  PetscCall(AssemblyP1Applies(dm, user, &reason));
+  PetscCheck(user->assembly != ASSEMBLY_P1 || !reason, comm, PETSC_ERR_USER_INPUT,
+             "-assembly p1 needs P1 displacements on triangles or tetrahedra, but %s: use -assembly fe or auto", reason);
+  PetscCheck(!user->assembly_check || !reason, comm, PETSC_ERR_USER_INPUT, "-assembly_check compares with the P1 assembly, which does not apply: %s",
+             reason);
+  if (user->assembly == ASSEMBLY_AUTO) user->assembly = reason ? ASSEMBLY_FE : ASSEMBLY_P1;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Element stiffness of a P1 simplex with vertices x[(dim+1)*dim], dofs ordered vertex by vertex:
+   Ke[(a,c),(b,e)] = |T| (mu (g_a . g_b) delta_ce + mu g_a[e] g_b[c] + lambda g_a[c] g_b[e]), g_a = grad phi_a. */
+static PetscErrorCode AssemblyP1ElementStiffness(PetscInt dim, PetscReal lambda, PetscReal mu, const PetscReal x[], PetscScalar Ke[])
+{
+  const PetscInt nv = dim + 1, n = nv * dim;
+  PetscReal      J[9], inv[9], det, vol, g[4][3];
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < dim; ++i) /* J[i][k] = d x_i / d xi_k = x_{k+1,i} - x_{0,i} */
+    for (PetscInt k = 0; k < dim; ++k) J[i * dim + k] = x[(k + 1) * dim + i] - x[i];
+  if (dim == 2) {
+    det    = J[0] * J[3] - J[1] * J[2];
+    inv[0] = J[3] / det;
+    inv[1] = -J[1] / det;
+    inv[2] = -J[2] / det;
+    inv[3] = J[0] / det;
+    vol    = PetscAbsReal(det) / 2.0;
+  } else {
+    det    = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
+    inv[0] = (J[4] * J[8] - J[5] * J[7]) / det;
+    inv[1] = (J[2] * J[7] - J[1] * J[8]) / det;
+    inv[2] = (J[1] * J[5] - J[2] * J[4]) / det;
+    inv[3] = (J[5] * J[6] - J[3] * J[8]) / det;
+    inv[4] = (J[0] * J[8] - J[2] * J[6]) / det;
+    inv[5] = (J[2] * J[3] - J[0] * J[5]) / det;
+    inv[6] = (J[3] * J[7] - J[4] * J[6]) / det;
+    inv[7] = (J[1] * J[6] - J[0] * J[7]) / det;
+    inv[8] = (J[0] * J[4] - J[1] * J[3]) / det;
+    vol    = PetscAbsReal(det) / 6.0;
+  }
+  PetscCheck(det != 0.0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Degenerate cell (zero volume)");
+  /* grad phi_{k+1} = J^-T e_k: row k of J^-1; grad phi_0 = -sum of the others */
+  for (PetscInt d = 0; d < dim; ++d) {
+    g[0][d] = 0.0;
+    for (PetscInt k = 0; k < dim; ++k) {
+      g[k + 1][d] = inv[k * dim + d];
+      g[0][d] -= inv[k * dim + d];
+    }
+  }
+  for (PetscInt a = 0; a < nv; ++a)
+    for (PetscInt b = 0; b < nv; ++b) {
+      PetscReal gab = 0.0;
+
+      for (PetscInt d = 0; d < dim; ++d) gab += g[a][d] * g[b][d];
+      for (PetscInt c = 0; c < dim; ++c)
+        for (PetscInt e = 0; e < dim; ++e)
+          Ke[(a * dim + c) * n + b * dim + e] = vol * ((c == e ? mu * gab : 0.0) + mu * g[a][e] * g[b][c] + lambda * g[a][c] * g[b][e]);
+    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Global index of each dof of each local vertex, as DMPlex's closure indices give them: -1 for a constrained dof,
+   otherwise the offset of the point in the global section (owner's, for a ghost) plus the free dofs before it. */
+static PetscErrorCode AssemblyP1VertexIndices(DM dm, PetscInt **vidx)
+{
+  PetscSection section, gsection;
+  PetscInt     dim, vStart, vEnd;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(DMGetLocalSection(dm, &section));
+  PetscCall(DMGetGlobalSection(dm, &gsection));
+  PetscCall(PetscMalloc1((vEnd - vStart) * dim, vidx));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    const PetscInt *cind = NULL;
+    PetscInt        off, cdof, k = 0;
+
+    PetscCall(PetscSectionGetOffset(gsection, v, &off));
+    PetscCall(PetscSectionGetConstraintDof(section, v, &cdof));
+    if (cdof) PetscCall(PetscSectionGetConstraintIndices(section, v, &cind));
+    off = off < 0 ? -(off + 1) : off;
+    for (PetscInt c = 0; c < dim; ++c) {
+      if (k < cdof && cind[k] == c) {
+        (*vidx)[(v - vStart) * dim + c] = -1;
+        ++k;
+      } else
+        (*vidx)[(v - vStart) * dim + c] = off + c - k;
+    }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The dim + 1 vertices of each local cell, [cells][dim + 1], by walking the cones down to the vertices (faster than
+   DMPlexGetTransitiveClosure(), which dominated the preallocation). */
+static PetscErrorCode AssemblyP1CellVertices(DM dm, PetscInt **cverts)
+{
+  PetscInt dim, cStart, cEnd, vStart, vEnd;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(PetscMalloc1((cEnd - cStart) * (dim + 1), cverts));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    PetscInt *verts = &(*cverts)[(c - cStart) * (dim + 1)], stack[64], top = 0, nv = 0;
+
+    stack[top++] = c;
+    while (top) {
+      const PetscInt p = stack[--top];
+
+      if (p >= vStart && p < vEnd) {
+        PetscBool seen = PETSC_FALSE;
+
+        for (PetscInt i = 0; i < nv; ++i) seen = (PetscBool)(seen || verts[i] == p);
+        if (!seen) {
+          PetscCheck(nv <= dim, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Cell %" PetscInt_FMT " has more than %" PetscInt_FMT " vertices", c, dim + 1);
+          verts[nv++] = p;
+        }
+      } else {
+        const PetscInt *cone;
+        PetscInt        ncone;
+
+        PetscCall(DMPlexGetConeSize(dm, p, &ncone));
+        PetscCall(DMPlexGetCone(dm, p, &cone));
+        PetscCheck(top + ncone <= 64, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Cone walk of cell %" PetscInt_FMT " too deep", c);
+        for (PetscInt i = 0; i < ncone; ++i) stack[top++] = cone[i];
+      }
+    }
+    PetscCheck(nv == dim + 1, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Cell %" PetscInt_FMT " has %" PetscInt_FMT " vertices", c, nv);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The block size DMCreateMatrix() gives: the dofs per point, 1 if a point is partially constrained or the points differ. */
+static PetscErrorCode AssemblyP1BlockSize(DM dm, PetscInt *bs)
+{
+  PetscSection gsection;
+  PetscInt     pStart, pEnd, b = -1, local[2], minmax[2];
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetGlobalSection(dm, &gsection));
+  PetscCall(PetscSectionGetChart(gsection, &pStart, &pEnd));
+  for (PetscInt p = pStart; p < pEnd; ++p) {
+    PetscInt dof, cdof, bdof;
+
+    PetscCall(PetscSectionGetDof(gsection, p, &dof));
+    PetscCall(PetscSectionGetConstraintDof(gsection, p, &cdof));
+    dof  = dof < 0 ? -(dof + 1) : dof;
+    bdof = cdof && (dof - cdof) ? 1 : dof;
+    if (dof) {
+      if (b < 0)
+        b = bdof;
+      else if (b != bdof) {
+        b = 1;
+        break;
+      }
+    }
+  }
+  local[0] = b < 0 ? PETSC_MAX_INT : b;
+  local[1] = b;
+  PetscCall(PetscGlobalMinMaxInt(PetscObjectComm((PetscObject)dm), local, minmax));
+  *bs = PetscMax(1, minmax[0] != minmax[1] ? 1 : minmax[0]);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Preallocates K by a dry run of the cell loop into a MATPREALLOCATOR whose rows and columns are blocks of bs dofs (one
+   per vertex when bs = dim), which also counts the entries of rows owned by other ranks. Its pattern, filled into a
+   helper matrix of blocks, gives the exact counts of blocks per block row, in and off the diagonal part and on and above
+   the diagonal (for sbaij). */
+static PetscErrorCode AssemblyP1Preallocate(DM dm, PetscInt bs, PetscInt nlocal, const PetscInt vidx[], const PetscInt cverts[], Mat K)
+{
+  MPI_Comm comm = PetscObjectComm((PetscObject)dm);
+  Mat      pre, H;
+  PetscInt dim, cStart, cEnd, vStart, vEnd, nb = nlocal / bs, rstart, rend, *dnz, *onz, *dnzu, *onzu;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCheck(bs == 1 || bs == dim, comm, PETSC_ERR_PLIB, "Block size %" PetscInt_FMT " is neither 1 nor dim", bs);
+  PetscCall(MatCreate(comm, &pre));
+  PetscCall(MatSetType(pre, MATPREALLOCATOR));
+  PetscCall(MatSetSizes(pre, nb, nb, PETSC_DETERMINE, PETSC_DETERMINE));
+  PetscCall(MatSetUp(pre));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    PetscInt idx[12], n = 0;
+
+    for (PetscInt a = 0; a <= dim; ++a) {
+      const PetscInt *v = &vidx[(cverts[(c - cStart) * (dim + 1) + a] - vStart) * dim];
+
+      if (bs == dim)
+        idx[n++] = v[0] < 0 ? -1 : v[0] / bs; /* fully free or fully constrained */
+      else
+        for (PetscInt e = 0; e < dim; ++e) idx[n++] = v[e];
+    }
+    PetscCall(MatSetValues(pre, n, idx, n, idx, NULL, INSERT_VALUES));
+  }
+  PetscCall(MatAssemblyBegin(pre, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(pre, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatCreate(comm, &H));
+  PetscCall(MatSetType(H, MATAIJ));
+  PetscCall(MatSetSizes(H, nb, nb, PETSC_DETERMINE, PETSC_DETERMINE));
+  PetscCall(MatPreallocatorPreallocate(pre, PETSC_TRUE, H));
+  PetscCall(MatAssemblyBegin(H, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(H, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatDestroy(&pre));
+  PetscCall(MatGetOwnershipRange(H, &rstart, &rend));
+  PetscCall(PetscCalloc4(nb, &dnz, nb, &onz, nb, &dnzu, nb, &onzu));
+  for (PetscInt i = rstart; i < rend; ++i) {
+    const PetscInt *cols;
+    PetscInt        ncols;
+
+    PetscCall(MatGetRow(H, i, &ncols, &cols, NULL));
+    for (PetscInt j = 0; j < ncols; ++j) {
+      const PetscBool diag = (PetscBool)(cols[j] >= rstart && cols[j] < rend);
+
+      if (diag)
+        ++dnz[i - rstart];
+      else
+        ++onz[i - rstart];
+      if (cols[j] >= i) {
+        if (diag)
+          ++dnzu[i - rstart];
+        else
+          ++onzu[i - rstart];
+      }
+    }
+    PetscCall(MatRestoreRow(H, i, &ncols, &cols, NULL));
+  }
+  PetscCall(MatDestroy(&H));
+  PetscCall(MatXAIJSetPreallocation(K, bs, dnz, onz, dnzu, onzu));
+  PetscCall(MatSetOption(K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  PetscCall(PetscFree4(dnz, onz, dnzu, onzu));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Creates and assembles K by the P1 path; the near-null space is left to the caller. */
+PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K)
+{
+  MPI_Comm               comm = PetscObjectComm((PetscObject)dm);
+  PetscSection           gsection, csection;
+  ISLocalToGlobalMapping ltog;
+  Vec                    coords;
+  const PetscScalar     *xa;
+  MatType                mtype;
+  PetscInt               dim, cStart, cEnd, vStart, vEnd, nlocal, bs = 1, *vidx, *cverts;
+  PetscBool              is_sbaij;
+
+  PetscFunctionBeginUser;
+  if (!ASSEMBLY_P1_Fill) {
+    PetscCall(PetscLogEventRegister("AssemblyP1Prealloc", DM_CLASSID, &ASSEMBLY_P1_Preallocate));
+    PetscCall(PetscLogEventRegister("AssemblyP1Fill", DM_CLASSID, &ASSEMBLY_P1_Fill));
+  }
+  PetscCall(PetscLogEventBegin(ASSEMBLY_P1_Preallocate, dm, 0, 0, 0));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(DMGetGlobalSection(dm, &gsection));
+  PetscCall(PetscSectionGetConstrainedStorageSize(gsection, &nlocal));
+  PetscCall(DMGetMatType(dm, &mtype));
+  PetscCall(AssemblyP1BlockSize(dm, &bs));
+  PetscCall(AssemblyP1VertexIndices(dm, &vidx));
+  PetscCall(AssemblyP1CellVertices(dm, &cverts));
+
+  PetscCall(MatCreate(comm, K));
+  PetscCall(MatSetSizes(*K, nlocal, nlocal, PETSC_DETERMINE, PETSC_DETERMINE));
+  PetscCall(MatSetType(*K, mtype));
+  PetscCall(MatSetBlockSize(*K, bs));
+  PetscCall(MatSetFromOptions(*K));
+  PetscCall(DMGetLocalToGlobalMapping(dm, &ltog));
+  PetscCall(MatSetLocalToGlobalMapping(*K, ltog, ltog));
+
+  PetscCall(AssemblyP1Preallocate(dm, bs, nlocal, vidx, cverts, *K));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)*K, &is_sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
+  if (is_sbaij) PetscCall(MatSetOption(*K, MAT_IGNORE_LOWER_TRIANGULAR, PETSC_TRUE));
+  PetscCall(PetscLogEventEnd(ASSEMBLY_P1_Preallocate, dm, 0, 0, 0));
+
+  PetscCall(PetscLogEventBegin(ASSEMBLY_P1_Fill, dm, 0, 0, 0));
+  PetscCall(DMGetCoordinateSection(dm, &csection));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(VecGetArrayRead(coords, &xa));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    PetscInt    idx[12], n = (dim + 1) * dim;
+    PetscReal   x[12];
+    PetscScalar Ke[144];
+
+    for (PetscInt a = 0; a <= dim; ++a) {
+      const PetscInt v = cverts[(c - cStart) * (dim + 1) + a];
+      PetscInt       off;
+
+      PetscCall(PetscSectionGetOffset(csection, v, &off));
+      for (PetscInt e = 0; e < dim; ++e) {
+        idx[a * dim + e] = vidx[(v - vStart) * dim + e];
+        x[a * dim + e]   = PetscRealPart(xa[off + e]);
+      }
+    }
+    PetscCall(AssemblyP1ElementStiffness(dim, user->material.lambda, user->material.mu, x, Ke));
+    PetscCall(MatSetValues(*K, n, idx, n, idx, Ke, ADD_VALUES));
+  }
+  PetscCall(VecRestoreArrayRead(coords, &xa));
+  PetscCall(MatAssemblyBegin(*K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(*K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatSetDM(*K, dm));
+  PetscCall(PetscFree(vidx));
+  PetscCall(PetscFree(cverts));
+  PetscCall(PetscLogEventEnd(ASSEMBLY_P1_Fill, dm, 0, 0, 0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -assembly_check: assembles K both ways (locX: the local solution the FE Jacobian is evaluated at) and prints
+   ||K_p1 - K_fe||_F / ||K_fe||_F with the type, block size and number of nonzeros of both. */
+PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX)
+{
+  MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
+  Mat       Kfe, Kp1, D;
+  MatInfo   info_fe, info_p1;
+  MatType   type_fe, type_p1;
+  PetscInt  bs_fe, bs_p1, m_fe, m_p1, n_fe, n_p1;
+  PetscReal norm_fe, norm_diff;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMCreateMatrix(dm, &Kfe));
+  PetscCall(DMPlexSNESComputeJacobianFEM(dm, locX, Kfe, Kfe, user));
+  PetscCall(MatAssemblyBegin(Kfe, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(Kfe, MAT_FINAL_ASSEMBLY));
+  PetscCall(AssemblyP1CreateMatrix(dm, user, &Kp1));
+  PetscCall(MatGetType(Kfe, &type_fe));
+  PetscCall(MatGetType(Kp1, &type_p1));
+  PetscCall(MatGetBlockSize(Kfe, &bs_fe));
+  PetscCall(MatGetBlockSize(Kp1, &bs_p1));
+  PetscCall(MatGetSize(Kfe, &m_fe, &n_fe));
+  PetscCall(MatGetSize(Kp1, &m_p1, &n_p1));
+  PetscCall(MatGetInfo(Kfe, MAT_GLOBAL_SUM, &info_fe));
+  PetscCall(MatGetInfo(Kp1, MAT_GLOBAL_SUM, &info_p1));
+  PetscCall(MatNorm(Kfe, NORM_FROBENIUS, &norm_fe));
+  PetscCall(MatDuplicate(Kfe, MAT_COPY_VALUES, &D));
+  PetscCall(MatAXPY(D, -1.0, Kp1, DIFFERENT_NONZERO_PATTERN));
+  PetscCall(MatNorm(D, NORM_FROBENIUS, &norm_diff));
+  PetscCall(PetscPrintf(comm,
+                        "  assembly check: ||K_p1 - K_fe||_F/||K_fe||_F = %.3e; size %" PetscInt_FMT "x%" PetscInt_FMT " (p1) %" PetscInt_FMT
+                        "x%" PetscInt_FMT " (fe); type %s (p1) %s (fe); block size %" PetscInt_FMT " (p1) %" PetscInt_FMT
+                        " (fe); nonzeros %.0f (p1) %.0f (fe); allocated %.0f (p1) %.0f (fe)\n",
+                        (double)(norm_diff / norm_fe), m_p1, n_p1, m_fe, n_fe, type_p1, type_fe, bs_p1, bs_fe, (double)info_p1.nz_used,
+                        (double)info_fe.nz_used, (double)info_p1.nz_allocated, (double)info_fe.nz_allocated));
+  PetscCall(MatDestroy(&D));
+  PetscCall(MatDestroy(&Kfe));
+  PetscCall(MatDestroy(&Kp1));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,84 @@
+/* Active set of Gamma_C and the per-Newton-step contact monitor (-contact_monitor). */
+#include "physics.h"
+#include "solver.h"
+
+/* An order-independent hash of the active vertices of Gamma_C, the same on any number of ranks. */
+static PetscErrorCode ActiveSetHash(AppCtx *user, Vec X, PetscInt64 *hash)
+{
+  const PetscScalar *x;
+  PetscInt           dim, rstart;
+  PetscInt64         local = 0;
+  DM                 dm;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetDM(X, &dm));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(VecGetOwnershipRange(X, &rstart, NULL));
+  PetscCall(VecGetArrayRead(X, &x));
+  for (PetscInt i = 0; i < user->cset.n; ++i) {
+    const unsigned long long g = (unsigned long long)(rstart + user->cset.global_off[i]);
+
+    if (user->cset.is_vertex[i] && ContactNodePenetration(user, dim, i, x) > 0.0)
+      local = (PetscInt64)((unsigned long long)local + ((g + 1) * 0x9E3779B97F4A7C15ULL ^ (g << 17)) % 0x7FFFFFFFFFFFULL);
+  }
+  PetscCall(VecRestoreArrayRead(X, &x));
+  PetscCall(MPIU_Allreduce(&local, hash, 1, MPIU_INT64, MPI_SUM, PetscObjectComm((PetscObject)dm)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Semismooth Newton on the penalty problem can cycle between active sets. When the active set of this step is one
+   already met two or more steps back (and not the previous one) with no less than half its residual, the cycle is
+   reported and, with -contact_cycle_damping, the next Newton step is damped by half (SNESLineSearchSetDamping) to leave
+   the cycle; the steps after it are full again (a damping kept on would lose the finite termination of Newton). */
+static PetscErrorCode DetectActiveSetCycle(SNES snes, AppCtx *user, PetscInt it, PetscReal fnorm, Vec X)
+{
+  SNESLineSearch ls;
+  PetscInt64     hash;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESGetLineSearch(snes, &ls));
+  PetscCall(SNESLineSearchSetDamping(ls, 1.0));
+  PetscCall(ActiveSetHash(user, X, &hash));
+  if (it >= CONTACT_HISTORY) PetscFunctionReturn(PETSC_SUCCESS);
+  user->active_history[it] = hash;
+  user->fnorm_history[it]  = fnorm;
+  for (PetscInt j = it - 2; j >= 0; --j) {
+    if (user->active_history[j] != hash || user->active_history[it - 1] == hash || fnorm < 0.5 * user->fnorm_history[j]) continue;
+    user->stats.active_set_cycles++;
+    if (user->contact.cycle_damping) PetscCall(SNESLineSearchSetDamping(ls, 0.5));
+    PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes),
+                          "  active-set cycle: Newton step %" PetscInt_FMT " is back at the active set of step %" PetscInt_FMT
+                          " (|F| %g, then %g)%s\n",
+                          it, j, (double)user->fnorm_history[j], (double)fnorm,
+                          user->contact.cycle_damping ? "; the next step is damped by 1/2" : "; not damped (-contact_cycle_damping 0)"));
+    break;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The SNES iterates on x~ = u/U with the residual F/U (solver.c): the monitor reports u and |F| in the user's units. */
+PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm_scaled, void *ctx)
+{
+  AppCtx         *user  = (AppCtx *)ctx;
+  const PetscReal fnorm = fnorm_scaled * user->snes_scale;
+  Vec             X, Xs;
+  PetscInt        active, entered, left;
+
+  PetscFunctionBeginUser;
+  user->stats.residual_norm = fnorm;
+  PetscCall(SNESGetSolution(snes, &Xs));
+  X = Xs;
+  if (user->snes_scale != 1.0) {
+    PetscCall(VecCopy(Xs, user->work));
+    PetscCall(VecScale(user->work, user->snes_scale));
+    X = user->work;
+  }
+  if (user->contact.method == CONTACT_PENALTY) PetscCall(DetectActiveSetCycle(snes, user, it, fnorm, X));
+  if (!user->contact.monitor) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactCountActive(user, X, PETSC_TRUE, &active, &entered, &left));
+  PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes),
+                        "  %3" PetscInt_FMT " contact: |F| %12.6e  active vertices %6" PetscInt_FMT "  entered %5" PetscInt_FMT
+                        "  left %5" PetscInt_FMT "\n",
+                        it, (double)fnorm, active, entered, left));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,46 @@
+/* The discrete problem on one mesh: everything that depends on the mesh, set up and destroyed as a unit
+   (the grid sequencing sets up one per level). */
+#include "mesh.h"
+#include "physics.h"
+#include "solver.h"
+#include "verify.h"
+
+PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
+{
+  PetscLogDouble t0, t1;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscTime(&t0));
+  PetscCall(MeshCheckContactBoundary(dm, user->scene.contact_id));
+  PetscCall(MeshCheckFaceSets(dm, user->scene.name, "the Dirichlet boundary Gamma_D (with none, nothing would fix the body)",
+                              user->scene.num_dirichlet, user->scene.dirichlet_ids));
+  PetscCall(DMGetLabel(dm, "Face Sets", &user->face_sets));
+  PetscCall(MeshGetMaxCellDiameter(dm, &user->h));
+  PetscCall(ContactComputeEps(user));
+  PetscCall(ElasticitySetUpDiscretization(dm, user));
+  PetscCall(ContactSetCreate(dm, user, &user->cset));
+  if (user->contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, user));
+  PetscCall(SolverAssembleBulk(dm, user));
+  PetscCall(WeakDataAddToResidual(dm, user, user->r0));
+  PetscCall(SolverComputeScales(dm, user));
+  PetscCall(PetscMemzero(&user->pc_reuse, sizeof(user->pc_reuse)));
+  PetscCall(SolverCreateSNES(dm, user, snes));
+  PetscCall(PetscTime(&t1));
+  user->level_setup_time = t1 - t0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes)
+{
+  PetscFunctionBeginUser;
+  PetscCall(SNESDestroy(snes));
+  PetscCall(MatDestroy(&user->K));
+  PetscCall(VecDestroy(&user->r0));
+  PetscCall(VecDestroy(&user->xl));
+  PetscCall(VecDestroy(&user->xu));
+  PetscCall(VecDestroy(&user->loc_bc));
+  PetscCall(VecDestroy(&user->work));
+  PetscCall(PetscWeakFormDestroy(&user->wf_penalty));
+  PetscCall(ContactSetDestroy(&user->cset));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,454 @@
+/* The nonlinear solve. The bulk operator is linear: K and r0 = F_bulk(0) are assembled once,
+   the residual is K u + r0 + (contact terms) and the Jacobian K + (contact Jacobian). */
+#include <math.h>
+#include "physics.h"
+#include "solver.h"
+
+PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
+{
+  Vec          locX, locF;
+  MatNullSpace rigid;
+
+  PetscFunctionBeginUser;
+  PetscCall(AssemblyResolve(dm, user)); /* -assembly auto: fe or p1 for this mesh */
+  if (user->assembly == ASSEMBLY_P1)
+    PetscCall(AssemblyP1CreateMatrix(dm, user, &user->K));
+  else
+    PetscCall(DMCreateMatrix(dm, &user->K));
+  PetscCall(DMCreateGlobalVector(dm, &user->r0));
+  PetscCall(DMGetLocalVector(dm, &locX));
+  PetscCall(DMGetLocalVector(dm, &locF));
+  PetscCall(VecZeroEntries(locX));
+  PetscCall(VecZeroEntries(locF));
+  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, locX, 0.0, NULL, NULL, NULL));
+  if (user->assembly == ASSEMBLY_FE) PetscCall(DMPlexSNESComputeJacobianFEM(dm, locX, user->K, user->K, user));
+  if (user->assembly_check) PetscCall(AssemblyP1Check(dm, user, locX));
+  PetscCall(MatAssemblyBegin(user->K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(user->K, MAT_FINAL_ASSEMBLY));
+  PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
+  PetscCall(VecZeroEntries(user->r0));
+  PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, user->r0));
+  PetscCall(DMRestoreLocalVector(dm, &locX));
+  PetscCall(DMRestoreLocalVector(dm, &locF));
+  if (user->degree == 1)
+    PetscCall(ElasticityRigidBodyModesP1(dm, &rigid)); /* unknowns at the vertices only */
+  else
+    PetscCall(DMPlexCreateRigidBody(dm, 0, &rigid));
+  PetscCall(MatSetNearNullSpace(user->K, rigid));
+  PetscCall(MatNullSpaceDestroy(&rigid));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* R = K X + r0: the residual of the elastic problem without the contact terms. */
+PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MatMult(user->K, X, R));
+  PetscCall(VecAXPY(R, 1.0, user->r0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The SNES works on x~ = u/U with the residual F~(x~) = F(U x~)/U, U = user->snes_scale a power of 2 (exact in floating
+   point): F~ has the Jacobian of F, so Newton's iterates are U times smaller and the same, while the absolute tolerances
+   inside PETSc (SNESVI's bound tolerance, the line searches' maximal step) see a displacement of size one in any units.
+   The displacement of the iterate, U x~, goes to user->work. */
+static PetscErrorCode SolverIterateDisplacement(AppCtx *user, Vec X, Vec *u)
+{
+  PetscFunctionBeginUser;
+  *u = X;
+  if (user->snes_scale == 1.0) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(VecCopy(X, user->work));
+  PetscCall(VecScale(user->work, user->snes_scale));
+  *u = user->work;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The residual K u + r0 + (penalty term) at the displacement u, in the user's units. */
+static PetscErrorCode SolverResidual(DM dm, AppCtx *user, Vec u, Vec F)
+{
+  PetscFunctionBeginUser;
+  PetscCall(SolverBulkResidual(user, u, F));
+  if (user->contact.method == CONTACT_PENALTY) PetscCall(PenaltyAddResidual(dm, user, u, F));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode FormFunction(SNES snes, Vec X, Vec F, void *ctx)
+{
+  AppCtx *user = (AppCtx *)ctx;
+  DM      dm;
+  Vec     u;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESGetDM(snes, &dm));
+  PetscCall(SolverIterateDisplacement(user, X, &u));
+  PetscCall(SolverResidual(dm, user, u, F));
+  if (user->snes_scale != 1.0) PetscCall(VecScale(F, 1.0 / user->snes_scale));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
+{
+  AppCtx *user = (AppCtx *)ctx;
+  DM      dm;
+  Vec     u;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESGetDM(snes, &dm));
+  PetscCall(SolverIterateDisplacement(user, X, &u));
+  if (user->contact.method == CONTACT_PENALTY) {
+    PetscCall(PcReuseDecide(snes, dm, user, u));
+    PetscCall(MatCopy(user->K, P, SAME_NONZERO_PATTERN));
+    PetscCall(PenaltyAddJacobian(dm, user, u, P));
+    PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
+  }
+  if (J != P) {
+    PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
+    PetscCall(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Newton stops, converged, when PETSc's tests say so (|F| fell by -snes_rtol, ...) or when |F| <= -contact_load_rtol
+   ||F(0)||: at round-off for the load, which a warm start (eps sweep, grid sequence) may reach before any reduction
+   by -snes_rtol. Every norm here is relative, so the test is the same in any units. */
+static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm, SNESConvergedReason *reason,
+                                      void *ctx)
+{
+  AppCtx         *user = (AppCtx *)ctx;
+  const PetscReal f    = fnorm * user->snes_scale; /* |F| in the user's units */
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, NULL));
+  if (it == 0) user->fnorm0 = f;
+  if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->contact.load_rtol * user->load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The scales of the problem on this mesh: the load ||F(0)||_2, and the displacement scale U, the largest entry of
+   the best displacement along F(0) (one steepest-descent step of the energy from u = 0: alpha F(0) with
+   alpha = |F(0)|^2 / F(0).K F(0)), rounded to a power of 2. Only U's order of magnitude matters. */
+PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
+{
+  MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
+  Vec         zero, F, KF;
+  PetscScalar fkf;
+  PetscReal   finf, U = 1.0;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMCreateGlobalVector(dm, &user->work));
+  PetscCall(DMGetGlobalVector(dm, &zero));
+  PetscCall(DMGetGlobalVector(dm, &F));
+  PetscCall(DMGetGlobalVector(dm, &KF));
+  PetscCall(VecZeroEntries(zero));
+  PetscCall(SolverResidual(dm, user, zero, F));
+  PetscCall(VecNorm(F, NORM_2, &user->load_norm));
+  PetscCheck(!PetscIsInfOrNanReal(user->load_norm), comm, PETSC_ERR_USER_INPUT,
+             "The load of the problem is not finite (||F(0)|| = %g): check the loads, the material and the mesh coordinates",
+             (double)user->load_norm);
+  if (user->load_norm > 0.0) {
+    PetscCall(VecNorm(F, NORM_INFINITY, &finf));
+    PetscCall(MatMult(user->K, F, KF));
+    PetscCall(VecDot(F, KF, &fkf));
+    if (PetscRealPart(fkf) > 0.0) U = PetscSqr(user->load_norm) / PetscRealPart(fkf) * finf;
+    if (!(U > 0.0) || PetscIsInfOrNanReal(U)) U = 1.0;
+  }
+  user->displacement_scale = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
+  user->snes_scale         = 1.0;
+  PetscCall(DMRestoreGlobalVector(dm, &zero));
+  PetscCall(DMRestoreGlobalVector(dm, &F));
+  PetscCall(DMRestoreGlobalVector(dm, &KF));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The default linear solver: a direct solve (MUMPS), robust for the small problems of a first run; for the penalty
+   method inside CG, so that a factorization can serve as the preconditioner of later Newton steps (pc_reuse.c).
+   The Newton steps are as accurate as with a fresh factorization, also when it is reused. */
+static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
+{
+  PC pc;
+
+  PetscFunctionBeginUser;
+  PetscCall(KSPSetType(ksp, user->contact.method == CONTACT_PENALTY && user->contact.pc_reuse ? KSPCG : KSPPREONLY));
+  PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCLU));
+  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
+{
+  MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
+  Mat       J;
+  KSP       ksp;
+  PC        pc;
+  PetscBool is_vi;
+  SNESType  type;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESCreate(comm, snes));
+  PetscCall(SNESSetDM(*snes, dm));
+  if (user->contact.method == CONTACT_PENALTY) {
+    MatNullSpace rigid;
+
+    PetscCall(MatDuplicate(user->K, MAT_COPY_VALUES, &J));
+    PetscCall(MatGetNearNullSpace(user->K, &rigid));
+    PetscCall(MatSetNearNullSpace(J, rigid));
+  } else {
+    J = user->K; /* the Jacobian is K itself */
+    PetscCall(PetscObjectReference((PetscObject)J));
+  }
+  PetscCall(SNESSetFunction(*snes, NULL, FormFunction, user));
+  PetscCall(SNESSetJacobian(*snes, J, J, FormJacobian, user));
+  PetscCall(MatDestroy(&J));
+  if (user->contact.method == CONTACT_VI) {
+    PetscCall(SNESSetType(*snes, SNESVINEWTONRSLS));
+    PetscCall(VICreateBounds(dm, user));
+    PetscCall(SNESVISetVariableBounds(*snes, user->xl, user->xu));
+  } else {
+    SNESLineSearch ls;
+
+    PetscCall(SNESSetType(*snes, SNESNEWTONLS));
+    /* the penalty problem is the minimization of a convex energy: the critical-point line search keeps the semismooth Newton
+       converging for small eps, where backtracking on |F| stalls (32x32 mms, eps = 1e-5: bt fails, cp converges) */
+    PetscCall(SNESGetLineSearch(*snes, &ls));
+    PetscCall(SNESLineSearchSetType(ls, SNESLINESEARCHCP));
+    /* no convergence on a small step: with eps = 1e-7 (128x128 mms) it stopped Newton at |F| = 3e-4, far from the solution */
+    PetscCall(SNESSetTolerances(*snes, PETSC_DEFAULT, PETSC_DEFAULT, 0.0, PETSC_DEFAULT, PETSC_DEFAULT));
+  }
+  {
+    SNESLineSearch ls;
+
+    /* no absolute test in the line search: the critical-point search would stop at the initial point, and report
+       CONVERGED_FNORM_ABS, wherever |F . dx| < 1e-15, that is for any problem whose loads are small in absolute terms */
+    PetscCall(SNESGetLineSearch(*snes, &ls));
+    PetscCall(SNESLineSearchSetTolerances(ls, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, 0.0, PETSC_DEFAULT, PETSC_DEFAULT));
+  }
+  PetscCall(SNESSetConvergenceTest(*snes, SolverConverged, user, NULL));
+  PetscCall(SNESGetKSP(*snes, &ksp));
+  PetscCall(SolverSetDefaultLinearSolver(ksp, user));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(SNESMonitorSet(*snes, ContactMonitor, user, NULL));
+  PetscCall(SNESSetFromOptions(*snes));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)*snes, &is_vi, SNESVINEWTONRSLS, SNESVINEWTONSSLS, ""));
+  PetscCall(SNESGetType(*snes, &type));
+  {
+    PetscBool is_gamg, is_rsls;
+
+    PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &is_gamg));
+    PetscCall(PetscObjectTypeCompare((PetscObject)*snes, SNESVINEWTONRSLS, &is_rsls));
+    PetscCheck(!(is_gamg && is_rsls), comm, PETSC_ERR_USER_INPUT,
+               "-pc_type gamg cannot follow the reduced system of -snes_type vinewtonrsls (its size changes between steps): use hypre or mumps with "
+               "-contact_method vi");
+  }
+  {
+    PetscBool is_preonly;
+
+    PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &is_preonly));
+    user->pc_reuse.enabled = (PetscBool)(user->contact.method == CONTACT_PENALTY && user->contact.pc_reuse && !is_preonly);
+  }
+  PetscCheck(is_vi == (user->contact.method == CONTACT_VI), comm, PETSC_ERR_USER_INPUT,
+             "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type,
+             ContactMethods[user->contact.method]);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Records the outcome of the last SNESSolve, with the iteration counts of all solves so far. A solve counts as
+   converged only if PETSc says so and the residual fell by -snes_rtol or reached round-off for the load (or the
+   user's -snes_atol): a stop on a small step or in the line search with a large residual is a failure. */
+static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, PetscInt *ksp)
+{
+  PetscInt  its, lits, maxit, maxf;
+  PetscReal fnorm, atol, rtol, stol;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESGetConvergedReason(snes, &user->stats.reason));
+  PetscCall(SNESGetIterationNumber(snes, &its));
+  PetscCall(SNESGetLinearSolveIterations(snes, &lits));
+  PetscCall(SNESGetFunctionNorm(snes, &fnorm));
+  PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
+  *newton += its;
+  *ksp += lits;
+  user->stats.newton_its       = *newton;
+  user->stats.ksp_its          = *ksp;
+  user->stats.residual_norm    = fnorm * user->displacement_scale; /* the SNES saw F/U */
+  user->stats.residual_reduced = (PetscBool)(user->stats.residual_norm <= rtol * user->fnorm0 ||
+                                             user->stats.residual_norm <= user->contact.load_rtol * user->load_norm || fnorm <= atol);
+  user->stats.converged        = (PetscBool)(user->stats.reason > 0 && user->stats.residual_reduced);
+  user->stats.pc_builds        = user->pc_reuse.enabled ? user->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Appends the outcome of the last SolverSolve() to the table of solves (/solves in the output). */
+static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal time_solve)
+{
+  SolveRecord       *r;
+  const PetscScalar *x;
+  PetscInt           dim;
+  PetscReal          pen = 0.0;
+  DM                 dm;
+
+  PetscFunctionBeginUser;
+  if (user->nrecords == user->maxrecords) { /* grow */
+    SolveRecord *grown;
+
+    user->maxrecords = PetscMax(16, 2 * user->maxrecords);
+    PetscCall(PetscMalloc1(user->maxrecords, &grown));
+    if (user->nrecords) PetscCall(PetscArraycpy(grown, user->records, user->nrecords));
+    PetscCall(PetscFree(user->records));
+    user->records = grown;
+  }
+  r = &user->records[user->nrecords++];
+  PetscCall(SNESGetDM(snes, &dm));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(VecGetArrayRead(u, &x));
+  for (PetscInt i = 0; i < user->cset.n; ++i) pen = PetscMax(pen, ContactNodePenetration(user, dim, i, x));
+  PetscCall(VecRestoreArrayRead(u, &x));
+  PetscCall(MPIU_Allreduce(&pen, &r->max_penetration, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
+  PetscCall(VecGetSize(u, &r->n_dofs));
+  r->level               = user->level;
+  r->h                   = user->h;
+  r->eps                 = user->contact.method == CONTACT_PENALTY ? user->eps : 0.0;
+  r->newton_its          = user->stats.newton_its;
+  r->ksp_its             = user->stats.ksp_its;
+  r->pc_builds           = user->stats.pc_builds;
+  r->converged           = user->stats.converged;
+  r->time_setup          = user->level_setup_time;
+  r->time_solve          = time_solve;
+  user->level_setup_time = 0.0; /* counted once, with the first solve on the mesh */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* SNESSolve on x~ = u/U (and the bounds of SNESVI divided by U): see SolverIterateDisplacement(). */
+static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
+{
+  const PetscReal U = user->displacement_scale;
+
+  PetscFunctionBeginUser;
+  user->snes_scale = U;
+  PetscCall(VecScale(u, 1.0 / U));
+  if (user->xl) PetscCall(VecScale(user->xl, 1.0 / U));
+  if (user->xu) PetscCall(VecScale(user->xu, 1.0 / U));
+  PetscCall(SNESSolve(snes, NULL, u));
+  PetscCall(VecScale(u, U));
+  if (user->xl) PetscCall(VecScale(user->xl, U));
+  if (user->xu) PetscCall(VecScale(user->xu, U));
+  user->snes_scale = 1.0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Solves from a zero initial guess (warm: from u) and records the outcome; a failed solve is recorded, not raised.
+   An eps below h/M is reached by continuation: the penalty problems for eps = h/M, h/M f, h/M f^2, ... are solved in turn,
+   each from the solution of the previous one, so that Newton starts near the active set and the 1/eps scale of the
+   residual never meets a far-off initial guess (the direct solve at eps = 1e-12 h diverges on the square scene).
+   A warm start needs no continuation: it starts from the solution for a nearby eps or a coarser mesh. */
+PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm)
+{
+  const PetscReal eps_target = user->eps, eps_start = user->h / ContactPenaltyModulus(user);
+  PetscLogDouble  t0, t1;
+  PetscInt        newton = 0, ksp = 0;
+  DM              dm;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESGetDM(snes, &dm));
+  if (!warm) PetscCall(VecZeroEntries(u));
+  PetscCall(PetscTime(&t0));
+  user->pc_reuse.builds           = 0; /* counted per solve */
+  user->stats.continuation_stages = 0;
+  if (!warm && user->contact.method == CONTACT_PENALTY && user->contact.continuation && eps_target < eps_start) {
+    for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= user->contact.continuation_factor) {
+      user->eps = eps;
+      PetscCall(ElasticityUpdateConstants(dm, user));
+      PetscCall(SolverSNESSolve(snes, user, u));
+      PetscCall(RecordSolve(snes, user, &newton, &ksp));
+      user->stats.continuation_stages++;
+      if (!user->stats.converged) break; /* reported as the failure of the whole solve */
+    }
+    user->eps = eps_target;
+    PetscCall(ElasticityUpdateConstants(dm, user));
+  }
+  if (user->stats.continuation_stages == 0 || user->stats.converged) {
+    PetscCall(SolverSNESSolve(snes, user, u));
+    PetscCall(RecordSolve(snes, user, &newton, &ksp));
+  }
+  PetscCall(PetscTime(&t1));
+  user->stats.time_solve += t1 - t0;
+  user->stats.newton_its_total += newton;
+  user->stats.ksp_its_total += ksp;
+  PetscCall(SolverAddRecord(snes, user, u, t1 - t0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Hager's estimate of ||J^-1||_1 (Higham, ACM TOMS 14, 1988), with solves by the SNES's own linear solver, times ||J||_1:
+   the 1-norm condition number of the Jacobian at the solution (for vi: of K). J is symmetric, so J^-T x is a solve with J.
+   SNESVI's linear solver holds the reduced system of the last active set, so vi gets a linear solver of its own for K,
+   set up as the SNES's (the same defaults and options). */
+PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
+{
+  KSP                ksp, ksp_vi = NULL;
+  Mat                J;
+  Vec                x, y, z;
+  PetscReal          normJ, est = 0.0;
+  PetscInt           n, last    = -1;
+  KSPConvergedReason reason;
+
+  PetscFunctionBeginUser;
+  user->stats.condition_1norm = PETSC_NAN;
+  if (!user->contact.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(SNESGetKSP(snes, &ksp));
+  PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
+  if (user->contact.method == CONTACT_VI) {
+    J = user->K;
+    PetscCall(KSPCreate(PetscObjectComm((PetscObject)snes), &ksp_vi));
+    PetscCall(SolverSetDefaultLinearSolver(ksp_vi, user));
+    PetscCall(KSPSetFromOptions(ksp_vi));
+    ksp = ksp_vi;
+  } else
+    PetscCall(SNESComputeJacobian(snes, u, J, J));
+  PetscCall(KSPSetReusePreconditioner(ksp, PETSC_FALSE)); /* a preconditioner built for this very J */
+  PetscCall(KSPSetOperators(ksp, J, J));
+  PetscCall(MatNorm(J, NORM_1, &normJ));
+  PetscCall(VecDuplicate(u, &x));
+  PetscCall(VecDuplicate(u, &y));
+  PetscCall(VecDuplicate(u, &z));
+  PetscCall(VecGetSize(u, &n));
+  PetscCall(VecSet(x, 1.0 / n));
+  for (PetscInt it = 0; it < 5; ++it) {
+    PetscScalar *a, ztx;
+    PetscReal    zmax;
+    PetscInt     jmax;
+    PetscInt     nloc;
+
+    PetscCall(KSPSolve(ksp, x, y)); /* y = J^-1 x */
+    PetscCall(KSPGetConvergedReason(ksp, &reason));
+    if (reason <= 0) { /* no estimate without solves: reported as not computed */
+      PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes), "  condition number estimate: the linear solve failed (%s), no estimate\n",
+                            KSPConvergedReasons[reason]));
+      est = PETSC_NAN;
+      break;
+    }
+    PetscCall(VecNorm(y, NORM_1, &est));
+    PetscCall(VecCopy(y, z));
+    PetscCall(VecGetLocalSize(z, &nloc));
+    PetscCall(VecGetArray(z, &a));
+    for (PetscInt i = 0; i < nloc; ++i) a[i] = PetscRealPart(a[i]) >= 0.0 ? 1.0 : -1.0;
+    PetscCall(VecRestoreArray(z, &a));
+    PetscCall(KSPSolve(ksp, z, y)); /* y = J^-T sign(J^-1 x) */
+    PetscCall(VecDot(y, x, &ztx));
+    PetscCall(VecAbs(y));
+    PetscCall(VecMax(y, &jmax, &zmax));
+    if (zmax <= PetscRealPart(ztx) || jmax == last) break;
+    last = jmax;
+    PetscCall(VecSet(x, 0.0));
+    PetscCall(VecSetValue(x, jmax, 1.0, INSERT_VALUES));
+    PetscCall(VecAssemblyBegin(x));
+    PetscCall(VecAssemblyEnd(x));
+  }
+  user->stats.condition_1norm = normJ * est;
+  PetscCall(VecDestroy(&x));
+  PetscCall(VecDestroy(&y));
+  PetscCall(KSPDestroy(&ksp_vi));
+  PetscCall(VecDestroy(&z));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,243 @@
+/* Error norms of the verification (verification.md section 1), integrated with the accurate rule of cell_quadrature.c:
+   ||u - u_h|| in L2, H1 (semi and full) and energy; on Gamma_C the contact-pressure residual R = sigma_n(u) + p_h in L2,
+   weighted by eps^1/2, and in the H^-1/2 dual norm; and the penetration [u_h,n - g]_+ in L2 and max.
+   p_h is the penalty law (1/eps)[u_h,n - g]_+ for the penalty method and the nodal multiplier, interpolated, otherwise. */
+#include "mesh.h"
+#include "physics.h"
+#include "verify.h"
+
+PetscErrorCode ErrorNormsReset(ErrorNorms *e)
+{
+  PetscFunctionBeginUser;
+  e->l2 = e->h1_semi = e->h1 = e->energy = PETSC_NAN;
+  e->pressure_l2 = e->pressure_weighted = e->pressure_dual = PETSC_NAN;
+  e->penetration_l2 = e->penetration_max = PETSC_NAN;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* loc_p = p n at the nodes of Gamma_C, from the nodal pressures of the contact set (zero elsewhere). */
+PetscErrorCode ErrorNormsPressureVector(DM dm, AppCtx *user, Vec loc_p)
+{
+  Vec          P;
+  PetscScalar *p;
+  PetscInt     dim;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMGetGlobalVector(dm, &P));
+  PetscCall(VecZeroEntries(P));
+  PetscCall(VecGetArray(P, &p));
+  for (PetscInt i = 0; i < user->cset.n; ++i)
+    for (PetscInt c = 0; c < dim; ++c) p[user->cset.global_off[i] + c] = user->cset.pressure[i] * user->scene.obstacle_normal[c];
+  PetscCall(VecRestoreArray(P, &p));
+  PetscCall(VecZeroEntries(loc_p));
+  PetscCall(DMGlobalToLocal(dm, P, INSERT_VALUES, loc_p));
+  PetscCall(DMRestoreGlobalVector(dm, &P));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Integrals over Omega: |e|^2, |grad e|^2 and sigma(e) : grad e with e = u_target - u_h. */
+static PetscErrorCode IntegrateBulk(DM dm, AppCtx *user, CellQuadrature *cq, Vec loc_uh, const ErrorTarget *t, PetscReal sums[3])
+{
+  const PetscInt dim = cq->dim;
+  PetscInt       cStart, cEnd;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    PetscScalar *uh = NULL, *ur = NULL;
+
+    PetscCall(CellQuadratureSetCell(cq, c));
+    PetscCall(DMPlexVecGetClosure(dm, NULL, loc_uh, c, NULL, &uh));
+    if (!t->scene) PetscCall(DMPlexVecGetClosure(dm, NULL, t->loc_u, c, NULL, &ur));
+    for (PetscInt q = 0; q < cq->Nq; ++q) {
+      PetscReal u[3], g[9], ut[3], gt[9], sigma[9], s0 = 0.0, s1 = 0.0, s2 = 0.0;
+
+      PetscCall(CellQuadratureInterpolate(cq, uh, q, u, g));
+      if (t->scene) {
+        PetscScalar us[3], gs[9];
+
+        PetscCall((*t->scene->exact)(dim, 0.0, &cq->x[q * dim], dim, us, (void *)t->scene->constants));
+        PetscCall((*t->scene->exact_gradient)(dim, 0.0, &cq->x[q * dim], dim * dim, gs, (void *)t->scene->constants));
+        for (PetscInt k = 0; k < dim; ++k) ut[k] = PetscRealPart(us[k]);
+        for (PetscInt k = 0; k < dim * dim; ++k) gt[k] = PetscRealPart(gs[k]);
+      } else
+        PetscCall(CellQuadratureInterpolate(cq, ur, q, ut, gt));
+      for (PetscInt k = 0; k < dim; ++k) s0 += PetscSqr(ut[k] - u[k]);
+      for (PetscInt k = 0; k < dim * dim; ++k) {
+        g[k] = gt[k] - g[k];
+        s1 += PetscSqr(g[k]);
+      }
+      ElasticStress(dim, &user->material, g, sigma);
+      for (PetscInt k = 0; k < dim * dim; ++k) s2 += sigma[k] * g[k];
+      sums[0] += cq->w[q] * s0;
+      sums[1] += cq->w[q] * s1;
+      sums[2] += cq->w[q] * s2;
+    }
+    PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc_uh, c, NULL, &uh));
+    if (!t->scene) PetscCall(DMPlexVecRestoreClosure(dm, NULL, t->loc_u, c, NULL, &ur));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Integrals over Gamma_C: R^2 and [d]_+^2, the max of [d]_+, and the load b_i = int R phi_i . n of the dual problem.
+   Without a target (t == NULL) only the penetration is integrated. */
+static PetscErrorCode IntegrateContact(DM dm, AppCtx *user, CellQuadrature *cq, Vec loc_uh, Vec loc_ph, const ErrorTarget *t, Vec loc_b,
+                                       PetscReal sums[2], PetscReal *dmax)
+{
+  const PetscInt   dim = cq->dim;
+  const PetscReal *n   = user->scene.obstacle_normal;
+  PetscInt        *faces, nf;
+  PetscScalar     *elem;
+
+  PetscFunctionBeginUser;
+  PetscCall(MeshGetBoundaryFaces(dm, user->scene.contact_id, &nf, &faces)); /* of this mesh, maybe a refinement of the run's */
+  PetscCall(PetscMalloc1(PetscMax(cq->Nb, 1), &elem));
+  for (PetscInt i = 0; i < nf; ++i) {
+    PetscScalar *uh = NULL, *ph = NULL, *pr = NULL;
+
+    PetscCall(CellQuadratureSetFace(cq, faces[i]));
+    PetscCall(DMPlexVecGetClosure(dm, NULL, loc_uh, cq->cell, NULL, &uh));
+    if (loc_ph) PetscCall(DMPlexVecGetClosure(dm, NULL, loc_ph, cq->cell, NULL, &ph));
+    if (t && !t->scene) PetscCall(DMPlexVecGetClosure(dm, NULL, t->loc_pressure, cq->cell, NULL, &pr));
+    for (PetscInt b = 0; b < cq->Nb; ++b) elem[b] = 0.0;
+    for (PetscInt q = 0; q < cq->Nq; ++q) {
+      const PetscReal *x = &cq->x[q * dim];
+      PetscReal        u[3], v[3], d = -user->scene.obstacle_offset, p_h = 0.0, p_target = 0.0, R;
+
+      PetscCall(CellQuadratureInterpolate(cq, uh, q, u, NULL));
+      for (PetscInt k = 0; k < dim; ++k) d += (u[k] + x[k]) * n[k];
+      sums[1] += cq->w[q] * PetscSqr(PetscMax(d, 0.0));
+      *dmax = PetscMax(*dmax, d);
+      if (!t) continue;
+      if (ph) { /* the interpolated nodal pressure, stored as p n */
+        PetscCall(CellQuadratureInterpolate(cq, ph, q, v, NULL));
+        for (PetscInt k = 0; k < dim; ++k) p_h += v[k] * n[k];
+      } else
+        p_h = d > 0.0 ? d / user->eps : 0.0;
+      if (t->scene) {
+        PetscReal sn;
+
+        PetscCall(WeakDataExactNormalStress(user, dim, x, &sn));
+        p_target = -sn;
+      } else {
+        PetscCall(CellQuadratureInterpolate(cq, pr, q, v, NULL));
+        for (PetscInt k = 0; k < dim; ++k) p_target += v[k] * n[k];
+      }
+      R = p_h - p_target; /* sigma_n(u) + p_h */
+      sums[0] += cq->w[q] * R * R;
+      for (PetscInt b = 0; b < cq->Nb; ++b) {
+        PetscReal vn = 0.0;
+
+        for (PetscInt k = 0; k < cq->Nc; ++k) vn += cq->B[(q * cq->Nb + b) * cq->Nc + k] * n[k];
+        elem[b] += cq->w[q] * R * vn;
+      }
+    }
+    if (t) PetscCall(DMPlexVecSetClosure(dm, NULL, loc_b, cq->cell, elem, ADD_VALUES));
+    PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc_uh, cq->cell, NULL, &uh));
+    if (ph) PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc_ph, cq->cell, NULL, &ph));
+    if (pr) PetscCall(DMPlexVecRestoreClosure(dm, NULL, t->loc_pressure, cq->cell, NULL, &pr));
+  }
+  PetscCall(PetscFree(faces));
+  PetscCall(PetscFree(elem));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* ||R||_{-1/2,Gamma_C} as the energy norm of w with a(w, v) = <R, v_n> for all v (Remark 3.10): sqrt(b . K^-1 b).
+   The solve uses the options prefix dual_ (default: a direct MUMPS solve, like the main solve). */
+static PetscErrorCode DualNorm(DM dm, Mat K, Vec loc_b, PetscReal *norm)
+{
+  KSP         ksp;
+  PC          pc;
+  Vec         b, w;
+  PetscScalar bw;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetGlobalVector(dm, &b));
+  PetscCall(DMGetGlobalVector(dm, &w));
+  PetscCall(VecZeroEntries(b));
+  PetscCall(DMLocalToGlobal(dm, loc_b, ADD_VALUES, b));
+  PetscCall(KSPCreate(PetscObjectComm((PetscObject)dm), &ksp));
+  PetscCall(KSPSetOptionsPrefix(ksp, "dual_"));
+  PetscCall(KSPSetOperators(ksp, K, K));
+  PetscCall(KSPSetType(ksp, KSPPREONLY));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCLU));
+  PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
+  PetscCall(KSPSetFromOptions(ksp));
+  PetscCall(KSPSolve(ksp, b, w));
+  {
+    KSPConvergedReason reason;
+
+    PetscCall(KSPGetConvergedReason(ksp, &reason));
+    PetscCheck(reason > 0, PetscObjectComm((PetscObject)dm), PETSC_ERR_NOT_CONVERGED, "The dual-norm solve (prefix dual_) failed: %s",
+               KSPConvergedReasons[reason]);
+  }
+  PetscCall(VecDot(b, w, &bw));
+  *norm = PetscSqrtReal(PetscMax(PetscRealPart(bw), 0.0));
+  PetscCall(KSPDestroy(&ksp));
+  PetscCall(DMRestoreGlobalVector(dm, &b));
+  PetscCall(DMRestoreGlobalVector(dm, &w));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* All norms of u_h (loc_uh, with its pressure loc_ph or the penalty law if NULL) against the target, on the mesh of dm;
+   K is the elastic operator of dm for the dual norm. Without a target (NULL) only the penetration norms. */
+PetscErrorCode ErrorNormsEvaluate(DM dm, AppCtx *user, Mat K, Vec loc_uh, Vec loc_ph, const ErrorTarget *target, ErrorNorms *e)
+{
+  MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
+  CellQuadrature cq;
+  PetscReal      bulk[3] = {0.0, 0.0, 0.0}, contact[2] = {0.0, 0.0}, dmax = PETSC_MIN_REAL, gbulk[3], gcontact[2], gmax;
+  Vec            loc_b = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(ErrorNormsReset(e));
+  PetscCall(CellQuadratureCreate(dm, &user->scene, &user->verify, &cq));
+  if (target) {
+    PetscCall(DMGetLocalVector(dm, &loc_b));
+    PetscCall(VecZeroEntries(loc_b));
+    PetscCall(IntegrateBulk(dm, user, &cq, loc_uh, target, bulk));
+  }
+  PetscCall(IntegrateContact(dm, user, &cq, loc_uh, loc_ph, target, loc_b, contact, &dmax));
+  PetscCall(CellQuadratureDestroy(&cq));
+  PetscCall(MPIU_Allreduce(bulk, gbulk, 3, MPIU_REAL, MPIU_SUM, comm));
+  PetscCall(MPIU_Allreduce(contact, gcontact, 2, MPIU_REAL, MPIU_SUM, comm));
+  PetscCall(MPIU_Allreduce(&dmax, &gmax, 1, MPIU_REAL, MPIU_MAX, comm));
+  e->penetration_l2  = PetscSqrtReal(gcontact[1]);
+  e->penetration_max = PetscMax(gmax, 0.0);
+  if (target) {
+    const PetscReal weight = user->contact.method == CONTACT_PENALTY ? user->eps : user->h;
+
+    e->l2                = PetscSqrtReal(gbulk[0]);
+    e->h1_semi           = PetscSqrtReal(gbulk[1]);
+    e->h1                = PetscSqrtReal(gbulk[0] + gbulk[1]);
+    e->energy            = PetscSqrtReal(gbulk[2]);
+    e->pressure_l2       = PetscSqrtReal(gcontact[0]);
+    e->pressure_weighted = PetscSqrtReal(weight) * e->pressure_l2;
+    PetscCall(DualNorm(dm, K, loc_b, &e->pressure_dual));
+    PetscCall(DMRestoreLocalVector(dm, &loc_b));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The norms of the run: penetration always, the errors when the scene has an exact solution, and against -reference. */
+PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
+{
+  Vec         loc_uh, loc_ph = NULL;
+  ErrorTarget exact = {&user->scene, NULL, NULL};
+
+  PetscFunctionBeginUser;
+  PetscCall(ErrorNormsReset(&user->errors));
+  PetscCall(DMGetLocalVector(dm, &loc_uh));
+  PetscCall(VecZeroEntries(loc_uh));
+  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, loc_uh, 0.0, NULL, NULL, NULL));
+  PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc_uh));
+  if (user->contact.method != CONTACT_PENALTY) {
+    PetscCall(DMGetLocalVector(dm, &loc_ph));
+    PetscCall(ErrorNormsPressureVector(dm, user, loc_ph));
+  }
+  PetscCall(ErrorNormsEvaluate(dm, user, user->K, loc_uh, loc_ph, user->scene.exact && user->scene.exact_gradient ? &exact : NULL, &user->errors));
+  if (loc_ph) PetscCall(DMRestoreLocalVector(dm, &loc_ph));
+  PetscCall(DMRestoreLocalVector(dm, &loc_uh));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -1,0 +1,88 @@
+/* Data of a manufactured solution through the weak form (verification.md section 2): for v = 0 on Gamma_D,
+     L(v) = int_Omega sigma(u_exact) : eps(v) dx - int_Gamma_C sigma_n(u_exact) v_n ds,
+   so no singular source term is ever evaluated pointwise. Integrated with the accurate rule of cell_quadrature.c. */
+#include "mesh.h"
+#include "physics.h"
+#include "verify.h"
+
+/* sigma_n(u_exact) = (sigma n) . n at x, with n the foundation normal */
+PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal *sn)
+{
+  const PetscReal *n = user->scene.obstacle_normal;
+  PetscScalar      g[9];
+  PetscReal        grad[9], sigma[9];
+
+  PetscFunctionBeginUser;
+  PetscCall((*user->scene.exact_gradient)(dim, 0.0, x, dim * dim, g, (void *)user->scene.constants));
+  for (PetscInt k = 0; k < dim * dim; ++k) grad[k] = PetscRealPart(g[k]);
+  ElasticStress(dim, &user->material, grad, sigma);
+  *sn = 0.0;
+  for (PetscInt i = 0; i < dim; ++i)
+    for (PetscInt j = 0; j < dim; ++j) *sn += n[i] * sigma[i * dim + j] * n[j];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* r0 -= L: r0 holds the bulk residual at u = 0 (the Dirichlet lifting) on entry. */
+PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0)
+{
+  CellQuadrature cq;
+  Vec            locL;
+  PetscInt       dim, cStart, cEnd, nf, *faces;
+  PetscScalar   *elem;
+
+  PetscFunctionBeginUser;
+  if (!user->scene.weak_data) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCheck(user->scene.exact && user->scene.exact_gradient, PetscObjectComm((PetscObject)dm), PETSC_ERR_PLIB,
+             "Scene %s asks for weak data but has no exact solution and gradient", user->scene.name);
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(CellQuadratureCreate(dm, &user->scene, &user->verify, &cq));
+  PetscCall(PetscMalloc1(PetscMax(cq.Nb, 1), &elem));
+  PetscCall(DMGetLocalVector(dm, &locL));
+  PetscCall(VecZeroEntries(locL));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    PetscCall(CellQuadratureSetCell(&cq, c));
+    for (PetscInt b = 0; b < cq.Nb; ++b) elem[b] = 0.0;
+    for (PetscInt q = 0; q < cq.Nq; ++q) {
+      PetscScalar g[9];
+      PetscReal   grad[9], sigma[9];
+
+      PetscCall((*user->scene.exact_gradient)(dim, 0.0, &cq.x[q * dim], dim * dim, g, (void *)user->scene.constants));
+      for (PetscInt k = 0; k < dim * dim; ++k) grad[k] = PetscRealPart(g[k]);
+      ElasticStress(dim, &user->material, grad, sigma);
+      for (PetscInt b = 0; b < cq.Nb; ++b) {
+        PetscReal s = 0.0;
+
+        for (PetscInt k = 0; k < cq.Nc; ++k)
+          for (PetscInt e = 0; e < dim; ++e) s += sigma[k * dim + e] * cq.D[((q * cq.Nb + b) * cq.Nc + k) * dim + e];
+        elem[b] += cq.w[q] * s;
+      }
+    }
+    PetscCall(DMPlexVecSetClosure(dm, NULL, locL, c, elem, ADD_VALUES));
+  }
+  PetscCall(MeshGetBoundaryFaces(dm, user->scene.contact_id, &nf, &faces));
+  for (PetscInt i = 0; i < nf; ++i) {
+    PetscCall(CellQuadratureSetFace(&cq, faces[i]));
+    for (PetscInt b = 0; b < cq.Nb; ++b) elem[b] = 0.0;
+    for (PetscInt q = 0; q < cq.Nq; ++q) {
+      PetscReal sn;
+
+      PetscCall(WeakDataExactNormalStress(user, dim, &cq.x[q * dim], &sn));
+      for (PetscInt b = 0; b < cq.Nb; ++b) {
+        PetscReal vn = 0.0;
+
+        for (PetscInt k = 0; k < cq.Nc; ++k) vn += cq.B[(q * cq.Nb + b) * cq.Nc + k] * user->scene.obstacle_normal[k];
+        elem[b] -= cq.w[q] * sn * vn;
+      }
+    }
+    PetscCall(DMPlexVecSetClosure(dm, NULL, locL, cq.cell, elem, ADD_VALUES));
+  }
+  PetscCall(PetscFree(faces));
+  /* r0 -= L */
+  PetscCall(VecScale(locL, -1.0));
+  PetscCall(DMLocalToGlobal(dm, locL, ADD_VALUES, r0));
+  PetscCall(DMRestoreLocalVector(dm, &locL));
+  PetscCall(PetscFree(elem));
+  PetscCall(CellQuadratureDestroy(&cq));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
