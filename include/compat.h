@@ -20,6 +20,15 @@
 
 /* DMPlexSNESComputeResidualFEM/JacobianFEM keep their arguments; DMPlexSetSNESLocalFEM is not used. */
 
+/* DMPlexCreateBoxMesh gained the localization arguments in 3.22. */
+#if PETSC_VERSION_LT(3, 22, 0)
+#  define CompatCreateBoxMesh(comm, dim, simplex, faces, lower, upper, periodicity, interpolate, dm) \
+    DMPlexCreateBoxMesh(comm, dim, simplex, faces, lower, upper, periodicity, interpolate, dm)
+#else
+#  define CompatCreateBoxMesh(comm, dim, simplex, faces, lower, upper, periodicity, interpolate, dm) \
+    DMPlexCreateBoxMesh(comm, dim, simplex, faces, lower, upper, periodicity, interpolate, 0, PETSC_FALSE, dm)
+#endif
+
 /* PETSC_NAN appeared after 3.18 */
 #if !defined(PETSC_NAN)
 #  include <math.h>

@@ -30,14 +30,14 @@ PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, cons
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Reads the mesh file (DMSetFromOptions), with an error that names the file and the reader's complaint. */
-static PetscErrorCode MeshReadFile(MPI_Comm comm, const char filename[], DM dm)
+/* Reads the mesh file, with an error that names the file and the reader's complaint. */
+static PetscErrorCode MeshReadFile(MPI_Comm comm, const char filename[], DM *dm)
 {
   PetscErrorCode ierr;
 
   PetscFunctionBeginUser;
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-  ierr = DMSetFromOptions(dm);
+  ierr = DMPlexCreateFromFile(comm, filename, "", PETSC_TRUE, dm);
   PetscCall(PetscPopErrorHandler());
   if (ierr) {
     const char *text     = NULL;
@@ -57,11 +57,9 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
 {
   PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
   PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
-  PetscBool           simplex, has_file, faces_set, dim_set, parallel_read = PETSC_FALSE;
+  PetscBool           simplex, has_file, dim_set, parallel_read = PETSC_FALSE;
   char                filename[PETSC_MAX_PATH_LEN] = "";
   MeshPartitionerType partitioner;
-  MatType             mtype;
-  char               *mtype_copy;
 
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, NULL, "Mesh options (PETSc's names, and -partitioner)", "DMPLEX");
@@ -73,8 +71,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
   PetscCall(PetscOptionsBool("-dm_plex_simplex", "Simplices (triangles, tetrahedra) or tensor cells (quads, hexes)", "DMPlexCreateBoxMesh", simplex,
                              &simplex, NULL));
   faces[0] = faces[1] = faces[2] = (dim == 2) ? 8 : 4;
-  PetscCall(
-      PetscOptionsIntArray("-dm_plex_box_faces", "Number of cells along each side of the box", "DMPlexCreateBoxMesh", faces, &nfaces, &faces_set));
+  PetscCall(PetscOptionsIntArray("-dm_plex_box_faces", "Number of cells along each side of the box", "DMPlexCreateBoxMesh", faces, &nfaces, NULL));
   PetscCall(PetscOptionsRealArray("-dm_plex_box_lower", "Lower corner of the box", "DMPlexCreateBoxMesh", lower, &nlower, NULL));
   PetscCall(PetscOptionsRealArray("-dm_plex_box_upper", "Upper corner of the box", "DMPlexCreateBoxMesh", upper, &nupper, NULL));
   partitioner = MESH_PARTITIONER_PTSCOTCH; /* PETSc 3.18's default where it has PTScotch and no ParMETIS */
@@ -83,10 +80,6 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
   refine = 0;
   PetscCall(PetscOptionsRangeInt("-dm_refine", "Uniform refinements, after the distribution", "DMRefine", refine, &refine, NULL, 0, 12));
   PetscOptionsEnd();
-  /* PETSc's DMSetFromOptions() would refine the serial mesh on rank 0, before the distribution: the project refines the
-     distributed mesh instead, on all ranks (at 1M unknowns the serial refinement and distribution cost more than the
-     whole elastic solve on 2 ranks) */
-  PetscCall(PetscOptionsClearValue(NULL, "-dm_refine"));
   PetscCall(OptionsCheckFiniteArray(comm, "-dm_plex_box_lower", dim, lower));
   PetscCall(OptionsCheckFiniteArray(comm, "-dm_plex_box_upper", dim, upper));
   for (PetscInt d = 0; d < dim; ++d) {
@@ -108,35 +101,23 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
     PetscCall(PetscSNPrintf(what, sizeof(what), "-dm_plex_box_faces with %" PetscInt_FMT " refinement(s)", refine + later_refinements));
     PetscCall(MeshCheckSize(comm, dim, ncells, what));
   }
-  if (simplex && !has_file)
-    PetscCall(MeshCreateSimplexBox(comm, dim, faces, lower, upper, dm));
-  else {
-    if (!has_file && !faces_set) { /* the same default number of cells for tensor boxes as for simplex boxes */
-      char value[64];
-
-      PetscCall(PetscSNPrintf(value, sizeof(value),
-                              dim == 2 ? "%" PetscInt_FMT ",%" PetscInt_FMT : "%" PetscInt_FMT ",%" PetscInt_FMT ",%" PetscInt_FMT, faces[0],
-                              faces[1], faces[2]));
-      PetscCall(PetscOptionsSetValue(NULL, "-dm_plex_box_faces", value));
-    }
-    PetscCall(DMCreate(comm, dm));
-    PetscCall(DMSetType(*dm, DMPLEX));
-  }
-  /* The serial mesh on rank 0: PETSc creates tensor boxes and file meshes here; MeshPartitionDistribute()
-     distributes, for every kind of mesh, with the partitioner of -partitioner. PETSc reads HDF5 meshes in parallel, in
-     pieces that are only consistent after its own distribution (without it the solution is wrong): they get both. */
-  if (has_file) PetscCall(PetscStrendswith(filename, ".h5", &parallel_read));
-  PetscCheck(!parallel_read || strlen(filename) <= 240, comm, PETSC_ERR_USER_INPUT,
-             "The HDF5 mesh file name '%s' (-dm_plex_filename) has %d characters: PETSc reads it with MPI-IO, which in Open MPI 4.1 crashes on names "
-             "of more than 240; use a shorter (for example relative) path",
-             filename, (int)strlen(filename));
-  if (!parallel_read) PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
+  /* The serial mesh on rank 0 (a file, the project's simplex box, PETSc's tensor box), distributed by
+     MeshPartitionDistribute() with the partitioner of -partitioner; PETSc's own DM options are applied to the
+     distributed mesh last (DMSetFromOptions()), so that -dm_refine refines it on all ranks (at 1M unknowns a serial
+     refinement before the distribution cost more than the whole elastic solve on 2 ranks). PETSc reads HDF5 meshes in
+     parallel, in pieces that are only consistent after its own distribution (without it the solution is wrong): they
+     get both. */
   if (has_file) {
     PetscInt  fdim, cStart, cEnd, n;
     PetscReal ncells;
     char      what[PETSC_MAX_PATH_LEN + 64];
 
-    PetscCall(MeshReadFile(comm, filename, *dm));
+    PetscCall(PetscStrendswith(filename, ".h5", &parallel_read));
+    PetscCheck(!parallel_read || strlen(filename) <= 240, comm, PETSC_ERR_USER_INPUT,
+               "The HDF5 mesh file name '%s' (-dm_plex_filename) has %d characters: PETSc reads it with MPI-IO, which in Open MPI 4.1 crashes on "
+               "names of more than 240; use a shorter (for example relative) path",
+               filename, (int)strlen(filename));
+    PetscCall(MeshReadFile(comm, filename, dm));
     PetscCall(DMGetDimension(*dm, &fdim));
     PetscCheck(!dim_set || fdim == dim, comm, PETSC_ERR_USER_INPUT,
                "The mesh file '%s' holds a %" PetscInt_FMT "D mesh, but -dm_plex_dim %" PetscInt_FMT " was given", filename, fdim, dim);
@@ -146,20 +127,22 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
     ncells = (PetscReal)n * PetscPowReal(2.0, (PetscReal)(fdim * (refine + later_refinements)));
     PetscCall(PetscSNPrintf(what, sizeof(what), "%s with %" PetscInt_FMT " refinement(s)", filename, refine + later_refinements));
     PetscCall(MeshCheckSize(comm, fdim, ncells, what));
-  } else
-    PetscCall(DMSetFromOptions(*dm));
-  PetscCall(DMGetMatType(*dm, &mtype));
-  PetscCall(PetscStrallocpy(mtype, &mtype_copy)); /* -dm_mat_type, which the distributed mesh does not inherit */
-  PetscCall(MeshPartitionDistribute(partitioner, dm));
-  for (PetscInt r = 0; r < refine; ++r) {
-    DM fine;
+    if (parallel_read) {
+      DM dist = NULL;
 
-    PetscCall(DMRefine(*dm, comm, &fine));
-    PetscCall(DMDestroy(dm));
-    *dm = fine;
-  }
-  PetscCall(DMSetMatType(*dm, mtype_copy));
-  PetscCall(PetscFree(mtype_copy));
+      PetscCall(DMPlexDistribute(*dm, 0, NULL, &dist));
+      if (dist) {
+        PetscCall(DMDestroy(dm));
+        *dm = dist;
+      }
+    }
+  } else if (simplex)
+    PetscCall(MeshCreateSimplexBox(comm, dim, faces, lower, upper, dm));
+  else
+    PetscCall(CompatCreateBoxMesh(comm, dim, PETSC_FALSE, faces, lower, upper, NULL, PETSC_TRUE, dm));
+  PetscCall(MeshPartitionDistribute(partitioner, dm));
+  PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
+  PetscCall(DMSetFromOptions(*dm)); /* -dm_refine on all ranks, -dm_mat_type, PETSc's checks */
   PetscCall(PetscObjectSetName((PetscObject)*dm, "mesh"));
   PetscCall(DMViewFromOptions(*dm, NULL, "-dm_view"));
   PetscFunctionReturn(PETSC_SUCCESS);
