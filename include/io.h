@@ -14,5 +14,5 @@ PetscErrorCode OutputFileLeaveDirectory(int cwd);
 PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, char temps[][PETSC_MAX_PATH_LEN], const char *targets[]);
 
 /* output_hdf5.c */
-PetscErrorCode OutputGetOptions(MPI_Comm comm, AppCtx *user);
-PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u);
+PetscErrorCode OutputGetOptions(MPI_Comm comm, RunOptions *opt);
+PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u);

@@ -22,8 +22,8 @@ static inline PetscReal ContactNodePenetration(const AppCtx *user, PetscInt dim,
 {
   PetscReal un = 0.0;
 
-  for (PetscInt c = 0; c < dim; ++c) un += PetscRealPart(x[user->cset.global_off[i] + c]) * user->scene.obstacle_normal[c];
-  return un - user->cset.gap[i];
+  for (PetscInt c = 0; c < dim; ++c) un += PetscRealPart(x[user->prob.cset.global_off[i] + c]) * user->scene.obstacle_normal[c];
+  return un - user->prob.cset.gap[i];
 }
 
 /* penalty.c */

@@ -156,38 +156,54 @@ typedef struct {
   PetscReal max_penetration;
 } SolveRecord;
 
+/* The options of the run, read once before any set-up (each module's *GetOptions fills its part), read-only after. */
 typedef struct {
   char           scene_name[64];
-  char           output[PETSC_MAX_PATH_LEN];
-  Scene          scene;
   Material       material;
+  PetscInt       degree; /* of the displacement, -displacement_petscspace_degree */
   ContactOptions contact;
-  PetscReal      h, eps;
-  PetscInt       degree;
-  ContactSet     cset;
-  DMLabel        face_sets;
-  PetscWeakForm  wf_penalty; /* the penalty term on Gamma_C, kept out of the bulk weak form */
-  Vec            loc_bc;     /* local vector holding the Dirichlet values, zero elsewhere (penalty only) */
-  Mat            K;          /* bulk elastic operator, assembled once */
-  Vec            r0;         /* bulk residual at u = 0 (loads and Dirichlet lifting) */
-  Vec            xl, xu;     /* SNESVI bounds */
-  PcReuse        pc_reuse;
   VerifyOptions  verify;
-  RunStats       stats;
-  PetscInt64     active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
-  PetscReal      fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */
-  ErrorNorms     errors;                          /* against the scene's exact solution */
-  ErrorNorms     ref_errors;                      /* against the -reference solution */
-  PetscInt       level;                           /* grid sequence level of the current mesh (0: the mesh of the options) */
-  PetscReal      level_setup_time;                /* set-up time of the current mesh's problem, until its first solve */
-  SolveRecord   *records;                         /* one per solve, any number */
-  PetscInt       nrecords, maxrecords;
-  PetscReal      load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
-  PetscReal      displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */
-  PetscReal      snes_scale;         /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
-  PetscReal      fnorm0;             /* |F| at the start of the last SNESSolve, in the user's units */
-  Vec            work;               /* U x~: the displacement of the SNES iterate x~ */
-  AssemblyType   assembly_option;    /* -assembly as given (auto, fe, p1) */
-  AssemblyType   assembly;           /* how K is assembled: fe or p1 (-assembly auto resolved) */
-  PetscBool      assembly_check;     /* -assembly_check: assemble K both ways and compare */
+  AssemblyType   assembly;       /* -assembly as given (auto, fe, p1) */
+  PetscBool      assembly_check; /* -assembly_check: assemble K both ways and compare */
+  char           output[PETSC_MAX_PATH_LEN];
+} RunOptions;
+
+/* The discrete problem on one mesh: created by ProblemSetUp(), destroyed by ProblemDestroy(), one per grid level. */
+typedef struct {
+  PetscInt      level;      /* grid sequence level of the mesh (0: the mesh of the options) */
+  PetscReal     setup_time; /* set-up time of this problem, counted with its first solve */
+  PetscReal     h, eps;
+  DMLabel       face_sets;
+  ContactSet    cset;
+  PetscWeakForm wf_penalty;         /* the penalty term on Gamma_C, kept out of the bulk weak form */
+  Vec           loc_bc;             /* local vector holding the Dirichlet values, zero elsewhere (penalty only) */
+  AssemblyType  assembly;           /* how K is assembled: fe or p1 (-assembly auto resolved) */
+  Mat           K;                  /* bulk elastic operator, assembled once */
+  Vec           r0;                 /* bulk residual at u = 0 (loads and Dirichlet lifting) */
+  Vec           xl, xu;             /* SNESVI bounds */
+  PetscReal     load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
+  PetscReal     displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */
+  PetscReal     snes_scale;         /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
+  Vec           work;               /* U x~: the displacement of the SNES iterate x~ */
+  PcReuse       pc_reuse;
+  PetscReal     fnorm0;                          /* |F| at the start of the last SNESSolve, in the user's units */
+  PetscInt64    active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
+  PetscReal     fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */
+} Problem;
+
+/* What the run produced: statistics, one row per solve, error norms; the summary and the writer only read it. */
+typedef struct {
+  RunStats     stats;
+  SolveRecord *records; /* one per solve, any number */
+  PetscInt     nrecords, maxrecords;
+  ErrorNorms   errors;     /* against the scene's exact solution */
+  ErrorNorms   ref_errors; /* against the -reference solution */
+} RunRecord;
+
+/* The state of a run, by concern: its options, its scene, the problem on the current mesh, and its record. */
+typedef struct {
+  RunOptions opt;
+  Scene      scene;
+  Problem    prob;
+  RunRecord  rec;
 } AppCtx;

@@ -11,10 +11,10 @@ static const char help[] =
 #include "verify.h"
 #include "io.h"
 
-static PetscErrorCode PrintSummary(DM dm, AppCtx *user, Vec u)
+static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
 {
   MPI_Comm        comm = PetscObjectComm((PetscObject)dm);
-  const RunStats *s    = &user->stats;
+  const RunStats *s    = &user->rec.stats;
   PetscInt        dim, ndofs;
   PetscMPIInt     size;
 
@@ -22,26 +22,28 @@ static PetscErrorCode PrintSummary(DM dm, AppCtx *user, Vec u)
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetSize(u, &ndofs));
   PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCall(PetscPrintf(comm, "scene %s, %" PetscInt_FMT "D, method %s", user->scene.name, dim, ContactMethods[user->contact.method]));
-  if (user->contact.method == CONTACT_PENALTY)
-    PetscCall(PetscPrintf(comm, " (%s quadrature, eps = %g)", PenaltyQuadratures[user->contact.quadrature], (double)user->eps));
-  PetscCall(PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, h = %g, %d rank(s)\n", user->degree, ndofs, (double)user->h, size));
+  PetscCall(PetscPrintf(comm, "scene %s, %" PetscInt_FMT "D, method %s", user->scene.name, dim, ContactMethods[user->opt.contact.method]));
+  if (user->opt.contact.method == CONTACT_PENALTY)
+    PetscCall(PetscPrintf(comm, " (%s quadrature, eps = %g)", PenaltyQuadratures[user->opt.contact.quadrature], (double)user->prob.eps));
+  PetscCall(
+      PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, h = %g, %d rank(s)\n", user->opt.degree, ndofs, (double)user->prob.h, size));
   PetscCall(PetscPrintf(
       comm, "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, %" PetscInt_FMT " preconditioner builds, |F| = %g\n",
       SNESConvergedReasons[s->reason], s->newton_its, s->ksp_its, s->pc_builds, (double)s->residual_norm));
   PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g, contact force %g, energy %.10g\n",
                         s->active_vertices, (double)s->max_penetration, (double)s->contact_force, (double)s->energy));
-  if (!PetscIsNanReal(user->errors.h1))
+  if (!PetscIsNanReal(user->rec.errors.h1))
     PetscCall(PetscPrintf(comm, "  error against the exact solution: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n",
-                          (double)user->errors.h1, (double)user->errors.l2, (double)user->errors.pressure_l2, (double)user->errors.pressure_dual));
-  if (!PetscIsNanReal(user->ref_errors.h1))
+                          (double)user->rec.errors.h1, (double)user->rec.errors.l2, (double)user->rec.errors.pressure_l2,
+                          (double)user->rec.errors.pressure_dual));
+  if (!PetscIsNanReal(user->rec.ref_errors.h1))
     PetscCall(PetscPrintf(comm, "  error against the reference: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n",
-                          (double)user->ref_errors.h1, (double)user->ref_errors.l2, (double)user->ref_errors.pressure_l2,
-                          (double)user->ref_errors.pressure_dual));
-  if (user->nrecords > 1) {
+                          (double)user->rec.ref_errors.h1, (double)user->rec.ref_errors.l2, (double)user->rec.ref_errors.pressure_l2,
+                          (double)user->rec.ref_errors.pressure_dual));
+  if (user->rec.nrecords > 1) {
     PetscCall(PetscPrintf(comm, "  solves: level   dofs        h           eps         Newton  Krylov  PC builds  setup s   solve s\n"));
-    for (PetscInt i = 0; i < user->nrecords; ++i) {
-      const SolveRecord *r = &user->records[i];
+    for (PetscInt i = 0; i < user->rec.nrecords; ++i) {
+      const SolveRecord *r = &user->rec.records[i];
 
       PetscCall(PetscPrintf(comm,
                             "          %5" PetscInt_FMT "  %9" PetscInt_FMT "  %.4e  %.4e  %6" PetscInt_FMT "  %6" PetscInt_FMT "  %9" PetscInt_FMT
@@ -113,58 +115,58 @@ int main(int argc, char **argv)
   PetscCall(PetscMemzero(&user, sizeof(user)));
   PetscCall(OutputFileInstallCleanup());
   PetscCall(SceneRegisterAll());
-  PetscCall(SceneGetOptions(comm, user.scene_name, sizeof(user.scene_name)));
-  PetscCall(ElasticityGetOptions(comm, &user.material, &user.degree));
-  PetscCall(ContactGetOptions(comm, &user.contact));
-  PetscCall(VerifyGetOptions(comm, &user.verify));
-  PetscCall(AssemblyGetOptions(comm, &user.assembly_option, &user.assembly_check));
-  PetscCall(OutputGetOptions(comm, &user));
+  PetscCall(SceneGetOptions(comm, user.opt.scene_name, sizeof(user.opt.scene_name)));
+  PetscCall(ElasticityGetOptions(comm, &user.opt.material, &user.opt.degree));
+  PetscCall(ContactGetOptions(comm, &user.opt.contact));
+  PetscCall(VerifyGetOptions(comm, &user.opt.verify));
+  PetscCall(AssemblyGetOptions(comm, &user.opt.assembly, &user.opt.assembly_check));
+  PetscCall(OutputGetOptions(comm, &user.opt));
 
-  PetscCall(MeshCreate(comm, user.contact.grid_sequence, &dm));
-  PetscCall(MeshPartitionGetStats(dm, &user.stats.partition));              /* the partitioner; the final mesh's cut is taken after the solve */
-  PetscCall(SceneCreate(user.scene_name, dm, &user.material, &user.scene)); /* its options, once for every level */
+  PetscCall(MeshCreate(comm, user.opt.contact.grid_sequence, &dm));
+  PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition)); /* the partitioner; the final mesh's cut is taken after the solve */
+  PetscCall(SceneCreate(user.opt.scene_name, dm, &user.opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(ReferenceCheckFile(dm, &user)); /* before the solve, not after it */
   PetscCall(DMCreateGlobalVector(dm, &u));
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
   PetscCall(DMSNESCheckFromOptions(snes, u)); /* -dmsnes_check: PETSc's checks against the exact solution */
   PetscCall(PetscTime(&t1));
-  user.stats.time_setup = t1 - t0;
+  user.rec.stats.time_setup = t1 - t0;
 
   PetscCall(GridSequenceSolve(&dm, &user, &snes, &u)); /* one solve without -contact_grid_sequence */
   PetscCall(EpsSweepSolve(dm, &user, snes, u));
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
   PetscCall(ErrorNormsCompute(dm, &user, u));
-  PetscCall(ReferenceCompute(dm, &user, u));                   /* -reference, if given */
-  PetscCall(MeshPartitionGetStats(dm, &user.stats.partition)); /* of the final mesh */
+  PetscCall(ReferenceCompute(dm, &user, u));                       /* -reference, if given */
+  PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition)); /* of the final mesh */
   PetscCall(PetscTime(&t1));
-  user.stats.time_total = t1 - t0;
-  PetscCall(RecordPeakMemory(comm, &user.stats));
+  user.rec.stats.time_total = t1 - t0;
+  PetscCall(RecordPeakMemory(comm, &user.rec.stats));
   PetscCall(CheckAllOptionsUsed(comm));
   PetscCall(PrintSummary(dm, &user, u));
   PetscCall(OutputWriteHDF5(dm, &user, u));
-  PetscCall(PetscPrintf(comm, "  output: %s\n", user.output));
-  if (!user.stats.converged && user.stats.reason > 0)
+  PetscCall(PetscPrintf(comm, "  output: %s\n", user.opt.output));
+  if (!user.rec.stats.converged && user.rec.stats.reason > 0)
     PetscCall(PetscPrintf(comm,
                           "ERROR: the nonlinear solve failed: it stopped with %s after %" PetscInt_FMT
                           " Newton steps at residual %g, which fell neither by -snes_rtol from %g nor to round-off for the load %g; written with "
                           "converged = 0\n",
-                          SNESConvergedReasons[user.stats.reason], user.stats.newton_its, (double)user.stats.residual_norm, (double)user.fnorm0,
-                          (double)user.load_norm));
-  else if (!user.stats.converged)
+                          SNESConvergedReasons[user.rec.stats.reason], user.rec.stats.newton_its, (double)user.rec.stats.residual_norm,
+                          (double)user.prob.fnorm0, (double)user.prob.load_norm));
+  else if (!user.rec.stats.converged)
     PetscCall(PetscPrintf(comm,
                           "ERROR: the nonlinear solve failed: %s after %" PetscInt_FMT " Newton steps, residual %g; written with converged = 0\n",
-                          SNESConvergedReasons[user.stats.reason], user.stats.newton_its, (double)user.stats.residual_norm));
+                          SNESConvergedReasons[user.rec.stats.reason], user.rec.stats.newton_its, (double)user.rec.stats.residual_norm));
 
   PetscCall(VecDestroy(&u));
   PetscCall(ProblemDestroy(&user, &snes));
   PetscCall(DMDestroy(&dm));
-  PetscCall(ContactOptionsDestroy(&user.contact));
-  PetscCall(PetscFree(user.records));
+  PetscCall(ContactOptionsDestroy(&user.opt.contact));
+  PetscCall(PetscFree(user.rec.records));
   PetscCall(SceneFinalize());
   {
-    const PetscBool converged = user.stats.converged;
+    const PetscBool converged = user.rec.stats.converged;
     PetscCall(PetscFinalize());
     return converged ? 0 : 3;
   }

@@ -12,17 +12,16 @@
 #include "physics.h"
 #include "io.h"
 
-PetscErrorCode OutputGetOptions(MPI_Comm comm, AppCtx *user)
+PetscErrorCode OutputGetOptions(MPI_Comm comm, RunOptions *opt)
 {
   PetscBool set;
 
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, NULL, "Output", "Signorini");
-  PetscCall(PetscSNPrintf(user->output, sizeof(user->output), "output/%s.h5", user->scene_name));
-  PetscCall(
-      PetscOptionsString("-output", "HDF5 output file (default output/<scene>.h5)", NULL, user->output, user->output, sizeof(user->output), &set));
+  PetscCall(PetscSNPrintf(opt->output, sizeof(opt->output), "output/%s.h5", opt->scene_name));
+  PetscCall(PetscOptionsString("-output", "HDF5 output file (default output/<scene>.h5)", NULL, opt->output, opt->output, sizeof(opt->output), &set));
   PetscOptionsEnd();
-  PetscCall(OutputFileCheckTarget(comm, user->output, (PetscBool)!set)); /* the default directory is created; a user's must exist */
+  PetscCall(OutputFileCheckTarget(comm, opt->output, (PetscBool)!set)); /* the default directory is created; a user's must exist */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -75,9 +74,9 @@ static PetscErrorCode ViewVertexField(Vec v, PetscInt nc, PetscViewer viewer)
 
 /* The vertex fields: displacement, contact pressure, normal gap g - u_n, Gamma_C indicator,
    and the exact solution and error when the scene has one. */
-static PetscErrorCode WriteVertexFields(DM dm, AppCtx *user, Vec u, PetscViewer viewer)
+static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscViewer viewer)
 {
-  const ContactSet  *cs = &user->cset;
+  const ContactSet  *cs = &user->prob.cset;
   DM                 vdm, sdm, cdm;
   Vec                locU, disp, pressure, gap, mask, exact = NULL, error = NULL, coords;
   PetscSection       usec, vsec, ssec, csec;
@@ -219,9 +218,9 @@ static PetscErrorCode WriteErrorNorms(PetscViewer v, const char prefix[], const 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v, PetscInt ncells, PetscInt nverts)
+static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscViewer v, PetscInt ncells, PetscInt nverts)
 {
-  const RunStats *s = &user->stats;
+  const RunStats *s = &user->rec.stats;
   PetscMPIInt     size;
   PetscInt        dim, ndofs;
   char            method[64];
@@ -230,36 +229,36 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)dm), &size));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetSize(u, &ndofs));
-  PetscCall(PetscStrncpy(method, ContactMethods[user->contact.method], sizeof(method)));
+  PetscCall(PetscStrncpy(method, ContactMethods[user->opt.contact.method], sizeof(method)));
   PetscCall(PetscViewerHDF5WriteGroup(v, "/run"));
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "scene", PETSC_STRING, user->scene.name));
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "method", PETSC_STRING, method));
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_quadrature", PETSC_STRING, PenaltyQuadratures[user->contact.quadrature]));
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_eps_modulus", PETSC_STRING, PenaltyModuli[user->contact.modulus]));
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "assembly", PETSC_STRING, AssemblyTypes[user->assembly]));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_quadrature", PETSC_STRING, PenaltyQuadratures[user->opt.contact.quadrature]));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_eps_modulus", PETSC_STRING, PenaltyModuli[user->opt.contact.modulus]));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "assembly", PETSC_STRING, AssemblyTypes[user->prob.assembly]));
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "snes_reason", PETSC_STRING, SNESConvergedReasons[s->reason]));
   PetscCall(WriteIntAttr(v, "dim", dim));
-  PetscCall(WriteIntAttr(v, "degree", user->degree));
+  PetscCall(WriteIntAttr(v, "degree", user->opt.degree));
   PetscCall(WriteIntAttr(v, "nprocs", size));
   PetscCall(WriteIntAttr(v, "n_cells", ncells));
   PetscCall(WriteIntAttr(v, "n_vertices", nverts));
   PetscCall(WriteIntAttr(v, "n_dofs", ndofs));
-  PetscCall(WriteRealAttr(v, "h", user->h));
-  PetscCall(WriteRealAttr(v, "eps", user->contact.method == CONTACT_PENALTY ? user->eps : 0.0));
-  PetscCall(WriteRealAttr(v, "young_modulus", user->material.young_modulus));
-  PetscCall(WriteRealAttr(v, "poisson_ratio", user->material.poisson_ratio));
+  PetscCall(WriteRealAttr(v, "h", user->prob.h));
+  PetscCall(WriteRealAttr(v, "eps", user->opt.contact.method == CONTACT_PENALTY ? user->prob.eps : 0.0));
+  PetscCall(WriteRealAttr(v, "young_modulus", user->opt.material.young_modulus));
+  PetscCall(WriteRealAttr(v, "poisson_ratio", user->opt.material.poisson_ratio));
   PetscCall(WriteIntAttr(v, "converged", s->converged ? 1 : 0));
   PetscCall(WriteIntAttr(v, "snes_reason_code", (PetscInt)s->reason));
   PetscCall(WriteIntAttr(v, "newton_its", s->newton_its));
   PetscCall(WriteIntAttr(v, "ksp_its", s->ksp_its));
   PetscCall(WriteIntAttr(v, "newton_its_total", s->newton_its_total));
   PetscCall(WriteIntAttr(v, "ksp_its_total", s->ksp_its_total));
-  PetscCall(WriteIntAttr(v, "grid_sequence", user->contact.grid_sequence));
-  PetscCall(WriteIntAttr(v, "n_solves", user->nrecords));
+  PetscCall(WriteIntAttr(v, "grid_sequence", user->opt.contact.grid_sequence));
+  PetscCall(WriteIntAttr(v, "n_solves", user->rec.nrecords));
   PetscCall(WriteRealAttr(v, "residual_norm", s->residual_norm));
   PetscCall(WriteIntAttr(v, "residual_reduced", s->residual_reduced ? 1 : 0));
-  PetscCall(WriteRealAttr(v, "load_norm", user->load_norm));
-  PetscCall(WriteRealAttr(v, "displacement_scale", user->displacement_scale));
+  PetscCall(WriteRealAttr(v, "load_norm", user->prob.load_norm));
+  PetscCall(WriteRealAttr(v, "displacement_scale", user->prob.displacement_scale));
   PetscCall(WriteRealAttr(v, "time_setup", s->time_setup));
   PetscCall(WriteRealAttr(v, "time_solve", s->time_solve));
   PetscCall(WriteRealAttr(v, "time_total", s->time_total));
@@ -268,7 +267,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCall(WriteRealAttr(v, "contact_force", s->contact_force));
   PetscCall(WriteRealAttr(v, "energy", s->energy));
   {
-    PetscInt n = user->cset.n, ntotal;
+    PetscInt n = user->prob.cset.n, ntotal;
 
     PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
     PetscCall(WriteIntAttr(v, "contact_nodes", ntotal)); /* the free nodes of Gamma_C the contact acts on, each counted once */
@@ -279,18 +278,18 @@ static PetscErrorCode WriteRunMetadata(DM dm, AppCtx *user, Vec u, PetscViewer v
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "partitioner", PETSC_STRING, MeshPartitionerTypes[s->partition.partitioner]));
   PetscCall(WriteIntAttr(v, "partition_edge_cut", s->partition.edge_cut));
   PetscCall(WriteRealAttr(v, "partition_imbalance", s->partition.imbalance));
-  if (user->contact.condition_estimate) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm)); /* NaN: the estimate failed */
+  if (user->opt.contact.condition_estimate) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm)); /* NaN: the estimate failed */
   PetscCall(WriteRealAttr(v, "peak_memory_mb", s->peak_memory_mb));
   PetscCall(WriteRealAttr(v, "peak_memory_total_mb", s->peak_memory_total_mb));
-  PetscCall(WriteRealAttr(v, "penetration_l2", user->errors.penetration_l2));
-  PetscCall(WriteRealAttr(v, "penetration_max", user->errors.penetration_max));
-  PetscCall(WriteErrorNorms(v, "error", &user->errors));
-  PetscCall(WriteErrorNorms(v, "reference_error", &user->ref_errors));
-  if (user->verify.reference[0]) {
-    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "reference", PETSC_STRING, user->verify.reference));
+  PetscCall(WriteRealAttr(v, "penetration_l2", user->rec.errors.penetration_l2));
+  PetscCall(WriteRealAttr(v, "penetration_max", user->rec.errors.penetration_max));
+  PetscCall(WriteErrorNorms(v, "error", &user->rec.errors));
+  PetscCall(WriteErrorNorms(v, "reference_error", &user->rec.ref_errors));
+  if (user->opt.verify.reference[0]) {
+    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "reference", PETSC_STRING, user->opt.verify.reference));
   }
-  PetscCall(WriteIntAttr(v, "verify_quadrature_points", user->verify.quad_points));
-  PetscCall(WriteIntAttr(v, "verify_quadrature_refine", user->verify.quad_refine));
+  PetscCall(WriteIntAttr(v, "verify_quadrature_points", user->opt.verify.quad_points));
+  PetscCall(WriteIntAttr(v, "verify_quadrature_refine", user->opt.verify.quad_refine));
   for (PetscInt i = 0; i < user->scene.num_constants; ++i) { /* the scene's parameters, scene_0, scene_1, ... */
     char name[32];
 
@@ -305,7 +304,7 @@ static PetscErrorCode WriteSolves(MPI_Comm comm, const AppCtx *user, PetscViewer
 {
   const char    *columns[] = {"level",     "n_dofs",    "h",          "eps",        "newton_its",     "ksp_its",
                               "pc_builds", "converged", "time_setup", "time_solve", "max_penetration"};
-  const PetscInt ncol = (PetscInt)(sizeof(columns) / sizeof(columns[0])), n = user->nrecords;
+  const PetscInt ncol = (PetscInt)(sizeof(columns) / sizeof(columns[0])), n = user->rec.nrecords;
   PetscMPIInt    rank;
 
   PetscFunctionBeginUser;
@@ -319,7 +318,7 @@ static PetscErrorCode WriteSolves(MPI_Comm comm, const AppCtx *user, PetscViewer
     PetscCall(PetscObjectSetName((PetscObject)col, columns[j]));
     PetscCall(VecGetArray(col, &a));
     for (PetscInt i = 0; rank == 0 && i < n; ++i) {
-      const SolveRecord *r      = &user->records[i];
+      const SolveRecord *r      = &user->rec.records[i];
       const PetscReal    vals[] = {
              (PetscReal)r->level,     (PetscReal)r->n_dofs,     r->h,          r->eps,        (PetscReal)r->newton_its, (PetscReal)r->ksp_its,
              (PetscReal)r->pc_builds, r->converged ? 1.0 : 0.0, r->time_setup, r->time_solve, r->max_penetration};
@@ -334,7 +333,7 @@ static PetscErrorCode WriteSolves(MPI_Comm comm, const AppCtx *user, PetscViewer
 }
 
 /* XDMF for ParaView into the file xdmf, pointing into h5name, the final .h5 beside it (rank 0 only). */
-static PetscErrorCode WriteXdmf(AppCtx *user, const char xdmf[], const char h5name[], PetscInt dim, PetscInt ncells, PetscInt ncorners,
+static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const char h5name[], PetscInt dim, PetscInt ncells, PetscInt ncorners,
                                 PetscInt nverts)
 {
   const char    *fields[] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "exact_displacement", "error"};
@@ -370,7 +369,7 @@ static PetscErrorCode WriteXdmf(AppCtx *user, const char xdmf[], const char h5na
 }
 
 /* The HDF5 file, written into the temporary h5tmp, and the XDMF file into xdmftmp, both in the current directory. */
-static PetscErrorCode WriteFiles(DM dm, AppCtx *user, Vec u, const char h5tmp[], const char xdmftmp[], const char h5name[])
+static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, const char h5tmp[], const char xdmftmp[], const char h5name[])
 {
   MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
   PetscViewer viewer;
@@ -402,20 +401,20 @@ static PetscErrorCode WriteFiles(DM dm, AppCtx *user, Vec u, const char h5tmp[],
 
 /* Writes FILE.h5 and FILE.xdmf (output_file.c: temporaries renamed when complete), from inside their directory
    (OutputFileEnterDirectory()). An I/O error is reported in one sentence naming the file and the cause. */
-PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
+PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u)
 {
   MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
   char           dir[PETSC_MAX_PATH_LEN], base[PETSC_MAX_PATH_LEN], xdmf[PETSC_MAX_PATH_LEN], temps[2][PETSC_MAX_PATH_LEN];
   char           tdir[PETSC_MAX_PATH_LEN], h5tmp[PETSC_MAX_PATH_LEN], xdmftmp[PETSC_MAX_PATH_LEN];
-  const char    *targets[2] = {xdmf, user->output};
+  const char    *targets[2] = {xdmf, user->opt.output};
   PetscErrorCode ierr;
   int            cwd, err = 0, local_failed, failed;
   H5E_auto2_t    h5_func;
   void          *h5_data;
 
   PetscFunctionBeginUser;
-  PetscCall(OutputFileSplitPath(user->output, dir, sizeof(dir), base, sizeof(base)));
-  PetscCall(OutputFileXdmfName(user->output, xdmf, sizeof(xdmf)));
+  PetscCall(OutputFileSplitPath(user->opt.output, dir, sizeof(dir), base, sizeof(base)));
+  PetscCall(OutputFileXdmfName(user->opt.output, xdmf, sizeof(xdmf)));
   PetscCall(OutputFileCreateTemps(comm, dir, 2, temps));                                  /* [0] the XDMF file, [1] the HDF5 file */
   PetscCall(OutputFileSplitPath(temps[0], tdir, sizeof(tdir), xdmftmp, sizeof(xdmftmp))); /* names inside dir */
   PetscCall(OutputFileSplitPath(temps[1], tdir, sizeof(tdir), h5tmp, sizeof(h5tmp)));
@@ -444,7 +443,7 @@ PetscErrorCode OutputWriteHDF5(DM dm, AppCtx *user, Vec u)
       PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", strerror(err)));
     else if (ierr)
       PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", specific && specific[0] ? specific : text));
-    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot write the output file %s: %s", user->output, cause);
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot write the output file %s: %s", user->opt.output, cause);
   }
   PetscCall(OutputFileCommit(comm, dir, 2, temps, targets));
   PetscFunctionReturn(PETSC_SUCCESS);

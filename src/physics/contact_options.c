@@ -106,16 +106,17 @@ PetscErrorCode ContactOptionsDestroy(ContactOptions *opts)
 /* M of eps = eps0 h^power / M: E, or the P-wave modulus lambda + 2 mu, which grows without bound as nu -> 1/2. */
 PetscReal ContactPenaltyModulus(const AppCtx *user)
 {
-  return user->contact.modulus == PENALTY_MODULUS_PWAVE ? user->material.lambda + 2.0 * user->material.mu : user->material.young_modulus;
+  return user->opt.contact.modulus == PENALTY_MODULUS_PWAVE ? user->opt.material.lambda + 2.0 * user->opt.material.mu
+                                                            : user->opt.material.young_modulus;
 }
 
 /* eps = eps0 h^power / M (Corollary 3.3 takes eps = h), or the fixed -penalty_eps. */
 PetscErrorCode ContactComputeEps(AppCtx *user)
 {
   PetscFunctionBeginUser;
-  if (user->contact.eps_fixed > 0.0)
-    user->eps = user->contact.eps_fixed;
+  if (user->opt.contact.eps_fixed > 0.0)
+    user->prob.eps = user->opt.contact.eps_fixed;
   else
-    user->eps = user->contact.eps0 * PetscPowReal(user->h, user->contact.eps_power) / ContactPenaltyModulus(user);
+    user->prob.eps = user->opt.contact.eps0 * PetscPowReal(user->prob.h, user->opt.contact.eps_power) / ContactPenaltyModulus(user);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -20,8 +20,8 @@ static PetscErrorCode ContactLumpedMass(DM dm, AppCtx *user, Vec M)
   PetscFunctionBeginUser;
   PetscCall(PetscWeakFormCreate(PetscObjectComm((PetscObject)dm), &wf));
   PetscCall(PetscWeakFormSetNumFields(wf, 1));
-  PetscCall(PetscWeakFormSetIndexBdResidual(wf, user->face_sets, user->scene.contact_id, 0, 0, 0, f0_bd_one, 0, NULL));
-  key.label = user->face_sets;
+  PetscCall(PetscWeakFormSetIndexBdResidual(wf, user->prob.face_sets, user->scene.contact_id, 0, 0, 0, f0_bd_one, 0, NULL));
+  key.label = user->prob.face_sets;
   key.value = user->scene.contact_id;
   key.field = 0;
   key.part  = 0;
@@ -177,7 +177,7 @@ PetscErrorCode ContactSetDestroy(ContactSet *cs)
    With update, the active flags are stored and the vertices that entered and left are counted. */
 PetscErrorCode ContactCountActive(AppCtx *user, Vec X, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left)
 {
-  const PetscReal    tol = user->contact.method == CONTACT_VI ? 1e-10 * user->displacement_scale : 0.0; /* on the bound, for vi */
+  const PetscReal    tol = user->opt.contact.method == CONTACT_VI ? 1e-10 * user->prob.displacement_scale : 0.0; /* on the bound, for vi */
   const PetscScalar *x;
   PetscInt           dim, local[3] = {0, 0, 0}, global[3];
   DM                 dm;
@@ -186,15 +186,15 @@ PetscErrorCode ContactCountActive(AppCtx *user, Vec X, PetscBool update, PetscIn
   PetscCall(VecGetDM(X, &dm));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetArrayRead(X, &x));
-  for (PetscInt i = 0; i < user->cset.n; ++i) {
+  for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
     PetscBool on;
 
-    if (!user->cset.is_vertex[i]) continue;
-    on = (PetscBool)(user->contact.method != CONTACT_NONE && ContactNodePenetration(user, dim, i, x) > -tol);
+    if (!user->prob.cset.is_vertex[i]) continue;
+    on = (PetscBool)(user->opt.contact.method != CONTACT_NONE && ContactNodePenetration(user, dim, i, x) > -tol);
     local[0] += on;
-    local[1] += on && !user->cset.active[i];
-    local[2] += !on && user->cset.active[i];
-    if (update) user->cset.active[i] = on;
+    local[1] += on && !user->prob.cset.active[i];
+    local[2] += !on && user->prob.cset.active[i];
+    if (update) user->prob.cset.active[i] = on;
   }
   PetscCall(VecRestoreArrayRead(X, &x));
   PetscCall(MPIU_Allreduce(local, global, 3, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));

@@ -152,9 +152,9 @@ PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user)
   PetscScalar c[CONST_SCENE_MAX];
 
   PetscFunctionBeginUser;
-  c[CONST_LAMBDA]          = user->material.lambda;
-  c[CONST_MU]              = user->material.mu;
-  c[CONST_PENALTY]         = (user->contact.method == CONTACT_PENALTY) ? 1.0 / user->eps : 0.0;
+  c[CONST_LAMBDA]          = user->opt.material.lambda;
+  c[CONST_MU]              = user->opt.material.mu;
+  c[CONST_PENALTY]         = (user->opt.contact.method == CONTACT_PENALTY) ? 1.0 / user->prob.eps : 0.0;
   c[CONST_NORMAL_X]        = user->scene.obstacle_normal[0];
   c[CONST_NORMAL_Y]        = user->scene.obstacle_normal[1];
   c[CONST_NORMAL_Z]        = user->scene.obstacle_normal[2];
@@ -178,7 +178,7 @@ PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user)
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexIsSimplex(dm, &simplex));
-  PetscCall(PetscFECreateLagrange(comm, dim, dim, simplex, user->degree, PETSC_DETERMINE, &fe)); /* the degree of ElasticityGetOptions() */
+  PetscCall(PetscFECreateLagrange(comm, dim, dim, simplex, user->opt.degree, PETSC_DETERMINE, &fe)); /* the degree of ElasticityGetOptions() */
   PetscCall(PetscObjectSetName((PetscObject)fe, "displacement"));
   PetscCall(DMSetField(dm, 0, NULL, (PetscObject)fe));
   PetscCall(PetscFEDestroy(&fe));
@@ -187,7 +187,7 @@ PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user)
   PetscCall(PetscDSSetResidual(ds, 0, scene->f0_body, f1_u));
   PetscCall(PetscDSSetJacobian(ds, 0, 0, NULL, NULL, NULL, g3_uu));
   if (scene->exact) PetscCall(PetscDSSetExactSolution(ds, 0, scene->exact, (void *)scene->constants));
-  PetscCall(DMAddBoundary(dm, DM_BC_ESSENTIAL, "Gamma_D", user->face_sets, scene->num_dirichlet, scene->dirichlet_ids, 0, 0, NULL,
+  PetscCall(DMAddBoundary(dm, DM_BC_ESSENTIAL, "Gamma_D", user->prob.face_sets, scene->num_dirichlet, scene->dirichlet_ids, 0, 0, NULL,
                           (void (*)(void))(scene->dirichlet_value ? scene->dirichlet_value : ZeroVector), NULL, (void *)scene->constants, NULL));
   PetscCall(DMSetNearNullSpaceConstructor(dm, 0, CreateRigidBodyModes));
   PetscCall(ElasticityUpdateConstants(dm, user));

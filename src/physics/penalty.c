@@ -51,21 +51,21 @@ enum { PENALTY_PART_TERM, PENALTY_PART_ENERGY }; /* parts of the penalty weak fo
 PetscErrorCode PenaltySetUp(DM dm, AppCtx *user)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscWeakFormCreate(PetscObjectComm((PetscObject)dm), &user->wf_penalty));
-  PetscCall(DMCreateLocalVector(dm, &user->loc_bc));
-  PetscCall(VecZeroEntries(user->loc_bc));
-  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, user->loc_bc, 0.0, NULL, NULL, NULL));
-  PetscCall(PetscWeakFormSetNumFields(user->wf_penalty, 1));
-  PetscCall(
-      PetscWeakFormSetIndexBdResidual(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, PENALTY_PART_TERM, 0, f0_bd_penalty, 0, NULL));
-  PetscCall(PetscWeakFormSetIndexBdResidual(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, PENALTY_PART_ENERGY, 0,
+  PetscCall(PetscWeakFormCreate(PetscObjectComm((PetscObject)dm), &user->prob.wf_penalty));
+  PetscCall(DMCreateLocalVector(dm, &user->prob.loc_bc));
+  PetscCall(VecZeroEntries(user->prob.loc_bc));
+  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, user->prob.loc_bc, 0.0, NULL, NULL, NULL));
+  PetscCall(PetscWeakFormSetNumFields(user->prob.wf_penalty, 1));
+  PetscCall(PetscWeakFormSetIndexBdResidual(user->prob.wf_penalty, user->prob.face_sets, user->scene.contact_id, 0, PENALTY_PART_TERM, 0,
+                                            f0_bd_penalty, 0, NULL));
+  PetscCall(PetscWeakFormSetIndexBdResidual(user->prob.wf_penalty, user->prob.face_sets, user->scene.contact_id, 0, PENALTY_PART_ENERGY, 0,
                                             f0_bd_penalty_energy, 0, NULL));
-  PetscCall(PetscWeakFormSetIndexBdJacobian(user->wf_penalty, user->face_sets, user->scene.contact_id, 0, 0, PENALTY_PART_TERM, 0, g0_bd_penalty, 0,
-                                            NULL, 0, NULL, 0, NULL));
-  if (user->contact.quadrature == PENALTY_QUADRATURE_NODAL) {
+  PetscCall(PetscWeakFormSetIndexBdJacobian(user->prob.wf_penalty, user->prob.face_sets, user->scene.contact_id, 0, 0, PENALTY_PART_TERM, 0,
+                                            g0_bd_penalty, 0, NULL, 0, NULL, 0, NULL));
+  if (user->opt.contact.quadrature == PENALTY_QUADRATURE_NODAL) {
     PetscInt bad = 0, nbad;
 
-    for (PetscInt i = 0; i < user->cset.n; ++i) bad += user->cset.weight[i] <= 0.0;
+    for (PetscInt i = 0; i < user->prob.cset.n; ++i) bad += user->prob.cset.weight[i] <= 0.0;
     PetscCall(MPIU_Allreduce(&bad, &nbad, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
     PetscCheck(!nbad, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT,
                "-penalty_quadrature nodal needs a positive lumped boundary mass at every node of Gamma_C; %" PetscInt_FMT
@@ -75,14 +75,14 @@ PetscErrorCode PenaltySetUp(DM dm, AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Local solution with the Dirichlet values inserted, for the boundary integrals. The values come from user->loc_bc,
+/* Local solution with the Dirichlet values inserted, for the boundary integrals. The values come from user->prob.loc_bc,
    filled once in PenaltySetUp(): inserting them is a projection over Gamma_D that cost more than the whole boundary
    integral (0.1 s per call at 512x512). */
 static PetscErrorCode GetLocalSolution(DM dm, AppCtx *user, Vec X, Vec *locX)
 {
   PetscFunctionBeginUser;
   PetscCall(DMGetLocalVector(dm, locX));
-  PetscCall(VecCopy(user->loc_bc, *locX));
+  PetscCall(VecCopy(user->prob.loc_bc, *locX));
   PetscCall(DMGlobalToLocal(dm, X, INSERT_VALUES, *locX));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -94,25 +94,25 @@ static PetscErrorCode ComputePenaltyPartLocal(DM dm, AppCtx *user, PetscInt part
   Vec          locX;
 
   PetscFunctionBeginUser;
-  key.label = user->face_sets;
+  key.label = user->prob.face_sets;
   key.value = user->scene.contact_id;
   key.field = 0;
   key.part  = part;
   PetscCall(GetLocalSolution(dm, user, X, &locX));
   PetscCall(VecZeroEntries(locF));
-  PetscCall(CompatComputeBdResidualSingle(dm, user->wf_penalty, key, locX, locF));
+  PetscCall(CompatComputeBdResidualSingle(dm, user->prob.wf_penalty, key, locX, locF));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F)
 {
-  const PetscReal kappa = 1.0 / user->eps;
+  const PetscReal kappa = 1.0 / user->prob.eps;
   PetscInt        dim;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
-  if (user->contact.quadrature == PENALTY_QUADRATURE_GAUSS) {
+  if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS) {
     Vec locF;
 
     PetscCall(DMGetLocalVector(dm, &locF));
@@ -125,10 +125,11 @@ PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F)
 
     PetscCall(VecGetArrayRead(X, &x));
     PetscCall(VecGetArray(F, &f));
-    for (PetscInt i = 0; i < user->cset.n; ++i) {
+    for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
       const PetscReal d = ContactNodePenetration(user, dim, i, x);
       if (d <= 0.0) continue;
-      for (PetscInt c = 0; c < dim; ++c) f[user->cset.global_off[i] + c] += kappa * user->cset.weight[i] * d * user->scene.obstacle_normal[c];
+      for (PetscInt c = 0; c < dim; ++c)
+        f[user->prob.cset.global_off[i] + c] += kappa * user->prob.cset.weight[i] * d * user->scene.obstacle_normal[c];
     }
     PetscCall(VecRestoreArray(F, &f));
     PetscCall(VecRestoreArrayRead(X, &x));
@@ -139,16 +140,16 @@ PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F)
 /* Adds the penalty Jacobian to J (ADD_VALUES); the caller assembles J. */
 PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J)
 {
-  const PetscReal kappa = 1.0 / user->eps;
+  const PetscReal kappa = 1.0 / user->prob.eps;
   PetscInt        dim;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
-  if (user->contact.quadrature == PENALTY_QUADRATURE_GAUSS) {
+  if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS) {
     Vec locX;
 
     PetscCall(GetLocalSolution(dm, user, X, &locX));
-    PetscCall(CompatComputeBdJacobianSingle(dm, user->wf_penalty, user->face_sets, 1, &user->scene.contact_id, locX, J));
+    PetscCall(CompatComputeBdJacobianSingle(dm, user->prob.wf_penalty, user->prob.face_sets, 1, &user->scene.contact_id, locX, J));
     PetscCall(DMRestoreLocalVector(dm, &locX));
   } else {
     const PetscScalar *x;
@@ -157,12 +158,12 @@ PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J)
 
     PetscCall(MatGetOwnershipRange(J, &rstart, NULL));
     PetscCall(VecGetArrayRead(X, &x));
-    for (PetscInt i = 0; i < user->cset.n; ++i) {
+    for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
       if (ContactNodePenetration(user, dim, i, x) <= 0.0) continue;
       for (PetscInt c = 0; c < dim; ++c) {
-        rows[c] = rstart + user->cset.global_off[i] + c;
+        rows[c] = rstart + user->prob.cset.global_off[i] + c;
         for (PetscInt e = 0; e < dim; ++e)
-          block[c * dim + e] = kappa * user->cset.weight[i] * user->scene.obstacle_normal[c] * user->scene.obstacle_normal[e];
+          block[c * dim + e] = kappa * user->prob.cset.weight[i] * user->scene.obstacle_normal[c] * user->scene.obstacle_normal[e];
       }
       PetscCall(MatSetValues(J, dim, rows, dim, rows, block, ADD_VALUES));
     }
@@ -179,8 +180,8 @@ PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy)
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   *energy = 0.0;
-  if (user->contact.method != CONTACT_PENALTY) PetscFunctionReturn(PETSC_SUCCESS);
-  if (user->contact.quadrature == PENALTY_QUADRATURE_GAUSS) {
+  if (user->opt.contact.method != CONTACT_PENALTY) PetscFunctionReturn(PETSC_SUCCESS);
+  if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS) {
     Vec         locE;
     PetscScalar e;
 
@@ -195,9 +196,9 @@ PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy)
     PetscReal          e = 0.0;
 
     PetscCall(VecGetArrayRead(X, &x));
-    for (PetscInt i = 0; i < user->cset.n; ++i) {
+    for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
       const PetscReal d = ContactNodePenetration(user, dim, i, x);
-      if (d > 0.0) e += 0.5 / user->eps * user->cset.weight[i] * d * d;
+      if (d > 0.0) e += 0.5 / user->prob.eps * user->prob.cset.weight[i] * d * d;
     }
     PetscCall(VecRestoreArrayRead(X, &x));
     PetscCall(MPIU_Allreduce(&e, energy, 1, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm)));

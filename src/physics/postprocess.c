@@ -6,7 +6,7 @@
 PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
-  ContactSet        *cs   = &user->cset;
+  ContactSet        *cs   = &user->prob.cset;
   Vec                R;
   const PetscScalar *x, *r;
   PetscInt           dim;
@@ -15,10 +15,10 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecDuplicate(u, &R));
-  PetscCall(MatMult(user->K, u, R));
+  PetscCall(MatMult(user->prob.K, u, R));
   PetscCall(VecDot(u, R, &uKu));
-  PetscCall(VecDot(u, user->r0, &r0u));
-  PetscCall(VecAXPY(R, 1.0, user->r0));
+  PetscCall(VecDot(u, user->prob.r0, &r0u));
+  PetscCall(VecAXPY(R, 1.0, user->prob.r0));
   PetscCall(VecGetArrayRead(u, &x));
   PetscCall(VecGetArrayRead(R, &r));
   for (PetscInt i = 0; i < cs->n; ++i) {
@@ -26,9 +26,9 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
     PetscReal       reaction = 0.0;
 
     for (PetscInt c = 0; c < dim; ++c) reaction -= PetscRealPart(r[cs->global_off[i] + c]) * user->scene.obstacle_normal[c];
-    switch (user->contact.method) {
+    switch (user->opt.contact.method) {
       case CONTACT_PENALTY:
-        cs->pressure[i] = d > 0.0 ? d / user->eps : 0.0;
+        cs->pressure[i] = d > 0.0 ? d / user->prob.eps : 0.0;
         break;
       case CONTACT_VI:
         cs->pressure[i] = cs->weight[i] > 0.0 ? reaction / cs->weight[i] : 0.0;
@@ -45,11 +45,11 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   PetscCall(VecDestroy(&R));
   PetscCall(MPIU_Allreduce(&local[0], &global[0], 1, MPIU_REAL, MPIU_MAX, comm));
   PetscCall(MPIU_Allreduce(&local[1], &global[1], 1, MPIU_REAL, MPIU_SUM, comm));
-  user->stats.max_penetration = global[0];
-  user->stats.contact_force   = global[1];
-  PetscCall(ContactCountActive(user, u, PETSC_FALSE, &user->stats.active_vertices, NULL, NULL));
+  user->rec.stats.max_penetration = global[0];
+  user->rec.stats.contact_force   = global[1];
+  PetscCall(ContactCountActive(user, u, PETSC_FALSE, &user->rec.stats.active_vertices, NULL, NULL));
   PetscCall(PenaltyEnergy(dm, user, u, &penalty_energy));
   /* 1/2 a(u,u) - L(u) on the free unknowns (exact for homogeneous Dirichlet data) + penalty energy */
-  user->stats.energy = 0.5 * uKu + r0u + penalty_energy;
+  user->rec.stats.energy = 0.5 * uKu + r0u + penalty_energy;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -33,20 +33,20 @@ PetscErrorCode VICreateBounds(DM dm, AppCtx *user)
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VIAxisOfNormal(user, dim, &axis, &sign));
-  PetscCall(DMCreateGlobalVector(dm, &user->xl));
-  PetscCall(DMCreateGlobalVector(dm, &user->xu));
-  PetscCall(VecSet(user->xl, PETSC_NINFINITY));
-  PetscCall(VecSet(user->xu, PETSC_INFINITY));
-  PetscCall(VecGetArray(user->xl, &xl));
-  PetscCall(VecGetArray(user->xu, &xu));
-  for (PetscInt i = 0; i < user->cset.n; ++i) {
-    const PetscInt k = user->cset.global_off[i] + axis;
+  PetscCall(DMCreateGlobalVector(dm, &user->prob.xl));
+  PetscCall(DMCreateGlobalVector(dm, &user->prob.xu));
+  PetscCall(VecSet(user->prob.xl, PETSC_NINFINITY));
+  PetscCall(VecSet(user->prob.xu, PETSC_INFINITY));
+  PetscCall(VecGetArray(user->prob.xl, &xl));
+  PetscCall(VecGetArray(user->prob.xu, &xu));
+  for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
+    const PetscInt k = user->prob.cset.global_off[i] + axis;
     if (sign > 0.0)
-      xu[k] = user->cset.gap[i];
+      xu[k] = user->prob.cset.gap[i];
     else
-      xl[k] = -user->cset.gap[i];
+      xl[k] = -user->prob.cset.gap[i];
   }
-  PetscCall(VecRestoreArray(user->xl, &xl));
-  PetscCall(VecRestoreArray(user->xu, &xu));
+  PetscCall(VecRestoreArray(user->prob.xl, &xl));
+  PetscCall(VecRestoreArray(user->prob.xu, &xu));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

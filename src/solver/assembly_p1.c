@@ -52,7 +52,7 @@ static PetscErrorCode AssemblyP1Applies(DM dm, const AppCtx *user, const char **
     PetscCall(DMPlexGetCellType(dm, c, &ct));
     if (ct != (dim == 2 ? DM_POLYTOPE_TRIANGLE : DM_POLYTOPE_TETRAHEDRON)) code = 2;
   }
-  if (!code && user->degree != 1) code = 3;
+  if (!code && user->opt.degree != 1) code = 3;
   if (!code && (nf != 1 || nc != dim || size != (vEnd - vStart) * dim)) code = 4;
   if (!code && (cdim != dim || localized || csize != (vEnd - vStart) * dim)) code = 5;
   if (!code && !known) code = 6;
@@ -84,13 +84,13 @@ PetscErrorCode AssemblyResolve(DM dm, AppCtx *user)
   const char *reason = NULL;
 
   PetscFunctionBeginUser;
-  user->assembly = user->assembly_option;
+  user->prob.assembly = user->opt.assembly;
   PetscCall(AssemblyP1Applies(dm, user, &reason));
-  PetscCheck(user->assembly != ASSEMBLY_P1 || !reason, comm, PETSC_ERR_USER_INPUT,
+  PetscCheck(user->prob.assembly != ASSEMBLY_P1 || !reason, comm, PETSC_ERR_USER_INPUT,
              "-assembly p1 needs P1 displacements on triangles or tetrahedra, but %s: use -assembly fe or auto", reason);
-  PetscCheck(!user->assembly_check || !reason, comm, PETSC_ERR_USER_INPUT, "-assembly_check compares with the P1 assembly, which does not apply: %s",
-             reason);
-  if (user->assembly == ASSEMBLY_AUTO) user->assembly = reason ? ASSEMBLY_FE : ASSEMBLY_P1;
+  PetscCheck(!user->opt.assembly_check || !reason, comm, PETSC_ERR_USER_INPUT,
+             "-assembly_check compares with the P1 assembly, which does not apply: %s", reason);
+  if (user->prob.assembly == ASSEMBLY_AUTO) user->prob.assembly = reason ? ASSEMBLY_FE : ASSEMBLY_P1;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -381,7 +381,7 @@ PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K)
         x[a * dim + e]   = PetscRealPart(xa[off + e]);
       }
     }
-    PetscCall(AssemblyP1ElementStiffness(dim, user->material.lambda, user->material.mu, x, Ke));
+    PetscCall(AssemblyP1ElementStiffness(dim, user->opt.material.lambda, user->opt.material.mu, x, Ke));
     PetscCall(MatSetValues(*K, n, idx, n, idx, Ke, ADD_VALUES));
   }
   PetscCall(VecRestoreArrayRead(coords, &xa));

@@ -15,10 +15,10 @@ static PetscErrorCode ActiveSetHash(AppCtx *user, Vec X, PetscInt64 *hash)
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetOwnershipRange(X, &rstart, NULL));
   PetscCall(VecGetArrayRead(X, &x));
-  for (PetscInt i = 0; i < user->cset.n; ++i) {
-    const unsigned long long g = (unsigned long long)(rstart + user->cset.global_off[i]);
+  for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
+    const unsigned long long g = (unsigned long long)(rstart + user->prob.cset.global_off[i]);
 
-    if (user->cset.is_vertex[i] && ContactNodePenetration(user, dim, i, x) > 0.0)
+    if (user->prob.cset.is_vertex[i] && ContactNodePenetration(user, dim, i, x) > 0.0)
       local = (PetscInt64)((unsigned long long)local + ((g + 1) * 0x9E3779B97F4A7C15ULL ^ (g << 17)) % 0x7FFFFFFFFFFFULL);
   }
   PetscCall(VecRestoreArrayRead(X, &x));
@@ -40,17 +40,17 @@ static PetscErrorCode DetectActiveSetCycle(SNES snes, AppCtx *user, PetscInt it,
   PetscCall(SNESLineSearchSetDamping(ls, 1.0));
   PetscCall(ActiveSetHash(user, X, &hash));
   if (it >= CONTACT_HISTORY) PetscFunctionReturn(PETSC_SUCCESS);
-  user->active_history[it] = hash;
-  user->fnorm_history[it]  = fnorm;
+  user->prob.active_history[it] = hash;
+  user->prob.fnorm_history[it]  = fnorm;
   for (PetscInt j = it - 2; j >= 0; --j) {
-    if (user->active_history[j] != hash || user->active_history[it - 1] == hash || fnorm < 0.5 * user->fnorm_history[j]) continue;
-    user->stats.active_set_cycles++;
-    if (user->contact.cycle_damping) PetscCall(SNESLineSearchSetDamping(ls, 0.5));
+    if (user->prob.active_history[j] != hash || user->prob.active_history[it - 1] == hash || fnorm < 0.5 * user->prob.fnorm_history[j]) continue;
+    user->rec.stats.active_set_cycles++;
+    if (user->opt.contact.cycle_damping) PetscCall(SNESLineSearchSetDamping(ls, 0.5));
     PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes),
                           "  active-set cycle: Newton step %" PetscInt_FMT " is back at the active set of step %" PetscInt_FMT
                           " (|F| %g, then %g)%s\n",
-                          it, j, (double)user->fnorm_history[j], (double)fnorm,
-                          user->contact.cycle_damping ? "; the next step is damped by 1/2" : "; not damped (-contact_cycle_damping 0)"));
+                          it, j, (double)user->prob.fnorm_history[j], (double)fnorm,
+                          user->opt.contact.cycle_damping ? "; the next step is damped by 1/2" : "; not damped (-contact_cycle_damping 0)"));
     break;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -60,21 +60,21 @@ static PetscErrorCode DetectActiveSetCycle(SNES snes, AppCtx *user, PetscInt it,
 PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm_scaled, void *ctx)
 {
   AppCtx         *user  = (AppCtx *)ctx;
-  const PetscReal fnorm = fnorm_scaled * user->snes_scale;
+  const PetscReal fnorm = fnorm_scaled * user->prob.snes_scale;
   Vec             X, Xs;
   PetscInt        active, entered, left;
 
   PetscFunctionBeginUser;
-  user->stats.residual_norm = fnorm;
+  user->rec.stats.residual_norm = fnorm;
   PetscCall(SNESGetSolution(snes, &Xs));
   X = Xs;
-  if (user->snes_scale != 1.0) {
-    PetscCall(VecCopy(Xs, user->work));
-    PetscCall(VecScale(user->work, user->snes_scale));
-    X = user->work;
+  if (user->prob.snes_scale != 1.0) {
+    PetscCall(VecCopy(Xs, user->prob.work));
+    PetscCall(VecScale(user->prob.work, user->prob.snes_scale));
+    X = user->prob.work;
   }
-  if (user->contact.method == CONTACT_PENALTY) PetscCall(DetectActiveSetCycle(snes, user, it, fnorm, X));
-  if (!user->contact.monitor) PetscFunctionReturn(PETSC_SUCCESS);
+  if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(DetectActiveSetCycle(snes, user, it, fnorm, X));
+  if (!user->opt.contact.monitor) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactCountActive(user, X, PETSC_TRUE, &active, &entered, &left));
   PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes),
                         "  %3" PetscInt_FMT " contact: |F| %12.6e  active vertices %6" PetscInt_FMT "  entered %5" PetscInt_FMT

@@ -8,8 +8,8 @@
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 {
   PetscFunctionBeginUser;
-  for (PetscInt k = 1; k < user->contact.n_sweep && user->stats.converged; ++k) {
-    user->contact.eps0 = user->contact.eps0_sweep[k];
+  for (PetscInt k = 1; k < user->opt.contact.n_sweep && user->rec.stats.converged; ++k) {
+    user->opt.contact.eps0 = user->opt.contact.eps0_sweep[k];
     PetscCall(ContactComputeEps(user));
     PetscCall(ElasticityUpdateConstants(dm, user));
     PetscCall(SolverSolve(snes, user, u, PETSC_TRUE));

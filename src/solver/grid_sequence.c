@@ -21,9 +21,9 @@ static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
   PetscCall(MeshRefineRegular(*dm, 1, &fine, &parent, &vertex_source));
-  user->level++;
+  user->prob.level++;
   PetscCall(ProblemSetUp(fine, user, snes));
-  if (user->degree == 1)
+  if (user->opt.degree == 1)
     PetscCall(MeshInterpolateVertexSources(*dm, fine, vertex_source, loc, &fine_loc)); /* exact and fast */
   else
     PetscCall(MeshInterpolateFromParents(*dm, fine, parent, 1, &loc, &fine_loc));
@@ -43,14 +43,14 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
 {
   PetscFunctionBeginUser;
   PetscCall(SolverSolve(*snes, user, *u, PETSC_FALSE));
-  for (PetscInt l = 1; l <= user->contact.grid_sequence && user->stats.converged; ++l) {
+  for (PetscInt l = 1; l <= user->opt.contact.grid_sequence && user->rec.stats.converged; ++l) {
     PetscLogDouble t0, t1;
 
     PetscCall(PetscTime(&t0));
     PetscCall(GridSequenceRefine(dm, user, snes, u));
     PetscCall(PetscTime(&t1));
-    user->level_setup_time = t1 - t0; /* refinement, set-up and interpolation */
-    user->stats.time_setup += t1 - t0;
+    user->prob.setup_time = t1 - t0; /* refinement, set-up and interpolation */
+    user->rec.stats.time_setup += t1 - t0;
     PetscCall(SolverSolve(*snes, user, *u, PETSC_TRUE));
   }
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -12,13 +12,13 @@ static PetscErrorCode CountChanges(AppCtx *user, PetscInt dim, const PetscScalar
   PetscInt local = 0;
 
   PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < user->cset.n; ++i) {
+  for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
     const PetscBool on = (PetscBool)(ContactNodePenetration(user, dim, i, x) > 0.0);
 
-    local += on != user->cset.built_active[i];
-    if (record) user->cset.built_active[i] = on;
+    local += on != user->prob.cset.built_active[i];
+    if (record) user->prob.cset.built_active[i] = on;
   }
-  PetscCall(MPIU_Allreduce(&local, changes, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)user->K)));
+  PetscCall(MPIU_Allreduce(&local, changes, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)user->prob.K)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -26,7 +26,7 @@ static PetscErrorCode CountChanges(AppCtx *user, PetscInt dim, const PetscScalar
    rebuild (-2) or reuse (-1), and records the state of the build. */
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
 {
-  PcReuse           *r = &user->pc_reuse;
+  PcReuse           *r = &user->prob.pc_reuse;
   KSP                ksp;
   PetscInt           dim, changes = 0, its = 0;
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
@@ -38,18 +38,19 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(VecGetArrayRead(X, &x));
-  rebuild = (PetscBool)(!r->built || r->eps != user->eps);
+  rebuild = (PetscBool)(!r->built || r->eps != user->prob.eps);
   if (!rebuild) {
     PetscCall(CountChanges(user, dim, x, PETSC_FALSE, &changes));
     PetscCall(KSPGetIterationNumber(ksp, &its));
     PetscCall(KSPGetConvergedReason(ksp, &reason));
     /* rebuild after a failed solve, or when the last solve needed twice the iterations of the first after the build */
-    rebuild = (PetscBool)(changes > user->contact.pc_reuse_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
+    rebuild =
+        (PetscBool)(changes > user->opt.contact.pc_reuse_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
   }
   if (rebuild) {
     PetscCall(CountChanges(user, dim, x, PETSC_TRUE, &changes));
     r->built           = PETSC_TRUE;
-    r->eps             = user->eps;
+    r->eps             = user->prob.eps;
     r->its_after_build = -1; /* set by the next call */
     r->builds++;
     PetscCall(SNESSetLagPreconditioner(snes, -2)); /* rebuild now, then reuse until told otherwise */

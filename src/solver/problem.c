@@ -14,19 +14,19 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(MeshCheckContactBoundary(dm, user->scene.contact_id));
   PetscCall(MeshCheckFaceSets(dm, user->scene.name, "the Dirichlet boundary Gamma_D (with none, nothing would fix the body)",
                               user->scene.num_dirichlet, user->scene.dirichlet_ids));
-  PetscCall(DMGetLabel(dm, "Face Sets", &user->face_sets));
-  PetscCall(MeshGetMaxCellDiameter(dm, &user->h));
+  PetscCall(DMGetLabel(dm, "Face Sets", &user->prob.face_sets));
+  PetscCall(MeshGetMaxCellDiameter(dm, &user->prob.h));
   PetscCall(ContactComputeEps(user));
   PetscCall(ElasticitySetUpDiscretization(dm, user));
-  PetscCall(ContactSetCreate(dm, user, &user->cset));
-  if (user->contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, user));
+  PetscCall(ContactSetCreate(dm, user, &user->prob.cset));
+  if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, user));
   PetscCall(SolverAssembleBulk(dm, user));
-  PetscCall(WeakDataAddToResidual(dm, user, user->r0));
+  PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0));
   PetscCall(SolverComputeScales(dm, user));
-  PetscCall(PetscMemzero(&user->pc_reuse, sizeof(user->pc_reuse)));
+  PetscCall(PetscMemzero(&user->prob.pc_reuse, sizeof(user->prob.pc_reuse)));
   PetscCall(SolverCreateSNES(dm, user, snes));
   PetscCall(PetscTime(&t1));
-  user->level_setup_time = t1 - t0;
+  user->prob.setup_time = t1 - t0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -34,13 +34,13 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes)
 {
   PetscFunctionBeginUser;
   PetscCall(SNESDestroy(snes));
-  PetscCall(MatDestroy(&user->K));
-  PetscCall(VecDestroy(&user->r0));
-  PetscCall(VecDestroy(&user->xl));
-  PetscCall(VecDestroy(&user->xu));
-  PetscCall(VecDestroy(&user->loc_bc));
-  PetscCall(VecDestroy(&user->work));
-  PetscCall(PetscWeakFormDestroy(&user->wf_penalty));
-  PetscCall(ContactSetDestroy(&user->cset));
+  PetscCall(MatDestroy(&user->prob.K));
+  PetscCall(VecDestroy(&user->prob.r0));
+  PetscCall(VecDestroy(&user->prob.xl));
+  PetscCall(VecDestroy(&user->prob.xu));
+  PetscCall(VecDestroy(&user->prob.loc_bc));
+  PetscCall(VecDestroy(&user->prob.work));
+  PetscCall(PetscWeakFormDestroy(&user->prob.wf_penalty));
+  PetscCall(ContactSetDestroy(&user->prob.cset));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

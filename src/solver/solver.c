@@ -11,30 +11,30 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
 
   PetscFunctionBeginUser;
   PetscCall(AssemblyResolve(dm, user)); /* -assembly auto: fe or p1 for this mesh */
-  if (user->assembly == ASSEMBLY_P1)
-    PetscCall(AssemblyP1CreateMatrix(dm, user, &user->K));
+  if (user->prob.assembly == ASSEMBLY_P1)
+    PetscCall(AssemblyP1CreateMatrix(dm, user, &user->prob.K));
   else
-    PetscCall(DMCreateMatrix(dm, &user->K));
-  PetscCall(DMCreateGlobalVector(dm, &user->r0));
+    PetscCall(DMCreateMatrix(dm, &user->prob.K));
+  PetscCall(DMCreateGlobalVector(dm, &user->prob.r0));
   PetscCall(DMGetLocalVector(dm, &locX));
   PetscCall(DMGetLocalVector(dm, &locF));
   PetscCall(VecZeroEntries(locX));
   PetscCall(VecZeroEntries(locF));
   PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, locX, 0.0, NULL, NULL, NULL));
-  if (user->assembly == ASSEMBLY_FE) PetscCall(DMPlexSNESComputeJacobianFEM(dm, locX, user->K, user->K, user));
-  if (user->assembly_check) PetscCall(AssemblyP1Check(dm, user, locX));
-  PetscCall(MatAssemblyBegin(user->K, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(user->K, MAT_FINAL_ASSEMBLY));
+  if (user->prob.assembly == ASSEMBLY_FE) PetscCall(DMPlexSNESComputeJacobianFEM(dm, locX, user->prob.K, user->prob.K, user));
+  if (user->opt.assembly_check) PetscCall(AssemblyP1Check(dm, user, locX));
+  PetscCall(MatAssemblyBegin(user->prob.K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(user->prob.K, MAT_FINAL_ASSEMBLY));
   PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
-  PetscCall(VecZeroEntries(user->r0));
-  PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, user->r0));
+  PetscCall(VecZeroEntries(user->prob.r0));
+  PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, user->prob.r0));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscCall(DMRestoreLocalVector(dm, &locF));
-  if (user->degree == 1)
+  if (user->opt.degree == 1)
     PetscCall(ElasticityRigidBodyModesP1(dm, &rigid)); /* unknowns at the vertices only */
   else
     PetscCall(DMPlexCreateRigidBody(dm, 0, &rigid));
-  PetscCall(MatSetNearNullSpace(user->K, rigid));
+  PetscCall(MatSetNearNullSpace(user->prob.K, rigid));
   PetscCall(MatNullSpaceDestroy(&rigid));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -43,23 +43,23 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R)
 {
   PetscFunctionBeginUser;
-  PetscCall(MatMult(user->K, X, R));
-  PetscCall(VecAXPY(R, 1.0, user->r0));
+  PetscCall(MatMult(user->prob.K, X, R));
+  PetscCall(VecAXPY(R, 1.0, user->prob.r0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The SNES works on x~ = u/U with the residual F~(x~) = F(U x~)/U, U = user->snes_scale a power of 2 (exact in floating
+/* The SNES works on x~ = u/U with the residual F~(x~) = F(U x~)/U, U = user->prob.snes_scale a power of 2 (exact in floating
    point): F~ has the Jacobian of F, so Newton's iterates are U times smaller and the same, while the absolute tolerances
    inside PETSc (SNESVI's bound tolerance, the line searches' maximal step) see a displacement of size one in any units.
-   The displacement of the iterate, U x~, goes to user->work. */
+   The displacement of the iterate, U x~, goes to user->prob.work. */
 static PetscErrorCode SolverIterateDisplacement(AppCtx *user, Vec X, Vec *u)
 {
   PetscFunctionBeginUser;
   *u = X;
-  if (user->snes_scale == 1.0) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(VecCopy(X, user->work));
-  PetscCall(VecScale(user->work, user->snes_scale));
-  *u = user->work;
+  if (user->prob.snes_scale == 1.0) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(VecCopy(X, user->prob.work));
+  PetscCall(VecScale(user->prob.work, user->prob.snes_scale));
+  *u = user->prob.work;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -68,7 +68,7 @@ static PetscErrorCode SolverResidual(DM dm, AppCtx *user, Vec u, Vec F)
 {
   PetscFunctionBeginUser;
   PetscCall(SolverBulkResidual(user, u, F));
-  if (user->contact.method == CONTACT_PENALTY) PetscCall(PenaltyAddResidual(dm, user, u, F));
+  if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltyAddResidual(dm, user, u, F));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -82,7 +82,7 @@ static PetscErrorCode FormFunction(SNES snes, Vec X, Vec F, void *ctx)
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(SolverIterateDisplacement(user, X, &u));
   PetscCall(SolverResidual(dm, user, u, F));
-  if (user->snes_scale != 1.0) PetscCall(VecScale(F, 1.0 / user->snes_scale));
+  if (user->prob.snes_scale != 1.0) PetscCall(VecScale(F, 1.0 / user->prob.snes_scale));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -95,9 +95,9 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
   PetscFunctionBeginUser;
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(SolverIterateDisplacement(user, X, &u));
-  if (user->contact.method == CONTACT_PENALTY) {
+  if (user->opt.contact.method == CONTACT_PENALTY) {
     PetscCall(PcReuseDecide(snes, dm, user, u));
-    PetscCall(MatCopy(user->K, P, SAME_NONZERO_PATTERN));
+    PetscCall(MatCopy(user->prob.K, P, SAME_NONZERO_PATTERN));
     PetscCall(PenaltyAddJacobian(dm, user, u, P));
     PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
@@ -116,12 +116,12 @@ static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, P
                                       void *ctx)
 {
   AppCtx         *user = (AppCtx *)ctx;
-  const PetscReal f    = fnorm * user->snes_scale; /* |F| in the user's units */
+  const PetscReal f    = fnorm * user->prob.snes_scale; /* |F| in the user's units */
 
   PetscFunctionBeginUser;
   PetscCall(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, NULL));
-  if (it == 0) user->fnorm0 = f;
-  if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->contact.load_rtol * user->load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
+  if (it == 0) user->prob.fnorm0 = f;
+  if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->opt.contact.load_rtol * user->prob.load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -136,25 +136,25 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
   PetscReal   finf, U = 1.0;
 
   PetscFunctionBeginUser;
-  PetscCall(DMCreateGlobalVector(dm, &user->work));
+  PetscCall(DMCreateGlobalVector(dm, &user->prob.work));
   PetscCall(DMGetGlobalVector(dm, &zero));
   PetscCall(DMGetGlobalVector(dm, &F));
   PetscCall(DMGetGlobalVector(dm, &KF));
   PetscCall(VecZeroEntries(zero));
   PetscCall(SolverResidual(dm, user, zero, F));
-  PetscCall(VecNorm(F, NORM_2, &user->load_norm));
-  PetscCheck(!PetscIsInfOrNanReal(user->load_norm), comm, PETSC_ERR_USER_INPUT,
+  PetscCall(VecNorm(F, NORM_2, &user->prob.load_norm));
+  PetscCheck(!PetscIsInfOrNanReal(user->prob.load_norm), comm, PETSC_ERR_USER_INPUT,
              "The load of the problem is not finite (||F(0)|| = %g): check the loads, the material and the mesh coordinates",
-             (double)user->load_norm);
-  if (user->load_norm > 0.0) {
+             (double)user->prob.load_norm);
+  if (user->prob.load_norm > 0.0) {
     PetscCall(VecNorm(F, NORM_INFINITY, &finf));
-    PetscCall(MatMult(user->K, F, KF));
+    PetscCall(MatMult(user->prob.K, F, KF));
     PetscCall(VecDot(F, KF, &fkf));
-    if (PetscRealPart(fkf) > 0.0) U = PetscSqr(user->load_norm) / PetscRealPart(fkf) * finf;
+    if (PetscRealPart(fkf) > 0.0) U = PetscSqr(user->prob.load_norm) / PetscRealPart(fkf) * finf;
     if (!(U > 0.0) || PetscIsInfOrNanReal(U)) U = 1.0;
   }
-  user->displacement_scale = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
-  user->snes_scale         = 1.0;
+  user->prob.displacement_scale = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
+  user->prob.snes_scale         = 1.0;
   PetscCall(DMRestoreGlobalVector(dm, &zero));
   PetscCall(DMRestoreGlobalVector(dm, &F));
   PetscCall(DMRestoreGlobalVector(dm, &KF));
@@ -169,7 +169,7 @@ static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
   PC pc;
 
   PetscFunctionBeginUser;
-  PetscCall(KSPSetType(ksp, user->contact.method == CONTACT_PENALTY && user->contact.pc_reuse ? KSPCG : KSPPREONLY));
+  PetscCall(KSPSetType(ksp, user->opt.contact.method == CONTACT_PENALTY && user->opt.contact.pc_reuse ? KSPCG : KSPPREONLY));
   PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCSetType(pc, PCLU));
@@ -189,23 +189,23 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscFunctionBeginUser;
   PetscCall(SNESCreate(comm, snes));
   PetscCall(SNESSetDM(*snes, dm));
-  if (user->contact.method == CONTACT_PENALTY) {
+  if (user->opt.contact.method == CONTACT_PENALTY) {
     MatNullSpace rigid;
 
-    PetscCall(MatDuplicate(user->K, MAT_COPY_VALUES, &J));
-    PetscCall(MatGetNearNullSpace(user->K, &rigid));
+    PetscCall(MatDuplicate(user->prob.K, MAT_COPY_VALUES, &J));
+    PetscCall(MatGetNearNullSpace(user->prob.K, &rigid));
     PetscCall(MatSetNearNullSpace(J, rigid));
   } else {
-    J = user->K; /* the Jacobian is K itself */
+    J = user->prob.K; /* the Jacobian is K itself */
     PetscCall(PetscObjectReference((PetscObject)J));
   }
   PetscCall(SNESSetFunction(*snes, NULL, FormFunction, user));
   PetscCall(SNESSetJacobian(*snes, J, J, FormJacobian, user));
   PetscCall(MatDestroy(&J));
-  if (user->contact.method == CONTACT_VI) {
+  if (user->opt.contact.method == CONTACT_VI) {
     PetscCall(SNESSetType(*snes, SNESVINEWTONRSLS));
     PetscCall(VICreateBounds(dm, user));
-    PetscCall(SNESVISetVariableBounds(*snes, user->xl, user->xu));
+    PetscCall(SNESVISetVariableBounds(*snes, user->prob.xl, user->prob.xu));
   } else {
     SNESLineSearch ls;
 
@@ -246,11 +246,11 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscBool is_preonly;
 
     PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &is_preonly));
-    user->pc_reuse.enabled = (PetscBool)(user->contact.method == CONTACT_PENALTY && user->contact.pc_reuse && !is_preonly);
+    user->prob.pc_reuse.enabled = (PetscBool)(user->opt.contact.method == CONTACT_PENALTY && user->opt.contact.pc_reuse && !is_preonly);
   }
-  PetscCheck(is_vi == (user->contact.method == CONTACT_VI), comm, PETSC_ERR_USER_INPUT,
+  PetscCheck(is_vi == (user->opt.contact.method == CONTACT_VI), comm, PETSC_ERR_USER_INPUT,
              "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type,
-             ContactMethods[user->contact.method]);
+             ContactMethods[user->opt.contact.method]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -263,20 +263,21 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   PetscReal fnorm, atol, rtol, stol;
 
   PetscFunctionBeginUser;
-  PetscCall(SNESGetConvergedReason(snes, &user->stats.reason));
+  PetscCall(SNESGetConvergedReason(snes, &user->rec.stats.reason));
   PetscCall(SNESGetIterationNumber(snes, &its));
   PetscCall(SNESGetLinearSolveIterations(snes, &lits));
   PetscCall(SNESGetFunctionNorm(snes, &fnorm));
   PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
   *newton += its;
   *ksp += lits;
-  user->stats.newton_its       = *newton;
-  user->stats.ksp_its          = *ksp;
-  user->stats.residual_norm    = fnorm * user->displacement_scale; /* the SNES saw F/U */
-  user->stats.residual_reduced = (PetscBool)(user->stats.residual_norm <= rtol * user->fnorm0 ||
-                                             user->stats.residual_norm <= user->contact.load_rtol * user->load_norm || fnorm <= atol);
-  user->stats.converged        = (PetscBool)(user->stats.reason > 0 && user->stats.residual_reduced);
-  user->stats.pc_builds        = user->pc_reuse.enabled ? user->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
+  user->rec.stats.newton_its    = *newton;
+  user->rec.stats.ksp_its       = *ksp;
+  user->rec.stats.residual_norm = fnorm * user->prob.displacement_scale; /* the SNES saw F/U */
+  user->rec.stats.residual_reduced =
+      (PetscBool)(user->rec.stats.residual_norm <= rtol * user->prob.fnorm0 ||
+                  user->rec.stats.residual_norm <= user->opt.contact.load_rtol * user->prob.load_norm || fnorm <= atol);
+  user->rec.stats.converged = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
+  user->rec.stats.pc_builds = user->prob.pc_reuse.enabled ? user->prob.pc_reuse.builds : *newton; /* without reuse: one per Newton step */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -290,51 +291,51 @@ static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal 
   DM                 dm;
 
   PetscFunctionBeginUser;
-  if (user->nrecords == user->maxrecords) { /* grow */
+  if (user->rec.nrecords == user->rec.maxrecords) { /* grow */
     SolveRecord *grown;
 
-    user->maxrecords = PetscMax(16, 2 * user->maxrecords);
-    PetscCall(PetscMalloc1(user->maxrecords, &grown));
-    if (user->nrecords) PetscCall(PetscArraycpy(grown, user->records, user->nrecords));
-    PetscCall(PetscFree(user->records));
-    user->records = grown;
+    user->rec.maxrecords = PetscMax(16, 2 * user->rec.maxrecords);
+    PetscCall(PetscMalloc1(user->rec.maxrecords, &grown));
+    if (user->rec.nrecords) PetscCall(PetscArraycpy(grown, user->rec.records, user->rec.nrecords));
+    PetscCall(PetscFree(user->rec.records));
+    user->rec.records = grown;
   }
-  r = &user->records[user->nrecords++];
+  r = &user->rec.records[user->rec.nrecords++];
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetArrayRead(u, &x));
-  for (PetscInt i = 0; i < user->cset.n; ++i) pen = PetscMax(pen, ContactNodePenetration(user, dim, i, x));
+  for (PetscInt i = 0; i < user->prob.cset.n; ++i) pen = PetscMax(pen, ContactNodePenetration(user, dim, i, x));
   PetscCall(VecRestoreArrayRead(u, &x));
   PetscCall(MPIU_Allreduce(&pen, &r->max_penetration, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
   PetscCall(VecGetSize(u, &r->n_dofs));
-  r->level               = user->level;
-  r->h                   = user->h;
-  r->eps                 = user->contact.method == CONTACT_PENALTY ? user->eps : 0.0;
-  r->newton_its          = user->stats.newton_its;
-  r->ksp_its             = user->stats.ksp_its;
-  r->pc_builds           = user->stats.pc_builds;
-  r->converged           = user->stats.converged;
-  r->time_setup          = user->level_setup_time;
-  r->time_solve          = time_solve;
-  user->level_setup_time = 0.0; /* counted once, with the first solve on the mesh */
+  r->level              = user->prob.level;
+  r->h                  = user->prob.h;
+  r->eps                = user->opt.contact.method == CONTACT_PENALTY ? user->prob.eps : 0.0;
+  r->newton_its         = user->rec.stats.newton_its;
+  r->ksp_its            = user->rec.stats.ksp_its;
+  r->pc_builds          = user->rec.stats.pc_builds;
+  r->converged          = user->rec.stats.converged;
+  r->time_setup         = user->prob.setup_time;
+  r->time_solve         = time_solve;
+  user->prob.setup_time = 0.0; /* counted once, with the first solve on the mesh */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* SNESSolve on x~ = u/U (and the bounds of SNESVI divided by U): see SolverIterateDisplacement(). */
 static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
 {
-  const PetscReal U = user->displacement_scale;
+  const PetscReal U = user->prob.displacement_scale;
 
   PetscFunctionBeginUser;
-  user->snes_scale = U;
+  user->prob.snes_scale = U;
   PetscCall(VecScale(u, 1.0 / U));
-  if (user->xl) PetscCall(VecScale(user->xl, 1.0 / U));
-  if (user->xu) PetscCall(VecScale(user->xu, 1.0 / U));
+  if (user->prob.xl) PetscCall(VecScale(user->prob.xl, 1.0 / U));
+  if (user->prob.xu) PetscCall(VecScale(user->prob.xu, 1.0 / U));
   PetscCall(SNESSolve(snes, NULL, u));
   PetscCall(VecScale(u, U));
-  if (user->xl) PetscCall(VecScale(user->xl, U));
-  if (user->xu) PetscCall(VecScale(user->xu, U));
-  user->snes_scale = 1.0;
+  if (user->prob.xl) PetscCall(VecScale(user->prob.xl, U));
+  if (user->prob.xu) PetscCall(VecScale(user->prob.xu, U));
+  user->prob.snes_scale = 1.0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -345,7 +346,7 @@ static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
    A warm start needs no continuation: it starts from the solution for a nearby eps or a coarser mesh. */
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm)
 {
-  const PetscReal eps_target = user->eps, eps_start = user->h / ContactPenaltyModulus(user);
+  const PetscReal eps_target = user->prob.eps, eps_start = user->prob.h / ContactPenaltyModulus(user);
   PetscLogDouble  t0, t1;
   PetscInt        newton = 0, ksp = 0;
   DM              dm;
@@ -354,28 +355,28 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm)
   PetscCall(SNESGetDM(snes, &dm));
   if (!warm) PetscCall(VecZeroEntries(u));
   PetscCall(PetscTime(&t0));
-  user->pc_reuse.builds           = 0; /* counted per solve */
-  user->stats.continuation_stages = 0;
-  if (!warm && user->contact.method == CONTACT_PENALTY && user->contact.continuation && eps_target < eps_start) {
-    for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= user->contact.continuation_factor) {
-      user->eps = eps;
+  user->prob.pc_reuse.builds          = 0; /* counted per solve */
+  user->rec.stats.continuation_stages = 0;
+  if (!warm && user->opt.contact.method == CONTACT_PENALTY && user->opt.contact.continuation && eps_target < eps_start) {
+    for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= user->opt.contact.continuation_factor) {
+      user->prob.eps = eps;
       PetscCall(ElasticityUpdateConstants(dm, user));
       PetscCall(SolverSNESSolve(snes, user, u));
       PetscCall(RecordSolve(snes, user, &newton, &ksp));
-      user->stats.continuation_stages++;
-      if (!user->stats.converged) break; /* reported as the failure of the whole solve */
+      user->rec.stats.continuation_stages++;
+      if (!user->rec.stats.converged) break; /* reported as the failure of the whole solve */
     }
-    user->eps = eps_target;
+    user->prob.eps = eps_target;
     PetscCall(ElasticityUpdateConstants(dm, user));
   }
-  if (user->stats.continuation_stages == 0 || user->stats.converged) {
+  if (user->rec.stats.continuation_stages == 0 || user->rec.stats.converged) {
     PetscCall(SolverSNESSolve(snes, user, u));
     PetscCall(RecordSolve(snes, user, &newton, &ksp));
   }
   PetscCall(PetscTime(&t1));
-  user->stats.time_solve += t1 - t0;
-  user->stats.newton_its_total += newton;
-  user->stats.ksp_its_total += ksp;
+  user->rec.stats.time_solve += t1 - t0;
+  user->rec.stats.newton_its_total += newton;
+  user->rec.stats.ksp_its_total += ksp;
   PetscCall(SolverAddRecord(snes, user, u, t1 - t0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -394,12 +395,12 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
   KSPConvergedReason reason;
 
   PetscFunctionBeginUser;
-  user->stats.condition_1norm = PETSC_NAN;
-  if (!user->contact.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
+  user->rec.stats.condition_1norm = PETSC_NAN;
+  if (!user->opt.contact.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
-  if (user->contact.method == CONTACT_VI) {
-    J = user->K;
+  if (user->opt.contact.method == CONTACT_VI) {
+    J = user->prob.K;
     PetscCall(KSPCreate(PetscObjectComm((PetscObject)snes), &ksp_vi));
     PetscCall(SolverSetDefaultLinearSolver(ksp_vi, user));
     PetscCall(KSPSetFromOptions(ksp_vi));
@@ -445,7 +446,7 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
     PetscCall(VecAssemblyBegin(x));
     PetscCall(VecAssemblyEnd(x));
   }
-  user->stats.condition_1norm = normJ * est;
+  user->rec.stats.condition_1norm = normJ * est;
   PetscCall(VecDestroy(&x));
   PetscCall(VecDestroy(&y));
   PetscCall(KSPDestroy(&ksp_vi));

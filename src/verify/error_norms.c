@@ -27,8 +27,8 @@ PetscErrorCode ErrorNormsPressureVector(DM dm, AppCtx *user, Vec loc_p)
   PetscCall(DMGetGlobalVector(dm, &P));
   PetscCall(VecZeroEntries(P));
   PetscCall(VecGetArray(P, &p));
-  for (PetscInt i = 0; i < user->cset.n; ++i)
-    for (PetscInt c = 0; c < dim; ++c) p[user->cset.global_off[i] + c] = user->cset.pressure[i] * user->scene.obstacle_normal[c];
+  for (PetscInt i = 0; i < user->prob.cset.n; ++i)
+    for (PetscInt c = 0; c < dim; ++c) p[user->prob.cset.global_off[i] + c] = user->prob.cset.pressure[i] * user->scene.obstacle_normal[c];
   PetscCall(VecRestoreArray(P, &p));
   PetscCall(VecZeroEntries(loc_p));
   PetscCall(DMGlobalToLocal(dm, P, INSERT_VALUES, loc_p));
@@ -68,7 +68,7 @@ static PetscErrorCode IntegrateBulk(DM dm, AppCtx *user, CellQuadrature *cq, Vec
         g[k] = gt[k] - g[k];
         s1 += PetscSqr(g[k]);
       }
-      ElasticStress(dim, &user->material, g, sigma);
+      ElasticStress(dim, &user->opt.material, g, sigma);
       for (PetscInt k = 0; k < dim * dim; ++k) s2 += sigma[k] * g[k];
       sums[0] += cq->w[q] * s0;
       sums[1] += cq->w[q] * s1;
@@ -114,7 +114,7 @@ static PetscErrorCode IntegrateContact(DM dm, AppCtx *user, CellQuadrature *cq, 
         PetscCall(CellQuadratureInterpolate(cq, ph, q, v, NULL));
         for (PetscInt k = 0; k < dim; ++k) p_h += v[k] * n[k];
       } else
-        p_h = d > 0.0 ? d / user->eps : 0.0;
+        p_h = d > 0.0 ? d / user->prob.eps : 0.0;
       if (t->scene) {
         PetscReal sn;
 
@@ -192,7 +192,7 @@ PetscErrorCode ErrorNormsEvaluate(DM dm, AppCtx *user, Mat K, Vec loc_uh, Vec lo
 
   PetscFunctionBeginUser;
   PetscCall(ErrorNormsReset(e));
-  PetscCall(CellQuadratureCreate(dm, &user->scene, &user->verify, &cq));
+  PetscCall(CellQuadratureCreate(dm, &user->scene, &user->opt.verify, &cq));
   if (target) {
     PetscCall(DMGetLocalVector(dm, &loc_b));
     PetscCall(VecZeroEntries(loc_b));
@@ -206,7 +206,7 @@ PetscErrorCode ErrorNormsEvaluate(DM dm, AppCtx *user, Mat K, Vec loc_uh, Vec lo
   e->penetration_l2  = PetscSqrtReal(gcontact[1]);
   e->penetration_max = PetscMax(gmax, 0.0);
   if (target) {
-    const PetscReal weight = user->contact.method == CONTACT_PENALTY ? user->eps : user->h;
+    const PetscReal weight = user->opt.contact.method == CONTACT_PENALTY ? user->prob.eps : user->prob.h;
 
     e->l2                = PetscSqrtReal(gbulk[0]);
     e->h1_semi           = PetscSqrtReal(gbulk[1]);
@@ -227,16 +227,17 @@ PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
   ErrorTarget exact = {&user->scene, NULL, NULL};
 
   PetscFunctionBeginUser;
-  PetscCall(ErrorNormsReset(&user->errors));
+  PetscCall(ErrorNormsReset(&user->rec.errors));
   PetscCall(DMGetLocalVector(dm, &loc_uh));
   PetscCall(VecZeroEntries(loc_uh));
   PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, loc_uh, 0.0, NULL, NULL, NULL));
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc_uh));
-  if (user->contact.method != CONTACT_PENALTY) {
+  if (user->opt.contact.method != CONTACT_PENALTY) {
     PetscCall(DMGetLocalVector(dm, &loc_ph));
     PetscCall(ErrorNormsPressureVector(dm, user, loc_ph));
   }
-  PetscCall(ErrorNormsEvaluate(dm, user, user->K, loc_uh, loc_ph, user->scene.exact && user->scene.exact_gradient ? &exact : NULL, &user->errors));
+  PetscCall(
+      ErrorNormsEvaluate(dm, user, user->prob.K, loc_uh, loc_ph, user->scene.exact && user->scene.exact_gradient ? &exact : NULL, &user->rec.errors));
   if (loc_ph) PetscCall(DMRestoreLocalVector(dm, &loc_ph));
   PetscCall(DMRestoreLocalVector(dm, &loc_uh));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -191,7 +191,7 @@ static PetscBool ReferenceHasCell(const Reference *ref, const PetscInt v[])
 /* The checks of the reference's /run against this run: same scene and dimension, converged, degree 1. */
 static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, PetscInt dim, PetscViewer v, PetscInt *ref_dim, PetscInt *ncells)
 {
-  const char *file       = user->verify.reference;
+  const char *file       = user->opt.verify.reference;
   const char *datasets[] = {"/geometry/vertices", "/vertex_fields/displacement", "/vertex_fields/contact_pressure", "/viz/topology/cells"};
   PetscInt    converged, degree;
   char       *scene = NULL;
@@ -212,10 +212,10 @@ static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, Pe
   PetscCall(PetscFree(scene));
   PetscCheck(*ref_dim == dim, comm, PETSC_ERR_USER_INPUT, "Reference %s is %" PetscInt_FMT "D, this run is %" PetscInt_FMT "D", file, *ref_dim, dim);
   PetscCheck(converged == 1, comm, PETSC_ERR_USER_INPUT, "Reference %s did not converge (/run converged = 0)", file);
-  PetscCheck(degree == 1 && user->degree == 1, comm, PETSC_ERR_USER_INPUT,
+  PetscCheck(degree == 1 && user->opt.degree == 1, comm, PETSC_ERR_USER_INPUT,
              "-reference needs degree 1 in the run and the reference (they are compared through vertex values); got %" PetscInt_FMT
              " and %" PetscInt_FMT,
-             user->degree, degree);
+             user->opt.degree, degree);
   for (size_t i = 0; i < sizeof(datasets) / sizeof(datasets[0]); ++i) {
     PetscCall(PetscViewerHDF5HasDataset(v, datasets[i], &has));
     PetscCheck(has, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "Reference file %s has no dataset %s: not an output of this solver", file, datasets[i]);
@@ -226,7 +226,7 @@ static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, Pe
 /* Before the solve: the -reference file (if any) opens as HDF5 and fits this run (ReferenceCheckHeader()). */
 PetscErrorCode ReferenceCheckFile(DM dm, const AppCtx *user)
 {
-  const char    *file = user->verify.reference;
+  const char    *file = user->opt.verify.reference;
   PetscViewer    v;
   PetscInt       dim, ref_dim, ncells;
   PetscErrorCode ierr;
@@ -250,7 +250,7 @@ PetscErrorCode ReferenceCheckFile(DM dm, const AppCtx *user)
 
 static PetscErrorCode ReferenceRead(MPI_Comm comm, const AppCtx *user, PetscInt dim, Reference *ref)
 {
-  const char *file = user->verify.reference;
+  const char *file = user->opt.verify.reference;
   PetscViewer v;
   PetscInt    n;
   PetscReal  *cells;
@@ -374,11 +374,11 @@ static PetscErrorCode MatchReference(DM fine, const AppCtx *user, const Referenc
   PetscCheck(!nbad[0], comm, PETSC_ERR_USER_INPUT,
              "Reference %s does not match: a vertex of this mesh refined is not one of its vertices. Run the reference on the same coarse mesh "
              "with a larger -dm_refine",
-             user->verify.reference);
+             user->opt.verify.reference);
   PetscCheck(!nbad[1], comm, PETSC_ERR_USER_INPUT,
              "Reference %s does not match: its vertices are those of this mesh refined, but not its cells. Run the reference on the same coarse "
              "mesh with a larger -dm_refine",
-             user->verify.reference);
+             user->opt.verify.reference);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -393,19 +393,19 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   ErrorTarget target;
 
   PetscFunctionBeginUser;
-  PetscCall(ErrorNormsReset(&user->ref_errors));
-  if (!user->verify.reference[0]) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ErrorNormsReset(&user->rec.ref_errors));
+  if (!user->opt.verify.reference[0]) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(ReferenceRead(comm, user, dim, &ref));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(MeshCountOwned(dm, cStart, cEnd, &ncells));
   while ((PetscInt64)ncells << (dim * levels) < (PetscInt64)ref.ncells && levels < 8) ++levels;
   PetscCheck((PetscInt64)ncells << (dim * levels) == (PetscInt64)ref.ncells, comm, PETSC_ERR_USER_INPUT,
-             "Reference %s has %" PetscInt_FMT " cells, which is not this mesh (%" PetscInt_FMT " cells) uniformly refined", user->verify.reference,
-             ref.ncells, ncells);
+             "Reference %s has %" PetscInt_FMT " cells, which is not this mesh (%" PetscInt_FMT " cells) uniformly refined",
+             user->opt.verify.reference, ref.ncells, ncells);
 
   /* the run's displacement and, without the penalty law, its nodal pressure, on the refined mesh */
-  nvec = user->contact.method == CONTACT_PENALTY ? 1 : 2;
+  nvec = user->opt.contact.method == CONTACT_PENALTY ? 1 : 2;
   PetscCall(DMCreateLocalVector(dm, &loc[0]));
   PetscCall(VecZeroEntries(loc[0]));
   PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, loc[0], 0.0, NULL, NULL, NULL));
@@ -423,7 +423,7 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(ReferenceDestroy(&ref));
 
   if (levels == 0) { /* the same mesh: the run's operator */
-    K = user->K;
+    K = user->prob.K;
     PetscCall(PetscObjectReference((PetscObject)K));
   } else {
     Vec locX;
@@ -439,8 +439,8 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   target.scene        = NULL;
   target.loc_u        = loc_uref;
   target.loc_pressure = loc_pref;
-  PetscCall(ErrorNormsEvaluate(fine, user, K, fine_loc[0], nvec == 2 ? fine_loc[1] : NULL, &target, &user->ref_errors));
-  PetscCall(PetscInfo(dm, "Reference %s: %" PetscInt_FMT " refinement(s)\n", user->verify.reference, levels));
+  PetscCall(ErrorNormsEvaluate(fine, user, K, fine_loc[0], nvec == 2 ? fine_loc[1] : NULL, &target, &user->rec.ref_errors));
+  PetscCall(PetscInfo(dm, "Reference %s: %" PetscInt_FMT " refinement(s)\n", user->opt.verify.reference, levels));
 
   PetscCall(MatDestroy(&K));
   for (PetscInt k = 0; k < nvec; ++k) PetscCall(VecDestroy(&fine_loc[k]));
