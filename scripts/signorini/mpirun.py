@@ -1,0 +1,86 @@
+"""Running bin/signorini under mpiexec: the MPI environment, a time limit, the console log, and the
+tail or the telling line of a failed run's output."""
+import os
+import re
+import signal
+import subprocess
+import time
+from dataclasses import dataclass
+from typing import Optional
+
+from .paths import ROOT
+
+# mpiexec as root, and more ranks than cores
+MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
+           "OMPI_MCA_rmaps_base_oversubscribe": "1"}
+LOG_TAIL_LINES = 40  # lines of solver output shown when a run fails without output
+
+
+@dataclass
+class MpiResult:
+    """What came back from one mpiexec: exit status, console output (stdout and stderr merged),
+    wall time in seconds, and whether it was killed at the time limit."""
+    returncode: Optional[int]
+    output: str
+    wall: float
+    timed_out: bool
+
+
+def _kill_group(proc, sig):
+    try:
+        os.killpg(proc.pid, sig)
+    except ProcessLookupError:
+        pass
+
+
+def run_mpi(cmd, log=None, timeout=None, env=None, header=""):
+    """Run `cmd` in ROOT with the MPI environment (plus `env`), stdout and stderr merged.
+
+    The process runs in its own session, so that at the time limit `timeout` (seconds, None: no
+    limit) mpiexec and its ranks are stopped together (SIGTERM, then SIGKILL after 10 s). The
+    console output, preceded by `header`, is written to the file `log` when given.
+    """
+    t0 = time.monotonic()
+    proc = subprocess.Popen(cmd, cwd=ROOT, env={**os.environ, **MPI_ENV, **(env or {})},
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            start_new_session=True)
+    timed_out = False
+    try:
+        try:
+            text, _ = proc.communicate(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            timed_out = True
+            _kill_group(proc, signal.SIGTERM)  # its own session: mpiexec and its ranks
+            try:
+                text, _ = proc.communicate(timeout=10)
+            except subprocess.TimeoutExpired:
+                _kill_group(proc, signal.SIGKILL)
+                text, _ = proc.communicate()
+    except BaseException:  # e.g. Ctrl-C: do not leave the ranks running
+        _kill_group(proc, signal.SIGKILL)
+        proc.wait()
+        raise
+    wall = time.monotonic() - t0
+    if log is not None:
+        with open(log, "w") as fh:
+            fh.write(header + text)
+    return MpiResult(proc.returncode, text, wall, timed_out)
+
+
+def tail(text, n=LOG_TAIL_LINES):
+    """The last `n` lines of `text` (trailing blank space removed)."""
+    return "\n".join(text.rstrip().splitlines()[-n:])
+
+
+def error_line(text):
+    """The most telling line of a failed run's output (PETSc's error message if any)."""
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    for ln in lines:
+        if "PETSC ERROR" in ln and not re.search(r"-{5}|Error Message|See https", ln):
+            msg = ln.split("PETSC ERROR:", 1)[-1].strip()
+            if msg and not msg.startswith(("Missing or incorrect", "#", "Petsc Release")):
+                return msg
+    for ln in reversed(lines):
+        if "ERROR" in ln:
+            return ln
+    return lines[-1] if lines else "(no output)"
