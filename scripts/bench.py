@@ -17,20 +17,22 @@ A run longer than the bench file's `timeout` (seconds, default 3600) is stopped 
 Usage: scripts/bench.py [options/bench/bench.yaml] [--outdir DIR] [--resume]
 """
 import argparse
-import csv
 import os
 import shlex
-import subprocess
 import sys
 import time
 
 import h5py
-import numpy as np
 import yaml
 
 SCRIPTS = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, SCRIPTS)
-from study import BIN, MPI_ENV, ROOT, StudyError, option_value  # noqa: E402
+from signorini.formatting import fmt_sig as fmt  # noqa: E402
+from signorini.mpirun import MPI_ENV, run_mpi, tail  # noqa: E402,F401
+from signorini.paths import BIN, ROOT  # noqa: E402
+from signorini.report import dict_csv_text, write_atomic  # noqa: E402
+from signorini.runs import decoded_attrs, read_solves  # noqa: E402
+from signorini.studyfile import StudyError, option_value  # noqa: E402
 
 KINDS = ("elastic", "penalty", "penalty_gs", "vi", "sweep")
 COLUMNS = ["problem", "solver", "ranks", "kind", "n_dofs", "converged", "snes_reason", "newton_its", "newton_its_total",
@@ -94,12 +96,6 @@ def command(problem, solver, ranks, kind, bench, h5):
     return cmd + ["-output", h5]
 
 
-def read_solves(f):
-    if "solves" not in f:
-        return {}
-    return {k: np.asarray(f["solves"][k][:]).ravel() for k in f["solves"]}
-
-
 def run_case(problem, solver, ranks, kind, bench, outdir, resume=False):
     """Runs one case, or with resume reads the output an earlier invocation left (its log holds its exit status)."""
     row = {"problem": problem["name"], "solver": solver, "ranks": ranks, "kind": kind, "note": ""}
@@ -119,15 +115,9 @@ def run_case(problem, solver, ranks, kind, bench, outdir, resume=False):
             return read_case(row, name, h5, cmd, returncode, "", problem, kind)
     if os.path.exists(h5):
         os.remove(h5)
-    env = {**os.environ, **MPI_ENV, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
-    t0 = time.time()
-    try:
-        proc = subprocess.run(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=limit)
-        returncode, output = proc.returncode, proc.stdout
-    except subprocess.TimeoutExpired as exc:
-        out = exc.stdout or ""
-        returncode, output = None, out.decode() if isinstance(out, bytes) else out
-    row["wall"] = time.time() - t0
+    proc = run_mpi(cmd, timeout=limit, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"})
+    returncode, output = (None if proc.timed_out else proc.returncode), proc.output
+    row["wall"] = proc.wall
     with open(log, "w") as fh:
         fh.write(f"exit {returncode} {shlex.join(cmd)}\n" + output)
     if returncode is None:
@@ -139,10 +129,9 @@ def run_case(problem, solver, ranks, kind, bench, outdir, resume=False):
 def read_case(row, name, h5, cmd, returncode, output, problem, kind):
     """Fills row from the output file of one run."""
     if not os.path.exists(h5):
-        tail = "\n".join(output.rstrip().splitlines()[-15:])
-        raise StudyError(f"{name}: exit status {returncode}, no output; command:\n  {shlex.join(cmd)}\n{tail}")
+        raise StudyError(f"{name}: exit status {returncode}, no output; command:\n  {shlex.join(cmd)}\n{tail(output, 15)}")
     with h5py.File(h5, "r") as f:
-        a = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f["run"].attrs.items()}
+        a = decoded_attrs(f["run"])
         solves = read_solves(f)
     for key in ("n_dofs", "converged", "snes_reason", "newton_its", "newton_its_total", "ksp_its", "ksp_its_total",
                 "pc_builds", "time_setup", "time_solve", "peak_memory_mb", "contact_force"):
@@ -196,18 +185,6 @@ def summarize(rows, bench):
                 s["sweep_ksp_per_newton"] = g["sweep"]["sweep_ksp_per_newton"] if g["sweep"] else ""
                 out.append(s)
     return out
-
-
-def fmt(v, digits=3):
-    if v is None or v == "":
-        return "-"
-    if isinstance(v, str):
-        return v
-    if isinstance(v, (int, np.integer)):
-        return str(int(v))
-    if np.isnan(v):
-        return "-"
-    return f"{v:.{digits}g}"
 
 
 def markdown(rows, summary, bench, machine):
@@ -281,14 +258,8 @@ def main(argv=None):
     summary = summarize(rows, bench)
     md = markdown(rows, summary, bench, machine_line())
     base = os.path.join(outdir, bench["name"])
-    with open(base + ".md.tmp", "w") as fh:
-        fh.write(md)
-    os.replace(base + ".md.tmp", base + ".md")
-    with open(base + ".csv.tmp", "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=COLUMNS, extrasaction="ignore")
-        w.writeheader()
-        w.writerows(rows)
-    os.replace(base + ".csv.tmp", base + ".csv")
+    write_atomic(base + ".md", md)
+    write_atomic(base + ".csv", dict_csv_text(COLUMNS, rows))
     print(md)
     print(f"written {os.path.relpath(base, ROOT)}.md and .csv")
     return 0

@@ -14,45 +14,20 @@ The default output is FILE with .h5 replaced by _contact.png. Exit code 2 if
 the file cannot be read or has no contact-boundary vertices.
 """
 import argparse
+import os
 import sys
 
-import h5py
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from signorini.figures import plt, save_png  # noqa: E402
+from signorini.runs import read_contact  # noqa: E402,F401
 
 
 def default_output(h5path):
     """FILE.h5 -> FILE_contact.png (suffix appended if not ending in .h5)."""
     base = h5path[:-3] if h5path.endswith(".h5") else h5path
     return base + "_contact.png"
-
-
-def read_contact(h5path):
-    """Return (x1, pressure, gap, run_attrs) for the Gamma_C vertices.
-
-    Raises ValueError if the file cannot be read, lacks a needed dataset, or
-    has no contact-boundary vertices.
-    """
-    try:
-        with h5py.File(h5path, "r") as f:
-            x = f["geometry/vertices"][()]
-            vf = f["vertex_fields"]
-            mask = np.isclose(vf["contact_boundary"][()], 1.0)
-            p = vf["contact_pressure"][()]
-            g = vf["normal_gap"][()]
-            run = {}
-            if "run" in f:
-                for k, v in f["run"].attrs.items():
-                    run[k] = v.decode() if isinstance(v, bytes) else v
-    except Exception as exc:
-        raise ValueError(f"{h5path}: cannot read contact data ({exc})") from exc
-    if not mask.any():
-        raise ValueError(f"{h5path}: no contact_boundary vertices (Gamma_C is empty)")
-    x1 = x[mask, 0] if x.ndim == 2 else x[mask]
-    order = np.argsort(x1, kind="stable")
-    return x1[order], p[mask][order], g[mask][order], run
 
 
 def mean_per_x(x1, values, decimals=10):
@@ -92,9 +67,7 @@ def plot_contact(h5path, pngpath):
     ax_g.axhline(0.0, color="gray", lw=1, ls="--")
     ax_g.set_xlabel("$x_1$")
     fig.suptitle(make_title(run), fontsize=10)
-    fig.tight_layout()
-    fig.savefig(pngpath, dpi=120)
-    plt.close(fig)
+    save_png(fig, pngpath, 120)
     return pngpath
 
 

@@ -8,13 +8,12 @@ one without /run is an error (exit code 2), never skipped.
 Usage: read_runs.py FILE_OR_DIR [...] [--format markdown|csv] [--columns a,b,c] [-o OUT]
 """
 import argparse
-import csv
-import io
 import os
 import sys
 
-import h5py
-import numpy as np
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from signorini.report import csv_text, md_row, md_rule  # noqa: E402
+from signorini.runs import all_columns, expand_paths, read_run, read_runs, to_python  # noqa: E402,F401
 
 DEFAULT_COLUMNS = [
     "file", "scene", "dim", "method", "penalty_quadrature", "degree", "nprocs",
@@ -25,71 +24,6 @@ DEFAULT_COLUMNS = [
 FORMATS = ("markdown", "csv")
 
 
-def to_python(value):
-    """Convert an HDF5 attribute value to plain Python (bytes -> str, numpy -> int/float/list)."""
-    if isinstance(value, (bytes, np.bytes_)):
-        return bytes(value).decode("utf-8", errors="replace")
-    if isinstance(value, np.ndarray):
-        if value.ndim == 0:
-            return to_python(value[()])
-        return [to_python(v) for v in value]
-    if isinstance(value, np.generic):
-        return value.item()
-    return value
-
-
-def read_run(path):
-    """Return all attributes of /run in the HDF5 file `path` as a dict.
-
-    The key "file" is set to `path`. Raises ValueError naming the file if it
-    cannot be opened or has no /run group.
-    """
-    try:
-        with h5py.File(path, "r") as f:
-            if "run" not in f:
-                raise ValueError(f"{path}: no /run group")
-            run = {"file": str(path)}
-            for key, value in f["run"].attrs.items():
-                run[key] = to_python(value)
-            return run
-    except ValueError:
-        raise
-    except Exception as exc:  # h5py raises OSError and others
-        raise ValueError(f"{path}: cannot read HDF5 file ({exc})") from exc
-
-
-def expand_paths(paths):
-    """Expand directories into their sorted *.h5 files; ValueError on a missing path or empty dir."""
-    out = []
-    for p in paths:
-        p = str(p)
-        if os.path.isdir(p):
-            files = sorted(os.path.join(p, n) for n in os.listdir(p)
-                           if n.endswith(".h5") and os.path.isfile(os.path.join(p, n)))
-            if not files:
-                raise ValueError(f"{p}: directory contains no *.h5 files")
-            out.extend(files)
-        elif os.path.exists(p):
-            out.append(p)
-        else:
-            raise ValueError(f"{p}: no such file or directory")
-    return out
-
-
-def read_runs(paths):
-    """Read /run of every file in `paths` (directories expanded); list of dicts."""
-    return [read_run(p) for p in expand_paths(paths)]
-
-
-def all_columns(runs):
-    """Union of the keys of all runs, in order of first appearance."""
-    cols = {}
-    for run in runs:
-        for key in run:
-            cols.setdefault(key, None)
-    return list(cols)
-
-
 def format_markdown(runs, columns):
     """Render runs as a markdown table; floats with %.6g, missing -> empty."""
     def cell(v):
@@ -98,22 +32,15 @@ def format_markdown(runs, columns):
         if isinstance(v, float):
             return "%.6g" % v
         return str(v).replace("|", "\\|")
-    lines = ["| " + " | ".join(columns) + " |",
-             "|" + "|".join("---" for _ in columns) + "|"]
+    lines = [md_row(columns), md_rule(len(columns))]
     for run in runs:
-        lines.append("| " + " | ".join(cell(run.get(c)) for c in columns) + " |")
+        lines.append(md_row(cell(run.get(c)) for c in columns))
     return "\n".join(lines) + "\n"
 
 
 def format_csv(runs, columns):
     """Render runs as CSV with full float precision (repr); missing -> empty."""
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(columns)
-    for run in runs:
-        writer.writerow([repr(v) if isinstance(v, float) else ("" if v is None else v)
-                         for v in (run.get(c) for c in columns)])
-    return buf.getvalue()
+    return csv_text(columns, ([run.get(c) for c in columns] for run in runs))
 
 
 def main(argv=None):

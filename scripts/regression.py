@@ -15,16 +15,16 @@ import shlex
 import subprocess
 import sys
 
-import h5py
 import numpy as np
 import yaml
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-sys.path.insert(0, os.path.join(ROOT, "scripts"))
-from read_runs import read_run  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from signorini.mpirun import run_mpi  # noqa: E402
+from signorini.paths import ROOT  # noqa: E402
+from signorini.runs import read_run, vertex_fields  # noqa: E402
 
 NOT_COMPARED = ("time_", "peak_memory", "reference")
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
+TIMEOUT = 600  # seconds per run
 
 
 def load_runs(path):
@@ -42,19 +42,14 @@ def run_all(directory, binary, runs):
     for r in runs:
         out = os.path.join(os.path.abspath(directory), r["name"] + ".h5")
         cmd = ["mpiexec", "-n", str(r.get("ranks", 1)), binary] + shlex.split(r["args"]) + ["-output", out]
-        p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+        p = run_mpi(cmd, timeout=TIMEOUT)
+        if p.timed_out:
+            raise subprocess.TimeoutExpired(cmd, TIMEOUT)
         with open(out[:-3] + ".log", "w") as fh:
-            fh.write(p.stdout)
+            fh.write(p.output)
         print(f"{r['name']}: exit {p.returncode}")
         failed += p.returncode != 0
     return 1 if failed else 0
-
-
-def fields(path):
-    with h5py.File(path, "r") as f:
-        x = f["geometry/vertices"][:]
-        order = np.lexsort(np.round(x, 12).T)  # a vertex order that does not depend on the ranks
-        return {k: f["vertex_fields"][k][:][order] for k in f["vertex_fields"]}
 
 
 def compare_one(a, b, rtol, allow_added=False):
@@ -72,7 +67,7 @@ def compare_one(a, b, rtol, allow_added=False):
             same = va == vb
         if not same:
             diffs.append(f"/run {key}: {va} != {vb}")
-    fa, fb = fields(a), fields(b)
+    fa, fb = vertex_fields(a), vertex_fields(b)
     for key in sorted(set(fa) | set(fb)):
         if key not in fa or key not in fb or fa[key].shape != fb[key].shape:
             diffs.append(f"field {key}: missing or of another shape")

@@ -77,103 +77,37 @@ Exit status: 0 success; 1 a check failed (--check); 2 an error (bad study file, 
 no output, an unreadable output file or a missing attribute).
 """
 import argparse
-import csv
-import math
 import os
 import re
 import shlex
-import subprocess
 import sys
 from dataclasses import dataclass
 from typing import Optional
 
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-import yaml  # noqa: E402
+import numpy as np
 
 SCRIPTS = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(SCRIPTS)
 sys.path.insert(0, SCRIPTS)
-import read_runs  # noqa: E402
+from signorini.figures import no_values_note, plt, save_png  # noqa: E402
+from signorini.formatting import format_rate, format_value  # noqa: E402,F401
+from signorini.mpirun import LOG_TAIL_LINES, MPI_ENV, run_mpi, tail  # noqa: E402,F401
+from signorini.paths import BIN, ROOT, display_path  # noqa: E402,F401
+from signorini.rates import (FLOOR_BAND, MONOTONE_RTOL, agrees, fitted_rate, invalid,  # noqa: E402,F401
+                             level_rates, monotone_until_floor)
+from signorini.report import md_options, md_row, md_rule, write_csv as write_csv_file, write_lines  # noqa: E402
+from signorini.runs import read_run  # noqa: E402
+from signorini.studyfile import (NAME_RE, StudyError, check_keys, number, option_value,  # noqa: E402,F401
+                                 options, options_file, read_yaml, safe_label)
 
-BIN = "bin/signorini"  # relative to ROOT, the working directory of every run
-MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
-           "OMPI_MCA_rmaps_base_oversubscribe": "1"}
 TOP_KEYS = ("name", "description", "np", "options_file", "options", "x", "fit_levels",
             "tolerance", "norms", "series", "levels", "reference", "checks")
 REQUIRED_KEYS = ("name", "x", "norms", "series", "levels")
-MONOTONE_RTOL = 1e-6     # slack of the monotone-decrease test e_k <= e_{k-1} (1 + MONOTONE_RTOL)
-FLOOR_BAND = (0.5, 2.0)  # band around the floor value F that every later e must stay in
-LOG_TAIL_LINES = 40      # lines of solver output shown when a run fails without output
-
-
-class StudyError(Exception):
-    """An error in the study file, a run or its output; the message names the culprit."""
-
-
 # ------------------------------------------------------------------------------ study file
-
-def _check_keys(mapping, allowed, required, where):
-    """Raise StudyError if `mapping` is not a dict, lacks a required key or has an unknown one."""
-    if not isinstance(mapping, dict):
-        raise StudyError(f"{where}: expected a mapping, got {type(mapping).__name__}")
-    for key in required:
-        if key not in mapping:
-            raise StudyError(f"{where}: missing required key '{key}'")
-    for key in mapping:
-        if key not in allowed:
-            raise StudyError(f"{where}: unknown key '{key}' (allowed: {', '.join(allowed)})")
-
-
-def _number(value, where, integer=False):
-    """Return `value` if it is an int (or, unless `integer`, a float); booleans are refused."""
-    kinds = (int,) if integer else (int, float)
-    if isinstance(value, bool) or not isinstance(value, kinds):
-        raise StudyError(f"{where}: expected {'an integer' if integer else 'a number'}, got {value!r}")
-    return value
-
-
-def option_value(value, where):
-    """PETSc command-line text of an option value: booleans -> true/false, numbers via repr."""
-    if isinstance(value, bool):
-        return "true" if value else "false"
-    if isinstance(value, (int, float)):
-        return repr(value)
-    if isinstance(value, str):
-        return value
-    raise StudyError(f"{where}: option value must be a string, number or boolean, got {value!r}")
-
-
-def _options(mapping, where):
-    """Validate an options mapping; return {key: value text}, keys without the leading dash."""
-    if mapping is None:
-        return {}
-    if not isinstance(mapping, dict):
-        raise StudyError(f"{where}: expected a mapping of options, got {type(mapping).__name__}")
-    out = {}
-    for key, value in mapping.items():
-        if not isinstance(key, str):  # YAML 1.1 reads on/off/yes/no as booleans, 1 as a number
-            raise StudyError(f"{where}: option key {key!r} was read by YAML as "
-                             f"{type(key).__name__}; quote it")
-        if not re.fullmatch(r"[A-Za-z0-9_]+", key):
-            raise StudyError(f"{where}: invalid option key {key!r} (give it without the dash)")
-        if key == "output":
-            raise StudyError(f"{where}: option 'output' is set by the driver, remove it")
-        out[key] = option_value(value, f"{where}.{key}")
-    return out
-
-
-def safe_label(label):
-    """File-name stem of a series label: characters other than [A-Za-z0-9.-] become '_'."""
-    return re.sub(r"[^A-Za-z0-9.\-]", "_", label)
-
 
 def _levels(levels, where):
     """Expand `levels` (a list of option mappings, or {key, values}) to a list of option dicts."""
     if isinstance(levels, dict):
-        _check_keys(levels, ("key", "values"), ("key", "values"), where)
+        check_keys(levels, ("key", "values"), ("key", "values"), where)
         if not isinstance(levels["values"], list):
             raise StudyError(f"{where}.values: expected a list")
         levels = [{levels["key"]: v} for v in levels["values"]]
@@ -181,7 +115,7 @@ def _levels(levels, where):
         raise StudyError(f"{where}: expected a list of option mappings or {{key, values}}")
     if len(levels) < 2:
         raise StudyError(f"{where}: a convergence study needs at least 2 levels, got {len(levels)}")
-    return [_options(lev, f"{where}[{k}]") for k, lev in enumerate(levels)]
+    return [options(lev, f"{where}[{k}]") for k, lev in enumerate(levels)]
 
 
 def _series(series, norms, where):
@@ -191,7 +125,7 @@ def _series(series, norms, where):
     out, stems = [], {}
     for i, s in enumerate(series):
         w = f"{where}[{i}]"
-        _check_keys(s, ("label", "options", "predicted"), ("label",), w)
+        check_keys(s, ("label", "options", "predicted"), ("label",), w)
         if not isinstance(s["label"], (str, int, float)) or isinstance(s["label"], bool):
             raise StudyError(f"{w}.label: expected a string, got {s['label']!r}")
         label = str(s["label"])
@@ -207,8 +141,8 @@ def _series(series, norms, where):
             if norm not in norms:
                 raise StudyError(f"{w}.predicted: '{norm}' is not one of the study's norms "
                                  f"({', '.join(norms)})")
-            _number(p, f"{w}.predicted.{norm}")
-        out.append({"label": label, "stem": stem, "options": _options(s.get("options"), f"{w}.options"),
+            number(p, f"{w}.predicted.{norm}")
+        out.append({"label": label, "stem": stem, "options": options(s.get("options"), f"{w}.options"),
                     "predicted": {n: float(p) for n, p in predicted.items()}})
     return out
 
@@ -225,7 +159,7 @@ def _checks(checks, study, where):
         if not isinstance(c, dict) or "type" not in c:
             raise StudyError(f"{w}: expected a mapping with a 'type' (rate or monotone)")
         if c["type"] == "rate":
-            _check_keys(c, ("type", "norms"), (), w)
+            check_keys(c, ("type", "norms"), (), w)
             norms = c.get("norms", study["norms"])
             if not isinstance(norms, list) or not norms:
                 raise StudyError(f"{w}.norms: expected a non-empty list")
@@ -236,10 +170,10 @@ def _checks(checks, study, where):
                     raise StudyError(f"{w}: no series predicts a rate for '{norm}'")
             out.append({"type": "rate", "norms": list(norms)})
         elif c["type"] == "monotone":
-            _check_keys(c, ("type", "norm", "floor_ratio"), ("norm",), w)
+            check_keys(c, ("type", "norm", "floor_ratio"), ("norm",), w)
             if c["norm"] not in study["norms"]:
                 raise StudyError(f"{w}: '{c['norm']}' is not one of the study's norms")
-            ratio = float(_number(c.get("floor_ratio", 0.9), f"{w}.floor_ratio"))
+            ratio = float(number(c.get("floor_ratio", 0.9), f"{w}.floor_ratio"))
             if ratio <= 0:
                 raise StudyError(f"{w}.floor_ratio: must be > 0, got {ratio}")
             out.append({"type": "monotone", "norm": c["norm"], "floor_ratio": ratio})
@@ -254,17 +188,11 @@ def load_study(path):
     Every option value is converted to its command-line text, levels are expanded to a list of
     option dicts, and defaults are filled in. Raises StudyError naming the file and the key.
     """
-    try:
-        with open(path) as fh:
-            raw = yaml.safe_load(fh)
-    except OSError as exc:
-        raise StudyError(f"{path}: cannot read the study file ({exc.strerror})") from exc
-    except yaml.YAMLError as exc:
-        raise StudyError(f"{path}: invalid YAML ({exc})") from exc
-    _check_keys(raw, TOP_KEYS, REQUIRED_KEYS, path)
+    raw = read_yaml(path)
+    check_keys(raw, TOP_KEYS, REQUIRED_KEYS, path)
 
     name = raw["name"]
-    if not isinstance(name, str) or not re.fullmatch(r"[A-Za-z0-9._\-]+", name):
+    if not isinstance(name, str) or not re.fullmatch(NAME_RE, name):
         raise StudyError(f"{path}: name: {name!r} is not a file-name-safe string")
     norms = raw["norms"]
     if (not isinstance(norms, list) or not norms or not all(isinstance(n, str) for n in norms)
@@ -275,11 +203,11 @@ def load_study(path):
     study = {
         "name": name,
         "description": str(raw.get("description", "")),
-        "np": _number(raw.get("np", 1), f"{path}: np", integer=True),
+        "np": number(raw.get("np", 1), f"{path}: np", integer=True),
         "options_file": raw.get("options_file"),
-        "options": _options(raw.get("options"), f"{path}: options"),
+        "options": options(raw.get("options"), f"{path}: options"),
         "x": raw["x"],
-        "tolerance": float(_number(raw.get("tolerance", 0.1), f"{path}: tolerance")),
+        "tolerance": float(number(raw.get("tolerance", 0.1), f"{path}: tolerance")),
         "norms": norms,
         "levels": _levels(raw["levels"], f"{path}: levels"),
     }
@@ -289,24 +217,20 @@ def load_study(path):
     if study["tolerance"] < 0:
         raise StudyError(f"{path}: tolerance: must be >= 0, got {study['tolerance']}")
     nlev = len(study["levels"])
-    study["fit_levels"] = _number(raw.get("fit_levels", nlev), f"{path}: fit_levels", integer=True)
+    study["fit_levels"] = number(raw.get("fit_levels", nlev), f"{path}: fit_levels", integer=True)
     if not 2 <= study["fit_levels"] <= nlev:
         raise StudyError(f"{path}: fit_levels: must be between 2 and the number of levels "
                          f"({nlev}), got {study['fit_levels']}")
 
-    if study["options_file"] is not None:
-        f = study["options_file"]
-        if not isinstance(f, str) or not os.path.isfile(os.path.join(ROOT, f)):
-            raise StudyError(f"{path}: options_file: no such file {f!r} "
-                             f"(relative paths are relative to {ROOT})")
+    options_file(study["options_file"], f"{path}: options_file")
 
     ref = raw.get("reference")
     if ref is not None:
-        _check_keys(ref, ("options", "per"), (), f"{path}: reference")
+        check_keys(ref, ("options", "per"), (), f"{path}: reference")
         per = ref.get("per", "level")
         if per not in ("level", "series"):
             raise StudyError(f"{path}: reference.per: must be 'level' or 'series', got {per!r}")
-        ref = {"options": _options(ref.get("options"), f"{path}: reference.options"), "per": per}
+        ref = {"options": options(ref.get("options"), f"{path}: reference.options"), "per": per}
         scopes = [("options", study["options"])] + [
             (f"series {s['label']!r} options", s["options"]) for s in study["series"]] + [
             (f"levels[{k}]", lev) for k, lev in enumerate(study["levels"])]
@@ -338,13 +262,6 @@ class Run:
         label = study["series"][self.series]["label"]
         where = f"series {label!r}" + ("" if self.level is None else f" level {self.level}")
         return where if self.kind == "run" else f"reference of {where}"
-
-
-def display_path(path):
-    """`path` relative to ROOT when inside it (as the runs see it), else absolute."""
-    path = os.path.abspath(path)
-    rel = os.path.relpath(path, ROOT)
-    return path if rel.startswith("..") else rel
 
 
 def plan_runs(study, outdir):
@@ -393,19 +310,15 @@ def execute(run, cmd, study):
     h5 = os.path.join(ROOT, run.output)
     if os.path.exists(h5):
         os.remove(h5)  # never read back a file left by an earlier study
-    proc = subprocess.run(cmd, cwd=ROOT, env={**os.environ, **MPI_ENV}, stdout=subprocess.PIPE,
-                          stderr=subprocess.STDOUT, text=True)
     log = h5[:-3] + ".log"
-    with open(log, "w") as fh:
-        fh.write(proc.stdout)
+    proc = run_mpi(cmd, log)
     run.returncode = proc.returncode
     if not os.path.exists(h5):
-        tail = "\n".join(proc.stdout.rstrip().splitlines()[-LOG_TAIL_LINES:])
         raise StudyError(f"{run.describe(study)} exited with status {proc.returncode} and wrote no "
                          f"{run.output}; command:\n  {shlex.join(cmd)}\nlast lines of its output "
-                         f"(all in {display_path(log)}):\n{tail}")
+                         f"(all in {display_path(log)}):\n{tail(proc.output, LOG_TAIL_LINES)}")
     try:
-        run.attrs = read_runs.read_run(h5)
+        run.attrs = read_run(h5)
     except ValueError as exc:
         raise StudyError(str(exc)) from exc
     needed = ["converged"] + ([study["x"]] + study["norms"] if run.kind == "run" else [])
@@ -444,64 +357,6 @@ def run_table(plan, study):
 
 # ------------------------------------------------------------------------------ rates
 
-def _invalid(value):
-    """Why `value` cannot enter a logarithm ('' when it can: a finite number > 0)."""
-    if not isinstance(value, (int, float)) or isinstance(value, bool):
-        return "not a number"
-    if not math.isfinite(value):
-        return "not finite"
-    if value <= 0:
-        return "<= 0"
-    return ""
-
-
-def level_rates(x, e):
-    """Level-to-level rates [(rate, note)] for levels 1.., rate = log(e_k/e_{k-1})/log(x_k/x_{k-1}).
-
-    `note` is '' for a valid rate; otherwise rate is nan and note says why.
-    """
-    out = []
-    for k in range(1, len(x)):
-        note = _first_invalid(x, e, 0, [k - 1, k])
-        if not note and x[k] == x[k - 1]:
-            note = f"x_{k} = x_{k - 1}"
-        if note:
-            out.append((math.nan, note))
-        else:
-            out.append((math.log(e[k] / e[k - 1]) / math.log(x[k] / x[k - 1]), ""))
-    return out
-
-
-def _first_invalid(x, e, first_level, indices):
-    """Note naming the first x or e among `indices` that cannot enter a logarithm ('' if none).
-
-    Levels are numbered from `first_level` (the level of x[0]).
-    """
-    for name, values in (("x", x), ("e", e)):
-        for j in indices:
-            why = _invalid(values[j])
-            if why:
-                return f"{name}_{first_level + j} {why}"
-    return ""
-
-
-def fitted_rate(x, e, first_level=0):
-    """Least-squares slope of log e against log x over all given points: (rate, note).
-
-    Every point must be finite and positive, else the rate is nan and the note names the first
-    offending level (x[0] being level `first_level`); at least two distinct x are needed.
-    """
-    note = _first_invalid(x, e, first_level, range(len(x)))
-    if note:
-        return math.nan, note
-    lx, le = np.log(np.asarray(x, float)), np.log(np.asarray(e, float))
-    dx = lx - lx.mean()
-    sxx = float(dx @ dx)
-    if sxx == 0.0:
-        return math.nan, "fewer than two distinct x"
-    return float(dx @ (le - le.mean())) / sxx, ""
-
-
 def analyse(study, table):
     """Abscissae, values, level rates and fitted rates of every (series, norm).
 
@@ -520,34 +375,7 @@ def analyse(study, table):
     return res
 
 
-def agrees(fitted, predicted, tolerance):
-    """Agreement of a fitted rate with a predicted exponent: fitted >= predicted - tolerance."""
-    return math.isfinite(fitted) and fitted >= predicted - tolerance
-
-
 # ------------------------------------------------------------------------------ checks
-
-def monotone_until_floor(x, e, floor_ratio):
-    """The monotone check on one series (see the module docstring): (passed, detail)."""
-    for k in range(1, len(x)):
-        if not x[k] < x[k - 1]:  # also catches nan
-            return False, f"x does not decrease along the levels (x_{k - 1} = {x[k - 1]!r}, x_{k} = {x[k]!r})"
-    for k, v in enumerate(e):
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v) or v < 0:
-            return False, f"e_{k} = {v!r} is not a finite number >= 0"
-    for k in range(1, len(e)):
-        if e[k] > floor_ratio * e[k - 1]:
-            floor = e[k - 1]
-            lo, hi = FLOOR_BAND[0] * floor, FLOOR_BAND[1] * floor
-            for j in range(k, len(e)):
-                if not lo <= e[j] <= hi:
-                    return False, (f"floor from level {k} at {floor:.4g}, but e_{j} = {e[j]:.4g} "
-                                   f"is outside [{lo:.4g}, {hi:.4g}]")
-            return True, f"decreases until level {k - 1}, then stays at the floor {floor:.4g}"
-        if e[k] > e[k - 1] * (1 + MONOTONE_RTOL):
-            return False, f"e increases before the floor: e_{k - 1} = {e[k - 1]:.4g}, e_{k} = {e[k]:.4g}"
-    return True, f"decreases over all {len(e)} levels, no floor"
-
 
 def evaluate_checks(study, plan, analysis):
     """Evaluate the implicit 'all runs converged' check and the study's checks.
@@ -588,44 +416,20 @@ def evaluate_checks(study, plan, analysis):
 
 # ------------------------------------------------------------------------------ reports
 
-def format_rate(rate, note):
-    """A rate with 3 decimals, or 'nan (why)'."""
-    return f"{rate:.3f}" if not note else f"nan ({note})"
-
-
-def format_value(v):
-    """A norm or abscissa value for the Markdown tables."""
-    return f"{v:.4e}" if isinstance(v, float) else str(v)
-
-
-def _csv_value(v):
-    """CSV cell: floats at full precision (repr), None empty, anything else as is."""
-    if isinstance(v, float):
-        return repr(v)
-    return "" if v is None else v
-
-
 def write_csv(path, study, table, analysis):
     """One row per run; rate_<norm> is empty at level 0 and nan where it cannot be computed."""
     norms = study["norms"]
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh, lineterminator="\n")
-        w.writerow(["series", "level", study["x"]] + norms
+    rows = []
+    for i, row in enumerate(table):
+        for k, run in enumerate(row):
+            a = run.attrs
+            rates = [None if k == 0 else analysis[(i, n)]["rates"][k - 1][0] for n in norms]
+            rows.append([study["series"][i]["label"], k, a[study["x"]]] + [a[n] for n in norms]
+                        + [a.get("newton_its"), a.get("ksp_its"), a.get("time_solve"),
+                           a["converged"], run.returncode] + rates + [os.path.basename(run.output)])
+    write_csv_file(path, ["series", "level", study["x"]] + norms
                    + ["newton_its", "ksp_its", "time_solve", "converged", "exit_code"]
-                   + [f"rate_{n}" for n in norms] + ["file"])
-        for i, row in enumerate(table):
-            for k, run in enumerate(row):
-                a = run.attrs
-                rates = [None if k == 0 else analysis[(i, n)]["rates"][k - 1][0] for n in norms]
-                cells = ([study["series"][i]["label"], k, a[study["x"]]] + [a[n] for n in norms]
-                         + [a.get("newton_its"), a.get("ksp_its"), a.get("time_solve"),
-                            a["converged"], run.returncode] + rates + [os.path.basename(run.output)])
-                w.writerow([_csv_value(c) for c in cells])
-
-
-def _md_options(opts):
-    """Options as inline code, '-' if none."""
-    return " ".join(f"`-{k} {v}`" for k, v in opts.items()) or "-"
+                   + [f"rate_{n}" for n in norms] + ["file"], rows)
 
 
 def write_markdown(path, study, plan, table, analysis):
@@ -637,10 +441,10 @@ def write_markdown(path, study, plan, table, analysis):
     out += [f"- abscissa: `{x}`; fit over the last {nfit} of {len(study['levels'])} levels; "
             f"agreement: fitted >= predicted - {study['tolerance']:g}",
             f"- options file: `{study['options_file']}`" if study["options_file"] else "- options file: -",
-            f"- options of every run: {_md_options(study['options'])}"]
+            f"- options of every run: {md_options(study['options'])}"]
     if study["reference"]:
         out.append(f"- reference runs (one per {study['reference']['per']}): "
-                   f"{_md_options(study['reference']['options'])}")
+                   f"{md_options(study['reference']['options'])}")
     out.append("")
     failed = [r for r in plan if not run_ok(r)]
     if failed:
@@ -650,20 +454,20 @@ def write_markdown(path, study, plan, table, analysis):
                 for r in failed]
         out.append("")
     for i, s in enumerate(study["series"]):
-        out += [f"## Series {s['label']}", "", f"Options: {_md_options(s['options'])}", ""]
+        out += [f"## Series {s['label']}", "", f"Options: {md_options(s['options'])}", ""]
         head = ["level", "level options", x]
         for n in norms:
             head += [n, f"rate {n}"]
         head += ["newton_its", "ksp_its", "converged"]
-        out += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        out += [md_row(head), md_rule(len(head))]
         for k, run in enumerate(table[i]):
-            cells = [str(k), _md_options(study["levels"][k]), format_value(run.attrs[x])]
+            cells = [str(k), md_options(study["levels"][k]), format_value(run.attrs[x])]
             for n in norms:
                 a = analysis[(i, n)]
                 cells += [format_value(a["e"][k]), "" if k == 0 else format_rate(*a["rates"][k - 1])]
             cells += [str(run.attrs.get("newton_its", "")), str(run.attrs.get("ksp_its", "")),
                       "yes" if run_ok(run) else f"**NO** (exit {run.returncode})"]
-            out.append("| " + " | ".join(cells) + " |")
+            out.append(md_row(cells))
         out.append("")
     out += ["## Summary", "",
             f"| series | norm | predicted | fitted (last {nfit} levels) | agrees |",
@@ -678,8 +482,7 @@ def write_markdown(path, study, plan, table, analysis):
     out += ["", "nan: a rate needs finite, positive values at distinct x; the note names the "
             "offending level.", ""]
     out += [f"![{n}]({study['name']}_{n}.png)" for n in norms]
-    with open(path, "w") as fh:
-        fh.write("\n".join(out) + "\n")
+    write_lines(path, out)
 
 
 def write_plot(path, study, norm, analysis):
@@ -689,7 +492,7 @@ def write_plot(path, study, norm, analysis):
     plotted = False
     for i, s in enumerate(study["series"]):
         x, e = analysis["x"][i], analysis[(i, norm)]["e"]
-        pts = [(a, b) for a, b in zip(x, e) if not _invalid(a) and not _invalid(b)]
+        pts = [(a, b) for a, b in zip(x, e) if not invalid(a) and not invalid(b)]
         if not pts:
             continue
         plotted = True
@@ -698,7 +501,7 @@ def write_plot(path, study, norm, analysis):
         line, = ax.plot(px, pe, marker=markers[i % len(markers)], label=
                         f"{s['label']} (fitted {'nan' if note else f'{rate:.2f}'})")
         p = s["predicted"].get(norm)
-        if p is not None and not _invalid(x[-1]) and not _invalid(e[-1]):
+        if p is not None and not invalid(x[-1]) and not invalid(e[-1]):
             xs = np.array([min(px), max(px)])
             ax.plot(xs, e[-1] * (xs / x[-1]) ** p, "--", color=line.get_color(),
                     label=f"slope {p:g} ({s['label']})")
@@ -707,15 +510,12 @@ def write_plot(path, study, norm, analysis):
     if plotted:
         ax.legend(fontsize="small")
     else:
-        ax.text(0.5, 0.5, f"no finite positive values of {norm}", ha="center", va="center",
-                transform=ax.transAxes)
+        no_values_note(ax, norm)
     ax.grid(True, which="both", alpha=0.3)
     ax.set_xlabel(study["x"])
     ax.set_ylabel(norm)
     ax.set_title(f"{study['name']}: {norm}")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save_png(fig, path, 120)
 
 
 # ------------------------------------------------------------------------------ main

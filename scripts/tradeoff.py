@@ -106,30 +106,28 @@ as failed); 1 some run wrote no file or timed out (the reports are still written
 stops the study (bad study file, a failed reference run, an unreadable output file).
 """
 import argparse
-import csv
 import math
 import os
-import re
 import shlex
-import signal
-import subprocess
 import sys
 import time
 from dataclasses import dataclass, field
 from typing import Optional
 
-import matplotlib
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-from matplotlib.lines import Line2D  # noqa: E402
-import yaml  # noqa: E402
-
 SCRIPTS = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(SCRIPTS)
 sys.path.insert(0, SCRIPTS)
-import read_runs  # noqa: E402
-from study import BIN, MPI_ENV, StudyError, option_value, safe_label  # noqa: E402
-LOG_TAIL_LINES = 40
+from signorini.figures import no_values_note, plt, save_png  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402  (after figures, which selects the Agg backend)
+from signorini.formatting import finite, fmt_mem, fmt_time, fmt_val, sci, short  # noqa: E402
+from signorini.mpirun import LOG_TAIL_LINES, MPI_ENV, error_line, run_mpi, tail  # noqa: E402,F401
+from signorini.paths import BIN, ROOT, display_path  # noqa: E402
+from signorini.pareto import (ERROR_RTOL, dominates, pareto_front, recommend,  # noqa: E402,F401
+                              same_error, usable)
+from signorini.report import md_options, md_row, md_rule, write_csv as write_csv_file, write_lines  # noqa: E402
+from signorini.runs import read_run  # noqa: E402
+from signorini.studyfile import (NAME_RE, StudyError, check_keys, integer, name_list,  # noqa: E402,F401
+                                 option_value, options, options_file, positive, read_yaml,
+                                 safe_label, safe_name, string)
 
 TOP_KEYS = ("name", "description", "np", "timeout", "cost", "error_rtol", "norms", "targets",
             "problems", "methods", "eps_rules", "solvers", "skip")
@@ -141,7 +139,6 @@ FACTOR_KEYS = {"methods": ("name", "text", "options", "uses_eps"),
                "solvers": ("name", "text", "options_file", "options")}
 SKIP_SELECTORS = {"problem": "problems", "method": "methods", "eps_rule": "eps_rules",
                   "solver": "solvers"}
-NAME_RE = r"[A-Za-z0-9._\-]+"
 
 # Error columns of the CSV, in this order when present (plus any other norm a problem names).
 _BASE_ERRORS = ["error_h1", "error_h1_semi", "error_l2", "error_energy", "error_pressure_l2",
@@ -152,99 +149,22 @@ NORM_COLUMNS = (_BASE_ERRORS + ["reference_" + n for n in _BASE_ERRORS]
 EXPECTED = ["h", "eps", "n_dofs", "time_setup", "time_solve", "time_total", "newton_its",
             "ksp_its", "peak_memory_mb", "converged"]
 NO_EPS = "-"  # eps_rule of a method that does not use eps
-ERROR_RTOL = 1e-6  # default error_rtol: errors this close count as equal in the Pareto fronts
+RESERVED = ("output", "reference")  # options set by the driver
 NAN = float("nan")
 
 
 # ------------------------------------------------------------------------------ study file
 
-def _mapping(value, allowed, required, where):
-    """Check that `value` is a mapping with the required keys and no other than `allowed`."""
-    if not isinstance(value, dict):
-        raise StudyError(f"{where}: expected a mapping, got {type(value).__name__}")
-    for key in required:
-        if key not in value:
-            raise StudyError(f"{where}: missing required key '{key}'")
-    for key in value:
-        if key not in allowed:
-            raise StudyError(f"{where}: unknown key '{key}' (allowed: {', '.join(allowed)})")
-    return value
-
-
-def _name(value, where):
-    """A file-name-safe name."""
-    if not isinstance(value, str) or not re.fullmatch(NAME_RE, value):
-        raise StudyError(f"{where}: {value!r} is not a name of letters, digits, '.', '_', '-'")
-    return value
-
-
-def _text(value, where):
-    """A string (numbers are accepted and converted)."""
-    if isinstance(value, bool) or not isinstance(value, (str, int, float)):
-        raise StudyError(f"{where}: expected a string, got {value!r}")
-    return str(value)
-
-
-def _int(value, where, minimum):
-    if isinstance(value, bool) or not isinstance(value, int) or value < minimum:
-        raise StudyError(f"{where}: expected an integer >= {minimum}, got {value!r}")
-    return value
-
-
-def _positive(value, where):
-    """A number > 0; numeric strings such as '1e-2' (YAML 1.1 reads them as text) are accepted."""
-    if isinstance(value, str):
-        try:
-            value = float(value)
-        except ValueError:
-            raise StudyError(f"{where}: expected a number > 0, got {value!r}") from None
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not value > 0 \
-            or not math.isfinite(value):
-        raise StudyError(f"{where}: expected a finite number > 0, got {value!r}")
-    return float(value)
-
-
 def _options(value, where):
-    """An options mapping -> {key: command-line text}; keys without the dash."""
-    if value is None:
-        return {}
-    if not isinstance(value, dict):
-        raise StudyError(f"{where}: expected a mapping of options, got {type(value).__name__}")
-    out = {}
-    for key, v in value.items():
-        if not isinstance(key, str):
-            raise StudyError(f"{where}: option key {key!r} was read by YAML as "
-                             f"{type(key).__name__}; quote it")
-        if not re.fullmatch(r"[A-Za-z0-9_]+", key):
-            raise StudyError(f"{where}: invalid option key {key!r} (give it without the dash)")
-        if key in ("output", "reference"):
-            raise StudyError(f"{where}.{key}: option '{key}' is set by the driver, remove it")
-        out[key] = option_value(v, f"{where}.{key}")
-    return out
-
-
-def _options_file(value, where):
-    """An options file relative to ROOT (or absolute) that exists."""
-    if value is None:
-        return None
-    if not isinstance(value, str) or not os.path.isfile(os.path.join(ROOT, value)):
-        raise StudyError(f"{where}: no such file {value!r} (relative paths are relative to {ROOT})")
-    return value
-
-
-def _name_list(value, where):
-    """A non-empty list of distinct strings (attribute names)."""
-    if (not isinstance(value, list) or not value or not all(isinstance(n, str) for n in value)
-            or len(set(value)) != len(value)):
-        raise StudyError(f"{where}: expected a non-empty list of distinct attribute names")
-    return list(value)
+    """An options mapping -> {key: command-line text}; keys without the dash; no output, reference."""
+    return options(value, where, RESERVED, name_key=True)
 
 
 def _cost(value, where):
     """`cost`: an attribute name or a non-empty list of them -> list of names."""
     if isinstance(value, str):
         return [value]
-    return _name_list(value, where)
+    return name_list(value, where)
 
 
 def _targets(value, where):
@@ -257,7 +177,7 @@ def _targets(value, where):
             raise StudyError(f"{where}: norm {norm!r} is not a string")
         if not isinstance(ts, list) or not ts:
             raise StudyError(f"{where}.{norm}: expected a non-empty list of target errors")
-        vals = [_positive(t, f"{where}.{norm}[{i}]") for i, t in enumerate(ts)]
+        vals = [positive(t, f"{where}.{norm}[{i}]") for i, t in enumerate(ts)]
         out[norm] = sorted(set(vals), reverse=True)
     return out
 
@@ -273,7 +193,7 @@ def _levels(value, where):
     """Levels -> list of {"options", "label"}."""
     labels = None
     if isinstance(value, dict):
-        _mapping(value, ("key", "values", "labels"), ("key", "values"), where)
+        check_keys(value, ("key", "values", "labels"), ("key", "values"), where)
         if not isinstance(value["key"], str):
             raise StudyError(f"{where}.key: expected an option name")
         if not isinstance(value["values"], list) or not value["values"]:
@@ -290,7 +210,7 @@ def _levels(value, where):
     out = []
     for k, lev in enumerate(value):
         opts = _options(lev, f"{where}[{k}]")
-        label = level_label(opts) if labels is None else _text(labels[k], f"{where}.labels[{k}]")
+        label = level_label(opts) if labels is None else string(labels[k], f"{where}.labels[{k}]")
         out.append({"options": opts, "label": label})
     if len({lev["label"] for lev in out}) != len(out):
         raise StudyError(f"{where}: two levels have the same label; give distinct labels")
@@ -304,14 +224,14 @@ def _factor(value, kind, where):
     out, names = [], set()
     for i, item in enumerate(value):
         w = f"{where}[{i}]"
-        _mapping(item, FACTOR_KEYS[kind], ("name",), w)
-        name = _name(item["name"], f"{w}.name")
+        check_keys(item, FACTOR_KEYS[kind], ("name",), w)
+        name = safe_name(item["name"], f"{w}.name")
         if name in names:
             raise StudyError(f"{w}.name: {name!r} appears twice in {kind}")
         names.add(name)
-        entry = {"name": name, "text": _text(item.get("text", name), f"{w}.text"),
+        entry = {"name": name, "text": string(item.get("text", name), f"{w}.text"),
                  "options": _options(item.get("options"), f"{w}.options"),
-                 "options_file": _options_file(item.get("options_file"), f"{w}.options_file")}
+                 "options_file": options_file(item.get("options_file"), f"{w}.options_file")}
         if kind == "methods":
             uses = item.get("uses_eps", True)
             if not isinstance(uses, bool):
@@ -324,16 +244,16 @@ def _factor(value, kind, where):
 def _problem(value, i, study, where):
     """One problem -> normalized dict."""
     w = f"{where}[{i}]"
-    _mapping(value, PROBLEM_KEYS, ("name", "levels"), w)
-    p = {"name": _name(value["name"], f"{w}.name"),
-         "description": _text(value.get("description", ""), f"{w}.description"),
-         "options_file": _options_file(value.get("options_file"), f"{w}.options_file"),
+    check_keys(value, PROBLEM_KEYS, ("name", "levels"), w)
+    p = {"name": safe_name(value["name"], f"{w}.name"),
+         "description": string(value.get("description", ""), f"{w}.description"),
+         "options_file": options_file(value.get("options_file"), f"{w}.options_file"),
          "options": _options(value.get("options"), f"{w}.options"),
-         "np": _int(value.get("np", study["np"]), f"{w}.np", 1),
+         "np": integer(value.get("np", study["np"]), f"{w}.np", 1),
          "cost": _cost(value["cost"], f"{w}.cost") if "cost" in value else study["cost"],
          "levels": _levels(value["levels"], f"{w}.levels")}
     if "norms" in value:
-        p["norms"] = _name_list(value["norms"], f"{w}.norms")
+        p["norms"] = name_list(value["norms"], f"{w}.norms")
     elif study["norms"] is not None:
         p["norms"] = study["norms"]
     else:
@@ -348,12 +268,12 @@ def _problem(value, i, study, where):
     ref = value.get("reference")
     if ref is not None:
         rw = f"{w}.reference"
-        _mapping(ref, ("options", "options_file", "solver"), ("options",), rw)
+        check_keys(ref, ("options", "options_file", "solver"), ("options",), rw)
         solver = ref.get("solver")
         if solver is not None and solver not in [s["name"] for s in study["solvers"]]:
             raise StudyError(f"{rw}.solver: {solver!r} is not one of the solvers")
         ref = {"options": _options(ref["options"], f"{rw}.options"),
-               "options_file": _options_file(ref.get("options_file"), f"{rw}.options_file"),
+               "options_file": options_file(ref.get("options_file"), f"{rw}.options_file"),
                "solver": solver}
     p["reference"] = ref
     return p
@@ -368,8 +288,8 @@ def _skip(value, study, where):
     out = []
     for i, item in enumerate(value):
         w = f"{where}[{i}]"
-        _mapping(item, tuple(SKIP_SELECTORS) + ("reason",), ("reason",), w)
-        entry = {"reason": _text(item["reason"], f"{w}.reason")}
+        check_keys(item, tuple(SKIP_SELECTORS) + ("reason",), ("reason",), w)
+        entry = {"reason": string(item["reason"], f"{w}.reason")}
         for sel, kind in SKIP_SELECTORS.items():
             if sel not in item:
                 continue
@@ -391,23 +311,17 @@ def load_study(path):
 
     Raises StudyError naming the file and the key at fault.
     """
-    try:
-        with open(path) as fh:
-            raw = yaml.safe_load(fh)
-    except OSError as exc:
-        raise StudyError(f"{path}: cannot read the study file ({exc.strerror})") from exc
-    except yaml.YAMLError as exc:
-        raise StudyError(f"{path}: invalid YAML ({exc})") from exc
-    _mapping(raw, TOP_KEYS, TOP_REQUIRED, path)
+    raw = read_yaml(path)
+    check_keys(raw, TOP_KEYS, TOP_REQUIRED, path)
     w = f"{path}:"
-    study = {"name": _name(raw["name"], f"{w} name"),
-             "description": _text(raw.get("description", ""), f"{w} description"),
-             "np": _int(raw.get("np", 1), f"{w} np", 1),
+    study = {"name": safe_name(raw["name"], f"{w} name"),
+             "description": string(raw.get("description", ""), f"{w} description"),
+             "np": integer(raw.get("np", 1), f"{w} np", 1),
              "timeout": (None if raw.get("timeout") is None
-                         else _positive(raw["timeout"], f"{w} timeout")),
+                         else positive(raw["timeout"], f"{w} timeout")),
              "cost": _cost(raw.get("cost", "time_total"), f"{w} cost"),
-             "error_rtol": _positive(raw.get("error_rtol", ERROR_RTOL), f"{w} error_rtol"),
-             "norms": _name_list(raw["norms"], f"{w} norms") if "norms" in raw else None,
+             "error_rtol": positive(raw.get("error_rtol", ERROR_RTOL), f"{w} error_rtol"),
+             "norms": name_list(raw["norms"], f"{w} norms") if "norms" in raw else None,
              "targets": _targets(raw["targets"], f"{w} targets")}
     for kind in ("methods", "solvers"):
         study[kind] = _factor(raw[kind], kind, f"{w} {kind}")
@@ -461,13 +375,6 @@ class Run:
         eps = "" if self.eps_rule is None else f", eps {self.eps_rule['name']}"
         return (f"{p} level {self.problem['levels'][self.level]['label']}, "
                 f"{self.method['name']}{eps}, {self.solver['name']}")
-
-
-def display_path(path):
-    """`path` relative to ROOT when inside it (as the runs see it), else absolute."""
-    path = os.path.abspath(path)
-    rel = os.path.relpath(path, ROOT)
-    return path if rel.startswith("..") else rel
 
 
 def _args(files, option_maps):
@@ -542,24 +449,6 @@ def command(run):
 
 # ------------------------------------------------------------------------------ execution
 
-def _tail(text, n):
-    return "\n".join(text.rstrip().splitlines()[-n:])
-
-
-def _error_line(text):
-    """The most telling line of a failed run's output (PETSc's error message if any)."""
-    lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
-    for ln in lines:
-        if "PETSC ERROR" in ln and not re.search(r"-{5}|Error Message|See https", ln):
-            msg = ln.split("PETSC ERROR:", 1)[-1].strip()
-            if msg and not msg.startswith(("Missing or incorrect", "#", "Petsc Release")):
-                return msg
-    for ln in reversed(lines):
-        if "ERROR" in ln:
-            return ln
-    return lines[-1] if lines else "(no output)"
-
-
 def execute(run, timeout):
     """Run it in ROOT; save the console log beside the HDF5 file; read /run back.
 
@@ -571,38 +460,23 @@ def execute(run, timeout):
     for stale in (h5, h5[:-3] + ".xdmf"):
         if os.path.exists(stale):
             os.remove(stale)  # never read back a file left by an earlier study
-    t0 = time.monotonic()
-    proc = subprocess.Popen(cmd, cwd=ROOT, env={**os.environ, **MPI_ENV}, stdout=subprocess.PIPE,
-                            stderr=subprocess.STDOUT, text=True, start_new_session=True)
-    try:
-        text, _ = proc.communicate(timeout=timeout)
-        timed_out = False
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, signal.SIGTERM)  # its own session: mpiexec and its ranks
-        try:
-            text, _ = proc.communicate(timeout=10)
-        except subprocess.TimeoutExpired:
-            os.killpg(proc.pid, signal.SIGKILL)
-            text, _ = proc.communicate()
-        timed_out = True
-    run.wall = time.monotonic() - t0
+    proc = run_mpi(cmd, h5[:-3] + ".log", timeout)
+    run.wall = proc.wall
     run.returncode = proc.returncode
-    with open(h5[:-3] + ".log", "w") as fh:
-        fh.write(text)
-    if timed_out:
+    if proc.timed_out:
         run.status = "timeout"
         run.notes.append(f"killed after the timeout of {timeout:g} s")
         return
     if not os.path.exists(h5):
         run.status = "no output"
-        run.notes.append(f"exit {proc.returncode}, no file: {_error_line(text)}")
+        run.notes.append(f"exit {proc.returncode}, no file: {error_line(proc.output)}")
         if run.kind == "reference":
             raise StudyError(f"{run.describe()} exited with status {proc.returncode} and wrote no "
                              f"{run.output}; command:\n  {shlex.join(cmd)}\nlast lines of its "
-                             f"output:\n{_tail(text, LOG_TAIL_LINES)}")
+                             f"output:\n{tail(proc.output, LOG_TAIL_LINES)}")
         return
     try:
-        run.attrs = read_runs.read_run(h5)
+        run.attrs = read_run(h5)
     except ValueError as exc:
         raise StudyError(str(exc)) from exc
     conv = run.attrs.get("converged")
@@ -636,10 +510,6 @@ def _num(v):
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         return NAN
     return float(v)
-
-
-def finite(v):
-    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
 def make_row(run):
@@ -676,39 +546,6 @@ def make_row(run):
 
 # ------------------------------------------------------------------------------ analysis
 
-def usable(row, norm):
-    """A converged run with a finite cost and a finite value of `norm`."""
-    return bool(row.get("ok")) and finite(row.get("cost")) and finite(row.get(norm))
-
-
-def same_error(ea, eb, rtol):
-    """Errors equal within the relative tolerance rtol."""
-    return abs(ea - eb) <= rtol * max(abs(ea), abs(eb))
-
-
-def dominates(a, b, norm, rtol=ERROR_RTOL):
-    """a is no slower and no less accurate than b (errors within rtol count as equal), and
-    strictly better in one of the two."""
-    ca, cb, ea, eb = a["cost"], b["cost"], a[norm], b[norm]
-    close = same_error(ea, eb, rtol)
-    return ca <= cb and (ea <= eb or close) and (ca < cb or (ea < eb and not close))
-
-
-def pareto_front(rows, norm, rtol=ERROR_RTOL):
-    """The usable rows that no usable row dominates, sorted by cost, error, plan order."""
-    cand = [r for r in rows if usable(r, norm)]
-    front = [r for r in cand if not any(dominates(o, r, norm, rtol) for o in cand if o is not r)]
-    return sorted(front, key=lambda r: (r["cost"], r[norm], r.get("index", 0)))
-
-
-def recommend(rows, norm, target):
-    """The cheapest usable row with error <= target (ties: smaller error, then plan order)."""
-    ok = [r for r in rows if usable(r, norm) and r[norm] <= target]
-    if not ok:
-        return None
-    return min(ok, key=lambda r: (r["cost"], r[norm], r.get("index", 0)))
-
-
 def recommendations(study, rows):
     """[(problem, norm, target, row or None)] for every problem, norm and target."""
     out = []
@@ -721,38 +558,6 @@ def recommendations(study, rows):
 
 
 # ------------------------------------------------------------------------------ formatting
-
-def sci(v, digits=2):
-    """Compact scientific notation: 8.1e-3; nan -> 'nan'."""
-    if not finite(v):
-        return "nan"
-    s = f"{v:.{digits - 1}e}"
-    mant, exp = s.split("e")
-    return f"{mant}e{int(exp)}"
-
-
-def short(v):
-    """Shortest scientific form that reads back as v (targets: 1e-2, 3e-3, 2.5e-2)."""
-    for d in range(1, 8):
-        s = sci(v, d)
-        if float(s) == v:
-            return s
-    return repr(v)
-
-
-def fmt_time(v):
-    return "nan" if not finite(v) else (f"{v:.3g}" if v < 100 else f"{v:.0f}")
-
-
-def fmt_mem(v):
-    return "n/a" if not finite(v) else f"{v:.0f}"
-
-
-def fmt_val(v):
-    if isinstance(v, float):
-        return sci(v, 3)
-    return "" if v is None else str(v)
-
 
 def cost_name(problem):
     return " + ".join(problem["cost"])
@@ -800,33 +605,17 @@ def csv_columns(study, rows):
                                   "exit_code", "status", "wall_time", "notes", "file"])
 
 
-def _csv_cell(v):
-    """CSV cell: floats at full precision (repr, nan as 'nan'), lists joined, None empty."""
-    if isinstance(v, float):
-        return repr(v)
-    if isinstance(v, list):
-        return "; ".join(v)
-    return "" if v is None else v
-
-
 def write_csv(path, study, rows):
     cols = csv_columns(study, rows)
-    with open(path, "w", newline="") as fh:
-        w = csv.writer(fh, lineterminator="\n")
-        w.writerow(cols)
-        for r in rows:
-            cells = []
-            for c in cols:
-                v = r.get(c)
-                if c in ("n_dofs", "newton_its", "ksp_its") and finite(v):
-                    v = int(v)
-                cells.append(_csv_cell(v))
-            w.writerow(cells)
-
-
-def _md_opts(files, opts):
-    parts = [f"`-options_file {f}`" for f in files if f] + [f"`-{k} {v}`" for k, v in opts.items()]
-    return " ".join(parts) or "-"
+    cells = []
+    for r in rows:
+        cells.append([])
+        for c in cols:
+            v = r.get(c)
+            if c in ("n_dofs", "newton_its", "ksp_its") and finite(v):
+                v = int(v)
+            cells[-1].append(v)
+    write_csv_file(path, cols, cells, list_sep="; ")
 
 
 def write_markdown(path, study, plan, skipped, rows, recs, elapsed):
@@ -843,12 +632,12 @@ def write_markdown(path, study, plan, skipped, rows, recs, elapsed):
             "only usable runs enter the Pareto fronts and the recommendations",
             "- cost: " + "; ".join(f"{p['name']}: `{cost_name(p)}`" for p in study["problems"])
             + " (seconds measured by the solver; the MPI start-up is not included)",
-            "- methods: " + "; ".join(f"{m['name']} {_md_opts([], m['options'])}"
+            "- methods: " + "; ".join(f"{m['name']} {md_options(m['options'])}"
                                       + ("" if m["uses_eps"] else " (no eps)")
                                       for m in study["methods"]),
-            "- eps rules (penalty only): " + ("; ".join(f"{e['name']} {_md_opts([], e['options'])}"
+            "- eps rules (penalty only): " + ("; ".join(f"{e['name']} {md_options(e['options'])}"
                                                           for e in study["eps_rules"]) or "-"),
-            "- solvers: " + "; ".join(f"{s['name']} {_md_opts([s['options_file']], s['options'])}"
+            "- solvers: " + "; ".join(f"{s['name']} {md_options(files=[s['options_file']], opts=s['options'])}"
                                       for s in study["solvers"]), ""]
     if skipped:
         out += ["## Skipped combinations", "", "| problem | method | eps rule | solver | reason |",
@@ -876,18 +665,18 @@ def write_markdown(path, study, plan, skipped, rows, recs, elapsed):
         out += [f"## Problem {p['name']}", ""]
         if p["description"]:
             out += [p["description"].strip(), ""]
-        out += [f"Options: {_md_opts([p['options_file']], p['options'])}; {p['np']} rank(s); "
-                f"levels: " + ", ".join(f"{lev['label']} ({_md_opts([], lev['options'])})"
+        out += [f"Options: {md_options(files=[p['options_file']], opts=p['options'])}; {p['np']} rank(s); "
+                f"levels: " + ", ".join(f"{lev['label']} ({md_options(lev['options'])})"
                                         for lev in p["levels"])]
         if p["reference"]:
             ref = p["reference"]
-            out[-1] += (f"; reference run: {_md_opts([ref['options_file']], ref['options'])}"
+            out[-1] += (f"; reference run: {md_options(files=[ref['options_file']], opts=ref['options'])}"
                         + (f" with {ref['solver']}" if ref["solver"] else ""))
         out.append("")
         head = (["level", "method", "eps rule", "solver", "h", "eps", "n_dofs"] + p["norms"]
                 + ["time_setup", "time_solve", "time_total", "cost", "newton", "ksp", "memory [MB]",
                    "status"])
-        out += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        out += [md_row(head), md_rule(len(head))]
         for r in prow:
             cells = ([r["level_label"], r["method"], r["eps_rule"], r["solver"], fmt_val(r["h"]),
                       fmt_val(r["eps"]),
@@ -897,7 +686,7 @@ def write_markdown(path, study, plan, skipped, rows, recs, elapsed):
                      + [fmt_val(int(r[k]) if finite(r[k]) else r[k]) for k in ("newton_its", "ksp_its")]
                      + [fmt_mem(r["peak_memory_mb"]),
                         "ok" if r["ok"] else f"**{r['status'].upper()}** (exit {r['exit_code']})"])
-            out.append("| " + " | ".join(cells) + " |")
+            out.append(md_row(cells))
         out.append("")
     out += ["## Pareto fronts", "",
             f"Runs that no other usable run beats in both cost and error (errors within a relative "
@@ -920,8 +709,7 @@ def write_markdown(path, study, plan, skipped, rows, recs, elapsed):
             "(generated from the runs above).", ""]
     out += recommendation_table(recs)
     out += [""] + [f"- {sentence(p, n, t, r)}" for p, n, t, r in recs]
-    with open(path, "w") as fh:
-        fh.write("\n".join(out) + "\n")
+    write_lines(path, out)
 
 
 def write_plot(path, study, problem, norm, rows):
@@ -972,8 +760,7 @@ def write_plot(path, study, problem, norm, rows):
         ax.set_xscale("log")
         ax.set_yscale("log")
     else:
-        ax.text(0.5, 0.5, f"no finite positive values of {norm}", ha="center", va="center",
-                transform=ax.transAxes)
+        no_values_note(ax, norm)
     if pos:  # the targets inside the range of the data (a target far below would squash it)
         lo, hi = min(r[norm] for r in pos), max(r[norm] for r in pos)
         ax.set_ylim(lo / 1.5, hi * 1.5)
@@ -986,9 +773,7 @@ def write_plot(path, study, problem, norm, rows):
     ax.set_title(f"{study['name']}: {problem['name']}, {norm} (dotted: targets)")
     if handles:
         ax.legend(handles=handles, fontsize="small", loc="center left", bbox_to_anchor=(1.01, 0.5))
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_png(fig, path, 110)
 
 
 # ------------------------------------------------------------------------------ main
