@@ -107,6 +107,7 @@ def file_digest(path):
         return hashlib.sha256(fh.read()).hexdigest()
 
 
+@pytest.mark.slow
 def test_bad_input_leaves_a_previous_good_output_untouched(outdir):
     """A good run writes FILE.h5; each bad run aimed at the same FILE.h5 fails with its message and leaves it as it was."""
     _, good = run(SQUARE, "keep_me")

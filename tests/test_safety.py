@@ -12,6 +12,7 @@ import xml.etree.ElementTree as ET
 
 import h5py
 import numpy as np
+import pytest
 
 from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position
 
@@ -116,6 +117,7 @@ def test_sigterm_during_set_up_solve_and_write():
     assert outcomes == ["old"] * 6, outcomes
 
 
+@pytest.mark.slow
 def test_sigterm_at_spread_times_leaves_old_or_new():
     """SIGTERM at 10 times spread over a whole run: each leaves the old pair or the new one, complete, and nothing else."""
     d, h5, old = prepare("spread_timing")
@@ -134,6 +136,7 @@ def test_sigterm_at_spread_times_leaves_old_or_new():
     assert "old" in seen, seen
 
 
+@pytest.mark.slow
 def test_sigterm_to_mpiexec_with_two_ranks():
     """mpiexec forwards SIGTERM to both ranks. In the solve: the old output stays. In the write: mpiexec forwards the
     signal late enough that the write may have ended, so the old pair or the new one, complete; nothing else either way."""

@@ -7,6 +7,8 @@ import os
 import re
 import subprocess
 
+import pytest
+
 from harness import ENV, OUT, ROOT
 
 ASAN_BIN = os.path.join(ROOT, "bin", "signorini-asan")
@@ -21,6 +23,7 @@ CASES = {
 }
 
 
+@pytest.mark.slow
 def test_sanitizers_report_nothing():
     p = subprocess.run(["make", "--no-print-directory", "asan"], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert p.returncode == 0, p.stdout[-3000:]

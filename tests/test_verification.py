@@ -7,6 +7,7 @@ import os
 import subprocess
 
 import numpy as np
+import pytest
 
 from harness import ENV, OUT, ROOT, load, run
 
@@ -145,6 +146,7 @@ def test_mms_bad_parameters_are_refused():
         assert not os.path.exists(h5)
 
 
+@pytest.mark.slow
 def test_study_rates_2d_reach_the_predictions():
     """Small version of study 1 (make rates): eps = h, nu = 0.25 and 0.5, 8x8 to 64x64; study.py --check asserts
     that the fitted H1 and pressure rates reach the predicted exponents within 0.1."""
@@ -152,6 +154,7 @@ def test_study_rates_2d_reach_the_predictions():
     assert out.count("PASS") == 2, out
 
 
+@pytest.mark.slow
 def test_study_eps_refinement_is_monotone_until_the_floor():
     """Small version of study 4: on a 32x32 mesh the error against the exact solution falls with eps until the
     discretization floor, and the distance to the SNESVI solution falls like eps (rate >= 0.9)."""
