@@ -92,6 +92,7 @@ def finish(p):
     return p.wait(timeout=120)
 
 
+@pytest.mark.slow
 def test_sigterm_during_set_up_solve_and_write():
     """SIGTERM (and SIGINT) sent to the solver in its set-up, in its Newton steps, and inside the write (the process is
     stopped when its temporary file appears, signalled, then continued): the old output is untouched, nothing is left."""
