@@ -29,7 +29,7 @@ all: $(BIN)
 
 deps:
 	@pkg-config --exists petsc && [ -f /usr/include/metis.h ] && [ -f /usr/include/yaml.h ] && command -v mpicc >/dev/null && command -v mpiexec >/dev/null && \
-	  $(PYTHON) -c "import h5py, numpy, matplotlib, yaml" 2>/dev/null || sh scripts/install-deps.sh
+	  $(PYTHON) -c "import h5py, numpy, matplotlib, yaml, pytest" 2>/dev/null || sh scripts/install-deps.sh
 
 # -MMD -MP: each object depends on the headers it includes (build/*.d), and only those
 build/%.o: src/%.c
@@ -40,7 +40,7 @@ $(BIN): $(OBJ)
 	@mkdir -p bin
 	$(CC) $(CFLAGS) -o $@ $(OBJ) $(LDLIBS)
 
-# AddressSanitizer and UndefinedBehaviorSanitizer build of the same sources (tests/sanitize.py runs a few cases with it)
+# AddressSanitizer and UndefinedBehaviorSanitizer build of the same sources (tests/test_sanitize.py runs a few cases with it)
 ASAN_FLAGS = -O1 -g -fsanitize=address,undefined -fno-omit-frame-pointer
 ASAN_OBJ   = $(SRC:src/%.c=build-asan/%.o)
 ASAN_BIN   = bin/signorini-asan
@@ -61,7 +61,7 @@ run: deps
 
 test: deps
 	@$(MAKE) --no-print-directory $(BIN)
-	$(PYTHON) tests/run_tests.py
+	$(PYTHON) -m pytest
 
 # The paper's convergence studies (README, "Reproducing the paper"): output/studies/<name>/<name>.{csv,md,png}
 rates: deps
@@ -94,6 +94,6 @@ format:
 	clang-format -i src/*.c src/*/*.c include/*.h
 
 clean:
-	rm -rf build build-asan bin output tests/out
+	rm -rf build build-asan bin output tests/out .pytest_cache
 
 -include $(OBJ:.o=.d) $(ASAN_OBJ:.o=.d)

@@ -13,12 +13,6 @@ import read_runs  # noqa: E402
 BIN = os.path.join(ROOT, "bin", "signorini")
 OUT = os.path.join(ROOT, "tests", "out")
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
-TESTS = []
-
-
-def test(fn):
-    TESTS.append(fn)
-    return fn
 
 
 def run(args, name, np_=1, expect_rc=0, output=None):

@@ -7,7 +7,7 @@ import sys
 
 import h5py
 
-from harness import ENV, OUT, ROOT, test
+from harness import ENV, ROOT
 
 SCRIPT = os.path.join(ROOT, "scripts", "regression.py")
 
@@ -17,11 +17,9 @@ def regression(*args):
                           timeout=300)
 
 
-@test
-def regression_script_finds_a_changed_number():
-    base = os.path.join(OUT, "regression")
+def test_regression_script_finds_a_changed_number(outdir):
+    base = outdir
     runs = os.path.join(base, "runs.yaml")
-    os.makedirs(base, exist_ok=True)
     with open(runs, "w") as fh:
         fh.write('runs:\n  - {name: small, args: "-dm_plex_box_faces 8,8"}\n  - {name: small_np2, ranks: 2, args: "-dm_plex_box_faces 8,8 -contact_method vi"}\n')
     for d in ("a", "b"):

@@ -1,32 +1,27 @@
-#!/usr/bin/python3
-"""Tests of scripts/study.py: rates and checks on synthetic data, the study file, and small real
-studies of the square scene run end to end. Ends with 'N passed, N failed'; exits 1 on a failure.
-
-Usage: tests/test_study.py [NAME ...]   (runs the tests whose names contain one of the words)
-"""
+"""Tests of scripts/study.py (make test): rates and checks on synthetic data, the study file, and small real
+studies of the square scene run end to end. Each test writes its files in a temporary directory of its own (TMP)."""
 import csv
 import math
 import os
-import shutil
 import subprocess
 import sys
-import tempfile
-import time
-import traceback
+
+import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import study  # noqa: E402
 
 STUDY = os.path.join(ROOT, "scripts", "study.py")
-TMP = tempfile.mkdtemp(prefix="test_study_")
-TESTS = []
+TMP = None  # the test's own temporary directory, set by the fixture tmp
 
 
-def test(fn):
-    """Register a test function."""
-    TESTS.append(fn)
-    return fn
+@pytest.fixture(autouse=True)
+def tmp(tmp_path):
+    """Every test writes its study files and outputs in a temporary directory of its own (pytest's tmp_path)."""
+    global TMP
+    TMP = str(tmp_path)
+    return TMP
 
 
 def write(name, text):
@@ -80,8 +75,7 @@ def synthetic(study_text, values, converged=None):
 
 # ---------------------------------------------------------------- rates
 
-@test
-def rates_of_an_exact_power_law():
+def test_rates_of_an_exact_power_law():
     for r in (0.5, 0.6875, 1.0, 2.0, 3.7):
         for x in ([0.5, 0.25, 0.125, 0.0625], [0.3, 0.17, 0.05, 0.011]):  # uniform and irregular
             e = [3.7 * h ** r for h in x]
@@ -91,8 +85,7 @@ def rates_of_an_exact_power_law():
                 assert nk == "" and abs(rk - r) < 1e-12, f"level rate {rk!r} for r = {r}"
 
 
-@test
-def fit_uses_only_the_last_fit_levels():
+def test_fit_uses_only_the_last_fit_levels():
     h = [0.5, 0.25, 0.125, 0.0625]
     vals = [[{"h": x, "e1": (1.0 if k == 0 else x ** 2), "e2": x} for k, x in enumerate(h)]] * 2
     s, _, a = synthetic(MINIMAL + "fit_levels: 3\n", vals)
@@ -102,8 +95,7 @@ def fit_uses_only_the_last_fit_levels():
     assert abs(a[(0, "e1")]["fit"][0] - 2.0) > 0.1
 
 
-@test
-def zero_negative_and_missing_values_give_nan_with_a_reason():
+def test_zero_negative_and_missing_values_give_nan_with_a_reason():
     x = [0.5, 0.25, 0.125, 0.0625]
     for bad, why in ((0.0, "<= 0"), (-1e-3, "<= 0"), (math.nan, "not finite"), (None, "not a number")):
         e = [1.0, 0.5, bad, 0.1]
@@ -122,8 +114,7 @@ def zero_negative_and_missing_values_give_nan_with_a_reason():
 
 # ---------------------------------------------------------------- checks
 
-@test
-def monotone_check_on_synthetic_series():
+def test_monotone_check_on_synthetic_series():
     x = [1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125]
     cases = [  # (e, floor_ratio, expected to pass)
         ([1.0, 0.5, 0.25, 0.125, 0.0625, 0.03125], 0.9, True),   # clean decrease, no floor
@@ -143,8 +134,7 @@ def monotone_check_on_synthetic_series():
     assert not ok and "x does not decrease" in detail
 
 
-@test
-def rate_and_converged_checks_on_synthetic_data():
+def test_rate_and_converged_checks_on_synthetic_data():
     h = [0.5, 0.25, 0.125, 0.0625]
     text = MINIMAL + "fit_levels: 3\ntolerance: 0.1\nchecks:\n  - {type: rate}\n" \
                      "  - {type: monotone, norm: e2}\n"
@@ -166,16 +156,14 @@ def rate_and_converged_checks_on_synthetic_data():
     assert "series 'b' level 2" in results[0][1]
 
 
-@test
-def agreement_is_one_sided():
+def test_agreement_is_one_sided():
     assert study.agrees(2.5, 2.0, 0.1) and study.agrees(1.9, 2.0, 0.1)
     assert not study.agrees(1.89, 2.0, 0.1) and not study.agrees(math.nan, 2.0, 0.1)
 
 
 # ---------------------------------------------------------------- study file
 
-@test
-def study_file_errors_name_the_key():
+def test_study_file_errors_name_the_key():
     expect_study_error(MINIMAL.replace("x: h\n", ""), "missing required key 'x'")
     expect_study_error(MINIMAL.replace("norms: [e1, e2]\n", ""), "missing required key 'norms'")
     expect_study_error(MINIMAL + "colour: red\n", "unknown key 'colour'")
@@ -193,8 +181,7 @@ def study_file_errors_name_the_key():
     expect_study_error(MINIMAL.replace("label: b", "label: a"), "same file name")
 
 
-@test
-def options_precedence_levels_form_and_reference_order():
+def test_options_precedence_levels_form_and_reference_order():
     text = """\
 name: prec
 np: 2
@@ -233,8 +220,7 @@ reference: {options: {d: ref}, per: level}
     assert a["levels"] == b["levels"]
 
 
-@test
-def cli_missing_file_and_dry_run():
+def test_cli_missing_file_and_dry_run():
     p = cli(os.path.join(TMP, "no_such_study.yaml"))
     assert p.returncode == 2 and "no_such_study.yaml" in p.stderr, p.stderr
     out = os.path.join(TMP, "dry")
@@ -266,8 +252,7 @@ checks:
 """
 
 
-@test
-def square_study_end_to_end():
+def test_square_study_end_to_end():
     out = os.path.join(TMP, "square")
     p = cli(write("square.yaml", SQUARE), "--outdir", out, "--check")
     assert p.returncode == 0, f"exit {p.returncode}\n{p.stdout}\n{p.stderr}"
@@ -287,8 +272,7 @@ def square_study_end_to_end():
     assert "| gauss | max_penetration | 1 |" in md and "| yes |" in md and "nan (e_0 <= 0)" in md
 
 
-@test
-def failed_runs_and_rates_fail_the_check():
+def test_failed_runs_and_rates_fail_the_check():
     text = """\
 name: failing
 options_file: options/square.yaml
@@ -315,8 +299,7 @@ checks: [{type: rate}]
     assert [(r["converged"], r["exit_code"]) for r in rows] == [("1", "0"), ("0", "3")], rows
 
 
-@test
-def run_without_output_aborts_with_the_solver_output():
+def test_run_without_output_aborts_with_the_solver_output():
     text = """\
 name: bogus
 options_file: options/square.yaml
@@ -331,8 +314,7 @@ levels: {key: dm_plex_box_faces, values: ["4,4", "8,8"]}
     assert "bogus_option" in p.stderr, "the tail of the solver output is not shown"
 
 
-@test
-def missing_norm_attribute_is_an_error_naming_file_and_attribute():
+def test_missing_norm_attribute_is_an_error_naming_file_and_attribute():
     text = """\
 name: noattr
 options_file: options/square.yaml
@@ -344,29 +326,3 @@ levels: {key: dm_plex_box_faces, values: ["2,2", "4,4"]}
     p = cli(write("noattr.yaml", text), "--outdir", os.path.join(TMP, "noattr"), "--quiet")
     assert p.returncode == 2 and "a_0.h5: /run has no attribute 'no_such_norm'" in p.stderr, p.stderr
 
-
-def main():
-    """Run the selected tests; print one line per test and the totals; exit 1 on a failure."""
-    words = sys.argv[1:]
-    selected = [t for t in TESTS if not words or any(w in t.__name__ for w in words)]
-    passed = failed = 0
-    for t in selected:
-        t0 = time.time()
-        try:
-            t()
-            passed += 1
-            print(f"PASS {t.__name__} ({time.time() - t0:.1f} s)")
-        except Exception:
-            failed += 1
-            print(f"FAIL {t.__name__} ({time.time() - t0:.1f} s)")
-            traceback.print_exc(file=sys.stdout)
-    if failed:
-        print(f"files of the tests kept in {TMP}")
-    else:
-        shutil.rmtree(TMP)
-    print(f"{passed} passed, {failed} failed")
-    return 1 if failed else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -1,20 +1,14 @@
-#!/usr/bin/python3
-"""Tests of scripts/tradeoff.py: the Pareto front and the recommendations on synthetic rows, the
-validation of the study file, and a tiny real grid run end to end. Ends with 'N passed, N failed';
-exits 1 on a failure.
-
-Usage: tests/test_tradeoff.py [NAME ...]   (runs the tests whose names contain one of the words)
-"""
+"""Tests of scripts/tradeoff.py (make test): the Pareto front and the recommendations on synthetic rows, the
+validation of the study file, and a tiny real grid run end to end. Each test writes its files in a temporary
+directory of its own (TMP)."""
 import csv
 import math
 import os
 import random
-import shutil
 import subprocess
 import sys
-import tempfile
-import time
-import traceback
+
+import pytest
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
@@ -22,15 +16,16 @@ import tradeoff  # noqa: E402
 from study import StudyError  # noqa: E402
 
 SCRIPT = os.path.join(ROOT, "scripts", "tradeoff.py")
-TMP = tempfile.mkdtemp(prefix="test_tradeoff_")
-TESTS = []
+TMP = None  # the test's own temporary directory, set by the fixture tmp
 NAN = float("nan")
 
 
-def test(fn):
-    """Register a test function."""
-    TESTS.append(fn)
-    return fn
+@pytest.fixture(autouse=True)
+def tmp(tmp_path):
+    """Every test writes its study files and outputs in a temporary directory of its own (pytest's tmp_path)."""
+    global TMP
+    TMP = str(tmp_path)
+    return TMP
 
 
 def write(name, text):
@@ -67,14 +62,12 @@ def points(rows):
 
 # ------------------------------------------------------------------------------ Pareto front
 
-@test
-def pareto_front_basic():
+def test_pareto_front_basic():
     rows = [row(1, 1.0), row(2, 0.5), row(3, 0.6), row(4, 0.1), row(0.5, 2.0), row(5, 0.2)]
     assert points(tradeoff.pareto_front(rows, "e")) == [(0.5, 2.0), (1, 1.0), (2, 0.5), (4, 0.1)]
 
 
-@test
-def pareto_front_excludes_failed_runs():
+def test_pareto_front_excludes_failed_runs():
     bad = row(0.1, 1e-6, ok=False)  # would dominate every other run
     rows = [row(1, 1.0), bad, row(2, 0.5)]
     front = tradeoff.pareto_front(rows, "e")
@@ -83,8 +76,7 @@ def pareto_front_excludes_failed_runs():
     assert tradeoff.pareto_front([bad], "e") == []
 
 
-@test
-def pareto_front_ties():
+def test_pareto_front_ties():
     a, b = row(1, 0.5), row(1, 0.5)          # identical: both kept, in plan order
     same_cost_worse = row(1, 0.6)             # dominated by a (same cost, larger error)
     same_err_slower = row(2, 0.5)             # dominated by a (same error, larger cost)
@@ -95,14 +87,12 @@ def pareto_front_ties():
     assert same_cost_worse not in front and same_err_slower not in front
 
 
-@test
-def pareto_front_skips_nan():
+def test_pareto_front_skips_nan():
     rows = [row(NAN, 0.01), row(1, NAN), row(2, 0.5), row(3, math.inf)]
     assert points(tradeoff.pareto_front(rows, "e")) == [(2, 0.5)]
 
 
-@test
-def pareto_front_matches_brute_force():
+def test_pareto_front_matches_brute_force():
     rng = random.Random(7)
     rows = [row(rng.choice([1, 2, 3, 4, 5]) * rng.random(), rng.choice([0.1, 0.2, rng.random()]),
                 ok=rng.random() > 0.2) for _ in range(200)]
@@ -119,8 +109,7 @@ def pareto_front_matches_brute_force():
     assert costs == sorted(costs)
 
 
-@test
-def pareto_front_round_off_tolerance():
+def test_pareto_front_round_off_tolerance():
     fast, slow = row(1.0, 1.0e-2), row(100.0, 1.0e-2 * (1 - 1e-12))  # same solution, slower solver
     better = row(5.0, 0.9e-2)
     assert tradeoff.pareto_front([slow, fast, better], "e") == [fast, better]
@@ -132,24 +121,21 @@ def pareto_front_round_off_tolerance():
 
 # ------------------------------------------------------------------------------ recommendations
 
-@test
-def recommend_cheapest_reaching_the_target():
+def test_recommend_cheapest_reaching_the_target():
     rows = [row(1, 0.3), row(2, 0.05), row(3, 0.01), row(10, 0.001)]
     assert tradeoff.recommend(rows, "e", 0.1) is rows[1]
     assert tradeoff.recommend(rows, "e", 0.01) is rows[2]  # error == target reaches it
     assert tradeoff.recommend(rows, "e", 1.0) is rows[0]
 
 
-@test
-def recommend_excludes_failed_runs():
+def test_recommend_excludes_failed_runs():
     bad = row(0.5, 0.001, ok=False)
     rows = [row(1, 0.3), bad, row(4, 0.02)]
     assert tradeoff.recommend(rows, "e", 0.05) is rows[2]
     assert tradeoff.recommend([bad], "e", 1.0) is None
 
 
-@test
-def recommend_target_nobody_reaches():
+def test_recommend_target_nobody_reaches():
     rows = [row(1, 0.3), row(2, 0.05)]
     assert tradeoff.recommend(rows, "e", 0.01) is None
     p = {"name": "mms2d"}
@@ -159,15 +145,13 @@ def recommend_target_nobody_reaches():
     assert "| mms2d | error_h1 | 1e-2 | none reaches it |" in table[-1], table
 
 
-@test
-def recommend_ties():
+def test_recommend_ties():
     a, b, c = row(1, 0.05), row(1, 0.02), row(1, 0.02)
     assert tradeoff.recommend([a, c, b], "e", 0.1) is b  # equal cost: smaller error, then plan order
     assert tradeoff.recommend([a, b, c], "e", 0.1) is b
 
 
-@test
-def recommendation_lies_on_the_front():
+def test_recommendation_lies_on_the_front():
     rng = random.Random(3)
     rows = [row(rng.random() * 10, rng.random(), ok=rng.random() > 0.3) for _ in range(100)]
     front = tradeoff.pareto_front(rows, "e")
@@ -179,8 +163,7 @@ def recommendation_lies_on_the_front():
             assert r in front and r["ok"] and r["e"] <= t
 
 
-@test
-def sentence_format():
+def test_sentence_format():
     p = {"name": "mms2d"}
     r = row(0.2134, NAN, peak_memory_mb=45.2, error_h1=8.1e-3)
     assert tradeoff.sentence(p, "error_h1", 1e-2, r) == ("For error_h1 <= 1e-2 on mms2d use penalty "
@@ -193,8 +176,7 @@ def sentence_format():
                                                           "(error 3.0e-3)")
 
 
-@test
-def recommendations_over_problems_norms_targets():
+def test_recommendations_over_problems_norms_targets():
     s = tradeoff.load_study(write("rec.yaml", SYNTH))
     rows = [row(1, NAN, problem="a", error_h1=0.2, error_l2=0.02),
             row(2, NAN, problem="a", error_h1=0.05, error_l2=0.01),
@@ -206,8 +188,7 @@ def recommendations_over_problems_norms_targets():
                    ("b", "error_l2", 0.05, rows[2]["index"])], got
 
 
-@test
-def missing_attribute_is_nan_with_a_note():
+def test_missing_attribute_is_nan_with_a_note():
     s = tradeoff.load_study(write("miss.yaml", SYNTH))
     plan, _ = tradeoff.plan_runs(s, TMP)
     run = plan[0]
@@ -260,8 +241,7 @@ def expect_error(text, *fragments):
     raise AssertionError(f"no StudyError for:\n{text}")
 
 
-@test
-def study_file_valid():
+def test_study_file_valid():
     s = tradeoff.load_study(write("ok.yaml", SYNTH))
     assert s["problems"][0]["targets"] == {"error_h1": [0.1, 0.01]}
     assert s["problems"][1]["targets"]["error_l2"] == [0.05]  # '5e-2' read as text is accepted
@@ -269,8 +249,7 @@ def study_file_valid():
     assert s["problems"][0]["cost"] == ["time_total"]
 
 
-@test
-def study_file_errors_name_the_key():
+def test_study_file_errors_name_the_key():
     cases = [
         (SYNTH.replace("targets: {error_h1: [1e-1, 1e-2], error_l2: [\"5e-2\"]}\n", ""),
          ["missing required key 'targets'"]),
@@ -312,8 +291,7 @@ def study_file_errors_name_the_key():
         expect_error(text, *fragments)
 
 
-@test
-def plan_skips_and_runs_vi_once_per_solver():
+def test_plan_skips_and_runs_vi_once_per_solver():
     s = tradeoff.load_study(write("plan.yaml", SYNTH.replace(
         "    levels: [{dm_refine: 0}]\n",
         "    levels: [{dm_refine: 0}]\n    reference: {options: {dm_refine: 2, contact_method: vi}, "
@@ -334,8 +312,7 @@ def plan_skips_and_runs_vi_once_per_solver():
     assert len({r.output for r in plan}) == len(plan)
 
 
-@test
-def dry_run_prints_every_command():
+def test_dry_run_prints_every_command():
     p = cli(write("dry.yaml", SYNTH), "--dry-run", "--outdir", os.path.join(TMP, "dry"))
     assert p.returncode == 0, p.stderr
     cmds = [ln for ln in p.stdout.splitlines() if ln.startswith("mpiexec")]
@@ -379,8 +356,7 @@ def read_csv(path):
         return list(csv.DictReader(fh))
 
 
-@test
-def end_to_end_tiny_grid():
+def test_end_to_end_tiny_grid():
     out = os.path.join(TMP, "tiny")
     p = cli(write("tiny.yaml", TINY), "--outdir", out, "--quiet")
     assert p.returncode == 0, p.stdout + p.stderr
@@ -421,8 +397,7 @@ def end_to_end_tiny_grid():
         assert os.path.getsize(os.path.join(out, f"tiny_mms2d_{norm}.png")) > 1000
 
 
-@test
-def end_to_end_failed_run_is_shown_not_recommended():
+def test_end_to_end_failed_run_is_shown_not_recommended():
     text = TINY.replace('values: ["8,8", "16,16"]', 'values: ["8,8"]').replace(
         "options: {dm_plex_dim: 2}", "options: {dm_plex_dim: 2, snes_max_it: 1}").replace(
         "  - {name: vi, text: SNESVI, options: {contact_method: vi}, uses_eps: false}\n", "").replace(
@@ -440,31 +415,3 @@ def end_to_end_failed_run_is_shown_not_recommended():
     assert "| mms2d | error_h1 | 3e-1 | none reaches it |" in md
     assert "FAILED" in p.stderr
 
-
-# ------------------------------------------------------------------------------ main
-
-def main(argv):
-    words = argv[1:]
-    selected = [t for t in TESTS if not words or any(w in t.__name__ for w in words)]
-    passed = failed = 0
-    t0 = time.time()
-    for t in selected:
-        t1 = time.time()
-        try:
-            t()
-            passed += 1
-            print(f"PASS {t.__name__} ({time.time() - t1:.1f} s)", flush=True)
-        except Exception:
-            failed += 1
-            print(f"FAIL {t.__name__}\n{traceback.format_exc()}", flush=True)
-    if not failed:
-        shutil.rmtree(TMP, ignore_errors=True)
-    else:
-        print(f"files kept in {TMP}")
-    print(f"total {time.time() - t0:.1f} s")
-    print(f"{passed} passed, {failed} failed")
-    return 1 if failed or not passed else 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv))

@@ -7,7 +7,9 @@ import os
 import re
 import subprocess
 
-from harness import ENV, OUT, ROOT, test
+import pytest
+
+from harness import ENV, OUT, ROOT
 
 ASAN_BIN = os.path.join(ROOT, "bin", "signorini-asan")
 CASES = {
@@ -21,8 +23,8 @@ CASES = {
 }
 
 
-@test
-def sanitizers_report_nothing():
+@pytest.mark.slow
+def test_sanitizers_report_nothing():
     p = subprocess.run(["make", "--no-print-directory", "asan"], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert p.returncode == 0, p.stdout[-3000:]
     env = dict(ENV, ASAN_OPTIONS="detect_leaks=0", UBSAN_OPTIONS="print_stacktrace=1")

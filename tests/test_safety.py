@@ -12,8 +12,9 @@ import xml.etree.ElementTree as ET
 
 import h5py
 import numpy as np
+import pytest
 
-from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position, test
+from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position
 
 SAFETY = os.path.join(OUT, "safety")
 OLD = ["-dm_plex_box_faces", "8,8"]
@@ -91,8 +92,8 @@ def finish(p):
     return p.wait(timeout=120)
 
 
-@test
-def sigterm_during_set_up_solve_and_write():
+@pytest.mark.slow
+def test_sigterm_during_set_up_solve_and_write():
     """SIGTERM (and SIGINT) sent to the solver in its set-up, in its Newton steps, and inside the write (the process is
     stopped when its temporary file appears, signalled, then continued): the old output is untouched, nothing is left."""
     outcomes = []
@@ -117,8 +118,8 @@ def sigterm_during_set_up_solve_and_write():
     assert outcomes == ["old"] * 6, outcomes
 
 
-@test
-def sigterm_at_spread_times_leaves_old_or_new():
+@pytest.mark.slow
+def test_sigterm_at_spread_times_leaves_old_or_new():
     """SIGTERM at 10 times spread over a whole run: each leaves the old pair or the new one, complete, and nothing else."""
     d, h5, old = prepare("spread_timing")
     t0 = time.time()
@@ -136,8 +137,8 @@ def sigterm_at_spread_times_leaves_old_or_new():
     assert "old" in seen, seen
 
 
-@test
-def sigterm_to_mpiexec_with_two_ranks():
+@pytest.mark.slow
+def test_sigterm_to_mpiexec_with_two_ranks():
     """mpiexec forwards SIGTERM to both ranks. In the solve: the old output stays. In the write: mpiexec forwards the
     signal late enough that the write may have ended, so the old pair or the new one, complete; nothing else either way."""
     for stage in ("solve", "write"):
@@ -154,8 +155,7 @@ def sigterm_to_mpiexec_with_two_ranks():
         assert stage == "write" or outcome == "old", f"{stage}: the run was not stopped by SIGTERM"
 
 
-@test
-def concurrent_runs_leave_one_whole_pair():
+def test_concurrent_runs_leave_one_whole_pair():
     """Two runs (24x24 and 32x32 cells) write the same output at once, 6 times over: both succeed, and the .h5 and .xdmf
     left are both of one run, equal to that run's solution computed alone."""
     configs = {2 * 24 * 24: ["-dm_plex_box_faces", "24,24"], 2 * 32 * 32: ["-dm_plex_box_faces", "32,32"]}

@@ -6,8 +6,9 @@ import subprocess
 
 import h5py
 import numpy as np
+import pytest
 
-from harness import ENV, OUT, ROOT, load, run, sorted_by_position, test
+from harness import ENV, ROOT, load, run, sorted_by_position
 
 SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "0"]
 
@@ -25,8 +26,7 @@ def max_diff(h5a, h5b):
     return np.abs(ua - ub).max() / np.abs(ub).max()
 
 
-@test
-def grid_sequence_gives_the_direct_solution_with_few_newton_steps():
+def test_grid_sequence_gives_the_direct_solution_with_few_newton_steps():
     """4x4 refined 3 times by the sequence = 32x32 solved directly; the finest level needs <= 3 Newton steps."""
     _, direct = run(SQUARE + ["-dm_plex_box_faces", "4,4", "-dm_refine", "3"], "gs_direct")
     _, seq = run(SQUARE + ["-dm_plex_box_faces", "4,4", "-contact_grid_sequence", "3"], "gs_sequence")
@@ -39,8 +39,7 @@ def grid_sequence_gives_the_direct_solution_with_few_newton_steps():
     assert a["newton_its_total"] == s["newton_its"].sum()
 
 
-@test
-def grid_sequence_with_snesvi_equals_the_direct_solution():
+def test_grid_sequence_with_snesvi_equals_the_direct_solution():
     base = SQUARE + ["-contact_method", "vi", "-dm_plex_box_faces", "8,8"]
     _, seq = run(base + ["-contact_grid_sequence", 2], "gs_vi")
     _, direct = run(base + ["-dm_refine", 2], "gs_vi_direct")
@@ -49,8 +48,7 @@ def grid_sequence_with_snesvi_equals_the_direct_solution():
     assert a["newton_its"] <= 3 and a["max_penetration"] <= 0.0
 
 
-@test
-def grid_sequence_in_parallel_and_3d_equals_serial():
+def test_grid_sequence_in_parallel_and_3d_equals_serial():
     args = SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3", "-contact_grid_sequence", "1"]
     _, one = run(args, "gs3d_np1")
     _, two = run(args, "gs3d_np2", np_=2)
@@ -58,19 +56,17 @@ def grid_sequence_in_parallel_and_3d_equals_serial():
     assert max_diff(two, one) < 1e-8 and max_diff(one, direct) < 1e-8
 
 
-@test
-def grid_sequence_on_quads_and_hexes_equals_the_direct_solution():
+@pytest.mark.parametrize("dim,faces", ((2, "4,4"), (3, "2,2,2")), ids=("quads", "hexes"))
+def test_grid_sequence_on_quads_and_hexes_equals_the_direct_solution(dim, faces):
     """Q1: the new vertices are edge midpoints and face or cell centres, interpolated as means of their corners."""
-    for dim, faces in ((2, "4,4"), (3, "2,2,2")):
-        base = SQUARE + ["-dm_plex_simplex", 0, "-dm_plex_dim", dim, "-dm_plex_box_faces", faces]
-        _, seq = run(base + ["-contact_grid_sequence", 2], f"gs_q1_{dim}d")
-        _, direct = run(base + ["-dm_refine", 2], f"gs_q1_{dim}d_direct")
-        assert max_diff(seq, direct) < 1e-8
-        assert load(seq)[0]["newton_its"] <= 3
+    base = SQUARE + ["-dm_plex_simplex", 0, "-dm_plex_dim", dim, "-dm_plex_box_faces", faces]
+    _, seq = run(base + ["-contact_grid_sequence", 2], f"gs_q1_{dim}d")
+    _, direct = run(base + ["-dm_refine", 2], f"gs_q1_{dim}d_direct")
+    assert max_diff(seq, direct) < 1e-8
+    assert load(seq)[0]["newton_its"] <= 3
 
 
-@test
-def eps_sweep_ends_at_the_direct_solution_for_its_last_eps():
+def test_eps_sweep_ends_at_the_direct_solution_for_its_last_eps():
     sweep = [100, 10, 1, 0.1, 0.01, 1e-3, 1e-4, 1e-6]
     _, h5 = run(SQUARE + ["-dm_plex_box_faces", "32,32", "-penalty_eps0_sweep", ",".join(map(str, sweep))], "sweep")
     _, direct = run(SQUARE + ["-dm_plex_box_faces", "32,32", "-penalty_eps0", "1e-6"], "sweep_direct")
@@ -82,8 +78,7 @@ def eps_sweep_ends_at_the_direct_solution_for_its_last_eps():
     assert np.all(np.diff(s["max_penetration"]) < 0), "penetration must fall with eps"
 
 
-@test
-def preconditioner_reuse_changes_the_cost_not_the_answer():
+def test_preconditioner_reuse_changes_the_cost_not_the_answer():
     args = SQUARE + ["-dm_plex_box_faces", "64,64"]
     _, reuse = run(args, "reuse_on")
     _, fresh = run(args + ["-contact_pc_reuse", "0"], "reuse_off")
@@ -96,30 +91,30 @@ def preconditioner_reuse_changes_the_cost_not_the_answer():
     assert a["pc_builds"] <= c["pc_builds"] <= c["newton_its"], (a["pc_builds"], c["pc_builds"])
 
 
-@test
-def gamg_converges_at_small_eps_and_agrees_with_mumps():
+def test_gamg_converges_at_small_eps_and_agrees_with_mumps():
     args = SQUARE + ["-dm_plex_box_faces", "32,32", "-penalty_eps0", "1e-6"]
     _, gamg = run(args + ["-options_file", "options/solvers/gamg.yaml"], "gamg_eps1e-6")
     _, mumps = run(args, "mumps_eps1e-6")
     assert max_diff(gamg, mumps) < 1e-7
 
 
-@test
-def bad_sequence_and_sweep_options_are_refused():
-    for args, message in ((["-contact_grid_sequence", "-1"], "-contact_grid_sequence must lie in [0, 8]"),
-                          (["-penalty_eps0_sweep", "1,0,0.1"], "-penalty_eps0_sweep: every value must be positive"),
-                          (["-penalty_eps0_sweep", "1,0.1", "-penalty_eps", "1e-3"], "cannot be given together with -penalty_eps"),
-                          (["-penalty_eps0_sweep", "1,0.1", "-contact_method", "vi"], "needs -contact_method penalty")):
-        out, h5 = run(SQUARE + args, "bad_perf", expect_rc=None)
-        assert message in out, f"'{message}' not in the output of {args}:\n{out[-1500:]}"
-        assert not os.path.exists(h5)
+BAD_PERF_CASES = {"grid_sequence_negative": (["-contact_grid_sequence", "-1"], "-contact_grid_sequence must lie in [0, 8]"),
+                  "sweep_zero": (["-penalty_eps0_sweep", "1,0,0.1"], "-penalty_eps0_sweep: every value must be positive"),
+                  "sweep_with_eps": (["-penalty_eps0_sweep", "1,0.1", "-penalty_eps", "1e-3"], "cannot be given together with -penalty_eps"),
+                  "sweep_with_vi": (["-penalty_eps0_sweep", "1,0.1", "-contact_method", "vi"], "needs -contact_method penalty")}
 
 
-@test
-def bench_script_tables_come_from_its_runs():
+@pytest.mark.parametrize("case", BAD_PERF_CASES)
+def test_bad_sequence_and_sweep_options_are_refused(case):
+    args, message = BAD_PERF_CASES[case]
+    out, h5 = run(SQUARE + args, "bad_perf", expect_rc=None)
+    assert message in out, f"'{message}' not in the output of {args}:\n{out[-1500:]}"
+    assert not os.path.exists(h5)
+
+
+def test_bench_script_tables_come_from_its_runs(outdir):
     """scripts/bench.py on a tiny bench: every run is listed, VI + GAMG skipped with its reason, and each ratio
     of the Markdown table is the ratio of the times in the CSV."""
-    outdir = os.path.join(OUT, "bench")
     p = subprocess.run(["/usr/bin/python3", "scripts/bench.py", "options/bench/test.yaml", "--outdir", os.path.relpath(outdir, ROOT)],
                        cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
     assert p.returncode == 0, p.stdout[-3000:]

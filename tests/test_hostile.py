@@ -10,20 +10,26 @@ import shutil
 import stat
 import subprocess
 
-from harness import BIN, ENV, OUT, ROOT, run, test, write_gmsh_cube, write_gmsh_square
+import pytest
+
+from harness import BIN, ENV, OUT, ROOT, run, write_gmsh_cube, write_gmsh_square
 
 HOSTILE = os.path.join(OUT, "hostile")
 SMALL = ["-dm_plex_box_faces", "4,4"]
-_GOOD = {}
 
 
-def good_output():
+@pytest.fixture(scope="session")
+def hostile_dir(out_root):
+    """tests/out/hostile, the directory of the hostile cases."""
+    os.makedirs(HOSTILE, exist_ok=True)
+    return HOSTILE
+
+
+@pytest.fixture(scope="session")
+def good_output(hostile_dir):
     """A good run's FILE.h5 and FILE.xdmf, made once and copied into each case's directory."""
-    if not _GOOD:
-        os.makedirs(HOSTILE, exist_ok=True)
-        _, h5 = run(SMALL, "hostile/good")
-        _GOOD["h5"], _GOOD["xdmf"] = h5, h5[:-3] + ".xdmf"
-    return _GOOD
+    _, h5 = run(SMALL, "hostile/good")
+    return {"h5": h5, "xdmf": h5[:-3] + ".xdmf"}
 
 
 def digest(path):
@@ -46,14 +52,17 @@ def snapshot(directory):
     return state
 
 
-def case_dir(name):
-    d = os.path.join(HOSTILE, name)
-    shutil.rmtree(d, ignore_errors=True)
-    os.makedirs(d)
-    good = good_output()
-    shutil.copy2(good["h5"], os.path.join(d, "result.h5"))
-    shutil.copy2(good["xdmf"], os.path.join(d, "result.xdmf"))
-    return d
+@pytest.fixture
+def case_dir(good_output):
+    """case_dir(name): tests/out/hostile/NAME, made anew with a copy of the good output (result.h5, result.xdmf)."""
+    def make(name):
+        d = os.path.join(HOSTILE, name)
+        shutil.rmtree(d, ignore_errors=True)
+        os.makedirs(d)
+        shutil.copy2(good_output["h5"], os.path.join(d, "result.h5"))
+        shutil.copy2(good_output["xdmf"], os.path.join(d, "result.xdmf"))
+        return d
+    return make
 
 
 def refuse(d, args, message, output=None, np_=1):
@@ -114,15 +123,12 @@ OPTION_CASES = [
     ("vi_with_gamg", ["-contact_method", "vi", "-pc_type", "gamg"], "-pc_type gamg cannot follow the reduced system"),
     ("p1_assembly_on_p2", ["-displacement_petscspace_degree", 2, "-assembly", "p1"], "-assembly p1 needs P1 displacements"),
 ]
-for _name, _args, _message in OPTION_CASES:
-    def _case(name=_name, args=_args, message=_message):
-        refuse(case_dir(name), SMALL + args, message)
-    _case.__name__ = f"hostile_{_name}"
-    test(_case)
+@pytest.mark.parametrize("name,args,message", OPTION_CASES, ids=[c[0] for c in OPTION_CASES])
+def test_hostile_option(case_dir, name, args, message):
+    refuse(case_dir(name), SMALL + args, message)
 
 
-@test
-def hostile_parallel_runs_refuse_alike():
+def test_hostile_parallel_runs_refuse_alike(case_dir):
     """On 2 ranks too: an infinite modulus and a missing mesh are named, and the output is left alone."""
     refuse(case_dir("parallel_young_inf"), SMALL + ["-young_modulus", "inf"], "-young_modulus must be a finite number", np_=2)
     d = case_dir("parallel_missing_mesh")
@@ -163,19 +169,16 @@ FILE_CASES = [
     ("malformed_yaml", "malformed.yaml", write_text("scene: square\n  bad: [unclosed\n"), lambda f: ["-options_file", f],
      lambda f: f"the options file '{f}' is not valid YAML: mapping values are not allowed in this context at line 2"),
 ]
-for _name, _file, _writer, _args, _message in FILE_CASES:
-    def _case(name=_name, file=_file, writer=_writer, args=_args, message=_message):
-        d = case_dir(name)
-        path = os.path.join(d, file)
-        if writer:
-            writer(path)
-        refuse(d, args(path), message(path))
-    _case.__name__ = f"hostile_{_name}"
-    test(_case)
+@pytest.mark.parametrize("name,file,writer,args,message", FILE_CASES, ids=[c[0] for c in FILE_CASES])
+def test_hostile_file(case_dir, name, file, writer, args, message):
+    d = case_dir(name)
+    path = os.path.join(d, file)
+    if writer:
+        writer(path)
+    refuse(d, args(path), message(path))
 
 
-@test
-def hostile_reference_files():
+def test_hostile_reference_files(case_dir):
     """-reference: missing, not HDF5, of another scene, without its displacement; all refused before the solve."""
     d = case_dir("reference")
     missing, not_h5 = os.path.join(d, "missing.h5"), os.path.join(d, "mesh.msh")
@@ -194,8 +197,7 @@ def hostile_reference_files():
 
 
 # ---------------------------------------------------------------- -output itself
-@test
-def hostile_output_is_a_directory():
+def test_hostile_output_is_a_directory(case_dir):
     d = case_dir("output_dir")
     os.mkdir(os.path.join(d, "adir.h5"))
     out = refuse(d, SMALL, f"-output {d}/adir.h5 is a directory", output=os.path.join(d, "adir.h5"))
@@ -215,25 +217,21 @@ OUTPUT_CASES = [
     ("output_nodir", lambda d: None, lambda d: os.path.join(d, "nope", "x.h5"),
      lambda d: f"Output directory '{d}/nope' (-output {d}/nope/x.h5) does not exist or is not writable"),
 ]
-for _name, _make, _output, _message in OUTPUT_CASES:
-    def _case(name=_name, make=_make, output=_output, message=_message):
-        d = case_dir(name)
-        make(d)
-        refuse(d, SMALL, message(d), output=output(d))
-    _case.__name__ = f"hostile_{_name}"
-    test(_case)
+@pytest.mark.parametrize("name,make,output,message", OUTPUT_CASES, ids=[c[0] for c in OUTPUT_CASES])
+def test_hostile_output(case_dir, name, make, output, message):
+    d = case_dir(name)
+    make(d)
+    refuse(d, SMALL, message(d), output=output(d))
 
 
-@test
-def hostile_output_names_too_long():
+def test_hostile_output_names_too_long(case_dir):
     """A name the file system refuses (256 characters), and a 255-character FILE.h5 whose FILE.xdmf would be 257."""
     d = case_dir("output_long")
     refuse(d, SMALL, "has 259 characters, more than the 255 the file system", output=os.path.join(d, "a" * 256 + ".h5"))
     refuse(d, SMALL, "-output: the XDMF file beside it", output=os.path.join(d, "b" * 252 + ".h5"))
 
 
-@test
-def hostile_disk_full():
+def test_hostile_disk_full(case_dir, good_output):
     """A full file system (a 96 kB tmpfs holding a good 4x4 output) during the write: one sentence naming the file and
     the cause, the good output untouched, no temporary left."""
     d = case_dir("disk_full")
@@ -242,7 +240,7 @@ def hostile_disk_full():
     p = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=96k", "tmpfs", small], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert p.returncode == 0, f"cannot mount a small tmpfs for the disk-full test (the test suite runs as root): {p.stdout}"
     try:
-        good = good_output()
+        good = good_output
         shutil.copy2(good["h5"], os.path.join(small, "result.h5"))
         shutil.copy2(good["xdmf"], os.path.join(small, "result.xdmf"))
         target = os.path.join(small, "result.h5")
@@ -253,18 +251,15 @@ def hostile_disk_full():
 
 
 # ---------------------------------------------------------------- limits that used to crash or truncate
-@test
-def long_output_file_name_is_written():
+def test_long_output_file_name_is_written(hostile_dir):
     """A 240-character file name crashed Open MPI's MPI-IO ("buffer overflow detected"); the solver now writes it."""
     name = "c" * 237 + ".h5"
-    os.makedirs(HOSTILE, exist_ok=True)
     _, h5 = run(SMALL, "hostile/" + name)
     assert os.path.getsize(h5) > 0 and os.path.getsize(h5[:-3] + ".xdmf") > 0
     assert not [n for n in os.listdir(HOSTILE) if n.startswith(".signorini-")]
 
 
-@test
-def long_paths_are_read_and_written():
+def test_long_paths_are_read_and_written(hostile_dir):
     """A 250-character directory: a reference written there, read back by -reference, and a run written there, on 2
     ranks (reading a long path crashed in Open MPI's MPI-IO as writing did)."""
     from harness import load
@@ -276,8 +271,7 @@ def long_paths_are_read_and_written():
     assert a["converged"] == 1 and a["nprocs"] == 2 and 0.0 < a["reference_error_h1"] < 1.0, a.get("reference_error_h1")
 
 
-@test
-def hostile_long_hdf5_mesh_path():
+def test_hostile_long_hdf5_mesh_path(case_dir):
     """PETSc reads an HDF5 mesh with MPI-IO itself, where the name cannot be shortened: a name over 240 characters is
     refused with the reason instead of the crash."""
     d = case_dir("long_h5_mesh")
@@ -288,12 +282,10 @@ def hostile_long_hdf5_mesh_path():
     refuse(d, ["-dm_plex_filename", mesh], f"The HDF5 mesh file name '{mesh}' (-dm_plex_filename) has {len(mesh)} characters")
 
 
-@test
-def eps_sweep_of_any_length():
+def test_eps_sweep_of_any_length(hostile_dir):
     """40 values (the sweep used to drop all past the 32nd silently): 40 solves, and the output is the 40th value's."""
     import h5py
     values = [10.0 ** (-k / 8.0) for k in range(40)]
-    os.makedirs(HOSTILE, exist_ok=True)
     _, h5 = run(["-dm_plex_box_faces", "8,8", "-penalty_eps0_sweep", ",".join(f"{v:.17g}" for v in values)], "hostile/sweep40")
     with h5py.File(h5, "r") as f:
         eps = f["solves/eps"][:]
@@ -303,24 +295,20 @@ def eps_sweep_of_any_length():
         assert abs(eps[-1] - values[-1] * h) <= 1e-12 * values[-1] * h
 
 
-@test
-def condition_estimate_with_vi_is_that_of_k():
+def test_condition_estimate_with_vi_is_that_of_k(hostile_dir):
     """With SNESVI the estimate used to fail after converging ("Cannot change local size of Amat"); it is the estimate
     of K, the same number as the elastic run's (whose Jacobian is K)."""
     from harness import load
-    os.makedirs(HOSTILE, exist_ok=True)
     a_vi, _ = load(run(SMALL + ["-contact_method", "vi", "-contact_condition_estimate"], "hostile/cond_vi")[1])
     a_none, _ = load(run(SMALL + ["-contact_method", "none", "-contact_condition_estimate"], "hostile/cond_none")[1])
     assert a_vi["converged"] == 1 and a_vi["condition_1norm"] > 1.0
     assert abs(a_vi["condition_1norm"] - a_none["condition_1norm"]) <= 1e-8 * a_none["condition_1norm"]
 
 
-@test
-def stop_with_a_large_residual_is_a_failure():
+def test_stop_with_a_large_residual_is_a_failure(hostile_dir):
     """PETSc's step-length test (-snes_stol) stops Newton with CONVERGED_SNORM_RELATIVE far from the solution: the run
     reports it as a failure (exit 3, converged = 0), never as a converged result."""
     from harness import load
-    os.makedirs(HOSTILE, exist_ok=True)
     out, h5 = run(["-dm_plex_box_faces", "32,32", "-penalty_eps0", 1e-6, "-penalty_continuation", "false", "-snes_stol", 0.9], "hostile/stol", expect_rc=3)
     a, _ = load(h5)
     assert a["snes_reason"] == "CONVERGED_SNORM_RELATIVE" and a["converged"] == 0 and a["residual_reduced"] == 0, (a["snes_reason"], a["converged"])

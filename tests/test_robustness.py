@@ -8,14 +8,14 @@ import os
 import subprocess
 
 import numpy as np
+import pytest
 
-from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position, test
+from harness import BIN, ENV, ROOT, load, run, sorted_by_position
 
 SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "false", "-dm_plex_box_faces", "16,16"]
 
 
-@test
-def tiny_eps_converges_by_continuation():
+def test_tiny_eps_converges_by_continuation():
     """eps = 1e-12 h: the continuation from h/E converges, the penetration vanishes with eps, and the solution is the
     eps = 1e-8 h one to within 1e-6 (both are the SNESVI solution up to O(eps))."""
     sol, pen = {}, {}
@@ -30,8 +30,7 @@ def tiny_eps_converges_by_continuation():
     assert diff <= 1e-6, diff
 
 
-@test
-def condition_estimate_grows_like_one_over_eps():
+def test_condition_estimate_grows_like_one_over_eps():
     """The Hager estimate of cond_1(J) grows by about 1e4 from eps = 1e-2 h to eps = 1e-6 h (the penalty term dominates)."""
     cond = {}
     for eps0 in (1e-2, 1e-6):
@@ -43,8 +42,7 @@ def condition_estimate_grows_like_one_over_eps():
     assert 1e3 <= ratio <= 1e5, (cond, ratio)
 
 
-@test
-def iterative_solver_failure_at_small_eps_is_loud():
+def test_iterative_solver_failure_at_small_eps_is_loud():
     """CG + GAMG with PETSc 3.18's default smoother bounds (-pc_gamg_use_sa_esteig 1, which options/solvers/gamg.yaml
     turns off) cannot solve the Jacobian at eps = 1e-8 h: the run must end with converged = 0, the reason, the
     residual and exit status 3, never with a result flagged converged."""
@@ -56,8 +54,7 @@ def iterative_solver_failure_at_small_eps_is_loud():
     assert "ERROR: the nonlinear solve failed" in out and a["residual_norm"] > 0
 
 
-@test
-def young_modulus_scaling_is_exact():
+def test_young_modulus_scaling_is_exact():
     """With eps = h/E the problem scales with E: u E is the same for E = 1e-6, 1 and 1e12."""
     ue = {}
     for E in ("1e-6", "1", "1e12"):
@@ -70,8 +67,7 @@ def young_modulus_scaling_is_exact():
         assert rel <= 1e-8, (E, rel)
 
 
-@test
-def loads_with_no_and_full_contact():
+def test_loads_with_no_and_full_contact():
     """x0 = -1 lifts the body everywhere: no active vertex and an open gap; x0 = 2 presses everywhere: every vertex of
     Gamma_C is active; a load 500 times larger still converges, with every vertex active."""
     _, h5 = run(SQUARE + ["-square_x0", -1], "load_none")
@@ -87,17 +83,15 @@ def loads_with_no_and_full_contact():
         assert a["contact_force"] > 0
 
 
-@test
-def two_cells_per_side():
-    for args in ([], ["-dm_plex_dim", 3]):
-        _, h5 = run(["-options_file", "options/square.yaml", "-contact_monitor", "false", "-dm_plex_box_faces", "2,2,2" if args else "2,2"] + args,
-                    f"two_cells_{len(args)}")
-        a, _ = load(h5)
-        assert a["converged"] == 1 and a["n_cells"] in (8, 48), a["n_cells"]
+@pytest.mark.parametrize("args", ([], ["-dm_plex_dim", 3]), ids=("2d", "3d"))
+def test_two_cells_per_side(args):
+    _, h5 = run(["-options_file", "options/square.yaml", "-contact_monitor", "false", "-dm_plex_box_faces", "2,2,2" if args else "2,2"] + args,
+                f"two_cells_{len(args)}")
+    a, _ = load(h5)
+    assert a["converged"] == 1 and a["n_cells"] in (8, 48), a["n_cells"]
 
 
-@test
-def active_set_cycle_is_detected_and_damped():
+def test_active_set_cycle_is_detected_and_damped():
     """P2, eps = 1e-6, full Newton steps: Newton step 11 returns to the active set of step 6 with a larger residual;
     the cycle is reported, counted in /run, the next step is damped, and the solve converges."""
     args = SQUARE + ["-dm_plex_box_faces", "32,32", "-displacement_petscspace_degree", 2, "-penalty_eps", 1e-6, "-penalty_continuation", "false", "-snes_linesearch_type", "basic",
@@ -113,15 +107,15 @@ def file_digest(path):
         return hashlib.sha256(fh.read()).hexdigest()
 
 
-@test
-def bad_input_leaves_a_previous_good_output_untouched():
+@pytest.mark.slow
+def test_bad_input_leaves_a_previous_good_output_untouched(outdir):
     """A good run writes FILE.h5; each bad run aimed at the same FILE.h5 fails with its message and leaves it as it was."""
     _, good = run(SQUARE, "keep_me")
     digest = file_digest(good)
-    bad_yaml = os.path.join(OUT, "malformed.yaml")
+    bad_yaml = os.path.join(outdir, "malformed.yaml")
     with open(bad_yaml, "w") as fh:
         fh.write("scene: square\n  bad: [unclosed\n")
-    garbage = os.path.join(OUT, "garbage.msh")
+    garbage = os.path.join(outdir, "garbage.msh")
     with open(garbage, "w") as fh:
         fh.write("garbage\n")
     cases = {
@@ -144,8 +138,7 @@ def bad_input_leaves_a_previous_good_output_untouched():
     assert "Output directory '/etc/passwd'" in out
 
 
-@test
-def every_contact_node_is_owned_once_in_parallel():
+def test_every_contact_node_is_owned_once_in_parallel():
     """The owner of a Gamma_C node may have no Gamma_C face around it; the node must still be in its contact set.
     3D nodal penalty with hypre on 2 ranks, repeated (the partition and hypre vary between runs): every run has the
     serial number of contact nodes and the serial answer (this caught runs with a node left out and a pressure error of 9)."""

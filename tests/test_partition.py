@@ -8,8 +8,9 @@ import re
 import subprocess
 
 import numpy as np
+import pytest
 
-from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position, test, write_gmsh_square
+from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position, write_gmsh_square
 
 SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "false"]  # 32x32, default solver (MUMPS)
 MMS3D = ["-options_file", "options/mms.yaml", "-dm_plex_dim", 3, "-dm_plex_box_faces", "6,6,6"]
@@ -43,34 +44,29 @@ def check_same_as_serial(args, name, nranks=(2, 3)):
         assert diff <= 1e-8, (n, diff)
 
 
-@test
-def metis_2d_square_matches_serial():
+def test_metis_2d_square_matches_serial():
     """The 2D square on 2 and 3 ranks partitioned by METIS: the serial displacement to 1e-8 (MUMPS, Newton to 1e-14)."""
     check_same_as_serial(SQUARE, "part_square")
 
 
-@test
-def metis_3d_mms_matches_serial():
+def test_metis_3d_mms_matches_serial():
     """The 3D manufactured solution on 2 and 3 ranks partitioned by METIS: the serial displacement to 1e-8."""
     check_same_as_serial(MMS3D, "part_mms3d")
 
 
-@test
-def metis_tensor_box_matches_serial():
+def test_metis_tensor_box_matches_serial():
     """Quadrilaterals come from DMSetFromOptions, not the project's generator: METIS must partition them too."""
     check_same_as_serial(SQUARE + ["-dm_plex_simplex", 0], "part_quads", nranks=(2,))
 
 
-@test
-def metis_gmsh_file_matches_serial():
+def test_metis_gmsh_file_matches_serial():
     """A mesh read from a Gmsh file goes through the same distribution: METIS on 2 ranks, the serial answer."""
     msh = os.path.join(OUT, "part_square16.msh")
     write_gmsh_square(msh, 16, quads=True)
     check_same_as_serial(SQUARE + ["-dm_plex_filename", msh], "part_msh", nranks=(2,))
 
 
-@test
-def metis_hdf5_mesh_matches_serial():
+def test_metis_hdf5_mesh_matches_serial():
     """PETSc reads an HDF5 mesh in parallel, in pieces: METIS (on the mesh gathered to rank 0) on 2 and 3 ranks gives the
     serial answer. Without PETSc's own distribution first, this gave a wrong solution (ptscotch, simple) or an error (metis)."""
     mesh = os.path.join(OUT, "part_square32_mesh.h5")
@@ -82,8 +78,7 @@ def metis_hdf5_mesh_matches_serial():
         assert a["partitioner"] == p and displacement_difference(f, ref) <= 1e-8, (p, displacement_difference(f, ref))
 
 
-@test
-def partition_quality_is_recorded():
+def test_partition_quality_is_recorded():
     """METIS on the 32x32 square (2048 triangles): imbalance in [1, 1.1], edge cut above 0 and below twice a straight cut
     (32 faces per straight line across the square). The simple partitioner splits the row-by-row cell numbering in
     halves, so on 2 ranks it cuts exactly the 32 faces of the line y = 1/2 with 1024 cells each, for triangles and quads."""
@@ -99,14 +94,13 @@ def partition_quality_is_recorded():
     assert a["partitioner"] == "ptscotch" and 0 < a["partition_edge_cut"] < 64 and 1.0 <= a["partition_imbalance"] <= 1.1
 
 
-@test
-def bad_partitioner_is_refused():
+@pytest.mark.parametrize("n", (1, 2), ids=("np1", "np2"))
+def test_bad_partitioner_is_refused(n):
     """-partitioner bogus: non-zero exit, a message naming the choices, and no output file."""
-    for n in (1, 2):
-        out = os.path.join(OUT, f"bad_partitioner_{n}.h5")
-        cmd = ["mpiexec", "-n", str(n), BIN, "-output", out] + SQUARE + ["-partitioner", "bogus"]
-        p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
-        assert p.returncode != 0, "bad -partitioner accepted"
-        message = "Unknown option bogus for -partitioner. Available options: ptscotch metis simple"
-        assert message in p.stdout, f"'{message}' not in:\n{p.stdout[-2000:]}"
-        assert not os.path.exists(out) and not os.path.exists(out + ".part"), "output left behind"
+    out = os.path.join(OUT, f"bad_partitioner_{n}.h5")
+    cmd = ["mpiexec", "-n", str(n), BIN, "-output", out] + SQUARE + ["-partitioner", "bogus"]
+    p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
+    assert p.returncode != 0, "bad -partitioner accepted"
+    message = "Unknown option bogus for -partitioner. Available options: ptscotch metis simple"
+    assert message in p.stdout, f"'{message}' not in:\n{p.stdout[-2000:]}"
+    assert not os.path.exists(out) and not os.path.exists(out + ".part"), "output left behind"

@@ -7,8 +7,9 @@ import os
 import subprocess
 
 import numpy as np
+import pytest
 
-from harness import ENV, OUT, ROOT, load, run, test
+from harness import ENV, OUT, ROOT, load, run
 
 STUDY = os.path.join(ROOT, "scripts", "study.py")
 NORMS = ["error_l2", "error_h1_semi", "error_h1", "error_energy", "error_pressure_l2", "error_pressure_weighted", "error_pressure_dual"]
@@ -25,8 +26,7 @@ def run_study(name):
     return p.stdout
 
 
-@test
-def error_norms_vanish_for_the_patch_test():
+def test_error_norms_vanish_for_the_patch_test():
     """The patch test field is in the FE space: every norm must be round-off, on every cell type."""
     for mesh, args in {"tri": [], "quad": ["-dm_plex_simplex", 0], "tet": ["-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3"]}.items():
         _, h5 = run(["-scene", "patch"] + args, f"norms_patch_{mesh}")
@@ -36,8 +36,7 @@ def error_norms_vanish_for_the_patch_test():
         assert attrs["penetration_l2"] == 0.0 and attrs["penetration_max"] == 0.0
 
 
-@test
-def mms_norms_are_consistent():
+def test_mms_norms_are_consistent():
     """h1^2 = l2^2 + h1_semi^2, the energy norm is at most sqrt(2 mu + d lambda) times the semi-norm,
     the weighted pressure norm is eps^1/2 times the L2 one, and the dual norm is at most the energy error (Galerkin)."""
     _, h5 = run(["-options_file", "options/mms.yaml", "-dm_plex_box_faces", "16,16"], "mms_norms")
@@ -56,8 +55,7 @@ def mms_norms_are_consistent():
     assert np.all(f["exact_displacement"][on_c, 1] >= -1e-15)
 
 
-@test
-def mms_quadrature_does_not_pollute_the_error():
+def test_mms_quadrature_does_not_pollute_the_error():
     """Refining the composite rule on the cells cut by x = a from 2 to 4 levels changes the norms by less than 1%."""
     vals = {}
     for r in (2, 4):
@@ -69,8 +67,7 @@ def mms_quadrature_does_not_pollute_the_error():
         assert rel < 1e-2, f"{k}: {vals[2][k]:.6e} (refine 2) vs {vals[4][k]:.6e} (refine 4)"
 
 
-@test
-def mms_3d_error_decreases():
+def test_mms_3d_error_decreases():
     """3D tetrahedra: halving h must cut the H1 error by at least 2^0.65 (predicted exponent 3/4, minus 0.1)."""
     errs = []
     for n in (4, 8):
@@ -81,8 +78,7 @@ def mms_3d_error_decreases():
     assert errs[1] <= errs[0] / 2 ** 0.65, errs
 
 
-@test
-def mms_norms_parallel_match_serial():
+def test_mms_norms_parallel_match_serial():
     """The norms computed on 2 ranks equal the serial ones to solver tolerance."""
     args = ["-options_file", "options/mms.yaml", "-dm_plex_box_faces", "16,16"]
     a1, _ = load(run(args, "mms_serial")[1])
@@ -91,15 +87,13 @@ def mms_norms_parallel_match_serial():
         assert abs(a1[k] - a2[k]) <= 1e-9 * max(abs(a1[k]), 1e-14), f"{k}: {a1[k]:.12e} vs {a2[k]:.12e}"
 
 
-@test
-def dmsnes_check_runs_against_the_exact_solution():
+def test_dmsnes_check_runs_against_the_exact_solution():
     out, _ = run(["-options_file", "options/mms.yaml", "-dm_plex_box_faces", "8,8", "-dmsnes_check"], "mms_dmsnes_check")
     err = float(out.split("L_2 Error:")[1].split()[0])
     assert 0.0 < err < 0.05, f"L_2 error of the interpolated exact solution {err}"
 
 
-@test
-def reference_on_nested_meshes_is_exact_for_the_patch_test():
+def test_reference_on_nested_meshes_is_exact_for_the_patch_test():
     """A P1-exact field compared with its own solution on a twice refined mesh: zero difference, serial and parallel,
     triangles and tetrahedra (the coarse solution is interpolated to the fine mesh)."""
     for dim, faces in ((2, "4,4"), (3, "2,2,2")):
@@ -111,8 +105,7 @@ def reference_on_nested_meshes_is_exact_for_the_patch_test():
                 assert a["reference_" + k] <= 1e-12, f"{dim}D np {np_}: reference_{k} = {a['reference_' + k]:.3e}"
 
 
-@test
-def reference_errors_of_square_converge():
+def test_reference_errors_of_square_converge():
     """square scene against a VI run refined 3 times: the H1 difference falls with h (rate > 0.7) and vanishes
     for the reference itself."""
     base = ["-options_file", "options/square.yaml", "-contact_monitor", "false", "-dm_plex_box_faces", "4,4"]
@@ -128,8 +121,7 @@ def reference_errors_of_square_converge():
     assert a["reference_error_h1"] == 0.0 and a["reference_error_pressure_l2"] == 0.0
 
 
-@test
-def reference_mismatch_is_refused():
+def test_reference_mismatch_is_refused():
     _, ref = run(["-scene", "patch", "-dm_plex_box_faces", "4,4", "-dm_refine", 1], "ref_mismatch_fine")
     cases = {
         "scene": (["-scene", "square", "-dm_plex_box_faces", "4,4"], "is a run of scene patch, this is scene square"),
@@ -146,8 +138,7 @@ def reference_mismatch_is_refused():
         assert not glob.glob(h5 + "*"), f"{name}: output left behind"
 
 
-@test
-def mms_bad_parameters_are_refused():
+def test_mms_bad_parameters_are_refused():
     for args, message in ((["-mms_nu", 0], "-mms_nu must lie in (0, 1]"), (["-mms_nu", 1.5], "-mms_nu must lie in (0, 1]"),
                           (["-mms_a", 1], "-mms_a must lie in (0, 1)"), (["-mms_amplitude_B", -1], "must be positive")):
         out, h5 = run(["-scene", "mms"] + args, "mms_bad", expect_rc=None)
@@ -155,31 +146,17 @@ def mms_bad_parameters_are_refused():
         assert not os.path.exists(h5)
 
 
-@test
-def study_rates_2d_reach_the_predictions():
+@pytest.mark.slow
+def test_study_rates_2d_reach_the_predictions():
     """Small version of study 1 (make rates): eps = h, nu = 0.25 and 0.5, 8x8 to 64x64; study.py --check asserts
     that the fitted H1 and pressure rates reach the predicted exponents within 0.1."""
     out = run_study("quick_rates2d")
     assert out.count("PASS") == 2, out
 
 
-@test
-def study_eps_refinement_is_monotone_until_the_floor():
+@pytest.mark.slow
+def test_study_eps_refinement_is_monotone_until_the_floor():
     """Small version of study 4: on a 32x32 mesh the error against the exact solution falls with eps until the
     discretization floor, and the distance to the SNESVI solution falls like eps (rate >= 0.9)."""
     out = run_study("quick_epsrefine2d")
     assert out.count("PASS") == 3, out
-
-
-@test
-def tradeoff_script_unit_tests():
-    p = subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "tests", "test_tradeoff.py")], cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
-                       stderr=subprocess.STDOUT, text=True, timeout=600)
-    assert p.returncode == 0 and " 0 failed" in p.stdout, p.stdout[-3000:]
-
-
-@test
-def study_script_unit_tests():
-    p = subprocess.run(["/usr/bin/python3", os.path.join(ROOT, "tests", "test_study.py")], cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
-                       stderr=subprocess.STDOUT, text=True, timeout=600)
-    assert p.returncode == 0 and " 0 failed" in p.stdout, p.stdout[-3000:]

@@ -1,0 +1,100 @@
+"""Assembly tests (make test): the P1 path of the bulk matrix K (-assembly p1) against PETSc's FE assembly (-assembly fe).
+
+-assembly_check assembles K both ways and prints the relative Frobenius distance with the type, size, block size and
+number of nonzeros (used and allocated) of both; every assertion checks those numbers or the solver's output.
+"""
+import glob
+import os
+import re
+import subprocess
+
+import numpy as np
+import pytest
+
+from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position
+
+CHECK = re.compile(r"assembly check: \|\|K_p1 - K_fe\|\|_F/\|\|K_fe\|\|_F = (\S+); size (\d+)x(\d+) \(p1\) (\d+)x(\d+) \(fe\); "
+                   r"type (\S+) \(p1\) (\S+) \(fe\); block size (\d+) \(p1\) (\d+) \(fe\); nonzeros (\d+) \(p1\) (\d+) \(fe\); "
+                   r"allocated (\d+) \(p1\) (\d+) \(fe\)")
+MESH = {2: ["-dm_plex_dim", 2, "-dm_plex_box_faces", "12,12"], 3: ["-dm_plex_dim", 3, "-dm_plex_box_faces", "4,4,4"]}
+
+
+def check_matrices(out, dim, mat_type=None):
+    """Parses the -assembly_check line and asserts that the two matrices are the same."""
+    m = CHECK.search(out)
+    assert m, f"no assembly check line in:\n{out[-2000:]}"
+    rel = float(m.group(1))
+    size_p1, size_fe = m.group(2, 3), m.group(4, 5)
+    type_p1, type_fe = m.group(6, 7)
+    bs_p1, bs_fe = int(m.group(8)), int(m.group(9))
+    nz_p1, nz_fe, alloc_p1, alloc_fe = (int(m.group(i)) for i in (10, 11, 12, 13))
+    assert rel < 1e-12, f"||K_p1 - K_fe||_F/||K_fe||_F = {rel:.3e}"
+    assert size_p1 == size_fe, (size_p1, size_fe)
+    assert type_p1 == type_fe, (type_p1, type_fe)
+    assert mat_type is None or type_p1.endswith(mat_type) and type_p1 in ("seq" + mat_type, "mpi" + mat_type), (type_p1, mat_type)
+    assert bs_p1 == bs_fe == dim, (bs_p1, bs_fe, dim)
+    assert nz_p1 == nz_fe > 0, (nz_p1, nz_fe)  # same nonzero pattern size: no entry missing or extra
+    assert alloc_p1 == nz_p1, f"preallocation not exact: {alloc_p1} allocated for {nz_p1} nonzeros"
+    return rel
+
+
+@pytest.mark.parametrize("np_", (1, 2), ids=("np1", "np2"))
+@pytest.mark.parametrize("scene", ("square", "mms"))
+@pytest.mark.parametrize("dim", (2, 3), ids=("2d", "3d"))
+def test_assembly_p1_equals_fe(dim, scene, np_):
+    """K_p1 = K_fe to round-off, with the same type, size, block size and pattern; mms has inhomogeneous
+    Dirichlet data, so its constrained dofs must be absent from both."""
+    out, h5 = run(["-options_file", f"options/{scene}.yaml", "-contact_monitor", 0, "-assembly_check"] + MESH[dim],
+                  f"assembly_check_{scene}_{dim}d_np{np_}", np_=np_)
+    check_matrices(out, dim)
+    a, _ = load(h5)
+    assert a["assembly"] == "p1" and a["converged"] == 1, (a["assembly"], a["converged"])
+    assert a["nprocs"] == np_
+
+
+@pytest.mark.parametrize("mat_type,scene,dim,np_", (("baij", "mms", 3, 2), ("sbaij", "square", 2, 1)), ids=("baij", "sbaij"))
+def test_assembly_p1_honours_the_matrix_type(mat_type, scene, dim, np_):
+    """-dm_mat_type baij (mms, 3D, 2 ranks) and sbaij (square, 2D, 1 rank; the dual-norm LU of mms refuses sbaij): the
+    P1 matrix has the type and equals the FE one."""
+    out, h5 = run(["-options_file", f"options/{scene}.yaml", "-contact_monitor", 0, "-assembly", "p1", "-assembly_check", "-dm_mat_type", mat_type, "-ksp_type", "cg",
+                   "-pc_type", "jacobi", "-ksp_rtol", 1e-12] + MESH[dim], f"assembly_type_{mat_type}", np_=np_)
+    check_matrices(out, dim, mat_type)
+    assert load(h5)[0]["converged"] == 1
+
+
+@pytest.mark.parametrize("name,args,np_", (("square_2d", ["-options_file", "options/square.yaml", "-dm_plex_box_faces", "32,32"], 1),
+                                          ("mms_3d", ["-options_file", "options/mms.yaml"] + MESH[3], 2)), ids=("square_2d", "mms_3d"))
+def test_assembly_p1_solution_equals_fe(name, args, np_):
+    """The solution with -assembly p1 is the -assembly fe one to solver tolerance (direct solves): 2D square on 1 rank,
+    3D mms on 2 ranks (inhomogeneous Dirichlet data), same Newton steps and active set."""
+    sol, attrs = {}, {}
+    for asm in ("fe", "p1"):
+        _, h5 = run(args + ["-contact_monitor", 0, "-assembly", asm], f"assembly_solution_{name}_{asm}", np_=np_)
+        attrs[asm], f = load(h5)
+        assert attrs[asm]["assembly"] == asm and attrs[asm]["converged"] == 1, (asm, attrs[asm]["assembly"])
+        sol[asm] = sorted_by_position(f, "displacement")
+    rel = np.abs(sol["p1"] - sol["fe"]).max() / np.abs(sol["fe"]).max()
+    assert rel <= 1e-10, f"{name}: max |u_p1 - u_fe| / max |u_fe| = {rel:.3e}"
+    for key in ("newton_its", "active_vertices"):
+        assert attrs["p1"][key] == attrs["fe"][key], (name, key, attrs["p1"][key], attrs["fe"][key])
+    assert abs(attrs["p1"]["energy"] - attrs["fe"]["energy"]) <= 1e-10 * abs(attrs["fe"]["energy"])
+
+
+REFUSED_CASES = {"quad": (["-dm_plex_simplex", 0], "the cells are not all triangles (2D) or tetrahedra (3D)"),
+                 "p2": (["-displacement_petscspace_degree", 2], "the displacement is not of degree 1")}
+
+
+@pytest.mark.parametrize("name", REFUSED_CASES)
+def test_assembly_p1_refused_where_it_does_not_apply(name):
+    """-assembly p1 on quads or P2 stops with the reason, a non-zero exit and no output; -assembly auto falls back to fe there."""
+    args, reason = REFUSED_CASES[name]
+    square = ["-options_file", "options/square.yaml", "-contact_monitor", 0, "-dm_plex_box_faces", "8,8"]
+    out = os.path.join(OUT, f"assembly_refused_{name}.h5")
+    cmd = ["mpiexec", "-n", "1", BIN, "-output", out] + [str(a) for a in square + args + ["-assembly", "p1"]]
+    p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
+    assert p.returncode != 0, f"{name}: -assembly p1 accepted"
+    assert "-assembly p1 needs P1 displacements on triangles or tetrahedra, but " + reason in p.stdout, p.stdout[-2000:]
+    assert not glob.glob(out + "*"), f"{name}: output left behind"
+    _, h5 = run(square + args, f"assembly_auto_{name}")
+    a, _ = load(h5)
+    assert a["assembly"] == "fe" and a["converged"] == 1, (name, a["assembly"])

@@ -1,0 +1,75 @@
+"""The output (make test): the HDF5 file read back by the Python reader, the XDMF beside it, the plot, YAML option
+files, and a Gmsh mesh equal to the built-in box."""
+import math
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+import h5py
+
+from harness import ENV, OUT, ROOT, load, read_runs, run, write_gmsh_square
+
+
+def test_hdf5_read_back_by_python_reader():
+    _, h5 = run(["-dm_plex_box_faces", "8,8"], "reader")
+    with h5py.File(h5, "r") as f:
+        raw = dict(f["run"].attrs)
+        nv = f["geometry/vertices"].shape[0]
+        assert f["vertex_fields/displacement"].shape == (nv, 2)
+    row = read_runs.read_run(h5)
+    for key, value in raw.items():
+        value = value.decode() if isinstance(value, bytes) else value
+        assert row[key] == value, key
+    required = ("scene dim method degree nprocs n_cells n_vertices n_dofs h eps young_modulus poisson_ratio snes_reason converged newton_its "
+                "ksp_its time_setup time_solve time_total active_vertices max_penetration contact_force energy").split()
+    missing = [k for k in required if k not in row]
+    assert not missing, f"missing /run attributes: {missing}"
+    assert row["n_vertices"] == nv == 81 and row["n_cells"] == 128 and row["n_dofs"] == 2 * (81 - 9)
+    assert abs(row["h"] - math.sqrt(2) / 8) < 1e-14 and abs(row["eps"] - row["h"]) < 1e-14
+    csv_out = os.path.join(OUT, "runs.csv")
+    _, h5b = run(["-dm_plex_box_faces", "8,8", "-contact_method", "vi"], "reader_vi")
+    assert read_runs.main([h5, h5b, "--format", "csv", "-o", csv_out]) == 0
+    lines = open(csv_out).read().strip().splitlines()
+    assert len(lines) == 3 and "contact_force" in lines[0]
+
+
+def test_xdmf_points_at_existing_datasets():
+    _, h5 = run(["-dm_plex_box_faces", "8,8"], "xdmf")
+    xdmf = h5[:-3] + ".xdmf"
+    root = ET.parse(xdmf).getroot()
+    with h5py.File(h5, "r") as f:
+        items = root.iter("DataItem")
+        n = 0
+        for item in items:
+            fname, path = item.text.strip().split(":")
+            assert fname == os.path.basename(h5)
+            dims = tuple(int(d) for d in item.get("Dimensions").split())
+            assert f[path].shape == dims, f"{path}: {f[path].shape} vs {dims}"
+            n += 1
+        assert n == 6
+
+
+def test_plot_script_writes_png(outdir):
+    _, h5 = run(["-dm_plex_box_faces", "8,8"], "plot")
+    png = os.path.join(outdir, "plot_contact.png")
+    subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "plot_contact.py"), h5, "-o", png], check=True, env=ENV,
+                   stdout=subprocess.DEVNULL)
+    with open(png, "rb") as fp:
+        assert fp.read(8) == b"\x89PNG\r\n\x1a\n"
+
+
+def test_yaml_options_file():
+    log, h5 = run(["-options_file", "options/square.yaml", "-dm_plex_box_faces", "8,8", "-options_file", "options/solvers/hypre.yaml"], "yaml")
+    attrs, _ = load(h5)
+    assert attrs["converged"] == 1 and attrs["scene"] == "square" and attrs["n_cells"] == 128 and attrs["ksp_its"] > attrs["newton_its"]
+
+
+def test_gmsh_mesh_matches_builtin_box(outdir):
+    msh = os.path.join(outdir, "square8.msh")
+    write_gmsh_square(msh, 8)
+    a_box, _ = load(run(["-dm_plex_box_faces", "8,8"], "box8")[1])
+    a_msh, _ = load(run(["-dm_plex_filename", msh], "msh8")[1])
+    assert a_msh["converged"] == 1 and a_msh["n_cells"] == a_box["n_cells"]
+    for key in ("contact_force", "energy", "max_penetration"):
+        assert abs(a_msh[key] - a_box[key]) <= 1e-10 * abs(a_box[key]), f"{key}: {a_msh[key]} vs {a_box[key]}"
