@@ -1,0 +1,103 @@
+"""Gmsh geometries for contact problems (Gmsh's Python API, Debian's python3-gmsh): bodies that touch a rigid plane at
+one point, meshed finer toward that point, with physical groups (numbered and named) that the solver reads as
+"Face Sets" values through -dm_plex_filename.
+
+Every shape rests on the plane {x_d = 0} and touches it at the origin; the mesh size grows linearly with the distance r
+from the origin, from h_near at r = 0 to h_far at r >= width.
+"""
+import gmsh
+
+# "Face Sets" values, as PETSc numbers the faces of its boxes (2D: bottom 1, top 3; 3D: bottom 1, top 2, front y = 0 3,
+# left x = 0 6), so that the built-in scenes (Gamma_C = 1, clamped top) run on these meshes as they are
+HALF_DISK_GROUPS = {"contact": 1, "top": 3}
+QUARTER_SPHERE_GROUPS = {"contact": 1, "top": 2, "symmetry_y": 3, "symmetry_x": 6}
+BODY_GROUP = 10
+
+
+def _size_field(h_near, h_far, width, dim):
+    """A mesh size field growing from h_near at the origin to h_far at the distance width, used everywhere."""
+    r = "Sqrt(x^2 + y^2)" if dim == 2 else "Sqrt(x^2 + y^2 + z^2)"
+    field = gmsh.model.mesh.field.add("MathEval")
+    gmsh.model.mesh.field.setString(field, "F", f"Min({h_far!r}, {h_near!r} + ({h_far!r} - {h_near!r}) * {r} / {width!r})")
+    gmsh.model.mesh.field.setAsBackgroundMesh(field)
+    for option in ("Mesh.MeshSizeExtendFromBoundary", "Mesh.MeshSizeFromPoints", "Mesh.MeshSizeFromCurvature"):
+        gmsh.option.setNumber(option, 0)
+
+
+def _entities_in_box(dim, lo, hi, eps):
+    return [tag for _, tag in gmsh.model.getEntitiesInBoundingBox(lo[0] - eps, lo[1] - eps, lo[2] - eps, hi[0] + eps, hi[1] + eps, hi[2] + eps, dim)]
+
+
+def _physical(dim, tags, tag, name):
+    if not tags:
+        raise ValueError(f"no entity of dimension {dim} for the physical group {name}")
+    gmsh.model.addPhysicalGroup(dim, tags, tag)
+    gmsh.model.setPhysicalName(dim, tag, name)
+
+
+def _check(radius, h_far, h_near, width):
+    for name, value in (("radius", radius), ("h_far", h_far), ("h_near", h_near), ("width", width)):
+        if not value > 0:
+            raise ValueError(f"{name} must be positive, got {value}")
+    if h_near > h_far:
+        raise ValueError(f"h_near ({h_near}) must not exceed h_far ({h_far})")
+
+
+def half_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None):
+    """The lower half of the disk of the given radius centred at (0, radius): the arc (Gamma_C, "contact") touches the
+    plane y = 0 at the origin, the flat top y = radius is "top". Triangles; writes a Gmsh .msh file at path."""
+    width = radius / 2 if width is None else width
+    _check(radius, h_far, h_near, width)
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("half_disk")
+        disk = gmsh.model.occ.addDisk(0, radius, 0, radius, radius)
+        upper = gmsh.model.occ.addRectangle(-2 * radius, radius, 0, 4 * radius, 2 * radius)
+        gmsh.model.occ.cut([(2, disk)], [(2, upper)])
+        gmsh.model.occ.synchronize()
+        eps = 1e-3 * radius  # OCC bounding boxes carry a tolerance
+        top = _entities_in_box(1, (-radius, radius, 0), (radius, radius, 0), eps)
+        curves = [tag for _, tag in gmsh.model.getEntities(1)]
+        _physical(1, [c for c in curves if c not in top], HALF_DISK_GROUPS["contact"], "contact")
+        _physical(1, top, HALF_DISK_GROUPS["top"], "top")
+        _physical(2, [tag for _, tag in gmsh.model.getEntities(2)], BODY_GROUP, "body")
+        _size_field(h_near, h_far, width, 2)
+        gmsh.model.mesh.generate(2)
+        gmsh.write(path)
+    finally:
+        gmsh.finalize()
+
+
+def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None):
+    """The quarter of the lower half of the ball of the given radius centred at (0, 0, radius) with x >= 0 and y >= 0:
+    the curved surface ("contact") touches the plane z = 0 at the origin, the flat top z = radius is "top", and the
+    planes x = 0 and y = 0 are "symmetry_x" and "symmetry_y". Tetrahedra; writes a Gmsh .msh file at path."""
+    width = radius / 2 if width is None else width
+    _check(radius, h_far, h_near, width)
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("quarter_sphere")
+        ball = gmsh.model.occ.addSphere(0, 0, radius, radius)
+        box = gmsh.model.occ.addBox(0, 0, 0, 2 * radius, 2 * radius, radius)
+        gmsh.model.occ.intersect([(3, ball)], [(3, box)])
+        gmsh.model.occ.synchronize()
+        eps = 1e-3 * radius  # OCC bounding boxes carry a tolerance
+        top = _entities_in_box(2, (0, 0, radius), (radius, radius, radius), eps)
+        sym_x = _entities_in_box(2, (0, 0, 0), (0, radius, radius), eps)
+        sym_y = _entities_in_box(2, (0, 0, 0), (radius, 0, radius), eps)
+        surfaces = [tag for _, tag in gmsh.model.getEntities(2)]
+        _physical(2, [s for s in surfaces if s not in top + sym_x + sym_y], QUARTER_SPHERE_GROUPS["contact"], "contact")
+        _physical(2, top, QUARTER_SPHERE_GROUPS["top"], "top")
+        _physical(2, sym_y, QUARTER_SPHERE_GROUPS["symmetry_y"], "symmetry_y")
+        _physical(2, sym_x, QUARTER_SPHERE_GROUPS["symmetry_x"], "symmetry_x")
+        _physical(3, [tag for _, tag in gmsh.model.getEntities(3)], BODY_GROUP, "body")
+        _size_field(h_near, h_far, width, 3)
+        gmsh.model.mesh.generate(3)
+        gmsh.write(path)
+    finally:
+        gmsh.finalize()
+
+
+SHAPES = {"half-disk": half_disk, "quarter-sphere": quarter_sphere}

@@ -1,0 +1,96 @@
+"""Gmsh geometries (scripts/make_mesh.py, scripts/signorini/geometry.py): a 2D half-disk and a 3D quarter sphere
+touching the plane x_d = 0 at the origin, graded toward that point, with numbered and named physical groups that the
+solver reads as "Face Sets"; the built-in square scene (Gamma_C = 1, clamped top) solves on them, penalty and SNESVI,
+and 2 ranks give the serial answer on curved contact faces."""
+import os
+import subprocess
+import sys
+
+import gmsh
+import numpy as np
+import pytest
+
+from harness import ENV, ROOT, load, run, sorted_by_position
+
+MAKE_MESH = os.path.join(ROOT, "scripts", "make_mesh.py")
+SHAPES = {"half-disk": (2, {"contact": 1, "top": 3}), "quarter-sphere": (3, {"contact": 1, "top": 2, "symmetry_y": 3, "symmetry_x": 6})}
+SIZES = {"half-disk": ["--h-far", "0.05", "--h-near", "0.01"], "quarter-sphere": ["--h-far", "0.15", "--h-near", "0.04"]}
+RADIUS = 0.5
+
+
+def make_mesh(shape, path, extra=()):
+    return subprocess.run([sys.executable, MAKE_MESH, shape, "-o", path, "--radius", str(RADIUS)] + SIZES[shape] + list(extra), cwd=ROOT, env=ENV,
+                          stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=300)
+
+
+def cell_sizes(path, dim):
+    """(distance of each cell's centroid to the origin, largest edge of the cell), read back with Gmsh's API."""
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(path)
+        tags, coords, _ = gmsh.model.mesh.getNodes()
+        x = dict(zip(tags, coords.reshape(-1, 3)))
+        types, _, nodes = gmsh.model.mesh.getElements(dim)
+        nv = dim + 1
+        cells = np.array([[x[n] for n in c] for c in nodes[0].reshape(-1, nv)])
+    finally:
+        gmsh.finalize()
+    r = np.linalg.norm(cells.mean(axis=1), axis=1)
+    edges = np.max([np.linalg.norm(cells[:, i] - cells[:, j], axis=1) for i in range(nv) for j in range(i + 1, nv)], axis=0)
+    return r, edges
+
+
+@pytest.fixture(scope="module")
+def meshes(tmp_path_factory):
+    d = tmp_path_factory.mktemp("geometry")
+    paths = {}
+    for shape in SHAPES:
+        paths[shape] = str(d / f"{shape}.msh")
+        p = make_mesh(shape, paths[shape])
+        assert p.returncode == 0, p.stdout
+    return paths
+
+
+@pytest.mark.parametrize("shape", SHAPES)
+def test_mesh_groups_and_grading(meshes, shape):
+    """The physical groups carry the documented numbers and names, and the cells at the contact point are several times
+    smaller than those far from it."""
+    dim, groups = SHAPES[shape]
+    text = open(meshes[shape]).read()
+    names = text[text.index("$PhysicalNames"):text.index("$EndPhysicalNames")]
+    for name, tag in groups.items():
+        assert f'{dim - 1} {tag} "{name}"' in names, (name, tag, names)
+    r, h = cell_sizes(meshes[shape], dim)
+    near, far = h[r < (0.05 if dim == 2 else 0.15) * RADIUS].mean(), h[r > 0.6 * RADIUS].mean()
+    assert near < far / 2, f"cells near the contact point {near:.3g}, far {far:.3g}"
+
+
+@pytest.mark.parametrize("method", ["penalty", "vi"])
+@pytest.mark.parametrize("shape", SHAPES)
+def test_square_scene_solves_on_the_mesh(meshes, shape, method):
+    """The body, clamped on its top and pushed down, touches the plane around the origin: converged, a contact force,
+    and the largest pressure at a vertex near the origin."""
+    a, f = load(run(["-dm_plex_filename", meshes[shape], "-contact_method", method], f"geometry_{shape}_{method}")[1])
+    assert a["converged"] == 1 and a["active_vertices"] > 0 and a["contact_force"] > 0, (a["snes_reason"], a["active_vertices"])
+    on = f["contact_boundary"] > 0.5
+    x, p = f["x"][on], f["contact_pressure"][on]
+    assert np.linalg.norm(x[np.argmax(p)]) < 0.25 * RADIUS, x[np.argmax(p)]
+    assert np.abs(p[x[:, -1] > 0.2 * RADIUS]).max() <= 1e-8 * p.max(), "contact far above the plane"
+
+
+def test_two_ranks_equal_serial_on_curved_contact_faces(meshes):
+    args = ["-dm_plex_filename", meshes["half-disk"], "-penalty_quadrature", "gauss"]
+    a1, f1 = load(run(args, "geometry_serial")[1])
+    a2, f2 = load(run(args, "geometry_np2", np_=2)[1])
+    assert a1["converged"] == a2["converged"] == 1 and a2["nprocs"] == 2
+    u1, u2 = sorted_by_position(f1, "displacement"), sorted_by_position(f2, "displacement")
+    assert np.abs(u1 - u2).max() <= 1e-9 * np.abs(u1).max()
+    assert a1["active_vertices"] == a2["active_vertices"]
+
+
+def test_bad_sizes_are_refused(tmp_path):
+    path = str(tmp_path / "bad.msh")
+    p = make_mesh("half-disk", path, ["--h-near", "0.5"])
+    assert p.returncode == 2 and "h_near (0.5) must not exceed h_far (0.05)" in p.stdout, p.stdout
+    assert not os.path.exists(path)
