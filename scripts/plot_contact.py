@@ -3,12 +3,16 @@
 
 Reads a solver HDF5 output file, selects the vertices with
 /vertex_fields/contact_boundary == 1 and plots, against the first coordinate
-x_1, the contact pressure (top) and the normal gap g - u_n (bottom). In 3D,
-where many vertices share an x_1 value, the values are scattered and the mean
-per distinct x_1 is overlaid as a line.
+x_1 (or the abscissa of --along), the contact pressure (top) and the normal gap
+g - u_n (bottom). Where many vertices share an abscissa (3D faces), the values
+are scattered and the mean per distinct abscissa is overlaid as a line.
+
+--along x|y|z: a coordinate; arc (2D): the signed arc length along a curved
+contact curve from its lowest vertex; r: the distance from the lowest vertex in
+the coordinates other than the last (a body touching a plane x_d = const).
 
 Usage:
-    plot_contact.py FILE.h5 [-o OUT.png]
+    plot_contact.py FILE.h5 [-o OUT.png] [--along x|y|z|arc|r]
 
 The default output is FILE with .h5 replaced by _contact.png. Exit code 2 if
 the file cannot be read or has no contact-boundary vertices.
@@ -21,7 +25,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from signorini.figures import plt, save_png  # noqa: E402
-from signorini.runs import read_contact  # noqa: E402,F401
+from signorini.runs import ABSCISSAE, read_contact  # noqa: E402,F401
 
 
 def default_output(h5path):
@@ -47,9 +51,12 @@ def make_title(run):
             f" | eps={fmt('eps')} | converged={fmt('converged')}")
 
 
-def plot_contact(h5path, pngpath):
+XLABELS = {"x": "$x_1$", "y": "$x_2$", "z": "$x_3$", "arc": "arc length from the lowest contact vertex", "r": "distance from the lowest contact vertex"}
+
+
+def plot_contact(h5path, pngpath, along="x"):
     """Plot pressure and gap along Gamma_C of `h5path` into `pngpath`; return it."""
-    x1, p, g, run = read_contact(h5path)
+    x1, p, g, run = read_contact(h5path, along)
     keys = np.unique(np.round(x1, 10))
     many = len(keys) < len(x1)  # several vertices per x_1 (3D faces)
     fig, (ax_p, ax_g) = plt.subplots(2, 1, sharex=True, figsize=(8, 6.5))
@@ -58,14 +65,14 @@ def plot_contact(h5path, pngpath):
         if many:
             ax.scatter(x1, vals, s=12, alpha=0.5, color=color, label="vertices")
             xm, vm = mean_per_x(x1, vals)
-            ax.plot(xm, vm, "-o", ms=3, color="k", lw=1.2, label="mean per $x_1$")
+            ax.plot(xm, vm, "-o", ms=3, color="k", lw=1.2, label="mean per abscissa")
             ax.legend(loc="best", fontsize=8)
         else:
             ax.plot(x1, vals, "-o", ms=4, color=color)
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
     ax_g.axhline(0.0, color="gray", lw=1, ls="--")
-    ax_g.set_xlabel("$x_1$")
+    ax_g.set_xlabel(XLABELS[along])
     fig.suptitle(make_title(run), fontsize=10)
     save_png(fig, pngpath, 120)
     return pngpath
@@ -77,10 +84,11 @@ def main(argv=None):
     ap.add_argument("h5file", metavar="FILE.h5", help="solver HDF5 output file")
     ap.add_argument("-o", "--output", metavar="OUT.png", default=None,
                     help="output PNG (default: FILE_contact.png)")
+    ap.add_argument("--along", choices=ABSCISSAE, default="x", help="abscissa: a coordinate, the arc length (2D) or r (default x)")
     args = ap.parse_args(argv)
     out = args.output or default_output(args.h5file)
     try:
-        plot_contact(args.h5file, out)
+        plot_contact(args.h5file, out, args.along)
     except ValueError as exc:
         print(f"plot_contact.py: error: {exc}", file=sys.stderr)
         return 2

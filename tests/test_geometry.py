@@ -94,3 +94,31 @@ def test_bad_sizes_are_refused(tmp_path):
     p = make_mesh("half-disk", path, ["--h-near", "0.5"])
     assert p.returncode == 2 and "h_near (0.5) must not exceed h_far (0.05)" in p.stdout, p.stdout
     assert not os.path.exists(path)
+
+
+def test_pressure_along_the_arc_and_the_radius(meshes, tmp_path):
+    """scripts/plot_contact.py --along arc (2D) follows the contact curve: the abscissa of each vertex is its arc length
+    R phi from the lowest point, to the chords' error; --along r (3D) is the distance from the touching point in the plane."""
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    from signorini.runs import read_contact
+    _, h5 = run(["-dm_plex_filename", meshes["half-disk"]], "geometry_arc")
+    s, p, _, _ = read_contact(h5, "arc")
+    _, f = load(h5)
+    on = f["contact_boundary"] > 0.5
+    x = f["x"][on]
+    phi = np.sort(np.arctan2(x[:, 0], RADIUS - x[:, 1]))
+    assert np.abs(s - RADIUS * phi).max() <= 2e-3 * RADIUS, np.abs(s - RADIUS * phi).max()
+    assert p.max() > 0
+    _, h5 = run(["-dm_plex_filename", meshes["quarter-sphere"]], "geometry_r")
+    r, _, _, _ = read_contact(h5, "r")
+    _, f = load(h5)
+    x = f["x"][f["contact_boundary"] > 0.5]
+    assert np.abs(r - np.sort(np.hypot(x[:, 0], x[:, 1]))).max() <= 1e-12
+    for along, h5file in (("arc", os.path.join(os.path.dirname(h5), "geometry_arc.h5")), ("r", h5)):
+        png = str(tmp_path / f"{along}.png")
+        q = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "plot_contact.py"), h5file, "-o", png, "--along", along], cwd=ROOT, env=ENV,
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        assert q.returncode == 0 and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n", q.stdout
+    q = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "plot_contact.py"), h5, "-o", str(tmp_path / "no.png"), "--along", "arc"],
+                       cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert q.returncode == 2 and "the arc length is for 2D contact curves" in q.stdout, q.stdout

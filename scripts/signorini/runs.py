@@ -92,12 +92,49 @@ def read_solves(f):
     return {k: np.asarray(f["solves"][k][:]).ravel() for k in f["solves"]}
 
 
-def read_contact(h5path):
-    """Return (x1, pressure, gap, run_attrs) for the Gamma_C vertices, sorted by x1.
+ABSCISSAE = ("x", "y", "z", "arc", "r")
 
-    Raises ValueError if the file cannot be read, lacks a needed dataset, or
-    has no contact-boundary vertices.
+
+def _arc_length(x, mask, cells):
+    """Signed arc length of the Gamma_C vertices along the contact curve (2D): the boundary edges with both ends on
+    Gamma_C, walked from the lowest vertex (smallest last coordinate), negative toward smaller x_1."""
+    count = {}
+    for c in cells:
+        for i in range(len(c)):
+            e = tuple(sorted((int(c[i]), int(c[(i + 1) % len(c)]))))
+            count[e] = count.get(e, 0) + 1
+    nbrs = {}
+    for (a, b), n in count.items():
+        if n == 1 and mask[a] and mask[b]:
+            nbrs.setdefault(a, []).append(b)
+            nbrs.setdefault(b, []).append(a)
+    idx = np.flatnonzero(mask)
+    start = idx[np.argmin(x[idx, -1])]
+    s = {start: 0.0}
+    for first in nbrs.get(start, []):
+        sign = 1.0 if x[first, 0] >= x[start, 0] else -1.0
+        prev, cur, length = start, first, 0.0
+        while cur is not None and cur not in s:
+            length += np.linalg.norm(x[cur] - x[prev])
+            s[cur] = sign * length
+            nxt = [v for v in nbrs.get(cur, []) if v != prev]
+            prev, cur = cur, (nxt[0] if nxt else None)
+    missing = [v for v in idx if v not in s]
+    if missing:
+        raise ValueError(f"{len(missing)} Gamma_C vertices are not on the curve through the lowest one: the arc length needs one connected contact curve")
+    return np.array([s[v] for v in idx])
+
+
+def read_contact(h5path, along="x"):
+    """Return (abscissa, pressure, gap, run_attrs) for the Gamma_C vertices, sorted by the abscissa.
+
+    along: "x", "y", "z" (a coordinate), "arc" (2D: the signed arc length along the contact curve from its lowest vertex)
+    or "r" (the distance from the lowest vertex in the coordinates other than the last, for bodies touching a plane
+    x_d = const). Raises ValueError if the file cannot be read, lacks a needed dataset, has no contact-boundary vertices,
+    or the abscissa does not apply.
     """
+    if along not in ABSCISSAE:
+        raise ValueError(f"unknown abscissa '{along}': one of {', '.join(ABSCISSAE)}")
     try:
         with h5py.File(h5path, "r") as f:
             x = f["geometry/vertices"][()]
@@ -106,10 +143,25 @@ def read_contact(h5path):
             p = vf["contact_pressure"][()]
             g = vf["normal_gap"][()]
             run = decoded_attrs(f["run"]) if "run" in f else {}
+            cells = f["viz/topology/cells"][()] if along == "arc" else None
     except Exception as exc:
         raise ValueError(f"{h5path}: cannot read contact data ({exc})") from exc
     if not mask.any():
         raise ValueError(f"{h5path}: no contact_boundary vertices (Gamma_C is empty)")
-    x1 = x[mask, 0] if x.ndim == 2 else x[mask]
-    order = np.argsort(x1, kind="stable")
-    return x1[order], p[mask][order], g[mask][order], run
+    x = x.reshape(len(mask), -1)
+    dim = x.shape[1]
+    if along in ("x", "y", "z"):
+        axis = "xyz".index(along)
+        if axis >= dim:
+            raise ValueError(f"{h5path}: a {dim}D mesh has no coordinate {along}")
+        t = x[mask, axis]
+    elif along == "arc":
+        if dim != 2:
+            raise ValueError(f"{h5path}: the arc length is for 2D contact curves; use r or a coordinate in {dim}D")
+        t = _arc_length(x, mask, cells.astype(int))
+    else:
+        idx = np.flatnonzero(mask)
+        low = x[idx[np.argmin(x[idx, -1])], :-1]
+        t = np.linalg.norm(x[mask, :-1] - low, axis=1)
+    order = np.argsort(t, kind="stable")
+    return t[order], p[mask][order], g[mask][order], run
