@@ -1,7 +1,7 @@
 /* Safe replacement of the output files. Every file is written under a unique temporary name in the target's
    directory and renamed over the target only when complete, the XDMF file before the HDF5 file (so no new .h5 ever
    stands without its .xdmf), under a lock of the directory (so two runs writing the same output leave the pair of
-   one run) and with SIGTERM/SIGINT held back (so a signal leaves the old pair or the new one). A failure, an exit on
+   one run) and with SIGTERM/SIGINT deferred until both are renamed (so a signal leaves the old pair or the new one). A failure, an exit on
    error or a signal removes the temporaries. A target that exists and is not a regular file (a directory, a device,
    a FIFO, a symbolic link) is refused before the solve. */
 #define _DEFAULT_SOURCE /* POSIX and BSD calls (mkstemp, lstat, sigaction, flock) under -std=c99 */
@@ -28,20 +28,39 @@ static void OutputFileRemoveTemps(void)
     if (output_temps[i][0]) (void)unlink(output_temps[i]); /* async-signal-safe */
 }
 
-static void OutputFileSignalHandler(int sig)
+/* The termination signals may be delivered to any thread of the process (Open MPI, PMIx and OpenBLAS start threads of
+   their own), so they cannot be held back by a signal mask. While the main thread creates the temporaries or renames
+   the pair, a signal is only recorded; it takes effect when the main thread leaves that critical section. */
+static volatile sig_atomic_t output_critical = 0; /* the main thread is creating temporaries or renaming the pair */
+static volatile sig_atomic_t output_pending  = 0; /* a termination signal that arrived meanwhile */
+
+static void OutputFileDie(int sig)
 {
   OutputFileRemoveTemps();
   (void)signal(sig, SIG_DFL);
   (void)raise(sig); /* die of the signal, as without the handler */
 }
 
-static void OutputFileBlockSignals(PetscBool block)
+static void OutputFileSignalHandler(int sig)
 {
-  sigset_t set;
+  if (output_critical)
+    output_pending = sig;
+  else
+    OutputFileDie(sig);
+}
 
-  sigemptyset(&set);
-  for (size_t i = 0; i < output_nsignals; ++i) sigaddset(&set, output_signals[i]);
-  (void)sigprocmask(block ? SIG_BLOCK : SIG_UNBLOCK, &set, NULL);
+static void OutputFileEnterCritical(void)
+{
+  output_critical = 1;
+  __sync_synchronize();
+}
+
+static void OutputFileLeaveCritical(void)
+{
+  __sync_synchronize();
+  output_critical = 0;
+  __sync_synchronize();
+  if (output_pending) OutputFileDie(output_pending);
 }
 
 /* Installs the clean-up of the temporaries at exit (also after an error in main) and on the usual termination signals
@@ -163,7 +182,7 @@ PetscErrorCode OutputFileCreateTemps(MPI_Comm comm, const char dir[], PetscInt n
   PetscCheck(n <= OUTPUT_MAX_TEMPS, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Too many temporary files");
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   if (rank == 0) {
-    OutputFileBlockSignals(PETSC_TRUE); /* no temporary created and not yet registered */
+    OutputFileEnterCritical(); /* no temporary created and not yet registered */
     for (PetscInt i = 0; i < n && !err; ++i) {
       int fd;
 
@@ -177,7 +196,7 @@ PetscErrorCode OutputFileCreateTemps(MPI_Comm comm, const char dir[], PetscInt n
         memcpy(output_temps[i], temps[i], PETSC_MAX_PATH_LEN);
       }
     }
-    OutputFileBlockSignals(PETSC_FALSE);
+    OutputFileLeaveCritical();
   }
   PetscCallMPI(MPI_Bcast(&err, 1, MPI_INT, 0, comm));
   if (err) PetscCall(OutputFileDiscardTemps(comm));
@@ -195,15 +214,15 @@ PetscErrorCode OutputFileDiscardTemps(MPI_Comm comm)
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  OutputFileBlockSignals(PETSC_TRUE);
+  OutputFileEnterCritical();
   if (rank == 0) OutputFileRemoveTemps();
   memset(output_temps, 0, sizeof(output_temps));
-  OutputFileBlockSignals(PETSC_FALSE);
+  OutputFileLeaveCritical();
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Renames the n temporaries over their targets, in order, as one step: under an exclusive lock of the directory and
-   with the termination signals held back. */
+   with the termination signals deferred until both are renamed. */
 PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, char temps[][PETSC_MAX_PATH_LEN], const char *targets[])
 {
   PetscMPIInt rank;
@@ -214,7 +233,7 @@ PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, cha
   if (rank == 0) {
     int dfd;
 
-    OutputFileBlockSignals(PETSC_TRUE);
+    OutputFileEnterCritical();
     dfd = open(dir, O_RDONLY | O_DIRECTORY);
     if (dfd >= 0) (void)flock(dfd, LOCK_EX);
     for (PetscInt i = 0; i < n && !err; ++i) {
@@ -228,7 +247,7 @@ PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, cha
       (void)flock(dfd, LOCK_UN);
       (void)close(dfd);
     }
-    OutputFileBlockSignals(PETSC_FALSE);
+    OutputFileLeaveCritical();
   }
   PetscCallMPI(MPI_Bcast(&err, 1, MPI_INT, 0, comm));
   PetscCallMPI(MPI_Bcast(&failed, 1, MPI_INT, 0, comm));
