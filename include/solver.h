@@ -7,6 +7,7 @@
 PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user);
 PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
 PetscErrorCode SolverComputeScales(DM dm, AppCtx *user);
+PetscErrorCode SolverIterateDisplacement(AppCtx *user, Vec X, Vec *u);
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm);
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
 PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);

@@ -5,6 +5,8 @@ one point, meshed finer toward that point, with physical groups (numbered and na
 Every shape rests on the plane {x_d = 0} and touches it at the origin; the mesh size grows linearly with the distance r
 from the origin, from h_near at r = 0 to h_far at r >= width.
 """
+import contextlib
+
 import gmsh
 
 # "Face Sets" values, as PETSc numbers the faces of its boxes (2D: bottom 1, top 3; 3D: bottom 1, top 2, front y = 0 3,
@@ -35,6 +37,26 @@ def _physical(dim, tags, tag, name):
     gmsh.model.setPhysicalName(dim, tag, name)
 
 
+@contextlib.contextmanager
+def _model(name):
+    """A Gmsh session with one model, quiet; finalized whatever happens."""
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add(name)
+        yield
+    finally:
+        gmsh.finalize()
+
+
+def _write(path, dim, h_near, h_far, width):
+    """The body's physical group, the size field, the mesh, and the file."""
+    _physical(dim, [tag for _, tag in gmsh.model.getEntities(dim)], BODY_GROUP, "body")
+    _size_field(h_near, h_far, width, dim)
+    gmsh.model.mesh.generate(dim)
+    gmsh.write(path)
+
+
 def _check(radius, h_far, h_near, width):
     for name, value in (("radius", radius), ("h_far", h_far), ("h_near", h_near), ("width", width)):
         if not value > 0:
@@ -48,10 +70,7 @@ def half_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None):
     plane y = 0 at the origin, the flat top y = radius is "top". Triangles; writes a Gmsh .msh file at path."""
     width = radius / 2 if width is None else width
     _check(radius, h_far, h_near, width)
-    gmsh.initialize()
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.model.add("half_disk")
+    with _model("half_disk"):
         disk = gmsh.model.occ.addDisk(0, radius, 0, radius, radius)
         upper = gmsh.model.occ.addRectangle(-2 * radius, radius, 0, 4 * radius, 2 * radius)
         gmsh.model.occ.cut([(2, disk)], [(2, upper)])
@@ -61,12 +80,7 @@ def half_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None):
         curves = [tag for _, tag in gmsh.model.getEntities(1)]
         _physical(1, [c for c in curves if c not in top], HALF_DISK_GROUPS["contact"], "contact")
         _physical(1, top, HALF_DISK_GROUPS["top"], "top")
-        _physical(2, [tag for _, tag in gmsh.model.getEntities(2)], BODY_GROUP, "body")
-        _size_field(h_near, h_far, width, 2)
-        gmsh.model.mesh.generate(2)
-        gmsh.write(path)
-    finally:
-        gmsh.finalize()
+        _write(path, 2, h_near, h_far, width)
 
 
 def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None):
@@ -75,10 +89,7 @@ def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None):
     planes x = 0 and y = 0 are "symmetry_x" and "symmetry_y". Tetrahedra; writes a Gmsh .msh file at path."""
     width = radius / 2 if width is None else width
     _check(radius, h_far, h_near, width)
-    gmsh.initialize()
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.model.add("quarter_sphere")
+    with _model("quarter_sphere"):
         ball = gmsh.model.occ.addSphere(0, 0, radius, radius)
         box = gmsh.model.occ.addBox(0, 0, 0, 2 * radius, 2 * radius, radius)
         gmsh.model.occ.intersect([(3, ball)], [(3, box)])
@@ -92,12 +103,7 @@ def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None):
         _physical(2, top, QUARTER_SPHERE_GROUPS["top"], "top")
         _physical(2, sym_y, QUARTER_SPHERE_GROUPS["symmetry_y"], "symmetry_y")
         _physical(2, sym_x, QUARTER_SPHERE_GROUPS["symmetry_x"], "symmetry_x")
-        _physical(3, [tag for _, tag in gmsh.model.getEntities(3)], BODY_GROUP, "body")
-        _size_field(h_near, h_far, width, 3)
-        gmsh.model.mesh.generate(3)
-        gmsh.write(path)
-    finally:
-        gmsh.finalize()
+        _write(path, 3, h_near, h_far, width)
 
 
 SHAPES = {"half-disk": half_disk, "quarter-sphere": quarter_sphere}

@@ -2,10 +2,8 @@
    as attributes of /run, an .xdmf beside it. Written under temporary names and renamed when complete (output_file.c). */
 #define _DEFAULT_SOURCE /* POSIX and BSD calls (mkstemp, lstat, sigaction, flock) under -std=c99 */
 #include <errno.h>
-#include <fcntl.h>
 #include <string.h>
 #include <sys/statvfs.h>
-#include <unistd.h>
 #include <petscsf.h>
 #include <petscviewerhdf5.h>
 #include "mesh.h"

@@ -67,12 +67,7 @@ PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm_scaled, vo
   PetscFunctionBeginUser;
   user->rec.stats.residual_norm = fnorm;
   PetscCall(SNESGetSolution(snes, &Xs));
-  X = Xs;
-  if (user->prob.snes_scale != 1.0) {
-    PetscCall(VecCopy(Xs, user->prob.work));
-    PetscCall(VecScale(user->prob.work, user->prob.snes_scale));
-    X = user->prob.work;
-  }
+  PetscCall(SolverIterateDisplacement(user, Xs, &X));
   if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(DetectActiveSetCycle(snes, user, it, fnorm, X));
   if (!user->opt.contact.monitor) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactCountActive(user, X, PETSC_TRUE, &active, &entered, &left));

@@ -52,7 +52,7 @@ PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R)
    point): F~ has the Jacobian of F, so Newton's iterates are U times smaller and the same, while the absolute tolerances
    inside PETSc (SNESVI's bound tolerance, the line searches' maximal step) see a displacement of size one in any units.
    The displacement of the iterate, U x~, goes to user->prob.work. */
-static PetscErrorCode SolverIterateDisplacement(AppCtx *user, Vec X, Vec *u)
+PetscErrorCode SolverIterateDisplacement(AppCtx *user, Vec X, Vec *u)
 {
   PetscFunctionBeginUser;
   *u = X;
