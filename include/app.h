@@ -10,3 +10,4 @@ int OptionsFilesCheckYAML(int argc, char **argv);
 PetscErrorCode OptionsCheckFinite(MPI_Comm comm, const char name[], PetscReal value);
 PetscErrorCode OptionsCheckFiniteArray(MPI_Comm comm, const char name[], PetscInt n, const PetscReal values[]);
 PetscErrorCode OptionsCountListValues(const char name[], PetscInt *n);
+PetscErrorCode OptionsCheckPrefixesUsed(MPI_Comm comm, const char prefixes[]);

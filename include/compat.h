@@ -34,3 +34,11 @@
 #  include <math.h>
 #  define PETSC_NAN ((PetscReal)NAN)
 #endif
+
+/* A helper that reads options inside a PetscOptionsBegin() block takes the block's PetscOptionsObject; its type became
+   a pointer typedef in 3.23. */
+#if PETSC_VERSION_LT(3, 23, 0)
+typedef PetscOptionItems *CompatOptionItems;
+#else
+typedef PetscOptionItems CompatOptionItems;
+#endif

@@ -9,9 +9,14 @@ PetscErrorCode MeshCheckFaceSets(DM dm, const char scene[], const char what[], P
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[], DM *dm);
 PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[]);
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
+PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam);
 PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id);
 PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count);
 PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **faces);
+PetscErrorCode MeshPointPosition(DM dm, PetscInt p, PetscReal x[]);
+
+/* mesh_gmsh_names.c */
+PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[]);
 
 /* mesh_refine.c */
 PetscErrorCode MeshCellVertices(DM dm, PetscInt c, PetscInt verts[], PetscInt *nv);

@@ -15,15 +15,25 @@ PetscErrorCode ContactComputeEps(AppCtx *user);
 PetscReal      ContactPenaltyModulus(const AppCtx *user);
 PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs);
 PetscErrorCode ContactSetDestroy(ContactSet *cs);
+PetscReal      ContactEpsFactor(const AppCtx *user, PetscReal h_local);
 PetscErrorCode ContactCountActive(AppCtx *user, Vec X, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left);
 
-/* Penetration u_n - g of contact node i, from the owned part x[] of a global vector. */
-static inline PetscReal ContactNodePenetration(const AppCtx *user, PetscInt dim, PetscInt i, const PetscScalar x[])
+/* Penetration u . n - g of contact node i, from the owned part x[] of a global vector (fixed components: their values). */
+static inline PetscReal ContactNodePenetration(const ContactSet *cs, PetscInt dim, PetscInt i, const PetscScalar x[])
 {
   PetscReal un = 0.0;
 
-  for (PetscInt c = 0; c < dim; ++c) un += PetscRealPart(x[user->prob.cset.global_off[i] + c]) * user->scene.obstacle_normal[c];
-  return un - user->prob.cset.gap[i];
+  for (PetscInt c = 0; c < dim; ++c) {
+    const PetscInt k = cs->dof[i * dim + c];
+    un += (k >= 0 ? PetscRealPart(x[k]) : cs->fixed[i * dim + c]) * cs->normal[i * dim + c];
+  }
+  return un - cs->gap[i];
+}
+
+/* The penalty parameter of contact node i: the run's eps scaled to the node's local mesh size. */
+static inline PetscReal ContactNodeEps(const ContactSet *cs, PetscReal eps, PetscInt i)
+{
+  return eps * cs->eps_factor[i];
 }
 
 /* penalty.c */
@@ -40,3 +50,9 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u);
 
 /* elasticity.c: sigma(grad u) = lambda tr(eps) I + 2 mu eps, grad[i*dim+j] = du_i/dx_j */
 void ElasticStress(PetscInt dim, const Material *mat, const PetscReal grad[], PetscReal sigma[]);
+
+/* boundary.c */
+PetscErrorCode BoundaryAddDirichlet(DM dm, AppCtx *user);
+PetscErrorCode BoundaryAddLoads(DM dm, AppCtx *user, Vec r0);
+PetscErrorCode BoundaryCheckFaceSets(DM dm, const Scene *scene);
+PetscErrorCode BoundaryCheckRigidMotions(DM dm, const Scene *scene);

@@ -10,3 +10,11 @@ PetscErrorCode SceneGetOptions(MPI_Comm comm, char name[], size_t len);
 PetscErrorCode SceneCreate_Square(DM, const Material *, Scene *);
 PetscErrorCode SceneCreate_Patch(DM, const Material *, Scene *);
 PetscErrorCode SceneCreate_MMS(DM, const Material *, Scene *);
+PetscErrorCode SceneCreate_General(DM, const Material *, Scene *);
+
+/* scenes/boundary_options.c, scenes/obstacle_options.c: the scenes' defaults, then the options */
+PetscErrorCode SceneAddBoundary(Scene *scene, BoundaryKind kind, PetscInt id, ScenePointFn fn);
+PetscErrorCode SceneAddContactFaces(Scene *scene, PetscInt id);
+PetscErrorCode SceneSetObstaclePlane(Scene *scene, const PetscReal point[], const PetscReal n[]);
+PetscErrorCode SceneBoundaryGetOptions(DM dm, Scene *scene);
+PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene);

@@ -8,17 +8,25 @@
 
 #include "compat.h"
 
+/* Parameters of the rigid obstacle, packed in this order (constants[CONST_OBSTACLE + k], ObstaclePack() in obstacle.h). */
+enum {
+  OBSTACLE_TYPE,                          /* ObstacleType */
+  OBSTACLE_POINT,                         /* plane: a point of it; sphere, cylinder: the center (x, y, z), translation included */
+  OBSTACLE_DIRECTION = OBSTACLE_POINT + 3, /* plane: unit normal from the body into the obstacle; cylinder: unit axis */
+  OBSTACLE_RADIUS    = OBSTACLE_DIRECTION + 3,
+  OBSTACLE_NUM_PARAMS
+};
+
 /* Index map of constants[] as every pointwise kernel sees it. */
 typedef enum {
-  CONST_LAMBDA,          /* first Lame parameter */
-  CONST_MU,              /* shear modulus */
-  CONST_PENALTY,         /* 1/eps (0 when there is no penalty term) */
-  CONST_NORMAL_X,        /* outward unit normal of the rigid foundation plane, */
-  CONST_NORMAL_Y,        /*   seen from the body: u_n = u . n */
-  CONST_NORMAL_Z,        /*   (3rd component unused in 2D) */
-  CONST_OBSTACLE_OFFSET, /* foundation plane {x : x . n = offset}; gap g(x) = offset - x . n */
-  CONST_SCENE,           /* first of the scene's own constants */
-  CONST_SCENE_MAX = CONST_SCENE + 8
+  CONST_LAMBDA,                                       /* first Lame parameter */
+  CONST_MU,                                           /* shear modulus */
+  CONST_PENALTY,                                      /* 1/eps (0 when there is no penalty term) */
+  CONST_OBSTACLE,                                     /* the obstacle's parameters, OBSTACLE_NUM_PARAMS of them */
+  CONST_BODY_FORCE = CONST_OBSTACLE + OBSTACLE_NUM_PARAMS, /* constant body force (x, y, z), -body_force */
+  CONST_LOAD       = CONST_BODY_FORCE + 3,                 /* the surface load being assembled: traction (x, y, z), or pressure p */
+  CONST_SCENE      = CONST_LOAD + 3,                       /* first of the scene's own constants */
+  CONST_SCENE_MAX  = CONST_SCENE + 8
 } ConstantIndex;
 
 typedef enum { CONTACT_PENALTY, CONTACT_VI, CONTACT_NONE } ContactMethod;
@@ -39,16 +47,46 @@ typedef struct {
 /* Pointwise function with PETSc's signature for boundary values and exact solutions. */
 typedef PetscErrorCode (*ScenePointFn)(PetscInt dim, PetscReal t, const PetscReal x[], PetscInt Nc, PetscScalar u[], void *ctx);
 
-/* What a scene (a problem set-up) provides; filled by its SceneCreate_* function. */
+/* Boundary conditions by "Face Sets" value (-bc_clamp, -bc_slip, -bc_traction, -bc_pressure). */
+typedef enum { BC_CLAMP, BC_SLIP, BC_TRACTION, BC_PRESSURE, BC_NUM_KINDS } BoundaryKind;
+extern const char *const BoundaryKinds[];
+#define BOUNDARY_MAX 32 /* face sets per family, and boundary conditions in all */
+typedef struct {
+  BoundaryKind kind;
+  PetscInt     id;              /* "Face Sets" value */
+  char         token[64];       /* as given: the number, or the name of the Gmsh physical group */
+  PetscInt     ncomp, comps[3]; /* clamp, slip: the fixed components */
+  PetscReal    value[3];        /* clamp, slip: the prescribed displacement; traction: force per unit area; pressure: p = value[0] */
+  ScenePointFn fn;              /* clamp: the scene's own displacement instead of value (NULL: value); called with ctx = constants */
+} BoundaryCondition;
+
+typedef struct {
+  PetscInt          n;
+  BoundaryCondition bc[BOUNDARY_MAX];
+  PetscInt          ncontact;                  /* Gamma_C: one or more face sets (-contact_faces) */
+  PetscInt          contact_ids[BOUNDARY_MAX];
+  char              contact_tokens[BOUNDARY_MAX][64];
+  PetscReal         body_force[3];             /* -body_force */
+} BoundarySet;
+
+/* The rigid obstacle (-obstacle plane | sphere | cylinder). */
+typedef enum { OBSTACLE_PLANE, OBSTACLE_SPHERE, OBSTACLE_CYLINDER } ObstacleType;
+extern const char *const ObstacleTypes[];
+typedef struct {
+  ObstacleType type;
+  PetscReal    point[3];     /* plane: a point of it; sphere, cylinder: the center */
+  PetscReal    direction[3]; /* plane: unit normal from the body into the obstacle; cylinder: unit axis (3D) */
+  PetscReal    radius;
+  PetscReal    translate[3]; /* rigid translation of the obstacle (-obstacle_translate) */
+} Obstacle;
+
+/* What a scene (a problem set-up) provides: its defaults of the boundary and obstacle options, filled by its
+   SceneCreate_* function, then the options themselves (scenes/boundary_options.c, scenes/obstacle_options.c). */
 typedef struct {
   char           name[64];
-  PetscInt       contact_id;    /* "Face Sets" value of Gamma_C */
-  PetscInt       num_dirichlet; /* "Face Sets" values of Gamma_D (clamped or prescribed) */
-  PetscInt       dirichlet_ids[6];
-  ScenePointFn   dirichlet_value; /* NULL: clamped, u = 0; called with ctx = constants */
-  PetscPointFunc f0_body;         /* volume residual term, -f; NULL: no body force */
-  PetscReal      obstacle_normal[3];
-  PetscReal      obstacle_offset;
+  BoundarySet    bcs;
+  Obstacle       obstacle;
+  PetscPointFunc f0_body;        /* volume residual term, -f, if not constant; it adds the -body_force of constants[] */
   ScenePointFn   exact;          /* exact solution, NULL if none; called with ctx = constants */
   ScenePointFn   exact_gradient; /* its gradient, G[i*dim+j] = du_i/dx_j (Nc = dim*dim); needed for the error norms */
   PetscBool      weak_data;      /* load from the exact solution: L(v) = a(u_exact, v) - int_Gamma_C sigma_n(u_exact) v_n */
@@ -66,6 +104,7 @@ typedef struct {
   ContactMethod     method;
   PenaltyQuadrature quadrature;
   PetscReal         eps0, eps_power, eps_fixed; /* eps = eps0 h^power / M, or eps_fixed when > 0 */
+  PetscBool         eps_local;                  /* h of each contact face (Gauss) or node (nodal), not of the whole mesh */
   PenaltyModulus    modulus;                    /* M = E (young) or lambda + 2 mu (pwave) */
   PetscBool         monitor;
   PetscBool         continuation;        /* reach an eps below h/M through a sequence of larger ones */
@@ -89,13 +128,17 @@ typedef struct {
   PetscInt  builds;          /* builds so far */
 } PcReuse;
 
-/* The nodes of Gamma_C owned by this rank and free to move: the unknowns the contact acts on. */
+/* The nodes of Gamma_C owned by this rank with at least one free component: the unknowns the contact acts on. */
 typedef struct {
   PetscInt   n;
   PetscInt  *point;      /* DMPlex point holding the node */
-  PetscInt  *global_off; /* offset of its first component in the global vector (ownership start subtracted) */
+  PetscInt  *global_off; /* offset of its first free component in the global vector (ownership start subtracted) */
+  PetscInt  *dof;        /* [n][dim]: offset of each component in the global vector (ownership start subtracted), -1 if fixed */
+  PetscReal *fixed;      /* [n][dim]: the prescribed value of each fixed component (0 for the free ones) */
+  PetscReal *normal;     /* [n][dim]: unit normal from the body into the obstacle at the node's undeformed position */
   PetscBool *is_vertex;
-  PetscReal *gap;          /* g = offset - x . n at the node */
+  PetscReal *gap;          /* g: distance from the node to the obstacle along the normal (negative: initial penetration) */
+  PetscReal *eps_factor;   /* the node's eps over the run's eps: (h_node / h)^power, h_node the largest cell at its contact faces */
   PetscReal *weight;       /* lumped boundary mass, the integral of the node's basis function over Gamma_C */
   PetscBool *active;       /* active set at the last monitor call */
   PetscBool *built_active; /* active set when the preconditioner was last built */
@@ -172,7 +215,8 @@ typedef struct {
 typedef struct {
   PetscInt      level;      /* grid sequence level of the mesh (0: the mesh of the options) */
   PetscReal     setup_time; /* set-up time of this problem, counted with its first solve */
-  PetscReal     h, eps;
+  PetscReal     h, eps;               /* the largest cell diameter, and eps = eps0 h^power / M for it (the node's: eps * eps_factor) */
+  PetscReal     eps_factor_min, eps_factor_max; /* over the contact nodes (local eps on graded meshes), all ranks */
   DMLabel       face_sets;
   ContactSet    cset;
   PetscWeakForm wf_penalty;         /* the penalty term on Gamma_C, kept out of the bulk weak form */

@@ -33,3 +33,38 @@ PetscErrorCode OptionsCountListValues(const char name[], PetscInt *n)
   for (const char *c = value; *c; ++c) *n += *c == ',';
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* Refuses options that start with one of the space-separated prefixes (with their dash) and were never read: once a
+   module has read all of its options, those are misspellings (-bc_clamp_3_tanslate), named before any solve. */
+PetscErrorCode OptionsCheckPrefixesUsed(MPI_Comm comm, const char prefixes[])
+{
+  PetscInt N, nbad = 0;
+  char   **names, **values, list[1024] = "";
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsLeftGet(NULL, &N, &names, &values));
+  for (PetscInt i = 0; i < N; ++i) {
+    char        buf[256];
+    const char *rest = prefixes;
+
+    while (*rest) { /* one prefix at a time */
+      size_t len = strcspn(rest, " ");
+      PetscBool match;
+
+      PetscCall(PetscStrncpy(buf, rest + 1, PetscMin(len, sizeof(buf)))); /* without the dash: the names below have none */
+      PetscCall(PetscStrbeginswith(names[i], buf, &match));
+      if (match) {
+        PetscCall(PetscStrlcat(list, " -", sizeof(list)));
+        PetscCall(PetscStrlcat(list, names[i], sizeof(list)));
+        ++nbad;
+        break;
+      }
+      rest += len;
+      while (*rest == ' ') ++rest;
+    }
+  }
+  PetscCall(PetscOptionsLeftRestore(NULL, &N, &names, &values));
+  PetscCheck(nbad == 0, comm, PETSC_ERR_USER_INPUT,
+             "%" PetscInt_FMT " option(s) given but never used (misspelled, or for a face set or obstacle not in use? see -help):%s", nbad, list);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

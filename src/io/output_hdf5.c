@@ -159,7 +159,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
     PetscCall(PetscSectionGetOffset(ssec, cs->point[i], &goff));
     goff -= srstart;
     p[goff] = cs->pressure[i];
-    g[goff] = -ContactNodePenetration(user, dim, i, x);
+    g[goff] = -ContactNodePenetration(&user->prob.cset, dim, i, x);
     m[goff] = 1.0;
   }
   PetscCall(VecRestoreArray(mask, &m));
@@ -243,6 +243,8 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteIntAttr(v, "n_dofs", ndofs));
   PetscCall(WriteRealAttr(v, "h", user->prob.h));
   PetscCall(WriteRealAttr(v, "eps", user->opt.contact.method == CONTACT_PENALTY ? user->prob.eps : 0.0));
+  PetscCall(WriteRealAttr(v, "eps_min", user->opt.contact.method == CONTACT_PENALTY ? user->prob.eps * user->prob.eps_factor_min : 0.0));
+  PetscCall(WriteRealAttr(v, "eps_max", user->opt.contact.method == CONTACT_PENALTY ? user->prob.eps * user->prob.eps_factor_max : 0.0));
   PetscCall(WriteRealAttr(v, "young_modulus", user->opt.material.young_modulus));
   PetscCall(WriteRealAttr(v, "poisson_ratio", user->opt.material.poisson_ratio));
   PetscCall(WriteIntAttr(v, "converged", s->converged ? 1 : 0));

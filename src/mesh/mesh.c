@@ -118,6 +118,12 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
                "names of more than 240; use a shorter (for example relative) path",
                filename, (int)strlen(filename));
     PetscCall(MeshReadFile(comm, filename, dm));
+    {
+      PetscBool gmsh;
+
+      PetscCall(PetscStrendswith(filename, ".msh", &gmsh));
+      if (gmsh) PetscCall(MeshLabelGmshNames(*dm, filename)); /* the physical groups' names, for the boundary options */
+    }
     PetscCall(DMGetDimension(*dm, &fdim));
     PetscCheck(!dim_set || fdim == dim, comm, PETSC_ERR_USER_INPUT,
                "The mesh file '%s' holds a %" PetscInt_FMT "D mesh, but -dm_plex_dim %" PetscInt_FMT " was given", filename, fdim, dim);
@@ -145,6 +151,32 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
   PetscCall(DMSetFromOptions(*dm)); /* -dm_refine on all ranks, -dm_mat_type, PETSc's checks */
   PetscCall(PetscObjectSetName((PetscObject)*dm, "mesh"));
   PetscCall(DMViewFromOptions(*dm, NULL, "-dm_view"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The diameter of cell c: the largest distance between two of its vertices. */
+PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam)
+{
+  DM           cdm;
+  PetscSection csection;
+  Vec          coords;
+  PetscInt     cdim, n;
+  PetscScalar *x = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetCoordinateDim(dm, &cdim));
+  PetscCall(DMGetCoordinateDM(dm, &cdm));
+  PetscCall(DMGetLocalSection(cdm, &csection));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  *diam = 0.0;
+  PetscCall(DMPlexVecGetClosure(cdm, csection, coords, c, &n, &x));
+  for (PetscInt i = 0; i < n / cdim; ++i)
+    for (PetscInt j = i + 1; j < n / cdim; ++j) {
+      PetscReal d2 = 0.0;
+      for (PetscInt d = 0; d < cdim; ++d) d2 += PetscSqr(PetscRealPart(x[i * cdim + d] - x[j * cdim + d]));
+      *diam = PetscMax(*diam, PetscSqrtReal(d2));
+    }
+  PetscCall(DMPlexVecRestoreClosure(cdm, csection, coords, c, &n, &x));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -259,5 +291,32 @@ PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **
     PetscCall(ISDestroy(&is));
   } else
     PetscCall(PetscMalloc1(1, faces));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Position of a node: the vertex itself, or the centroid of the edge/face that carries it (Lagrange P2/Q2). */
+PetscErrorCode MeshPointPosition(DM dm, PetscInt p, PetscReal x[])
+{
+  PetscInt depth, cdim;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetCoordinateDim(dm, &cdim));
+  PetscCall(DMPlexGetPointDepth(dm, p, &depth));
+  if (depth == 0) {
+    DM                 cdm;
+    PetscSection       cs;
+    Vec                coords;
+    PetscInt           off;
+    const PetscScalar *a;
+
+    PetscCall(DMGetCoordinateDM(dm, &cdm));
+    PetscCall(DMGetLocalSection(cdm, &cs));
+    PetscCall(DMGetCoordinatesLocal(dm, &coords));
+    PetscCall(PetscSectionGetOffset(cs, p, &off));
+    PetscCall(VecGetArrayRead(coords, &a));
+    for (PetscInt d = 0; d < cdim; ++d) x[d] = PetscRealPart(a[off + d]);
+    PetscCall(VecRestoreArrayRead(coords, &a));
+  } else
+    PetscCall(DMPlexComputeCellGeometryFVM(dm, p, NULL, x, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -23,6 +23,10 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   opts->eps_power = 1.0;
   PetscCall(
       PetscOptionsReal("-penalty_eps_power", "eps = eps0 h^power / E: the power of h, in [0, 4]", NULL, opts->eps_power, &opts->eps_power, NULL));
+  opts->eps_local = PETSC_TRUE;
+  PetscCall(PetscOptionsBool("-penalty_eps_local",
+                             "eps from the local h: the diameter of the cell at each contact face (gauss) or the largest at each node (nodal)", NULL,
+                             opts->eps_local, &opts->eps_local, NULL));
   opts->modulus = PENALTY_MODULUS_YOUNG;
   PetscCall(PetscOptionsEnum("-penalty_eps_modulus",
                              "Stiffness M of eps = eps0 h^power / M: young (E) or pwave (lambda + 2 mu, for nearly incompressible bodies)", NULL,

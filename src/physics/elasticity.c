@@ -1,5 +1,6 @@
 /* Isotropic linear elasticity (plane strain in 2D): material options, pointwise kernels, discretization. */
 #include "app.h"
+#include "obstacle.h"
 #include "physics.h"
 
 /* sigma(u) = 2 mu eps(u) + lambda tr(eps(u)) I */
@@ -34,10 +35,13 @@ static void g3_uu(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff
     }
 }
 
-static PetscErrorCode ZeroVector(PetscInt dim, PetscReal t, const PetscReal x[], PetscInt Nc, PetscScalar u[], void *ctx)
+/* residual term -f of the constant body force f = constants[CONST_BODY_FORCE..] (-body_force) */
+static void f0_body_constant(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
+                             const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
+                             const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[], PetscInt numConstants,
+                             const PetscScalar constants[], PetscScalar f0[])
 {
-  for (PetscInt c = 0; c < Nc; ++c) u[c] = 0.0;
-  return PETSC_SUCCESS;
+  for (PetscInt c = 0; c < dim; ++c) f0[c] = -constants[CONST_BODY_FORCE + c];
 }
 
 static PetscErrorCode CreateRigidBodyModes(DM dm, PetscInt origField, PetscInt field, MatNullSpace *nullspace)
@@ -145,7 +149,7 @@ PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degr
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Writes the material, penalty, obstacle and scene parameters into the constants[] of the kernels. */
+/* Writes the material, penalty, obstacle, body force and scene parameters into the constants[] of the kernels. */
 PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user)
 {
   PetscDS     ds;
@@ -155,10 +159,11 @@ PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user)
   c[CONST_LAMBDA]          = user->opt.material.lambda;
   c[CONST_MU]              = user->opt.material.mu;
   c[CONST_PENALTY]         = (user->opt.contact.method == CONTACT_PENALTY) ? 1.0 / user->prob.eps : 0.0;
-  c[CONST_NORMAL_X]        = user->scene.obstacle_normal[0];
-  c[CONST_NORMAL_Y]        = user->scene.obstacle_normal[1];
-  c[CONST_NORMAL_Z]        = user->scene.obstacle_normal[2];
-  c[CONST_OBSTACLE_OFFSET] = user->scene.obstacle_offset;
+  ObstaclePack(&user->scene.obstacle, &c[CONST_OBSTACLE]);
+  for (PetscInt k = 0; k < 3; ++k) {
+    c[CONST_BODY_FORCE + k] = user->scene.bcs.body_force[k];
+    c[CONST_LOAD + k]       = 0.0; /* set while a surface load is assembled (BoundaryAddLoads) */
+  }
   for (PetscInt i = 0; i < user->scene.num_constants; ++i) c[CONST_SCENE + i] = user->scene.constants[i];
   PetscCall(DMGetDS(dm, &ds));
   PetscCall(PetscDSSetConstants(ds, CONST_SCENE + user->scene.num_constants, c));
@@ -184,11 +189,15 @@ PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user)
   PetscCall(PetscFEDestroy(&fe));
   PetscCall(DMCreateDS(dm));
   PetscCall(DMGetDS(dm, &ds));
-  PetscCall(PetscDSSetResidual(ds, 0, scene->f0_body, f1_u));
+  {
+    PetscBool has_body_force = PETSC_FALSE;
+
+    for (PetscInt k = 0; k < dim; ++k) has_body_force = (PetscBool)(has_body_force || scene->bcs.body_force[k] != 0.0);
+    PetscCall(PetscDSSetResidual(ds, 0, scene->f0_body ? scene->f0_body : (has_body_force ? f0_body_constant : NULL), f1_u));
+  }
   PetscCall(PetscDSSetJacobian(ds, 0, 0, NULL, NULL, NULL, g3_uu));
   if (scene->exact) PetscCall(PetscDSSetExactSolution(ds, 0, scene->exact, (void *)scene->constants));
-  PetscCall(DMAddBoundary(dm, DM_BC_ESSENTIAL, "Gamma_D", user->prob.face_sets, scene->num_dirichlet, scene->dirichlet_ids, 0, 0, NULL,
-                          (void (*)(void))(scene->dirichlet_value ? scene->dirichlet_value : ZeroVector), NULL, (void *)scene->constants, NULL));
+  PetscCall(BoundaryAddDirichlet(dm, user));
   PetscCall(DMSetNearNullSpaceConstructor(dm, 0, CreateRigidBodyModes));
   PetscCall(ElasticityUpdateConstants(dm, user));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -1,15 +1,16 @@
-/* The penalty term on Gamma_C: (1/eps) int [u_n - g]_+ v_n and its generalized Jacobian (1/eps) H(u_n - g) n n^T.
+/* The penalty term on Gamma_C: (1/eps) int [u . n - g]_+ v . n and its generalized Jacobian (1/eps) H(u . n - g) n n^T,
+   with the obstacle's gap g and normal n at the undeformed position (include/obstacle.h).
    gauss: PetscFE boundary kernels with the face Gauss rule (the paper's L2 product);
    nodal: the same term with the vertex rule, node by node with the lumped boundary mass. */
+#include "obstacle.h"
+#include "mesh.h"
 #include "physics.h"
 
-/* u_n - g with g = offset - x . n: the penetration into the foundation (positive = penetrating). */
-static inline PetscReal Penetration(PetscInt dim, const PetscScalar u[], const PetscReal x[], const PetscScalar constants[])
+/* 1/eps at the face: 1/eps of the run (constants) over the face's eps factor, held inverted by the auxiliary field of the
+   local eps (a cellwise constant) when there is one. */
+static inline PetscReal Kappa(PetscInt NfAux, const PetscScalar a[], const PetscScalar constants[])
 {
-  PetscReal d = -PetscRealPart(constants[CONST_OBSTACLE_OFFSET]);
-
-  for (PetscInt c = 0; c < dim; ++c) d += (PetscRealPart(u[c]) + x[c]) * PetscRealPart(constants[CONST_NORMAL_X + c]);
-  return d;
+  return PetscRealPart(constants[CONST_PENALTY]) * (NfAux > 0 ? PetscRealPart(a[0]) : 1.0);
 }
 
 static void f0_bd_penalty(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
@@ -17,20 +18,24 @@ static void f0_bd_penalty(PetscInt dim, PetscInt Nf, PetscInt NfAux, const Petsc
                           const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[], const PetscReal n[],
                           PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
 {
-  const PetscReal d = Penetration(dim, u, x, constants);
-  const PetscReal p = d > 0.0 ? PetscRealPart(constants[CONST_PENALTY]) * d : 0.0;
+  PetscReal       nu[3];
+  const PetscReal d = ObstaclePenetration(dim, &constants[CONST_OBSTACLE], x, u, nu);
+  const PetscReal p = d > 0.0 ? Kappa(NfAux, a, constants) * d : 0.0;
 
-  for (PetscInt c = 0; c < dim; ++c) f0[c] = p * constants[CONST_NORMAL_X + c];
+  for (PetscInt c = 0; c < dim; ++c) f0[c] = p * nu[c];
 }
 
+/* The normal nu depends on the undeformed position only, so the Jacobian is exact: (1/eps) H(u . nu - g) nu nu^T. */
 static void g0_bd_penalty(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
                           const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
                           const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, PetscReal u_tShift, const PetscReal x[], const PetscReal n[],
                           PetscInt numConstants, const PetscScalar constants[], PetscScalar g0[])
 {
-  if (Penetration(dim, u, x, constants) <= 0.0) return;
+  PetscReal nu[3];
+
+  if (ObstaclePenetration(dim, &constants[CONST_OBSTACLE], x, u, nu) <= 0.0) return;
   for (PetscInt c = 0; c < dim; ++c)
-    for (PetscInt e = 0; e < dim; ++e) g0[c * dim + e] = constants[CONST_PENALTY] * constants[CONST_NORMAL_X + c] * constants[CONST_NORMAL_X + e];
+    for (PetscInt e = 0; e < dim; ++e) g0[c * dim + e] = Kappa(NfAux, a, constants) * nu[c] * nu[e];
 }
 
 /* (1/2eps) [u_n - g]_+^2, the penalty energy density, in the first component: summed over the
@@ -40,28 +45,88 @@ static void f0_bd_penalty_energy(PetscInt dim, PetscInt Nf, PetscInt NfAux, cons
                                  const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[],
                                  const PetscReal n[], PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
 {
-  const PetscReal d = Penetration(dim, u, x, constants);
+  PetscReal       nu[3];
+  const PetscReal d = ObstaclePenetration(dim, &constants[CONST_OBSTACLE], x, u, nu);
 
   for (PetscInt c = 1; c < dim; ++c) f0[c] = 0.0;
-  f0[0] = d > 0.0 ? 0.5 * constants[CONST_PENALTY] * d * d : 0.0;
+  f0[0] = d > 0.0 ? 0.5 * Kappa(NfAux, a, constants) * d * d : 0.0;
 }
 
 enum { PENALTY_PART_TERM, PENALTY_PART_ENERGY }; /* parts of the penalty weak form */
 
+/* The local eps of the Gauss rule: 1 / ContactEpsFactor() of the cell at each contact face, a cellwise constant
+   auxiliary field that PETSc hands to the boundary kernels of the penalty weak form (and 1 on every other cell). */
+static PetscErrorCode PenaltySetUpLocalEps(DM dm, AppCtx *user)
+{
+  MPI_Comm     comm = PetscObjectComm((PetscObject)dm);
+  DM           dm_aux;
+  PetscFE      fe;
+  PetscSection sec;
+  Vec          loc_a;
+  PetscScalar *a;
+  PetscInt     dim;
+  PetscBool    simplex;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexIsSimplex(dm, &simplex));
+  PetscCall(DMClone(dm, &dm_aux));
+  PetscCall(PetscFECreateLagrange(comm, dim, 1, simplex, 0, PETSC_DETERMINE, &fe));
+  PetscCall(PetscObjectSetName((PetscObject)fe, "inverse_eps_factor"));
+  {
+    PetscObject disp;
+
+    PetscCall(DMGetField(dm, 0, NULL, &disp));
+    PetscCall(PetscFECopyQuadrature((PetscFE)disp, fe)); /* PETSc tabulates both at the same points */
+  }
+  PetscCall(DMSetField(dm_aux, 0, NULL, (PetscObject)fe));
+  PetscCall(PetscFEDestroy(&fe));
+  PetscCall(DMCreateDS(dm_aux));
+  PetscCall(DMCreateLocalVector(dm_aux, &loc_a));
+  PetscCall(VecSet(loc_a, 1.0));
+  PetscCall(DMGetLocalSection(dm_aux, &sec));
+  PetscCall(VecGetArray(loc_a, &a));
+  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
+    PetscInt *faces, nf;
+
+    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces));
+    for (PetscInt i = 0; i < nf; ++i) {
+      const PetscInt *support;
+      PetscInt        off;
+      PetscReal       diam;
+
+      PetscCall(DMPlexGetSupport(dm, faces[i], &support));
+      PetscCall(MeshCellDiameter(dm, support[0], &diam));
+      PetscCall(PetscSectionGetOffset(sec, support[0], &off));
+      a[off] = 1.0 / ContactEpsFactor(user, diam);
+    }
+    PetscCall(PetscFree(faces));
+  }
+  PetscCall(VecRestoreArray(loc_a, &a));
+  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s)
+    for (PetscInt part = PENALTY_PART_TERM; part <= PENALTY_PART_ENERGY; ++part)
+      PetscCall(DMSetAuxiliaryVec(dm, user->prob.face_sets, user->scene.bcs.contact_ids[s], part, loc_a));
+  PetscCall(VecDestroy(&loc_a));
+  PetscCall(DMDestroy(&dm_aux));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PenaltySetUp(DM dm, AppCtx *user)
 {
   PetscFunctionBeginUser;
+  if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS && user->prob.eps_factor_min != user->prob.eps_factor_max)
+    PetscCall(PenaltySetUpLocalEps(dm, user)); /* a graded mesh: eps varies along Gamma_C */
   PetscCall(PetscWeakFormCreate(PetscObjectComm((PetscObject)dm), &user->prob.wf_penalty));
-  PetscCall(DMCreateLocalVector(dm, &user->prob.loc_bc));
-  PetscCall(VecZeroEntries(user->prob.loc_bc));
-  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, user->prob.loc_bc, 0.0, NULL, NULL, NULL));
   PetscCall(PetscWeakFormSetNumFields(user->prob.wf_penalty, 1));
-  PetscCall(PetscWeakFormSetIndexBdResidual(user->prob.wf_penalty, user->prob.face_sets, user->scene.contact_id, 0, PENALTY_PART_TERM, 0,
-                                            f0_bd_penalty, 0, NULL));
-  PetscCall(PetscWeakFormSetIndexBdResidual(user->prob.wf_penalty, user->prob.face_sets, user->scene.contact_id, 0, PENALTY_PART_ENERGY, 0,
-                                            f0_bd_penalty_energy, 0, NULL));
-  PetscCall(PetscWeakFormSetIndexBdJacobian(user->prob.wf_penalty, user->prob.face_sets, user->scene.contact_id, 0, 0, PENALTY_PART_TERM, 0,
-                                            g0_bd_penalty, 0, NULL, 0, NULL, 0, NULL));
+  for (PetscInt i = 0; i < user->scene.bcs.ncontact; ++i) {
+    const PetscInt id = user->scene.bcs.contact_ids[i];
+
+    PetscCall(PetscWeakFormSetIndexBdResidual(user->prob.wf_penalty, user->prob.face_sets, id, 0, PENALTY_PART_TERM, 0, f0_bd_penalty, 0, NULL));
+    PetscCall(
+      PetscWeakFormSetIndexBdResidual(user->prob.wf_penalty, user->prob.face_sets, id, 0, PENALTY_PART_ENERGY, 0, f0_bd_penalty_energy, 0, NULL));
+    PetscCall(PetscWeakFormSetIndexBdJacobian(user->prob.wf_penalty, user->prob.face_sets, id, 0, 0, PENALTY_PART_TERM, 0, g0_bd_penalty, 0, NULL, 0,
+                                              NULL, 0, NULL));
+  }
   if (user->opt.contact.quadrature == PENALTY_QUADRATURE_NODAL) {
     PetscInt bad = 0, nbad;
 
@@ -87,28 +152,31 @@ static PetscErrorCode GetLocalSolution(DM dm, AppCtx *user, Vec X, Vec *locX)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* locF = the local boundary residual of one part of the penalty weak form (Gauss rule). */
+/* locF = the local boundary residual of one part of the penalty weak form (Gauss rule), over every contact face set. */
 static PetscErrorCode ComputePenaltyPartLocal(DM dm, AppCtx *user, PetscInt part, Vec X, Vec locF)
 {
-  PetscFormKey key;
-  Vec          locX;
+  Vec locX;
 
   PetscFunctionBeginUser;
-  key.label = user->prob.face_sets;
-  key.value = user->scene.contact_id;
-  key.field = 0;
-  key.part  = part;
   PetscCall(GetLocalSolution(dm, user, X, &locX));
   PetscCall(VecZeroEntries(locF));
-  PetscCall(CompatComputeBdResidualSingle(dm, user->prob.wf_penalty, key, locX, locF));
+  for (PetscInt i = 0; i < user->scene.bcs.ncontact; ++i) {
+    PetscFormKey key;
+
+    key.label = user->prob.face_sets;
+    key.value = user->scene.bcs.contact_ids[i];
+    key.field = 0;
+    key.part  = part;
+    PetscCall(CompatComputeBdResidualSingle(dm, user->prob.wf_penalty, key, locX, locF));
+  }
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F)
 {
-  const PetscReal kappa = 1.0 / user->prob.eps;
-  PetscInt        dim;
+  const ContactSet *cs = &user->prob.cset;
+  PetscInt          dim;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
@@ -125,11 +193,11 @@ PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F)
 
     PetscCall(VecGetArrayRead(X, &x));
     PetscCall(VecGetArray(F, &f));
-    for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
-      const PetscReal d = ContactNodePenetration(user, dim, i, x);
+    for (PetscInt i = 0; i < cs->n; ++i) {
+      const PetscReal d = ContactNodePenetration(cs, dim, i, x);
       if (d <= 0.0) continue;
       for (PetscInt c = 0; c < dim; ++c)
-        f[user->prob.cset.global_off[i] + c] += kappa * user->prob.cset.weight[i] * d * user->scene.obstacle_normal[c];
+        if (cs->dof[i * dim + c] >= 0) f[cs->dof[i * dim + c]] += cs->weight[i] * d / ContactNodeEps(cs, user->prob.eps, i) * cs->normal[i * dim + c];
     }
     PetscCall(VecRestoreArray(F, &f));
     PetscCall(VecRestoreArrayRead(X, &x));
@@ -140,8 +208,8 @@ PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F)
 /* Adds the penalty Jacobian to J (ADD_VALUES); the caller assembles J. */
 PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J)
 {
-  const PetscReal kappa = 1.0 / user->prob.eps;
-  PetscInt        dim;
+  const ContactSet *cs = &user->prob.cset;
+  PetscInt          dim;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
@@ -149,7 +217,8 @@ PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J)
     Vec locX;
 
     PetscCall(GetLocalSolution(dm, user, X, &locX));
-    PetscCall(CompatComputeBdJacobianSingle(dm, user->prob.wf_penalty, user->prob.face_sets, 1, &user->scene.contact_id, locX, J));
+    PetscCall(CompatComputeBdJacobianSingle(dm, user->prob.wf_penalty, user->prob.face_sets, user->scene.bcs.ncontact, user->scene.bcs.contact_ids,
+                                            locX, J));
     PetscCall(DMRestoreLocalVector(dm, &locX));
   } else {
     const PetscScalar *x;
@@ -158,14 +227,18 @@ PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J)
 
     PetscCall(MatGetOwnershipRange(J, &rstart, NULL));
     PetscCall(VecGetArrayRead(X, &x));
-    for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
-      if (ContactNodePenetration(user, dim, i, x) <= 0.0) continue;
-      for (PetscInt c = 0; c < dim; ++c) {
-        rows[c] = rstart + user->prob.cset.global_off[i] + c;
-        for (PetscInt e = 0; e < dim; ++e)
-          block[c * dim + e] = kappa * user->prob.cset.weight[i] * user->scene.obstacle_normal[c] * user->scene.obstacle_normal[e];
-      }
-      PetscCall(MatSetValues(J, dim, rows, dim, rows, block, ADD_VALUES));
+    for (PetscInt i = 0; i < cs->n; ++i) {
+      PetscInt nfree = 0, comp[3];
+
+      if (ContactNodePenetration(cs, dim, i, x) <= 0.0) continue;
+      for (PetscInt c = 0; c < dim; ++c)
+        if (cs->dof[i * dim + c] >= 0) {
+          comp[nfree]   = c;
+          rows[nfree++] = rstart + cs->dof[i * dim + c];
+        }
+      for (PetscInt a = 0; a < nfree; ++a)
+        for (PetscInt b = 0; b < nfree; ++b) block[a * nfree + b] = cs->weight[i] / ContactNodeEps(cs, user->prob.eps, i) * cs->normal[i * dim + comp[a]] * cs->normal[i * dim + comp[b]];
+      PetscCall(MatSetValues(J, nfree, rows, nfree, rows, block, ADD_VALUES));
     }
     PetscCall(VecRestoreArrayRead(X, &x));
   }
@@ -175,7 +248,8 @@ PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J)
 /* (1/2eps) int [u_n - g]_+^2 with the quadrature of the penalty term. */
 PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy)
 {
-  PetscInt dim;
+  const ContactSet *cs = &user->prob.cset;
+  PetscInt          dim;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
@@ -196,9 +270,9 @@ PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy)
     PetscReal          e = 0.0;
 
     PetscCall(VecGetArrayRead(X, &x));
-    for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
-      const PetscReal d = ContactNodePenetration(user, dim, i, x);
-      if (d > 0.0) e += 0.5 / user->prob.eps * user->prob.cset.weight[i] * d * d;
+    for (PetscInt i = 0; i < cs->n; ++i) {
+      const PetscReal d = ContactNodePenetration(cs, dim, i, x);
+      if (d > 0.0) e += 0.5 / ContactNodeEps(cs, user->prob.eps, i) * cs->weight[i] * d * d;
     }
     PetscCall(VecRestoreArrayRead(X, &x));
     PetscCall(MPIU_Allreduce(&e, energy, 1, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm)));

@@ -22,13 +22,14 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   PetscCall(VecGetArrayRead(u, &x));
   PetscCall(VecGetArrayRead(R, &r));
   for (PetscInt i = 0; i < cs->n; ++i) {
-    const PetscReal d        = ContactNodePenetration(user, dim, i, x);
-    PetscReal       reaction = 0.0;
+    const PetscReal d        = ContactNodePenetration(cs, dim, i, x);
+    PetscReal       reaction = 0.0; /* along the free components: a fixed one takes its reaction from its boundary condition */
 
-    for (PetscInt c = 0; c < dim; ++c) reaction -= PetscRealPart(r[cs->global_off[i] + c]) * user->scene.obstacle_normal[c];
+    for (PetscInt c = 0; c < dim; ++c)
+      if (cs->dof[i * dim + c] >= 0) reaction -= PetscRealPart(r[cs->dof[i * dim + c]]) * cs->normal[i * dim + c];
     switch (user->opt.contact.method) {
       case CONTACT_PENALTY:
-        cs->pressure[i] = d > 0.0 ? d / user->prob.eps : 0.0;
+        cs->pressure[i] = d > 0.0 ? d / ContactNodeEps(cs, user->prob.eps, i) : 0.0;
         break;
       case CONTACT_VI:
         cs->pressure[i] = cs->weight[i] > 0.0 ? reaction / cs->weight[i] : 0.0;

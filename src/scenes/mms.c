@@ -81,18 +81,21 @@ PetscErrorCode SceneCreate_MMS(DM dm, const Material *mat, Scene *scene)
   PetscCheck(a > 0.0 && a < 1.0, comm, PETSC_ERR_USER_INPUT, "-mms_a must lie in (0, 1), got %g", (double)a);
   PetscCheck(amp_a > 0.0 && amp_b > 0.0, comm, PETSC_ERR_USER_INPUT, "-mms_amplitude_A and -mms_amplitude_B must be positive, got %g and %g",
              (double)amp_a, (double)amp_b);
-  scene->contact_id               = 1; /* bottom, x_d = 0 */
-  scene->num_dirichlet            = 1;
-  scene->dirichlet_ids[0]         = dim == 2 ? 3 : 2; /* top, x_d = 1 */
-  scene->dirichlet_value          = MMSExact;
+  {
+    const PetscReal origin[3] = {0.0, 0.0, 0.0};
+    PetscReal       n[3]      = {0.0, 0.0, 0.0};
+
+    n[dim - 1] = -1.0;
+    PetscCall(SceneSetObstaclePlane(scene, origin, n));
+  }
+  PetscCall(SceneAddContactFaces(scene, 1));                          /* bottom, x_d = 0 */
+  PetscCall(SceneAddBoundary(scene, BC_CLAMP, dim == 2 ? 3 : 2, MMSExact)); /* top, x_d = 1 */
   scene->exact                    = MMSExact;
   scene->exact_gradient           = MMSExactGradient;
   scene->weak_data                = PETSC_TRUE;
   scene->has_kink                 = PETSC_TRUE;
   scene->kink_normal[0]           = 1.0;
   scene->kink_offset              = a;
-  scene->obstacle_normal[dim - 1] = -1.0;
-  scene->obstacle_offset          = 0.0;
   scene->num_constants            = MMS_NUM_CONSTANTS;
   scene->constants[MMS_NU]        = nu;
   scene->constants[MMS_A]         = a;

@@ -49,16 +49,19 @@ PetscErrorCode SceneCreate_Patch(DM dm, const Material *mat, Scene *scene)
   PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-patch_strain", strain));
   PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-patch_lift", lift));
   PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-patch_rotation", rotation));
-  scene->contact_id    = 1;
-  scene->num_dirichlet = 2 * dim - 1; /* every box face but the bottom */
-  for (PetscInt i = 0; i < scene->num_dirichlet; ++i) scene->dirichlet_ids[i] = i + 2;
-  scene->dirichlet_value          = PatchExact;
-  scene->exact                    = PatchExact;
-  scene->exact_gradient           = PatchExactGradient;
-  scene->obstacle_normal[dim - 1] = -1.0;
-  scene->obstacle_offset          = 0.0;
-  scene->num_constants            = PATCH_NUM_CONSTANTS;
-  scene->constants[PATCH_STRAIN]  = strain;
+  {
+    const PetscReal origin[3] = {0.0, 0.0, 0.0};
+    PetscReal       n[3]      = {0.0, 0.0, 0.0};
+
+    n[dim - 1] = -1.0;
+    PetscCall(SceneSetObstaclePlane(scene, origin, n));
+  }
+  PetscCall(SceneAddContactFaces(scene, 1));
+  for (PetscInt i = 0; i < 2 * dim - 1; ++i) PetscCall(SceneAddBoundary(scene, BC_CLAMP, i + 2, PatchExact)); /* every box face but the bottom */
+  scene->exact                   = PatchExact;
+  scene->exact_gradient          = PatchExactGradient;
+  scene->num_constants           = PATCH_NUM_CONSTANTS;
+  scene->constants[PATCH_STRAIN] = strain;
   /* lateral strain of a uniaxial stress: -nu in 3D, -nu/(1-nu) in plane strain */
   scene->constants[PATCH_LATERAL]  = dim == 3 ? -mat->poisson_ratio * strain : -mat->poisson_ratio / (1.0 - mat->poisson_ratio) * strain;
   scene->constants[PATCH_LIFT]     = lift;

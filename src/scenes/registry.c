@@ -1,4 +1,5 @@
 /* Scenes are registered by name; -scene NAME picks one. */
+#include "app.h"
 #include "scenes.h"
 
 static PetscFunctionList scene_list = NULL;
@@ -9,6 +10,7 @@ PetscErrorCode SceneRegisterAll(void)
   PetscCall(PetscFunctionListAdd(&scene_list, "square", SceneCreate_Square));
   PetscCall(PetscFunctionListAdd(&scene_list, "patch", SceneCreate_Patch));
   PetscCall(PetscFunctionListAdd(&scene_list, "mms", SceneCreate_MMS));
+  PetscCall(PetscFunctionListAdd(&scene_list, "general", SceneCreate_General));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -40,6 +42,9 @@ PetscErrorCode SceneCreate(const char name[], DM dm, const Material *mat, Scene 
              "Unknown scene '%s' (-scene); run with -help to list the registered scenes", name);
   PetscCall(PetscMemzero(scene, sizeof(*scene)));
   PetscCall(PetscStrncpy(scene->name, name, sizeof(scene->name)));
-  PetscCall((*create)(dm, mat, scene));
+  PetscCall((*create)(dm, mat, scene)); /* the scene's own options and its defaults of the ones below */
+  PetscCall(SceneBoundaryGetOptions(dm, scene));
+  PetscCall(SceneObstacleGetOptions(dm, scene));
+  PetscCall(OptionsCheckPrefixesUsed(PetscObjectComm((PetscObject)dm), "-bc_ -obstacle -contact_faces -body_force")); /* typos, before the solve */
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -1,5 +1,5 @@
 /* Scene "square": Omega = (0,1)^d clamped on top (x_d = 1), Gamma_C the bottom (x_d = 0) on a flat
-   foundation, other faces traction-free, body force f = (0, ..., 0, beta (x_1 - x0)): the body is
+   foundation, other faces traction-free, body force f = (0, ..., 0, beta (x_1 - x0)) (plus -body_force): the body is
    pressed down where x_1 < x0 and lifted where x_1 > x0, so the contact zone ends inside Gamma_C. */
 #include "app.h"
 #include "scenes.h"
@@ -14,8 +14,8 @@ static void f0_body_square(PetscInt dim, PetscInt Nf, PetscInt NfAux, const Pets
 {
   const PetscScalar beta = constants[CONST_SCENE + SQUARE_BETA], x0 = constants[CONST_SCENE + SQUARE_X0];
 
-  for (PetscInt c = 0; c < dim - 1; ++c) f0[c] = 0.0;
-  f0[dim - 1] = -beta * (x[0] - x0);
+  for (PetscInt c = 0; c < dim; ++c) f0[c] = -constants[CONST_BODY_FORCE + c]; /* -body_force, 0 by default */
+  f0[dim - 1] -= beta * (x[0] - x0);
 }
 
 PetscErrorCode SceneCreate_Square(DM dm, const Material *mat, Scene *scene)
@@ -39,15 +39,19 @@ PetscErrorCode SceneCreate_Square(DM dm, const Material *mat, Scene *scene)
   PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-square_tilt", tilt));
   PetscCheck(PetscAbsReal(tilt) < 45.0, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT, "-square_tilt must lie in (-45, 45) degrees, got %g",
              (double)tilt);
-  scene->contact_id               = 1; /* bottom, x_d = 0, in 2D and 3D */
-  scene->num_dirichlet            = 1;
-  scene->dirichlet_ids[0]         = dim == 2 ? 3 : 2; /* top, x_d = 1 */
-  scene->f0_body                  = f0_body_square;
-  scene->obstacle_normal[0]       = PetscSinReal(tilt * PETSC_PI / 180.0); /* foundation below: u_n = -u_d when not tilted */
-  scene->obstacle_normal[dim - 1] = -PetscCosReal(tilt * PETSC_PI / 180.0);
-  scene->obstacle_offset          = 0.0; /* plane x_d = 0 */
-  scene->num_constants            = SQUARE_NUM_CONSTANTS;
-  scene->constants[SQUARE_BETA]   = beta;
-  scene->constants[SQUARE_X0]     = x0;
+  {
+    const PetscReal origin[3] = {0.0, 0.0, 0.0};
+    PetscReal       n[3]      = {0.0, 0.0, 0.0};
+
+    n[0]       = PetscSinReal(tilt * PETSC_PI / 180.0); /* foundation below: u_n = -u_d when not tilted */
+    n[dim - 1] = -PetscCosReal(tilt * PETSC_PI / 180.0);
+    PetscCall(SceneSetObstaclePlane(scene, origin, n)); /* plane through the origin: x_d = 0 when not tilted */
+  }
+  PetscCall(SceneAddContactFaces(scene, 1));                      /* bottom, x_d = 0, in 2D and 3D */
+  PetscCall(SceneAddBoundary(scene, BC_CLAMP, dim == 2 ? 3 : 2, NULL)); /* top, x_d = 1 */
+  scene->f0_body                = f0_body_square;
+  scene->num_constants          = SQUARE_NUM_CONSTANTS;
+  scene->constants[SQUARE_BETA] = beta;
+  scene->constants[SQUARE_X0]   = x0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

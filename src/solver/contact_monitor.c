@@ -18,7 +18,7 @@ static PetscErrorCode ActiveSetHash(AppCtx *user, Vec X, PetscInt64 *hash)
   for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
     const unsigned long long g = (unsigned long long)(rstart + user->prob.cset.global_off[i]);
 
-    if (user->prob.cset.is_vertex[i] && ContactNodePenetration(user, dim, i, x) > 0.0)
+    if (user->prob.cset.is_vertex[i] && ContactNodePenetration(&user->prob.cset, dim, i, x) > 0.0)
       local = (PetscInt64)((unsigned long long)local + ((g + 1) * 0x9E3779B97F4A7C15ULL ^ (g << 17)) % 0x7FFFFFFFFFFFULL);
   }
   PetscCall(VecRestoreArrayRead(X, &x));

@@ -13,7 +13,7 @@ static PetscErrorCode CountChanges(AppCtx *user, PetscInt dim, const PetscScalar
 
   PetscFunctionBeginUser;
   for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
-    const PetscBool on = (PetscBool)(ContactNodePenetration(user, dim, i, x) > 0.0);
+    const PetscBool on = (PetscBool)(ContactNodePenetration(&user->prob.cset, dim, i, x) > 0.0);
 
     local += on != user->prob.cset.built_active[i];
     if (record) user->prob.cset.built_active[i] = on;

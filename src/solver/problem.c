@@ -11,16 +11,20 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
 
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
-  PetscCall(MeshCheckContactBoundary(dm, user->scene.contact_id));
-  PetscCall(MeshCheckFaceSets(dm, user->scene.name, "the Dirichlet boundary Gamma_D (with none, nothing would fix the body)",
-                              user->scene.num_dirichlet, user->scene.dirichlet_ids));
+  for (PetscInt i = 0; i < user->scene.bcs.ncontact; ++i) PetscCall(MeshCheckContactBoundary(dm, user->scene.bcs.contact_ids[i]));
+  PetscCall(BoundaryCheckFaceSets(dm, &user->scene));
   PetscCall(DMGetLabel(dm, "Face Sets", &user->prob.face_sets));
   PetscCall(MeshGetMaxCellDiameter(dm, &user->prob.h));
   PetscCall(ContactComputeEps(user));
   PetscCall(ElasticitySetUpDiscretization(dm, user));
+  PetscCall(BoundaryCheckRigidMotions(dm, &user->scene));
+  PetscCall(DMCreateLocalVector(dm, &user->prob.loc_bc)); /* the Dirichlet values, zero elsewhere */
+  PetscCall(VecZeroEntries(user->prob.loc_bc));
+  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, user->prob.loc_bc, 0.0, NULL, NULL, NULL));
   PetscCall(ContactSetCreate(dm, user, &user->prob.cset));
   if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, user));
   PetscCall(SolverAssembleBulk(dm, user));
+  PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
   PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0));
   PetscCall(SolverComputeScales(dm, user));
   PetscCall(PetscMemzero(&user->prob.pc_reuse, sizeof(user->prob.pc_reuse)));

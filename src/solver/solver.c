@@ -304,7 +304,7 @@ static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal 
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetArrayRead(u, &x));
-  for (PetscInt i = 0; i < user->prob.cset.n; ++i) pen = PetscMax(pen, ContactNodePenetration(user, dim, i, x));
+  for (PetscInt i = 0; i < user->prob.cset.n; ++i) pen = PetscMax(pen, ContactNodePenetration(&user->prob.cset, dim, i, x));
   PetscCall(VecRestoreArrayRead(u, &x));
   PetscCall(MPIU_Allreduce(&pen, &r->max_penetration, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
   PetscCall(VecGetSize(u, &r->n_dofs));

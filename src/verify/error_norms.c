@@ -3,6 +3,7 @@
    weighted by eps^1/2, and in the H^-1/2 dual norm; and the penetration [u_h,n - g]_+ in L2 and max.
    p_h is the penalty law (1/eps)[u_h,n - g]_+ for the penalty method and the nodal multiplier, interpolated, otherwise. */
 #include "mesh.h"
+#include "obstacle.h"
 #include "physics.h"
 #include "verify.h"
 
@@ -27,8 +28,9 @@ PetscErrorCode ErrorNormsPressureVector(DM dm, AppCtx *user, Vec loc_p)
   PetscCall(DMGetGlobalVector(dm, &P));
   PetscCall(VecZeroEntries(P));
   PetscCall(VecGetArray(P, &p));
-  for (PetscInt i = 0; i < user->prob.cset.n; ++i)
-    for (PetscInt c = 0; c < dim; ++c) p[user->prob.cset.global_off[i] + c] = user->prob.cset.pressure[i] * user->scene.obstacle_normal[c];
+  for (PetscInt i = 0; i < user->prob.cset.n; ++i) /* fixed components stay 0 */
+    for (PetscInt c = 0; c < dim; ++c)
+      if (user->prob.cset.dof[i * dim + c] >= 0) p[user->prob.cset.dof[i * dim + c]] = user->prob.cset.pressure[i] * user->prob.cset.normal[i * dim + c];
   PetscCall(VecRestoreArray(P, &p));
   PetscCall(VecZeroEntries(loc_p));
   PetscCall(DMGlobalToLocal(dm, P, INSERT_VALUES, loc_p));
@@ -85,14 +87,14 @@ static PetscErrorCode IntegrateBulk(DM dm, AppCtx *user, CellQuadrature *cq, Vec
 static PetscErrorCode IntegrateContact(DM dm, AppCtx *user, CellQuadrature *cq, Vec loc_uh, Vec loc_ph, const ErrorTarget *t, Vec loc_b,
                                        PetscReal sums[2], PetscReal *dmax)
 {
-  const PetscInt   dim = cq->dim;
-  const PetscReal *n   = user->scene.obstacle_normal;
-  PetscInt        *faces, nf;
-  PetscScalar     *elem;
+  const PetscInt dim = cq->dim;
+  PetscInt      *faces, nf;
+  PetscScalar   *elem;
 
   PetscFunctionBeginUser;
-  PetscCall(MeshGetBoundaryFaces(dm, user->scene.contact_id, &nf, &faces)); /* of this mesh, maybe a refinement of the run's */
   PetscCall(PetscMalloc1(PetscMax(cq->Nb, 1), &elem));
+  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
+  PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces)); /* of this mesh, maybe a refinement of the run's */
   for (PetscInt i = 0; i < nf; ++i) {
     PetscScalar *uh = NULL, *ph = NULL, *pr = NULL;
 
@@ -103,10 +105,12 @@ static PetscErrorCode IntegrateContact(DM dm, AppCtx *user, CellQuadrature *cq, 
     for (PetscInt b = 0; b < cq->Nb; ++b) elem[b] = 0.0;
     for (PetscInt q = 0; q < cq->Nq; ++q) {
       const PetscReal *x = &cq->x[q * dim];
-      PetscReal        u[3], v[3], d = -user->scene.obstacle_offset, p_h = 0.0, p_target = 0.0, R;
+      PetscReal        u[3], v[3], n[3], d, p_h = 0.0, p_target = 0.0, R;
 
       PetscCall(CellQuadratureInterpolate(cq, uh, q, u, NULL));
-      for (PetscInt k = 0; k < dim; ++k) d += (u[k] + x[k]) * n[k];
+      ObstacleGapNormalAt(&user->scene.obstacle, dim, x, n, &d);
+      d = -d;
+      for (PetscInt k = 0; k < dim; ++k) d += u[k] * n[k];
       sums[1] += cq->w[q] * PetscSqr(PetscMax(d, 0.0));
       *dmax = PetscMax(*dmax, d);
       if (!t) continue;
@@ -139,6 +143,7 @@ static PetscErrorCode IntegrateContact(DM dm, AppCtx *user, CellQuadrature *cq, 
     if (pr) PetscCall(DMPlexVecRestoreClosure(dm, NULL, t->loc_pressure, cq->cell, NULL, &pr));
   }
   PetscCall(PetscFree(faces));
+  }
   PetscCall(PetscFree(elem));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

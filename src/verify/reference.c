@@ -5,6 +5,7 @@
 #include <petscdmplextransform.h>
 #include <petscviewerhdf5.h>
 #include "mesh.h"
+#include "obstacle.h"
 #include "verify.h"
 #include "io.h"
 
@@ -337,11 +338,12 @@ static PetscErrorCode MatchReference(DM fine, const AppCtx *user, const Referenc
   PetscCall(VecGetArray(loc_p, &p));
   for (PetscInt v = vStart; v < vEnd; ++v) {
     PetscInt  coff, off, i;
-    PetscReal x[3];
+    PetscReal x[3], n[3], gap;
 
     PetscCall(PetscSectionGetOffset(csec, v, &coff));
     for (PetscInt d = 0; d < dim; ++d) x[d] = PetscRealPart(xc[coff + d]);
-    i                = ReferenceFindVertex(ref, x);
+    ObstacleGapNormalAt(&user->scene.obstacle, dim, x, n, &gap);
+    i = ReferenceFindVertex(ref, x);
     vmap[v - vStart] = i;
     if (i < 0) {
       if (bad_vertex < 0) bad_vertex = v;
@@ -350,7 +352,7 @@ static PetscErrorCode MatchReference(DM fine, const AppCtx *user, const Referenc
     PetscCall(PetscSectionGetOffset(lsec, v, &off));
     for (PetscInt d = 0; d < dim; ++d) {
       u[off + d] = ref->u[i * dim + d];
-      p[off + d] = ref->p[i] * user->scene.obstacle_normal[d];
+      p[off + d] = ref->p[i] * n[d];
     }
   }
   PetscCall(VecRestoreArray(loc_p, &p));

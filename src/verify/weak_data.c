@@ -2,17 +2,18 @@
      L(v) = int_Omega sigma(u_exact) : eps(v) dx - int_Gamma_C sigma_n(u_exact) v_n ds,
    so no singular source term is ever evaluated pointwise. Integrated with the accurate rule of cell_quadrature.c. */
 #include "mesh.h"
+#include "obstacle.h"
 #include "physics.h"
 #include "verify.h"
 
-/* sigma_n(u_exact) = (sigma n) . n at x, with n the foundation normal */
+/* sigma_n(u_exact) = (sigma n) . n at x, with n the obstacle normal at x */
 PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal *sn)
 {
-  const PetscReal *n = user->scene.obstacle_normal;
-  PetscScalar      g[9];
-  PetscReal        grad[9], sigma[9];
+  PetscScalar g[9];
+  PetscReal   grad[9], sigma[9], n[3], gap;
 
   PetscFunctionBeginUser;
+  ObstacleGapNormalAt(&user->scene.obstacle, dim, x, n, &gap);
   PetscCall((*user->scene.exact_gradient)(dim, 0.0, x, dim * dim, g, (void *)user->scene.constants));
   for (PetscInt k = 0; k < dim * dim; ++k) grad[k] = PetscRealPart(g[k]);
   ElasticStress(dim, &user->opt.material, grad, sigma);
@@ -60,24 +61,27 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0)
     }
     PetscCall(DMPlexVecSetClosure(dm, NULL, locL, c, elem, ADD_VALUES));
   }
-  PetscCall(MeshGetBoundaryFaces(dm, user->scene.contact_id, &nf, &faces));
-  for (PetscInt i = 0; i < nf; ++i) {
-    PetscCall(CellQuadratureSetFace(&cq, faces[i]));
-    for (PetscInt b = 0; b < cq.Nb; ++b) elem[b] = 0.0;
-    for (PetscInt q = 0; q < cq.Nq; ++q) {
-      PetscReal sn;
+  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
+    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces));
+    for (PetscInt i = 0; i < nf; ++i) {
+      PetscCall(CellQuadratureSetFace(&cq, faces[i]));
+      for (PetscInt b = 0; b < cq.Nb; ++b) elem[b] = 0.0;
+      for (PetscInt q = 0; q < cq.Nq; ++q) {
+        PetscReal sn, n[3], gap;
 
-      PetscCall(WeakDataExactNormalStress(user, dim, &cq.x[q * dim], &sn));
-      for (PetscInt b = 0; b < cq.Nb; ++b) {
-        PetscReal vn = 0.0;
+        PetscCall(WeakDataExactNormalStress(user, dim, &cq.x[q * dim], &sn));
+        ObstacleGapNormalAt(&user->scene.obstacle, dim, &cq.x[q * dim], n, &gap);
+        for (PetscInt b = 0; b < cq.Nb; ++b) {
+          PetscReal vn = 0.0;
 
-        for (PetscInt k = 0; k < cq.Nc; ++k) vn += cq.B[(q * cq.Nb + b) * cq.Nc + k] * user->scene.obstacle_normal[k];
-        elem[b] -= cq.w[q] * sn * vn;
+          for (PetscInt k = 0; k < cq.Nc; ++k) vn += cq.B[(q * cq.Nb + b) * cq.Nc + k] * n[k];
+          elem[b] -= cq.w[q] * sn * vn;
+        }
       }
+      PetscCall(DMPlexVecSetClosure(dm, NULL, locL, cq.cell, elem, ADD_VALUES));
     }
-    PetscCall(DMPlexVecSetClosure(dm, NULL, locL, cq.cell, elem, ADD_VALUES));
+    PetscCall(PetscFree(faces));
   }
-  PetscCall(PetscFree(faces));
   /* r0 -= L */
   PetscCall(VecScale(locL, -1.0));
   PetscCall(DMLocalToGlobal(dm, locL, ADD_VALUES, r0));

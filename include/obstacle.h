@@ -1,0 +1,66 @@
+/* The rigid obstacle's geometry, shared by the pointwise kernels (which read it from constants[CONST_OBSTACLE]) and
+   the node-by-node code: the gap g and the unit normal n at an undeformed position x (small deformation), so that
+   the penetration of a displacement u is u . n - g. No PETSc calls: the kernels call it. */
+#pragma once
+#include "signorini.h"
+
+/* p: the packed parameters (OBSTACLE_* order). n points from the body into the obstacle; g is the distance from x
+   to the obstacle's surface along n (negative when x starts inside the obstacle).
+   plane:    n = the plane's normal, g = (point - x) . n;
+   sphere:   the body stays outside the ball, r = x - center, n = -r/|r|, g = |r| - radius;
+   cylinder: the same with r perpendicular to the axis (in 2D a disk, like the sphere). */
+static inline void ObstacleGapNormal(PetscInt dim, const PetscScalar p[], const PetscReal x[], PetscReal n[], PetscReal *g)
+{
+  const ObstacleType type = (ObstacleType)(PetscInt)PetscRealPart(p[OBSTACLE_TYPE]);
+  PetscReal          r[3] = {0.0, 0.0, 0.0}, len = 0.0;
+
+  if (type == OBSTACLE_PLANE) {
+    *g = 0.0;
+    for (PetscInt c = 0; c < dim; ++c) {
+      n[c] = PetscRealPart(p[OBSTACLE_DIRECTION + c]);
+      *g += (PetscRealPart(p[OBSTACLE_POINT + c]) - x[c]) * n[c];
+    }
+    return;
+  }
+  for (PetscInt c = 0; c < dim; ++c) r[c] = x[c] - PetscRealPart(p[OBSTACLE_POINT + c]);
+  if (type == OBSTACLE_CYLINDER && dim == 3) {
+    PetscReal ra = 0.0;
+
+    for (PetscInt c = 0; c < 3; ++c) ra += r[c] * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
+    for (PetscInt c = 0; c < 3; ++c) r[c] -= ra * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
+  }
+  for (PetscInt c = 0; c < dim; ++c) len += r[c] * r[c];
+  len = PetscSqrtReal(len);
+  for (PetscInt c = 0; c < dim; ++c) n[c] = len > 0.0 ? -r[c] / len : 0.0;
+  *g = len - PetscRealPart(p[OBSTACLE_RADIUS]);
+}
+
+/* The parameters of an obstacle in the packed order, its translation added to its point. */
+static inline void ObstaclePack(const Obstacle *obs, PetscScalar p[])
+{
+  p[OBSTACLE_TYPE] = (PetscReal)obs->type;
+  for (PetscInt c = 0; c < 3; ++c) {
+    p[OBSTACLE_POINT + c]     = obs->point[c] + obs->translate[c];
+    p[OBSTACLE_DIRECTION + c] = obs->direction[c];
+  }
+  p[OBSTACLE_RADIUS] = obs->radius;
+}
+
+/* The penetration u . n - g at x for the packed obstacle p; n is returned too. */
+static inline PetscReal ObstaclePenetration(PetscInt dim, const PetscScalar p[], const PetscReal x[], const PetscScalar u[], PetscReal n[])
+{
+  PetscReal g, d = 0.0;
+
+  ObstacleGapNormal(dim, p, x, n, &g);
+  for (PetscInt c = 0; c < dim; ++c) d += PetscRealPart(u[c]) * n[c];
+  return d - g;
+}
+
+/* The obstacle's normal (and gap) at x, from the unpacked obstacle. */
+static inline void ObstacleGapNormalAt(const Obstacle *obs, PetscInt dim, const PetscReal x[], PetscReal n[], PetscReal *g)
+{
+  PetscScalar p[OBSTACLE_NUM_PARAMS];
+
+  ObstaclePack(obs, p);
+  ObstacleGapNormal(dim, p, x, n, g);
+}

@@ -1,0 +1,94 @@
+/* The rigid obstacle: the scene's default, then -obstacle plane | sphere | cylinder and its geometry, read once. */
+#include "app.h"
+#include "scenes.h"
+
+const char *const ObstacleTypes[] = {"plane", "sphere", "cylinder", "ObstacleType", "OBSTACLE_", NULL};
+
+/* A default of a scene: the plane through point with unit normal n (from the body into the obstacle). */
+PetscErrorCode SceneSetObstaclePlane(Scene *scene, const PetscReal point[], const PetscReal n[])
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(&scene->obstacle, sizeof(scene->obstacle)));
+  scene->obstacle.type = OBSTACLE_PLANE;
+  for (PetscInt c = 0; c < 3; ++c) {
+    scene->obstacle.point[c]     = point[c];
+    scene->obstacle.direction[c] = n[c];
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -NAME as dim reals; required: refuse its absence. The vector keeps its value when not given. */
+static PetscErrorCode ReadVector(CompatOptionItems PetscOptionsObject, MPI_Comm comm, const char name[], const char help[], PetscInt dim, PetscBool required, const char what[],
+                                 PetscReal v[])
+{
+  PetscInt  n = dim;
+  PetscBool set;
+
+  PetscFunctionBeginUser;
+  PetscCall(OptionsCountListValues(name, &n)); /* all of them: a longer list would be cut silently to the array */
+  PetscCheck(n <= dim, comm, PETSC_ERR_USER_INPUT, "%s needs %" PetscInt_FMT " comma-separated values (one per coordinate), got %" PetscInt_FMT, name,
+             dim, n);
+  n = dim;
+  PetscCall(PetscOptionsRealArray(name, help, NULL, v, &n, &set));
+  PetscCheck(set || !required, comm, PETSC_ERR_USER_INPUT, "%s needs %s (%" PetscInt_FMT " comma-separated values)", what, name, dim);
+  if (set) {
+    PetscCheck(n == dim, comm, PETSC_ERR_USER_INPUT, "%s needs %" PetscInt_FMT " comma-separated values (one per coordinate), got %" PetscInt_FMT,
+               name, dim, n);
+    PetscCall(OptionsCheckFiniteArray(comm, name, dim, v));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Scales v (dim entries) to unit length; refuses a zero vector. */
+static PetscErrorCode Normalize(MPI_Comm comm, const char name[], PetscInt dim, PetscReal v[])
+{
+  PetscReal len = 0.0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt c = 0; c < dim; ++c) len += v[c] * v[c];
+  len = PetscSqrtReal(len);
+  PetscCheck(len > 0.0, comm, PETSC_ERR_USER_INPUT, "%s must not be the zero vector", name);
+  for (PetscInt c = 0; c < dim; ++c) v[c] /= len;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
+{
+  MPI_Comm   comm = PetscObjectComm((PetscObject)dm);
+  Obstacle  *obs  = &scene->obstacle;
+  PetscInt   dim;
+  PetscBool  type_set;
+  const char what[] = "-obstacle";
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscOptionsBegin(comm, NULL, "Rigid obstacle", "Signorini");
+  PetscCall(PetscOptionsEnum("-obstacle", "Rigid obstacle: plane, sphere (the body stays outside a ball), cylinder (in 2D a disk)", NULL,
+                             ObstacleTypes, (PetscEnum)obs->type, (PetscEnum *)&obs->type, &type_set));
+  switch (obs->type) {
+    case OBSTACLE_PLANE:
+      PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_point", "A point of the plane", dim, PETSC_FALSE, what, obs->point));
+      PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_normal", "Normal of the plane, from the body into the obstacle", dim, PETSC_FALSE, what, obs->direction));
+      PetscCall(Normalize(comm, "-obstacle_normal", dim, obs->direction));
+      break;
+    case OBSTACLE_SPHERE:
+    case OBSTACLE_CYLINDER: {
+      const PetscBool required = (PetscBool)(type_set && scene->obstacle.radius <= 0.0);
+      const char     *kind     = obs->type == OBSTACLE_SPHERE ? "-obstacle sphere" : "-obstacle cylinder";
+      PetscBool       set;
+
+      PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_center", "Center of the sphere or a point of the cylinder's axis", dim, required, kind, obs->point));
+      PetscCall(PetscOptionsReal("-obstacle_radius", "Radius of the sphere or cylinder", NULL, obs->radius, &obs->radius, &set));
+      PetscCall(OptionsCheckFinite(comm, "-obstacle_radius", obs->radius));
+      PetscCheck(obs->radius > 0.0, comm, PETSC_ERR_USER_INPUT, "%s needs a positive -obstacle_radius, got %g", kind, (double)obs->radius);
+      if (obs->type == OBSTACLE_CYLINDER && dim == 3) {
+        PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_axis", "Direction of the cylinder's axis", dim, required, kind, obs->direction));
+        PetscCall(Normalize(comm, "-obstacle_axis", dim, obs->direction));
+      }
+    } break;
+  }
+  PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_translate", "Rigid translation of the obstacle (an indenter driven by displacement)", dim, PETSC_FALSE, what,
+                       obs->translate));
+  PetscOptionsEnd();
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
