@@ -54,5 +54,7 @@ void ElasticStress(PetscInt dim, const Material *mat, const PetscReal grad[], Pe
 /* boundary.c */
 PetscErrorCode BoundaryAddDirichlet(DM dm, AppCtx *user);
 PetscErrorCode BoundaryAddLoads(DM dm, AppCtx *user, Vec r0);
+PetscErrorCode BoundaryAddLoadsLocal(DM dm, AppCtx *user, Vec locF);
+PetscErrorCode BoundaryComputeReactions(DM dm, AppCtx *user, Vec u, PetscReal reaction[][3]);
 PetscErrorCode BoundaryCheckFaceSets(DM dm, const Scene *scene);
 PetscErrorCode BoundaryCheckRigidMotions(DM dm, const Scene *scene);

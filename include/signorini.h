@@ -143,6 +143,7 @@ typedef struct {
   PetscBool *active;       /* active set at the last monitor call */
   PetscBool *built_active; /* active set when the preconditioner was last built */
   PetscReal *pressure;     /* contact pressure -sigma_n at the node, after the solve */
+  PetscReal *reaction;     /* normal reaction force of the obstacle on the node, -R . n with R = K u + r0, after the solve */
 } ContactSet;
 
 /* Accurate integration for the verification: Gauss points per direction, and how many times the reference
@@ -186,6 +187,8 @@ typedef struct {
   PetscReal           time_setup, time_solve, time_total;
   PetscInt            active_vertices;
   PetscReal           max_penetration, contact_force, energy;
+  PetscReal           contact_force_vector[3];       /* the obstacle's force on the body: the sum of R = K u + r0 over the contact nodes */
+  PetscReal           reaction[BOUNDARY_MAX][3];     /* force the support of each clamp or slip face set exerts on the body */
   MeshPartitionStats  partition; /* from MeshPartitionGetStats() */
 } RunStats;
 

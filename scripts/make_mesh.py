@@ -3,11 +3,17 @@
 (scripts/signorini/geometry.py), for -dm_plex_filename.
 
   make_mesh.py half-disk      -o FILE.msh [--radius R] [--h-far H] [--h-near h] [--width W]   (2D, triangles)
+  make_mesh.py quarter-disk   -o FILE.msh [--radius R] [--h-far H] [--h-near h] [--width W]   (2D, triangles)
   make_mesh.py quarter-sphere -o FILE.msh [--radius R] [--h-far H] [--h-near h] [--width W]   (3D, tetrahedra)
+  make_mesh.py block          -o FILE.msh [--radius R] ...   (2D: [0,R] x [-R,0], indented at the origin from above)
+  make_mesh.py quarter-block  -o FILE.msh [--radius R] ...   (3D: [0,R]^2 x [-R,0])
 
-The mesh size grows linearly from h_near at the origin to h_far at the distance W (default R/2).
-Physical groups ("Face Sets" values): half-disk contact 1, top 3; quarter-sphere contact 1, top 2, symmetry_y 3,
-symmetry_x 6; the body 10. The built-in scenes (Gamma_C = 1, clamped top) run on them as they are.
+The mesh size is h_near up to the distance --near from the origin (default 0), then grows linearly to h_far over the
+distance W (default R/2).
+Physical groups ("Face Sets" values, and names): half-disk contact 1, top 3; quarter-disk contact 1, top 3,
+symmetry_x 4; quarter-sphere contact 1, top 2, symmetry_y 3, symmetry_x 6; block contact 1, bottom 2, symmetry_x 4,
+side 5; quarter-block contact 1, bottom 2, symmetry_y 3, side 5, symmetry_x 6; the body 10. The built-in scenes
+(Gamma_C = 1, clamped top) run on the disk and sphere meshes as they are; the scene general takes the names.
 """
 import argparse
 import os
@@ -16,7 +22,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from signorini.geometry import SHAPES  # noqa: E402
 
-DEFAULTS = {"half-disk": (0.1, 0.02), "quarter-sphere": (0.2, 0.05)}
+DEFAULTS = {"half-disk": (0.1, 0.02), "quarter-disk": (0.1, 0.02), "quarter-sphere": (0.2, 0.05), "block": (0.1, 0.02), "quarter-block": (0.2, 0.05)}
 
 
 def main(argv=None):
@@ -27,11 +33,12 @@ def main(argv=None):
     parser.add_argument("--h-far", type=float, help="mesh size far from the contact point")
     parser.add_argument("--h-near", type=float, help="mesh size at the contact point")
     parser.add_argument("--width", type=float, help="distance over which the size grows from h-near to h-far (default radius/2)")
+    parser.add_argument("--near", type=float, default=0.0, help="distance from the origin up to which the size is h-near (default 0)")
     args = parser.parse_args(argv)
     h_far = args.h_far if args.h_far is not None else DEFAULTS[args.shape][0] * args.radius
     h_near = args.h_near if args.h_near is not None else DEFAULTS[args.shape][1] * args.radius
     try:
-        SHAPES[args.shape](args.output, radius=args.radius, h_far=h_far, h_near=h_near, width=args.width)
+        SHAPES[args.shape](args.output, radius=args.radius, h_far=h_far, h_near=h_near, width=args.width, near=args.near)
     except ValueError as exc:
         print(f"make_mesh.py: {exc}", file=sys.stderr)
         return 2

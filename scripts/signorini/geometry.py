@@ -2,8 +2,8 @@
 one point, meshed finer toward that point, with physical groups (numbered and named) that the solver reads as
 "Face Sets" values through -dm_plex_filename.
 
-Every shape rests on the plane {x_d = 0} and touches it at the origin; the mesh size grows linearly with the distance r
-from the origin, from h_near at r = 0 to h_far at r >= width.
+Every shape rests on the plane {x_d = 0} and touches it at the origin (or, for the blocks, is indented there); the mesh
+size is h_near up to the distance near from the origin and grows linearly to h_far over the distance width.
 """
 import contextlib
 
@@ -12,15 +12,21 @@ import gmsh
 # "Face Sets" values, as PETSc numbers the faces of its boxes (2D: bottom 1, top 3; 3D: bottom 1, top 2, front y = 0 3,
 # left x = 0 6), so that the built-in scenes (Gamma_C = 1, clamped top) run on these meshes as they are
 HALF_DISK_GROUPS = {"contact": 1, "top": 3}
+QUARTER_DISK_GROUPS = {"contact": 1, "top": 3, "symmetry_x": 4}
 QUARTER_SPHERE_GROUPS = {"contact": 1, "top": 2, "symmetry_y": 3, "symmetry_x": 6}
+# the blocks indented from above: their top {x_d = 0} is Gamma_C
+BLOCK_GROUPS = {"contact": 1, "bottom": 2, "symmetry_x": 4, "side": 5}
+QUARTER_BLOCK_GROUPS = {"contact": 1, "bottom": 2, "symmetry_y": 3, "symmetry_x": 6, "side": 5}
 BODY_GROUP = 10
 
 
-def _size_field(h_near, h_far, width, dim):
-    """A mesh size field growing from h_near at the origin to h_far at the distance width, used everywhere."""
+def _size_field(h_near, h_far, width, dim, near=0.0):
+    """A mesh size field equal to h_near up to the distance near from the origin, then growing linearly to h_far over
+    the distance width, used everywhere."""
     r = "Sqrt(x^2 + y^2)" if dim == 2 else "Sqrt(x^2 + y^2 + z^2)"
     field = gmsh.model.mesh.field.add("MathEval")
-    gmsh.model.mesh.field.setString(field, "F", f"Min({h_far!r}, {h_near!r} + ({h_far!r} - {h_near!r}) * {r} / {width!r})")
+    gmsh.model.mesh.field.setString(
+        field, "F", f"Min({h_far!r}, {h_near!r} + ({h_far!r} - {h_near!r}) * Max({r} - {near!r}, 0) / {width!r})")
     gmsh.model.mesh.field.setAsBackgroundMesh(field)
     for option in ("Mesh.MeshSizeExtendFromBoundary", "Mesh.MeshSizeFromPoints", "Mesh.MeshSizeFromCurvature"):
         gmsh.option.setNumber(option, 0)
@@ -49,27 +55,29 @@ def _model(name):
         gmsh.finalize()
 
 
-def _write(path, dim, h_near, h_far, width):
+def _write(path, dim, h_near, h_far, width, near=0.0):
     """The body's physical group, the size field, the mesh, and the file."""
     _physical(dim, [tag for _, tag in gmsh.model.getEntities(dim)], BODY_GROUP, "body")
-    _size_field(h_near, h_far, width, dim)
+    _size_field(h_near, h_far, width, dim, near)
     gmsh.model.mesh.generate(dim)
     gmsh.write(path)
 
 
-def _check(radius, h_far, h_near, width):
+def _check(radius, h_far, h_near, width, near=0.0):
     for name, value in (("radius", radius), ("h_far", h_far), ("h_near", h_near), ("width", width)):
         if not value > 0:
             raise ValueError(f"{name} must be positive, got {value}")
+    if not 0 <= near < radius:
+        raise ValueError(f"near must lie in [0, radius), got {near}")
     if h_near > h_far:
         raise ValueError(f"h_near ({h_near}) must not exceed h_far ({h_far})")
 
 
-def half_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None):
+def half_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0):
     """The lower half of the disk of the given radius centred at (0, radius): the arc (Gamma_C, "contact") touches the
     plane y = 0 at the origin, the flat top y = radius is "top". Triangles; writes a Gmsh .msh file at path."""
     width = radius / 2 if width is None else width
-    _check(radius, h_far, h_near, width)
+    _check(radius, h_far, h_near, width, near)
     with _model("half_disk"):
         disk = gmsh.model.occ.addDisk(0, radius, 0, radius, radius)
         upper = gmsh.model.occ.addRectangle(-2 * radius, radius, 0, 4 * radius, 2 * radius)
@@ -80,15 +88,15 @@ def half_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None):
         curves = [tag for _, tag in gmsh.model.getEntities(1)]
         _physical(1, [c for c in curves if c not in top], HALF_DISK_GROUPS["contact"], "contact")
         _physical(1, top, HALF_DISK_GROUPS["top"], "top")
-        _write(path, 2, h_near, h_far, width)
+        _write(path, 2, h_near, h_far, width, near)
 
 
-def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None):
+def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.0):
     """The quarter of the lower half of the ball of the given radius centred at (0, 0, radius) with x >= 0 and y >= 0:
     the curved surface ("contact") touches the plane z = 0 at the origin, the flat top z = radius is "top", and the
     planes x = 0 and y = 0 are "symmetry_x" and "symmetry_y". Tetrahedra; writes a Gmsh .msh file at path."""
     width = radius / 2 if width is None else width
-    _check(radius, h_far, h_near, width)
+    _check(radius, h_far, h_near, width, near)
     with _model("quarter_sphere"):
         ball = gmsh.model.occ.addSphere(0, 0, radius, radius)
         box = gmsh.model.occ.addBox(0, 0, 0, 2 * radius, 2 * radius, radius)
@@ -103,7 +111,65 @@ def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None):
         _physical(2, top, QUARTER_SPHERE_GROUPS["top"], "top")
         _physical(2, sym_y, QUARTER_SPHERE_GROUPS["symmetry_y"], "symmetry_y")
         _physical(2, sym_x, QUARTER_SPHERE_GROUPS["symmetry_x"], "symmetry_x")
-        _write(path, 3, h_near, h_far, width)
+        _write(path, 3, h_near, h_far, width, near)
 
 
-SHAPES = {"half-disk": half_disk, "quarter-sphere": quarter_sphere}
+def quarter_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0):
+    """The half of the half-disk with x >= 0: the arc ("contact") touches the plane y = 0 at the origin, the flat top
+    y = radius is "top", the plane x = 0 is "symmetry_x". Triangles; writes a Gmsh .msh file at path."""
+    width = radius / 2 if width is None else width
+    _check(radius, h_far, h_near, width, near)
+    with _model("quarter_disk"):
+        disk = gmsh.model.occ.addDisk(0, radius, 0, radius, radius)
+        box = gmsh.model.occ.addRectangle(0, 0, 0, 2 * radius, radius)
+        gmsh.model.occ.intersect([(2, disk)], [(2, box)])
+        gmsh.model.occ.synchronize()
+        eps = 1e-3 * radius
+        top = _entities_in_box(1, (0, radius, 0), (radius, radius, 0), eps)
+        sym_x = _entities_in_box(1, (0, 0, 0), (0, radius, 0), eps)
+        curves = [tag for _, tag in gmsh.model.getEntities(1)]
+        _physical(1, [c for c in curves if c not in top + sym_x], QUARTER_DISK_GROUPS["contact"], "contact")
+        _physical(1, top, QUARTER_DISK_GROUPS["top"], "top")
+        _physical(1, sym_x, QUARTER_DISK_GROUPS["symmetry_x"], "symmetry_x")
+        _write(path, 2, h_near, h_far, width, near)
+
+
+def block(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0):
+    """The rectangle [0, radius] x [-radius, 0], to be indented at the origin from above: its top y = 0 is "contact",
+    its bottom "bottom", x = 0 "symmetry_x", x = radius "side". Triangles; writes a Gmsh .msh file at path."""
+    width = radius / 2 if width is None else width
+    _check(radius, h_far, h_near, width, near)
+    with _model("block"):
+        gmsh.model.occ.addRectangle(0, -radius, 0, radius, radius)
+        gmsh.model.occ.synchronize()
+        eps = 1e-3 * radius
+        groups = {"contact": _entities_in_box(1, (0, 0, 0), (radius, 0, 0), eps),
+                  "bottom": _entities_in_box(1, (0, -radius, 0), (radius, -radius, 0), eps),
+                  "symmetry_x": _entities_in_box(1, (0, -radius, 0), (0, 0, 0), eps),
+                  "side": _entities_in_box(1, (radius, -radius, 0), (radius, 0, 0), eps)}
+        for name, tags in groups.items():
+            _physical(1, tags, BLOCK_GROUPS[name], name)
+        _write(path, 2, h_near, h_far, width, near)
+
+
+def quarter_block(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.0):
+    """The box [0, radius]^2 x [-radius, 0], to be indented at the origin from above: its top z = 0 is "contact", its
+    bottom "bottom", x = 0 "symmetry_x", y = 0 "symmetry_y", the faces x = radius and y = radius "side". Tetrahedra."""
+    width = radius / 2 if width is None else width
+    _check(radius, h_far, h_near, width, near)
+    with _model("quarter_block"):
+        gmsh.model.occ.addBox(0, 0, -radius, radius, radius, radius)
+        gmsh.model.occ.synchronize()
+        eps = 1e-3 * radius
+        r = radius
+        groups = {"contact": _entities_in_box(2, (0, 0, 0), (r, r, 0), eps),
+                  "bottom": _entities_in_box(2, (0, 0, -r), (r, r, -r), eps),
+                  "symmetry_x": _entities_in_box(2, (0, 0, -r), (0, r, 0), eps),
+                  "symmetry_y": _entities_in_box(2, (0, 0, -r), (r, 0, 0), eps),
+                  "side": _entities_in_box(2, (r, 0, -r), (r, r, 0), eps) + _entities_in_box(2, (0, r, -r), (r, r, 0), eps)}
+        for name, tags in groups.items():
+            _physical(2, tags, QUARTER_BLOCK_GROUPS[name], name)
+        _write(path, 3, h_near, h_far, width, near)
+
+
+SHAPES = {"half-disk": half_disk, "quarter-disk": quarter_disk, "quarter-sphere": quarter_sphere, "block": block, "quarter-block": quarter_block}

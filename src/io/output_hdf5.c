@@ -76,11 +76,11 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
 {
   const ContactSet  *cs = &user->prob.cset;
   DM                 vdm, sdm, cdm;
-  Vec                locU, disp, pressure, gap, mask, exact = NULL, error = NULL, coords;
+  Vec                locU, disp, pressure, gap, mask, react, exact = NULL, error = NULL, coords;
   PetscSection       usec, vsec, ssec, csec;
   PetscInt           dim, vStart, vEnd, vrstart, srstart;
   const PetscScalar *lu, *xc, *x;
-  PetscScalar       *d, *p, *g, *m, *ex = NULL, *er = NULL;
+  PetscScalar       *d, *p, *g, *m, *fr, *ex = NULL, *er = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
@@ -96,6 +96,9 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscCall(DMCreateGlobalVector(sdm, &pressure));
   PetscCall(DMCreateGlobalVector(sdm, &gap));
   PetscCall(DMCreateGlobalVector(sdm, &mask));
+  PetscCall(DMCreateGlobalVector(sdm, &react));
+  PetscCall(PetscObjectSetName((PetscObject)react, "contact_reaction")); /* the nodal force of the obstacle along n */
+  PetscCall(VecZeroEntries(react));
   PetscCall(PetscObjectSetName((PetscObject)disp, "displacement"));
   PetscCall(PetscObjectSetName((PetscObject)pressure, "contact_pressure"));
   PetscCall(PetscObjectSetName((PetscObject)gap, "normal_gap"));
@@ -152,6 +155,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscCall(VecGetArray(pressure, &p));
   PetscCall(VecGetArray(gap, &g));
   PetscCall(VecGetArray(mask, &m));
+  PetscCall(VecGetArray(react, &fr));
   for (PetscInt i = 0; i < cs->n; ++i) {
     PetscInt goff;
 
@@ -160,9 +164,11 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
     goff -= srstart;
     p[goff] = cs->pressure[i];
     g[goff] = -ContactNodePenetration(&user->prob.cset, dim, i, x);
-    m[goff] = 1.0;
+    m[goff]  = 1.0;
+    fr[goff] = cs->reaction[i];
   }
   PetscCall(VecRestoreArray(mask, &m));
+  PetscCall(VecRestoreArray(react, &fr));
   PetscCall(VecRestoreArray(gap, &g));
   PetscCall(VecRestoreArray(pressure, &p));
   PetscCall(VecRestoreArrayRead(u, &x));
@@ -171,6 +177,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscCall(ViewVertexField(pressure, 1, viewer));
   PetscCall(ViewVertexField(gap, 1, viewer));
   PetscCall(ViewVertexField(mask, 1, viewer));
+  PetscCall(ViewVertexField(react, 1, viewer));
   if (exact) {
     PetscCall(ViewVertexField(exact, dim, viewer));
     PetscCall(ViewVertexField(error, dim, viewer));
@@ -181,6 +188,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscCall(VecDestroy(&pressure));
   PetscCall(VecDestroy(&gap));
   PetscCall(VecDestroy(&mask));
+  PetscCall(VecDestroy(&react));
   PetscCall(DMDestroy(&vdm));
   PetscCall(DMDestroy(&sdm));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -266,6 +274,24 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteRealAttr(v, "max_penetration", s->max_penetration));
   PetscCall(WriteRealAttr(v, "contact_force", s->contact_force));
   PetscCall(WriteRealAttr(v, "energy", s->energy));
+  for (PetscInt c = 0; c < dim; ++c) { /* the total force of the obstacle, contact_force_x, _y, _z */
+    char name[32];
+
+    PetscCall(PetscSNPrintf(name, sizeof(name), "contact_force_%c", "xyz"[c]));
+    PetscCall(WriteRealAttr(v, name, s->contact_force_vector[c]));
+  }
+  for (PetscInt i = 0; i < user->scene.bcs.n; ++i) { /* reaction_clamp_3_x, ...: the force of each support on the body */
+    const BoundaryCondition *bc = &user->scene.bcs.bc[i];
+
+    if (bc->kind != BC_CLAMP && bc->kind != BC_SLIP) continue;
+    for (PetscInt c = 0; c < dim; ++c) {
+      char name[128];
+
+      PetscCall(PetscSNPrintf(name, sizeof(name), "reaction_%s_%s_%c", BoundaryKinds[bc->kind], bc->token, "xyz"[c]));
+      PetscCall(WriteRealAttr(v, name, s->reaction[i][c]));
+    }
+  }
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "obstacle", PETSC_STRING, ObstacleTypes[user->scene.obstacle.type]));
   {
     PetscInt n = user->prob.cset.n, ntotal;
 
@@ -336,9 +362,9 @@ static PetscErrorCode WriteSolves(MPI_Comm comm, const AppCtx *user, PetscViewer
 static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const char h5name[], PetscInt dim, PetscInt ncells, PetscInt ncorners,
                                 PetscInt nverts)
 {
-  const char    *fields[] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "exact_displacement", "error"};
-  const PetscInt ncomp[]  = {dim, 1, 1, 1, dim, dim};
-  const PetscInt nfields  = user->scene.exact ? 6 : 4;
+  const char    *fields[] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "contact_reaction", "exact_displacement", "error"};
+  const PetscInt ncomp[]  = {dim, 1, 1, 1, 1, dim, dim};
+  const PetscInt nfields  = user->scene.exact ? 7 : 5;
   const char    *topo     = dim == 2 ? (ncorners == 3 ? "Triangle" : "Quadrilateral") : (ncorners == 4 ? "Tetrahedron" : "Hexahedron");
   FILE          *fp;
   int            bad;

@@ -1,6 +1,7 @@
 /* The boundary conditions of the scene on the mesh: the Dirichlet ones (clamp, slip) as PETSc essential conditions, the
    surface loads (traction, pressure) in the residual of the load, and the checks that the face sets exist, do not
    overlap, and fix every rigid motion. */
+#include <petscbt.h>
 #include "mesh.h"
 #include "physics.h"
 
@@ -50,14 +51,14 @@ PetscErrorCode BoundaryAddDirichlet(DM dm, AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Adds the surface loads to the residual at u = 0 (global vector r0): -int t . v on each traction face set and
-   int p n . v on each pressure face set, each with its own value in constants[CONST_LOAD..] while it is integrated. */
-PetscErrorCode BoundaryAddLoads(DM dm, AppCtx *user, Vec r0)
+/* Adds the surface loads to the local residual locF: -int t . v on each traction face set and int p n . v on each
+   pressure face set, each with its own value in constants[CONST_LOAD..] while it is integrated. */
+PetscErrorCode BoundaryAddLoadsLocal(DM dm, AppCtx *user, Vec locF)
 {
   BoundarySet       *bcs = &user->scene.bcs;
   PetscDS            ds;
   PetscWeakForm      wf;
-  Vec                locX, locF;
+  Vec                locX;
   PetscInt           nc, nloads = 0;
   const PetscScalar *c0;
   PetscScalar        c[CONST_SCENE_MAX];
@@ -71,9 +72,7 @@ PetscErrorCode BoundaryAddLoads(DM dm, AppCtx *user, Vec r0)
   PetscCall(PetscWeakFormCreate(PetscObjectComm((PetscObject)dm), &wf));
   PetscCall(PetscWeakFormSetNumFields(wf, 1));
   PetscCall(DMGetLocalVector(dm, &locX));
-  PetscCall(DMGetLocalVector(dm, &locF));
   PetscCall(VecZeroEntries(locX));
-  PetscCall(VecZeroEntries(locF));
   for (PetscInt i = 0; i < bcs->n; ++i) {
     const BoundaryCondition *bc = &bcs->bc[i];
     PetscFormKey             key;
@@ -90,10 +89,84 @@ PetscErrorCode BoundaryAddLoads(DM dm, AppCtx *user, Vec r0)
   }
   for (PetscInt k = 0; k < 3; ++k) c[CONST_LOAD + k] = 0.0;
   PetscCall(PetscDSSetConstants(ds, nc, c));
+  PetscCall(DMRestoreLocalVector(dm, &locX));
+  PetscCall(PetscWeakFormDestroy(&wf));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Adds the surface loads to the residual at u = 0 (global vector r0). */
+PetscErrorCode BoundaryAddLoads(DM dm, AppCtx *user, Vec r0)
+{
+  Vec locF;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetLocalVector(dm, &locF));
+  PetscCall(VecZeroEntries(locF));
+  PetscCall(BoundaryAddLoadsLocal(dm, user, locF));
   PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, r0));
+  PetscCall(DMRestoreLocalVector(dm, &locF));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The reaction of each clamp and slip face set, the force its support exerts on the body: the sum, over the fixed
+   components of the points of its faces, of the residual K u - f (bulk and loads), which the support balances. Each cell adds to the local residual of one
+   rank only, so the local sums add up over the ranks. A point on two such face sets counts for the first listed.
+   reaction[i][c]: of the i-th boundary condition (zero for the loads). */
+PetscErrorCode BoundaryComputeReactions(DM dm, AppCtx *user, Vec u, PetscReal reaction[][3])
+{
+  MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
+  const BoundarySet *bcs  = &user->scene.bcs;
+  PetscSection       lsec;
+  Vec                locX, locF;
+  const PetscScalar *f;
+  PetscBT            seen;
+  PetscInt           pStart, pEnd, dim;
+  PetscReal          local[BOUNDARY_MAX][3];
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMGetLocalSection(dm, &lsec));
+  PetscCall(PetscSectionGetChart(lsec, &pStart, &pEnd));
+  PetscCall(DMGetLocalVector(dm, &locX));
+  PetscCall(DMGetLocalVector(dm, &locF));
+  PetscCall(VecCopy(user->prob.loc_bc, locX));
+  PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, locX));
+  PetscCall(VecZeroEntries(locF));
+  PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
+  PetscCall(BoundaryAddLoadsLocal(dm, user, locF));
+  PetscCall(PetscBTCreate(pEnd - pStart, &seen));
+  PetscCall(VecGetArrayRead(locF, &f));
+  for (PetscInt i = 0; i < bcs->n; ++i) {
+    PetscInt *faces, nf;
+
+    for (PetscInt c = 0; c < 3; ++c) local[i][c] = 0.0;
+    if (bcs->bc[i].kind != BC_CLAMP && bcs->bc[i].kind != BC_SLIP) continue;
+    PetscCall(MeshGetBoundaryFaces(dm, bcs->bc[i].id, &nf, &faces));
+    for (PetscInt k = 0; k < nf; ++k) {
+      PetscInt *closure = NULL, ncl;
+
+      PetscCall(DMPlexGetTransitiveClosure(dm, faces[k], PETSC_TRUE, &ncl, &closure));
+      for (PetscInt j = 0; j < ncl; ++j) {
+        const PetscInt  p = closure[2 * j];
+        const PetscInt *cind;
+        PetscInt        cdof, off;
+
+        if (PetscBTLookupSet(seen, p - pStart)) continue;
+        PetscCall(PetscSectionGetConstraintDof(lsec, p, &cdof));
+        if (!cdof) continue;
+        PetscCall(PetscSectionGetConstraintIndices(lsec, p, &cind));
+        PetscCall(PetscSectionGetOffset(lsec, p, &off));
+        for (PetscInt m = 0; m < cdof; ++m) local[i][cind[m]] += PetscRealPart(f[off + cind[m]]);
+      }
+      PetscCall(DMPlexRestoreTransitiveClosure(dm, faces[k], PETSC_TRUE, &ncl, &closure));
+    }
+    PetscCall(PetscFree(faces));
+  }
+  PetscCall(VecRestoreArrayRead(locF, &f));
+  PetscCall(PetscBTDestroy(&seen));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscCall(DMRestoreLocalVector(dm, &locF));
-  PetscCall(PetscWeakFormDestroy(&wf));
+  PetscCall(MPIU_Allreduce(local, reaction, 3 * bcs->n, MPIU_REAL, MPIU_SUM, comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -154,6 +154,7 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
   PetscCall(PetscMalloc3(npts * dim, &cs->fixed, npts * dim, &cs->normal, npts, &cs->eps_factor));
   PetscCall(PetscMalloc4(npts, &cs->gap, npts, &cs->weight, npts, &cs->active, npts, &cs->pressure));
   PetscCall(PetscCalloc1(npts, &cs->built_active));
+  PetscCall(PetscCalloc1(npts, &cs->reaction));
   for (PetscInt i = 0; i < npts; ++i) {
     const PetscInt  p    = pts[i];
     const PetscInt *cind = NULL;
@@ -223,6 +224,7 @@ PetscErrorCode ContactSetDestroy(ContactSet *cs)
   PetscCall(PetscFree3(cs->fixed, cs->normal, cs->eps_factor));
   PetscCall(PetscFree4(cs->gap, cs->weight, cs->active, cs->pressure));
   PetscCall(PetscFree(cs->built_active));
+  PetscCall(PetscFree(cs->reaction));
   cs->n = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -10,7 +10,7 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   Vec                R;
   const PetscScalar *x, *r;
   PetscInt           dim;
-  PetscReal          local[2] = {0.0, 0.0}, global[2], uKu, r0u, penalty_energy;
+  PetscReal          local[5] = {0.0, 0.0, 0.0, 0.0, 0.0}, global[5], uKu, r0u, penalty_energy;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
@@ -26,7 +26,11 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
     PetscReal       reaction = 0.0; /* along the free components: a fixed one takes its reaction from its boundary condition */
 
     for (PetscInt c = 0; c < dim; ++c)
-      if (cs->dof[i * dim + c] >= 0) reaction -= PetscRealPart(r[cs->dof[i * dim + c]]) * cs->normal[i * dim + c];
+      if (cs->dof[i * dim + c] >= 0) {
+        reaction -= PetscRealPart(r[cs->dof[i * dim + c]]) * cs->normal[i * dim + c];
+        local[2 + c] += PetscRealPart(r[cs->dof[i * dim + c]]); /* the obstacle's force on the body: R = K u + r0 */
+      }
+    cs->reaction[i] = reaction;
     switch (user->opt.contact.method) {
       case CONTACT_PENALTY:
         cs->pressure[i] = d > 0.0 ? d / ContactNodeEps(cs, user->prob.eps, i) : 0.0;
@@ -45,7 +49,9 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   PetscCall(VecRestoreArrayRead(u, &x));
   PetscCall(VecDestroy(&R));
   PetscCall(MPIU_Allreduce(&local[0], &global[0], 1, MPIU_REAL, MPIU_MAX, comm));
-  PetscCall(MPIU_Allreduce(&local[1], &global[1], 1, MPIU_REAL, MPIU_SUM, comm));
+  PetscCall(MPIU_Allreduce(&local[1], &global[1], 4, MPIU_REAL, MPIU_SUM, comm));
+  for (PetscInt c = 0; c < 3; ++c) user->rec.stats.contact_force_vector[c] = global[2 + c];
+  PetscCall(BoundaryComputeReactions(dm, user, u, user->rec.stats.reaction));
   user->rec.stats.max_penetration = global[0];
   user->rec.stats.contact_force   = global[1];
   PetscCall(ContactCountActive(user, u, PETSC_FALSE, &user->rec.stats.active_vertices, NULL, NULL));

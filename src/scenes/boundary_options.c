@@ -59,7 +59,7 @@ static PetscErrorCode ResolveFaceSet(DM dm, const char option[], const char toke
   }
   PetscCall(DMHasLabel(dm, token, &has));
   PetscCheck(has, comm, PETSC_ERR_USER_INPUT,
-             "%s: '%s' is neither a \"Face Sets\" value nor the name of a physical group of the mesh (names are read from a Gmsh .msh file's "
+             "%s: '%s' is neither a \"Face Sets\" value nor the name of a physical group of faces of the mesh (names are read from a Gmsh .msh file's "
              "$PhysicalNames)",
              option, token);
   PetscCall(DMGetLabel(dm, token, &label));
