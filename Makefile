@@ -23,7 +23,7 @@ SRC = $(wildcard src/*.c src/*/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test asan rates extremes tradeoff bench format clean
+.PHONY: all deps run test asan rates extremes tradeoff hertz bench format clean
 STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
@@ -80,6 +80,11 @@ extremes: deps
 tradeoff: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/tradeoff.py options/studies/tradeoff.yaml
+
+# Hertz contact against the closed form, 2D and 3D (README, "Hertz"): output/hertz/hertz.{md,csv}, hertz_<case>.png
+hertz: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) scripts/hertz.py --check 0.01
 
 # Performance (README, "Performance"): bench/bench.{md,csv}, runs under bench/runs/
 bench: deps

@@ -76,11 +76,11 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
 {
   const ContactSet  *cs = &user->prob.cset;
   DM                 vdm, sdm, cdm;
-  Vec                locU, disp, pressure, gap, mask, react, exact = NULL, error = NULL, coords;
+  Vec                locU, disp, pressure, gap, mask, react, area, exact = NULL, error = NULL, coords;
   PetscSection       usec, vsec, ssec, csec;
   PetscInt           dim, vStart, vEnd, vrstart, srstart;
   const PetscScalar *lu, *xc, *x;
-  PetscScalar       *d, *p, *g, *m, *fr, *ex = NULL, *er = NULL;
+  PetscScalar       *d, *p, *g, *m, *fr, *ar, *ex = NULL, *er = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
@@ -99,6 +99,9 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscCall(DMCreateGlobalVector(sdm, &react));
   PetscCall(PetscObjectSetName((PetscObject)react, "contact_reaction")); /* the nodal force of the obstacle along n */
   PetscCall(VecZeroEntries(react));
+  PetscCall(DMCreateGlobalVector(sdm, &area));
+  PetscCall(PetscObjectSetName((PetscObject)area, "contact_area")); /* the lumped boundary mass: reaction / area is a pressure */
+  PetscCall(VecZeroEntries(area));
   PetscCall(PetscObjectSetName((PetscObject)disp, "displacement"));
   PetscCall(PetscObjectSetName((PetscObject)pressure, "contact_pressure"));
   PetscCall(PetscObjectSetName((PetscObject)gap, "normal_gap"));
@@ -156,6 +159,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscCall(VecGetArray(gap, &g));
   PetscCall(VecGetArray(mask, &m));
   PetscCall(VecGetArray(react, &fr));
+  PetscCall(VecGetArray(area, &ar));
   for (PetscInt i = 0; i < cs->n; ++i) {
     PetscInt goff;
 
@@ -166,9 +170,11 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
     g[goff] = -ContactNodePenetration(&user->prob.cset, dim, i, x);
     m[goff]  = 1.0;
     fr[goff] = cs->reaction[i];
+    ar[goff] = cs->weight[i];
   }
   PetscCall(VecRestoreArray(mask, &m));
   PetscCall(VecRestoreArray(react, &fr));
+  PetscCall(VecRestoreArray(area, &ar));
   PetscCall(VecRestoreArray(gap, &g));
   PetscCall(VecRestoreArray(pressure, &p));
   PetscCall(VecRestoreArrayRead(u, &x));
@@ -178,6 +184,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscCall(ViewVertexField(gap, 1, viewer));
   PetscCall(ViewVertexField(mask, 1, viewer));
   PetscCall(ViewVertexField(react, 1, viewer));
+  PetscCall(ViewVertexField(area, 1, viewer));
   if (exact) {
     PetscCall(ViewVertexField(exact, dim, viewer));
     PetscCall(ViewVertexField(error, dim, viewer));
@@ -189,6 +196,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscCall(VecDestroy(&gap));
   PetscCall(VecDestroy(&mask));
   PetscCall(VecDestroy(&react));
+  PetscCall(VecDestroy(&area));
   PetscCall(DMDestroy(&vdm));
   PetscCall(DMDestroy(&sdm));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -362,9 +370,9 @@ static PetscErrorCode WriteSolves(MPI_Comm comm, const AppCtx *user, PetscViewer
 static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const char h5name[], PetscInt dim, PetscInt ncells, PetscInt ncorners,
                                 PetscInt nverts)
 {
-  const char    *fields[] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "contact_reaction", "exact_displacement", "error"};
-  const PetscInt ncomp[]  = {dim, 1, 1, 1, 1, dim, dim};
-  const PetscInt nfields  = user->scene.exact ? 7 : 5;
+  const char    *fields[] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "contact_reaction", "contact_area", "exact_displacement", "error"};
+  const PetscInt ncomp[]  = {dim, 1, 1, 1, 1, 1, dim, dim};
+  const PetscInt nfields  = user->scene.exact ? 8 : 6;
   const char    *topo     = dim == 2 ? (ncorners == 3 ? "Triangle" : "Quadrilateral") : (ncorners == 4 ? "Tetrahedron" : "Hexahedron");
   FILE          *fp;
   int            bad;

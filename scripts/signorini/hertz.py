@@ -1,0 +1,159 @@
+"""Hertz contact against the closed form (../shared/notes/verification.md, section 4): the four set-ups on the Gmsh
+geometries of geometry.py, the command line of each run, and the measurement of the contact half-width a, the peak
+pressure p0 and the total force from a run's HDF5 file.
+
+Closed forms, with E* = E / (1 - nu^2) (one elastic body against a rigid one):
+  2D (plane strain, per unit length, load P):  a = 2 sqrt(P R / (pi E*)),  p0 = 2 P / (pi a)
+  3D (load F):                                 a = (3 F R / (4 E*))^(1/3),  p0 = 3 F / (2 pi a^2),  approach a^2 / R
+and p(r) = p0 sqrt(1 - r^2 / a^2). Each run is displacement driven; P or F is the force the run measures (the obstacle's
+total force on the modelled part times the number of symmetric parts), and a, p0 are compared at that force.
+
+How a is measured: from the nodal contact forces f_i (the vertex field contact_reaction, -R . n with R = K u + r0),
+by the ratio of the second moment to the total, which for the Hertz pressure is a^2 / 4 in 2D and 2 a^2 / 5 in 3D:
+  a_h = 2 sqrt(sum f_i r_i^2 / sum f_i)  (2D),   a_h = sqrt(5/2 sum f_i r_i^2 / sum f_i)  (3D),
+with r_i the distance of node i from the axis of symmetry. How p0 is measured: the nodal tractions f_i / m_i (m_i the
+node's lumped boundary mass, contact_area) are fitted, inside r < 0.8 a_h, by the Hertz profile p0 sqrt(1 - r^2 / a^2)
+(a linear least-squares fit of p^2 against r^2). Their largest value is reported too (p0_max): on tetrahedra the nodal
+tractions scatter by a few percent from node to node, and the largest is that scatter's top, not the peak. The penalty
+law at a node, (1/eps)[u . n - g]_+, is not used: with the Gauss rule at small eps it oscillates from node to node (+32%
+at eps = h/100 on the coarse sphere), while the reaction, an integral, does not.
+"""
+import math
+
+import h5py
+import numpy as np
+
+from . import geometry
+from .paths import BIN
+
+YOUNG, POISSON, RADIUS = 1.0, 0.3, 1.0
+
+
+def e_star(young=YOUNG, poisson=POISSON):
+    return young / (1.0 - poisson * poisson)
+
+
+def closed_form(dim, load, radius=RADIUS, young=YOUNG, poisson=POISSON):
+    """(a, p0) of the Hertz solution at the load P (2D, per unit length) or F (3D)."""
+    es = e_star(young, poisson)
+    if dim == 2:
+        a = 2.0 * math.sqrt(load * radius / (math.pi * es))
+        return a, 2.0 * load / (math.pi * a)
+    a = (3.0 * load * radius / (4.0 * es)) ** (1.0 / 3.0)
+    return a, 3.0 * load / (2.0 * math.pi * a * a)
+
+
+def pressure_profile(r, a, p0):
+    return p0 * np.sqrt(np.clip(1.0 - (np.asarray(r) / a) ** 2, 0.0, None))
+
+
+# Each case: the mesh (a geometry.py shape), the copies of the modelled part in the whole body (symmetry), whether
+# SNESVI applies (a flat foundation: the normal is an axis at every node), the imposed displacement, and the options.
+CASES = {
+    "cylinder": {
+        "dim": 2, "shape": geometry.quarter_disk, "parts": 2, "vi": True, "near": 0.06, "h_far": 0.05, "width": 0.3,
+        "h_near": [0.004, 0.002, 0.001],
+        "args": ["-scene", "general", "-contact_faces", "contact", "-bc_slip", "top,symmetry_x",
+                 "-bc_slip_top_components", "1", "-bc_slip_top_translate", "0,-0.002", "-bc_slip_symmetry_x_components", "0"],
+        "what": "elastic cylinder (quarter disk, radius 1) pressed on a rigid plane by a displacement 0.002 of its axis plane",
+    },
+    "sphere": {
+        "dim": 3, "shape": geometry.quarter_sphere, "parts": 4, "vi": True, "near": 0.15, "h_far": 0.2, "width": 0.4,
+        "h_near": [0.02, 0.01, 0.005],
+        "args": ["-scene", "general", "-contact_faces", "contact", "-bc_slip", "top,symmetry_x,symmetry_y",
+                 "-bc_slip_top_components", "2", "-bc_slip_top_translate", "0,0,-0.01", "-bc_slip_symmetry_x_components", "0",
+                 "-bc_slip_symmetry_y_components", "1"],
+        "what": "elastic sphere (quarter sphere, radius 1) pressed on a rigid plane by a displacement 0.01 of its equator plane",
+    },
+    "cylinder-indenter": {
+        "dim": 2, "shape": geometry.block, "parts": 2, "vi": False, "near": 0.06, "h_far": 0.05, "width": 0.3,
+        "h_near": [0.004, 0.002, 0.001],
+        "args": ["-scene", "general", "-contact_faces", "contact", "-bc_clamp", "bottom", "-bc_slip", "symmetry_x",
+                 "-bc_slip_symmetry_x_components", "0", "-obstacle", "cylinder", "-obstacle_center", "0,1", "-obstacle_radius", "1",
+                 "-obstacle_translate", "0,-0.001"],
+        "what": "rigid cylinder (radius 1) indenting an elastic block [0,1] x [-1,0] (clamped bottom) by 0.001",
+    },
+    "sphere-indenter": {
+        "dim": 3, "shape": geometry.quarter_block, "parts": 4, "vi": False, "near": 0.15, "h_far": 0.2, "width": 0.4,
+        "h_near": [0.02, 0.01, 0.005],
+        "args": ["-scene", "general", "-contact_faces", "contact", "-bc_clamp", "bottom", "-bc_slip", "symmetry_x,symmetry_y",
+                 "-bc_slip_symmetry_x_components", "0", "-bc_slip_symmetry_y_components", "1", "-obstacle", "sphere",
+                 "-obstacle_center", "0,0,1", "-obstacle_radius", "1", "-obstacle_translate", "0,0,-0.01"],
+        "what": "rigid sphere (radius 1) indenting an elastic block [0,1]^2 x [-1,0] (clamped bottom) by 0.01",
+    },
+}
+
+METHODS = {  # label: solver options
+    "eps=h": ["-contact_method", "penalty", "-penalty_eps0", "1"],
+    "eps=h/10": ["-contact_method", "penalty", "-penalty_eps0", "0.1"],
+    "eps=h/100": ["-contact_method", "penalty", "-penalty_eps0", "0.01"],
+    "vi": ["-contact_method", "vi"],
+}
+
+
+def write_mesh(case, h_near, path):
+    c = CASES[case]
+    c["shape"](path, radius=RADIUS, h_far=c["h_far"], h_near=h_near, width=c["width"], near=c["near"])
+
+
+def command(case, mesh, method, output, ranks=1, mpiexec="mpiexec"):
+    """The mpiexec command line of one run."""
+    return ([mpiexec, "-n", str(ranks), BIN, "-dm_plex_filename", mesh, "-young_modulus", str(YOUNG), "-poisson_ratio",
+             str(POISSON)] + CASES[case]["args"] + METHODS[method] + ["-output", output])
+
+
+def measure(case, path):
+    """What a run gives against the closed form: a dict with the load, a, p0 (measured and closed form), their relative
+    errors, the force balance (|obstacle force + supports' reactions| / obstacle force, along the pressing axis), and the
+    contact nodes. Raises ValueError if the run has no contact."""
+    c = CASES[case]
+    dim = c["dim"]
+    axis = "xyz"[dim - 1]
+    with h5py.File(path, "r") as f:
+        run = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f["run"].attrs.items()}
+        x = f["geometry/vertices"][:]
+        force = f["vertex_fields/contact_reaction"][:].ravel()
+        pressure = f["vertex_fields/contact_pressure"][:].ravel()
+        boundary = f["vertex_fields/contact_boundary"][:].ravel() > 0
+        area = f["vertex_fields/contact_area"][:].ravel()
+    r2 = (x[:, 0] ** 2) if dim == 2 else (x[:, 0] ** 2 + x[:, 1] ** 2)
+    m0 = float(np.sum(force[boundary]))
+    if not m0 > 0:
+        raise ValueError(f"{path}: no contact force")
+    m2 = float(np.sum(force[boundary] * r2[boundary]))
+    a_h = 2.0 * math.sqrt(m2 / m0) if dim == 2 else math.sqrt(2.5 * m2 / m0)
+    obstacle = float(run[f"contact_force_{axis}"])
+    supports = sum(float(v) for k, v in run.items() if k.startswith("reaction_") and k.endswith(f"_{axis}"))
+    load = c["parts"] * abs(obstacle)
+    a, p0 = closed_form(dim, load)
+    traction = np.where(area[boundary] > 0, force[boundary] / np.where(area[boundary] > 0, area[boundary], 1.0), 0.0)
+    p0_h, a_fit = fit_profile(r2[boundary], traction, a_h)
+    return {"load": load, "a": a, "a_h": a_h, "a_error": a_h / a - 1.0, "p0": p0, "p0_h": p0_h, "p0_error": p0_h / p0 - 1.0,
+            "a_fit": a_fit, "p0_max": float(np.max(traction)), "p0_max_error": float(np.max(traction)) / p0 - 1.0,
+            "balance": abs(obstacle + supports) / abs(obstacle), "contact_nodes": int(np.sum(force[boundary] > 0)),
+            "converged": int(run.get("converged", 0)), "time_total": float(run.get("time_total", float("nan"))),
+            "n_dofs": int(run.get("n_dofs", 0)), "eps_min": float(run.get("eps_min", 0.0)),
+            "radius_sq": r2[boundary], "pressure": traction, "pressure_law": pressure[boundary]}
+
+
+def fit_profile(radius_sq, traction, a_h, inner=0.8):
+    """(p0, a) of the Hertz profile fitted to the nodal tractions inside r < inner a_h: p^2 = p0^2 - (p0 / a)^2 r^2 is
+    linear in r^2, so the fit is a linear least-squares one; it averages the node-to-node scatter of the tractions."""
+    sel = radius_sq < (inner * a_h) ** 2
+    if np.count_nonzero(sel) < 3:
+        return float("nan"), float("nan")
+    design = np.column_stack([np.ones(np.count_nonzero(sel)), -radius_sq[sel]])
+    (p0_sq, slope), *_ = np.linalg.lstsq(design, traction[sel] ** 2, rcond=None)
+    if not (p0_sq > 0 and slope > 0):
+        return float("nan"), float("nan")
+    return math.sqrt(p0_sq), math.sqrt(p0_sq / slope)
+
+
+def mesh_name(case, h_near):
+    return f"{case}_h{h_near:g}.msh"
+
+
+def output_name(case, h_near, method):
+    label = method.replace("=", "").replace("/", "_")
+    return f"{case}_h{h_near:g}_{label}.h5"
+
