@@ -32,17 +32,18 @@ static void f0_bd_pressure(PetscInt dim, PetscInt Nf, PetscInt NfAux, const Pets
   for (PetscInt c = 0; c < dim; ++c) f0[c] = constants[CONST_LOAD] * n[c];
 }
 
-/* The clamps and slips as essential conditions, one per face set. */
+/* The clamps and slips as essential conditions, one per face set. PETSc inserts them in this order, the later value
+   winning at a node two face sets share: the slips first, then the clamps, so a clamp's value holds at its edge. */
 PetscErrorCode BoundaryAddDirichlet(DM dm, AppCtx *user)
 {
   BoundarySet *bcs = &user->scene.bcs;
 
   PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < bcs->n; ++i) {
-    BoundaryCondition *bc = &bcs->bc[i];
+  for (PetscInt k = 0; k < 2 * bcs->n; ++k) {
+    BoundaryCondition *bc = &bcs->bc[k % bcs->n];
     char               name[96];
 
-    if (bc->kind != BC_CLAMP && bc->kind != BC_SLIP) continue;
+    if (bc->kind != (k < bcs->n ? BC_SLIP : BC_CLAMP)) continue;
     PetscCall(PetscSNPrintf(name, sizeof(name), "%s %s", BoundaryKinds[bc->kind], bc->token));
     PetscCall(DMAddBoundary(dm, DM_BC_ESSENTIAL, name, user->prob.face_sets, 1, &bc->id, 0, bc->kind == BC_SLIP ? bc->ncomp : 0,
                             bc->kind == BC_SLIP ? bc->comps : NULL, (void (*)(void))(bc->fn ? bc->fn : ConstantVector), NULL,

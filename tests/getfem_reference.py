@@ -1,0 +1,100 @@
+"""An independent solution of the nodal penalty contact problem with every boundary-condition family, by GetFEM
+(Debian's python3-getfem) on the very mesh the solver reads: GetFEM assembles the plane-strain stiffness, the body
+force, the traction, the pressure and the lumped contact masses; the obstacle's gap and normal, the Dirichlet
+elimination and the semismooth Newton iteration are written here in numpy, from the formulas, not from the solver."""
+import gmsh
+import numpy as np
+
+# the problem (tests/test_getfem.py passes the same to bin/signorini)
+E, NU = 1.0, 0.3
+BODY_FORCE = (0.05, -0.2)
+PRESSURE = 0.02                      # on "right" (x = 2)
+TRACTION = (0.01, -0.05)             # on "traction" (top, x in [1, 2])
+CLAMP = (0.001, -0.01)               # "clamp" (top, x in [0, 1]) moved by this translation
+SLIP_LEFT = 0.0                      # "left" (x = 0): u_x = this, u_y free
+CENTER, RADIUS = (1.0, -5.0), 5.0    # the rigid disk below: the body stays outside it
+EPS = 1e-2                           # -penalty_eps
+GROUPS = {"contact_a": 1, "contact_b": 2, "right": 3, "traction": 4, "clamp": 5, "left": 6}
+
+
+def write_mesh(path, size=0.1):
+    """The rectangle [0, 2] x [0, 1], its bottom in two contact face sets and its top in a clamped and a loaded half
+    (Gmsh 2.2, which GetFEM imports)."""
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("every_family")
+        pts = [gmsh.model.geo.addPoint(x, y, 0, size) for x, y in [(0, 0), (1, 0), (2, 0), (2, 1), (1, 1), (0, 1)]]
+        lines = [gmsh.model.geo.addLine(pts[i], pts[(i + 1) % 6]) for i in range(6)]
+        surface = gmsh.model.geo.addPlaneSurface([gmsh.model.geo.addCurveLoop(lines)])
+        gmsh.model.geo.synchronize()
+        for (name, tag), line in zip(GROUPS.items(), [lines[0], lines[1], lines[2], lines[3], lines[4], lines[5]]):
+            gmsh.model.addPhysicalGroup(1, [line], tag)
+            gmsh.model.setPhysicalName(1, tag, name)
+        gmsh.model.addPhysicalGroup(2, [surface], 10)
+        gmsh.model.setPhysicalName(2, 10, "body")
+        gmsh.model.mesh.generate(2)
+        gmsh.option.setNumber("Mesh.MshFileVersion", 2.2)
+        gmsh.write(path)
+    finally:
+        gmsh.finalize()
+
+
+def solver_options():
+    """The same problem as bin/signorini options (scene general, nodal penalty quadrature, a fixed eps)."""
+    return ["-scene", "general", "-young_modulus", E, "-poisson_ratio", NU, "-contact_faces", "contact_a,contact_b",
+            "-bc_clamp", "clamp", "-bc_clamp_clamp_translate", f"{CLAMP[0]},{CLAMP[1]}", "-bc_slip", "left",
+            "-bc_slip_left_components", "0", "-bc_slip_left_translate", f"{SLIP_LEFT},0", "-bc_traction", "traction",
+            "-bc_traction_traction", f"{TRACTION[0]},{TRACTION[1]}", "-bc_pressure", "right", "-bc_pressure_right", PRESSURE,
+            "-body_force", f"{BODY_FORCE[0]},{BODY_FORCE[1]}", "-obstacle", "cylinder", "-obstacle_center", f"{CENTER[0]},{CENTER[1]}",
+            "-obstacle_radius", RADIUS, "-penalty_quadrature", "nodal", "-penalty_eps", EPS, "-snes_rtol", "1e-14"]
+
+
+def solve(path, tol=1e-13, max_it=50):
+    """(vertex coordinates [n, 2], displacement [n, 2], contact force) of the nodal penalty problem on the mesh at path."""
+    import getfem as gf
+
+    lam, mu = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
+    mesh = gf.Mesh("import", "gmsh", path)
+    mfu = gf.MeshFem(mesh, 2)
+    mfu.set_classical_fem(1)
+    mim = gf.MeshIm(mesh, 4)
+    md = gf.Model("real")
+    md.add_fem_variable("u", mfu)
+    K = gf.asm_generic(mim, 2, f"{lam!r}*Div_u*Div_Test_u + {mu!r}*(Grad_u+Grad_u'):Grad_Test_u", -1, md).full()
+    F = gf.asm_generic(mim, 1, f"[{BODY_FORCE[0]!r},{BODY_FORCE[1]!r}].Test_u", -1, md)
+    F = F + gf.asm_generic(mim, 1, f"[{TRACTION[0]!r},{TRACTION[1]!r}].Test_u", GROUPS["traction"], md)
+    F = F - gf.asm_generic(mim, 1, f"{PRESSURE!r}*Normal.Test_u", GROUPS["right"], md)
+    W = sum(gf.asm_generic(mim, 1, "[1,1].Test_u", GROUPS[r], md) for r in ("contact_a", "contact_b"))
+    x = mfu.basic_dof_nodes().T  # [ndof, 2], the dofs node by node (x, y)
+    ndof = x.shape[0]
+    fixed, value = np.zeros(ndof, bool), np.zeros(ndof)
+    clamp = mfu.basic_dof_on_region(GROUPS["clamp"])
+    fixed[clamp] = True
+    value[clamp] = np.where(clamp % 2 == 0, CLAMP[0], CLAMP[1])
+    left = [d for d in mfu.basic_dof_on_region(GROUPS["left"]) if d % 2 == 0 and not fixed[d]]
+    fixed[left] = True
+    value[left] = SLIP_LEFT
+    nodes = np.unique(np.concatenate([mfu.basic_dof_on_region(GROUPS[r]) for r in ("contact_a", "contact_b")]) // 2)
+    r = x[2 * nodes] - np.array(CENTER)
+    dist = np.linalg.norm(r, axis=1)
+    normal, gap, weight = -r / dist[:, None], dist - RADIUS, W[2 * nodes]
+    free = ~fixed
+    u = value.copy()
+    for _ in range(max_it):
+        un = u[2 * nodes] * normal[:, 0] + u[2 * nodes + 1] * normal[:, 1]
+        d = un - gap
+        active = d > 0
+        R = K @ u - F
+        J = K.copy()
+        for k in np.nonzero(active)[0]:
+            i = 2 * nodes[k]
+            R[i:i + 2] += weight[k] / EPS * d[k] * normal[k]
+            J[i:i + 2, i:i + 2] += weight[k] / EPS * np.outer(normal[k], normal[k])
+        if np.linalg.norm(R[free]) < tol * max(np.linalg.norm(F), 1.0):
+            break
+        u[free] -= np.linalg.solve(J[np.ix_(free, free)], R[free])
+    else:
+        raise RuntimeError("the GetFEM reference Newton did not converge")
+    force = float(np.sum(weight / EPS * np.maximum(d, 0.0)))
+    return x[0::2], u.reshape(-1, 2), force

@@ -1,0 +1,161 @@
+"""Boundary conditions by face set (-contact_faces, -bc_clamp, -bc_slip, -bc_traction, -bc_pressure, -body_force) in the
+scene general: patch tests reproduced to round-off (slip and a traction or a pressure balancing a uniaxial stress, a
+clamp's translation), the supports' reactions, the built-in scenes as defaults of the options, Gmsh names for numbers,
+local eps on graded meshes, and every bad input refused by name before any solve, with no output written."""
+import os
+import sys
+
+import numpy as np
+import pytest
+
+from harness import ROOT, load, run, sorted_by_position
+
+sys.path.insert(0, os.path.join(ROOT, "scripts"))
+from signorini import geometry  # noqa: E402
+
+E, NU = 2.0, 0.3
+FAR = {2: ["-obstacle_point", "0,-1"], 3: ["-obstacle_point", "0,0,-1"]}  # the foundation out of reach
+
+
+def uniaxial(dim, s, lift):
+    """The exact displacement of the uniaxial stress sigma_xx = s with u_x = 0 at x = 0, the transverse components 0 on
+    their symmetry faces, and u_d = lift on the top face x_d = 1 (plane strain in 2D)."""
+    if dim == 2:
+        exx, eyy = (1 - NU**2) * s / E, -NU * (1 + NU) * s / E
+        return lambda x: np.column_stack([exx * x[:, 0], eyy * (x[:, 1] - 1) + lift])
+    exx, ett = s / E, -NU * s / E
+    return lambda x: np.column_stack([exx * x[:, 0], ett * x[:, 1], ett * (x[:, 2] - 1) + lift])
+
+
+def patch_args(dim, load_kind, s, lift):
+    """Left face x = 0 slips along x (component 0 fixed), the top face slips with u_d = lift, the right face x = 1
+    carries the traction (s, 0[, 0]) or the pressure -s; in 3D the front y = 0 slips along y. Gamma_C is the bottom."""
+    base = ["-scene", "general", "-young_modulus", E, "-poisson_ratio", NU, "-contact_faces", "1", "-snes_rtol", "1e-12"] + FAR[dim]
+    if dim == 2:
+        right, slips = "2", ["-bc_slip", "4,3", "-bc_slip_4_components", "0", "-bc_slip_3_components", "1", "-bc_slip_3_translate", f"0,{lift}"]
+        box = ["-dm_plex_box_faces", "4,4"]
+    else:
+        right = "5"
+        slips = ["-bc_slip", "6,3,2", "-bc_slip_6_components", "0", "-bc_slip_3_components", "1", "-bc_slip_2_components", "2",
+                 "-bc_slip_2_translate", f"0,0,{lift}"]
+        box = ["-dm_plex_dim", "3", "-dm_plex_box_faces", "3,3,3"]
+    if load_kind == "traction":
+        loads = ["-bc_traction", right, f"-bc_traction_{right}", ",".join([str(s)] + ["0"] * (dim - 1))]
+    else:
+        loads = ["-bc_pressure", right, f"-bc_pressure_{right}", str(-s)]
+    return base + box + slips + loads
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+@pytest.mark.parametrize("load_kind", ["traction", "pressure"])
+def test_patch_slip_and_surface_load(outdir, dim, load_kind):
+    """A traction (or a pressure) on the right face balancing sigma_xx = s, slips on the symmetry faces and a slip with a
+    translation on top: the linear exact field, reproduced to round-off, and the left support pulls with -s on area 1."""
+    s, lift = 0.05, 0.01
+    _, h5 = run(patch_args(dim, load_kind, s, lift), "patch", output=os.path.join(outdir, "patch.h5"))
+    attrs, fields = load(h5)
+    exact = uniaxial(dim, s, lift)(fields["x"])
+    err = np.max(np.abs(fields["displacement"] - exact))
+    assert err < 1e-12 * np.max(np.abs(exact)) + 1e-15, f"patch test error {err:.3e}"
+    assert attrs["active_vertices"] == 0
+    left = "4" if dim == 2 else "6"
+    assert abs(attrs[f"reaction_slip_{left}_x"] + s) < 1e-10, attrs[f"reaction_slip_{left}_x"]
+
+
+@pytest.mark.parametrize("dim", [2, 3])
+def test_clamp_translate(outdir, dim):
+    """-bc_clamp_ID_translate with no load: the body moves rigidly by the translation, to round-off."""
+    top = "3" if dim == 2 else "2"
+    t = [0.01, -0.02, 0.03][:dim]
+    args = ["-scene", "general", "-contact_faces", "1", "-bc_clamp", top, f"-bc_clamp_{top}_translate", ",".join(map(str, t))] + FAR[dim]
+    args += ["-dm_plex_box_faces", "4,4"] if dim == 2 else ["-dm_plex_dim", "3", "-dm_plex_box_faces", "2,2,2"]
+    _, h5 = run(args, "translate", output=os.path.join(outdir, "t.h5"))
+    _, fields = load(h5)
+    assert np.max(np.abs(fields["displacement"] - np.array(t))) < 1e-13
+
+
+def test_square_scene_is_defaults_of_the_options(outdir):
+    """The built-in square scene with its body force off and a -body_force equals the scene general given the square's
+    face sets as options: same iterations, same displacement."""
+    common = ["-dm_plex_box_faces", "16,16", "-body_force", "0.5,-1"]
+    _, a = run(["-scene", "square", "-square_beta", "0"] + common, "square", output=os.path.join(outdir, "square.h5"))
+    _, b = run(["-scene", "general", "-contact_faces", "1", "-bc_clamp", "3"] + common, "general", output=os.path.join(outdir, "general.h5"))
+    (ra, fa), (rb, fb) = load(a), load(b)
+    assert ra["newton_its"] == rb["newton_its"] and ra["active_vertices"] == rb["active_vertices"] > 0
+    assert np.max(np.abs(fa["displacement"] - fb["displacement"])) < 1e-14
+
+
+@pytest.fixture(scope="module")
+def quarter_disk(tmp_path_factory):
+    path = str(tmp_path_factory.mktemp("meshes") / "quarter_disk.msh")
+    geometry.quarter_disk(path, h_near=0.01, h_far=0.1, width=0.3, near=0.05)
+    return path
+
+
+HERTZ_2D = ["-scene", "general", "-contact_faces", "contact", "-bc_slip", "top,symmetry_x", "-bc_slip_top_components", "1",
+            "-bc_slip_top_translate", "0,-0.002", "-bc_slip_symmetry_x_components", "0"]
+
+
+def test_gmsh_names_equal_numbers(outdir, quarter_disk):
+    """Physical group names stand for their "Face Sets" values: the same run by names and by numbers."""
+    by_number = ["-scene", "general", "-contact_faces", "1", "-bc_slip", "3,4", "-bc_slip_3_components", "1", "-bc_slip_3_translate", "0,-0.002",
+                 "-bc_slip_4_components", "0"]
+    _, a = run(["-dm_plex_filename", quarter_disk] + HERTZ_2D, "names", output=os.path.join(outdir, "names.h5"))
+    _, b = run(["-dm_plex_filename", quarter_disk] + by_number, "numbers", output=os.path.join(outdir, "numbers.h5"))
+    ra, fa = load(a)
+    rb, fb = load(b)
+    assert ra["active_vertices"] > 2 and ra["active_vertices"] == rb["active_vertices"]
+    assert np.array_equal(fa["displacement"], fb["displacement"])
+
+
+def test_local_eps(outdir, quarter_disk):
+    """On a graded mesh eps follows the local cell size (/run eps_min < eps_max, the largest at the run's h); with
+    -penalty_eps_local 0 it is one value, and the answers differ; on a uniform box the range is one value."""
+    _, a = run(["-dm_plex_filename", quarter_disk] + HERTZ_2D, "local", output=os.path.join(outdir, "local.h5"))
+    _, b = run(["-dm_plex_filename", quarter_disk, "-penalty_eps_local", "0"] + HERTZ_2D, "global", output=os.path.join(outdir, "global.h5"))
+    ra, rb = load(a)[0], load(b)[0]
+    assert ra["eps_min"] < 0.5 * ra["eps_max"] and ra["eps_max"] <= ra["eps"] * (1 + 1e-12)
+    assert rb["eps_min"] == rb["eps_max"] == rb["eps"]
+    assert abs(ra["contact_force"] / rb["contact_force"] - 1) > 1e-3
+    _, c = run(["-dm_plex_box_faces", "8,8", "-penalty_quadrature", "nodal"], "uniform", output=os.path.join(outdir, "uniform.h5"))
+    rc = load(c)[0]
+    assert abs(rc["eps_min"] / rc["eps"] - 1) < 1e-12 and abs(rc["eps_max"] / rc["eps"] - 1) < 1e-12
+
+
+BAD = [  # (options after a valid general set-up on the unit square, a fragment of the message)
+    (["-bc_clamp", "7"], "no face of the mesh carries \"Face Sets\" value 7"),
+    (["-bc_clamp", "1"], "Face set 1 is listed twice"),
+    (["-bc_clamp", "top"], "'top' is neither a \"Face Sets\" value nor the name of a physical group"),
+    (["-bc_clamp", "3", "-bc_clamp_3_translate", "1,2,3"], "-bc_clamp_3_translate needs 2 comma-separated values"),
+    (["-bc_clamp", "3", "-bc_clamp_3_tanslate", "1,2"], "-bc_clamp_3_tanslate"),
+    (["-bc_clamp", "3", "-bc_slip", "4"], "-bc_slip 4 needs -bc_slip_4_components"),
+    (["-bc_clamp", "3", "-bc_slip", "4", "-bc_slip_4_components", "2"], "component 2 is outside 0..1"),
+    (["-bc_clamp", "3", "-bc_slip", "4", "-bc_slip_4_components", "0,1"], "fixes fewer than 2 components"),
+    (["-bc_clamp", "3", "-bc_traction", "2"], "-bc_traction 2 needs -bc_traction_2"),
+    (["-bc_clamp", "3", "-bc_pressure", "2"], "-bc_pressure 2 needs -bc_pressure_2"),
+    (["-bc_clamp", "3", "-bc_pressure", "2", "-bc_pressure_2", "nan"], "-bc_pressure_2 must be a finite number"),
+    (["-bc_clamp", "3", "-body_force", "1"], "-body_force needs 2 comma-separated values"),
+    (["-bc_slip", "3", "-bc_slip_3_components", "1"], "leave 1 rigid motion(s) free (mostly: translation along x)"),
+    (["-bc_traction", "3", "-bc_traction_3", "0,-1"], "leave 3 rigid motion(s) free"),
+    (["-bc_clamp", "3", "-obstacle", "sphere", "-obstacle_center", "0.5,2"], "-obstacle sphere needs a positive -obstacle_radius"),
+    (["-bc_clamp", "3", "-obstacle", "sphere", "-obstacle_radius", "1"], "-obstacle sphere needs -obstacle_center"),
+    (["-bc_clamp", "3", "-obstacle_normal", "0,0"], "-obstacle_normal must not be the zero vector"),
+    (["-bc_clamp", "3", "-obstacle", "plane", "-obstacle_radius", "1"], "-obstacle_radius"),
+    (["-bc_clamp", "3", "-contact_method", "vi", "-obstacle", "cylinder", "-obstacle_center", "0.5,-1", "-obstacle_radius", "1"],
+     "-contact_method vi needs the obstacle's normal along a coordinate axis"),
+]
+
+
+@pytest.mark.parametrize("extra,message", BAD, ids=[" ".join(b[0]) for b in BAD])
+def test_bad_boundary_input(outdir, extra, message):
+    out = os.path.join(outdir, "bad.h5")
+    contact = [] if any(e in ("-contact_faces",) for e in extra) else ["-contact_faces", "1"]
+    text, _ = run(["-scene", "general", "-dm_plex_box_faces", "4,4"] + contact + extra, "bad", expect_rc=None, output=out)
+    assert message in " ".join(text.split()), text[-2000:]
+    assert "PETSC ERROR" in text and not os.path.exists(out) and not os.path.exists(out[:-3] + ".xdmf")
+
+
+def test_no_contact_faces_refused(outdir):
+    out = os.path.join(outdir, "bad.h5")
+    text, _ = run(["-scene", "general", "-bc_clamp", "3"], "bad", expect_rc=None, output=out)
+    assert "Scene general has no contact boundary: give its face sets with -contact_faces" in text and not os.path.exists(out)
