@@ -74,8 +74,8 @@ CASES = {
         "what": "rigid cylinder (radius 1) indenting an elastic block [0,1] x [-1,0] (clamped bottom) by 0.001",
     },
     "sphere-indenter": {
-        "dim": 3, "shape": geometry.quarter_block, "parts": 4, "vi": False, "near": 0.15, "h_far": 0.2, "width": 0.4,
-        "h_near": [0.02, 0.01, 0.005],
+        "dim": 3, "shape": geometry.quarter_block, "parts": 4, "vi": False, "near": 0.2, "h_far": 0.15, "width": 0.5,
+        "h_near": [0.02, 0.01, 0.007],
         "args": ["-scene", "general", "-contact_faces", "contact", "-bc_clamp", "bottom", "-bc_slip", "symmetry_x,symmetry_y",
                  "-bc_slip_symmetry_x_components", "0", "-bc_slip_symmetry_y_components", "1", "-obstacle", "sphere",
                  "-obstacle_center", "0,0,1", "-obstacle_radius", "1", "-obstacle_translate", "0,0,-0.01"],
