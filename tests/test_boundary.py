@@ -159,3 +159,12 @@ def test_no_contact_faces_refused(outdir):
     out = os.path.join(outdir, "bad.h5")
     text, _ = run(["-scene", "general", "-bc_clamp", "3"], "bad", expect_rc=None, output=out)
     assert "Scene general has no contact boundary: give its face sets with -contact_faces" in text and not os.path.exists(out)
+
+
+def test_cylinder_options_file(outdir, quarter_disk):
+    """options/cylinder.yaml, the README's example of a problem stated in an options file, on a coarse quarter disk:
+    converged, in contact, and the obstacle's force balancing the top's reaction."""
+    _, h5 = run(["-options_file", "options/cylinder.yaml", "-dm_plex_filename", quarter_disk], "cylinder", output=os.path.join(outdir, "c.h5"))
+    attrs = load(h5)[0]
+    assert attrs["converged"] == 1 and attrs["active_vertices"] > 2 and attrs["obstacle"] == "plane"
+    assert abs(attrs["contact_force_y"] + attrs["reaction_slip_top_y"]) < 1e-10 * attrs["contact_force_y"]

@@ -101,7 +101,7 @@ OPTION_CASES = [
     ("beta_nan", ["-square_beta", "nan"], "-square_beta must be a finite number"),
     ("x0_inf", ["-square_x0", "-inf"], "-square_x0 must be a finite number"),
     ("tilt_range", ["-square_tilt", 60], "-square_tilt must lie in (-45, 45) degrees"),
-    ("vi_tilted", ["-contact_method", "vi", "-square_tilt", 5], "-contact_method vi needs Gamma_C normal to a coordinate axis"),
+    ("vi_tilted", ["-contact_method", "vi", "-square_tilt", 5], "-contact_method vi needs the obstacle's normal along a coordinate axis"),
     ("mms_amplitude_inf", ["-scene", "mms", "-mms_amplitude_A", "inf"], "-mms_amplitude_A must be a finite number"),
     ("mms_nu_zero", ["-scene", "mms", "-mms_nu", 0], "-mms_nu must lie in (0, 1]"),
     ("mms_a_outside", ["-scene", "mms", "-mms_a", 1.5], "-mms_a must lie in (0, 1)"),
@@ -162,7 +162,7 @@ FILE_CASES = [
      lambda f: 'The mesh has no contact boundary: no face carries "Face Sets" value 1 (Gamma_C)'),
     # a Gmsh mesh with no face of Gamma_D was a DIVERGED_LINEAR_SOLVE; now it is refused before the solve
     ("no_clamp", "no_clamp.msh", lambda f: write_gmsh_square(f, 4, with_clamp=False), lambda f: ["-dm_plex_filename", f],
-     lambda f: 'No face of the mesh carries "Face Sets" value 3, which scene square uses for the Dirichlet boundary Gamma_D'),
+     lambda f: '-bc_clamp 3: no face of the mesh carries "Face Sets" value 3 (scene square)'),
     ("tets_dim2", "cube.msh", lambda f: write_gmsh_cube(f, 2), lambda f: ["-dm_plex_filename", f, "-dm_plex_dim", 2],
      lambda f: f"The mesh file '{f}' holds a 3D mesh, but -dm_plex_dim 2 was given"),
     ("missing_options", "missing.yaml", None, lambda f: ["-options_file", f], lambda f: f"Unable to open YAML option file: {f}"),

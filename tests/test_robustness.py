@@ -121,7 +121,7 @@ def test_bad_input_leaves_a_previous_good_output_untouched(outdir):
     cases = {
         "malformed_yaml": (["-options_file", bad_yaml], f"the options file '{bad_yaml}' is not valid YAML"),
         "garbage_mesh": (["-dm_plex_filename", garbage], "File is not a valid Gmsh file"),
-        "vi_tilted": (["-contact_method", "vi", "-square_tilt", 5], "-contact_method vi needs Gamma_C normal to a coordinate axis"),
+        "vi_tilted": (["-contact_method", "vi", "-square_tilt", 5], "-contact_method vi needs the obstacle's normal along a coordinate axis"),
         "tilt_range": (["-square_tilt", 60], "-square_tilt must lie in (-45, 45) degrees"),
         "continuation_factor": (["-penalty_continuation_factor", 1.5], "-penalty_continuation_factor must lie in (0, 1)"),
         "typo": (["-penalty_eps0", 1, "-contact_cycle_dampng", 0], "-contact_cycle_dampng"),

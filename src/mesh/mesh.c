@@ -231,24 +231,6 @@ PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Refuses a mesh on which a face set the scene names (what: its role) is carried by no face. */
-PetscErrorCode MeshCheckFaceSets(DM dm, const char scene[], const char what[], PetscInt n, const PetscInt ids[])
-{
-  MPI_Comm comm = PetscObjectComm((PetscObject)dm);
-
-  PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < n; ++i) {
-    PetscInt nf, total, *faces;
-
-    PetscCall(MeshGetBoundaryFaces(dm, ids[i], &nf, &faces));
-    PetscCall(PetscFree(faces));
-    PetscCall(MPIU_Allreduce(&nf, &total, 1, MPIU_INT, MPI_SUM, comm));
-    PetscCheck(total > 0, comm, PETSC_ERR_USER_INPUT, "No face of the mesh carries \"Face Sets\" value %" PetscInt_FMT ", which scene %s uses for %s",
-               ids[i], scene, what);
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* Number of points of a stratum owned by this rank, summed over ranks. */
 PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count)
 {
