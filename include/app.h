@@ -11,3 +11,5 @@ PetscErrorCode OptionsCheckFinite(MPI_Comm comm, const char name[], PetscReal va
 PetscErrorCode OptionsCheckFiniteArray(MPI_Comm comm, const char name[], PetscInt n, const PetscReal values[]);
 PetscErrorCode OptionsCountListValues(const char name[], PetscInt *n);
 PetscErrorCode OptionsCheckPrefixesUsed(MPI_Comm comm, const char prefixes[]);
+PetscErrorCode OptionsReadVector(CompatOptionItems PetscOptionsObject, MPI_Comm comm, const char name[], const char help[], PetscInt dim,
+                                 PetscReal v[], PetscBool *set);

@@ -10,8 +10,8 @@
 
 /* Parameters of the rigid obstacle, packed in this order (constants[CONST_OBSTACLE + k], ObstaclePack() in obstacle.h). */
 enum {
-  OBSTACLE_TYPE,                          /* ObstacleType */
-  OBSTACLE_POINT,                         /* plane: a point of it; sphere, cylinder: the center (x, y, z), translation included */
+  OBSTACLE_TYPE,                           /* ObstacleType */
+  OBSTACLE_POINT,                          /* plane: a point of it; sphere, cylinder: the center (x, y, z), translation included */
   OBSTACLE_DIRECTION = OBSTACLE_POINT + 3, /* plane: unit normal from the body into the obstacle; cylinder: unit axis */
   OBSTACLE_RADIUS    = OBSTACLE_DIRECTION + 3,
   OBSTACLE_NUM_PARAMS
@@ -19,10 +19,10 @@ enum {
 
 /* Index map of constants[] as every pointwise kernel sees it. */
 typedef enum {
-  CONST_LAMBDA,                                       /* first Lame parameter */
-  CONST_MU,                                           /* shear modulus */
-  CONST_PENALTY,                                      /* 1/eps (0 when there is no penalty term) */
-  CONST_OBSTACLE,                                     /* the obstacle's parameters, OBSTACLE_NUM_PARAMS of them */
+  CONST_LAMBDA,                                            /* first Lame parameter */
+  CONST_MU,                                                /* shear modulus */
+  CONST_PENALTY,                                           /* 1/eps (0 when there is no penalty term) */
+  CONST_OBSTACLE,                                          /* the obstacle's parameters, OBSTACLE_NUM_PARAMS of them */
   CONST_BODY_FORCE = CONST_OBSTACLE + OBSTACLE_NUM_PARAMS, /* constant body force (x, y, z), -body_force */
   CONST_LOAD       = CONST_BODY_FORCE + 3,                 /* the surface load being assembled: traction (x, y, z), or pressure p */
   CONST_SCENE      = CONST_LOAD + 3,                       /* first of the scene's own constants */
@@ -63,10 +63,10 @@ typedef struct {
 typedef struct {
   PetscInt          n;
   BoundaryCondition bc[BOUNDARY_MAX];
-  PetscInt          ncontact;                  /* Gamma_C: one or more face sets (-contact_faces) */
+  PetscInt          ncontact; /* Gamma_C: one or more face sets (-contact_faces) */
   PetscInt          contact_ids[BOUNDARY_MAX];
   char              contact_tokens[BOUNDARY_MAX][64];
-  PetscReal         body_force[3];             /* -body_force */
+  PetscReal         body_force[3]; /* -body_force */
 } BoundarySet;
 
 /* The rigid obstacle (-obstacle plane | sphere | cylinder). */
@@ -187,9 +187,9 @@ typedef struct {
   PetscReal           time_setup, time_solve, time_total;
   PetscInt            active_vertices;
   PetscReal           max_penetration, contact_force, energy;
-  PetscReal           contact_force_vector[3];       /* the obstacle's force on the body: the sum of R = K u + r0 over the contact nodes */
-  PetscReal           reaction[BOUNDARY_MAX][3];     /* force the support of each clamp or slip face set exerts on the body */
-  MeshPartitionStats  partition; /* from MeshPartitionGetStats() */
+  PetscReal           contact_force_vector[3];   /* the obstacle's force on the body: the sum of R = K u + r0 over the contact nodes */
+  PetscReal           reaction[BOUNDARY_MAX][3]; /* force the support of each clamp or slip face set exerts on the body */
+  MeshPartitionStats  partition;                 /* from MeshPartitionGetStats() */
 } RunStats;
 
 /* One solve of a run: a level of the grid sequence or an eps of the sweep (/solves in the output). */
@@ -216,9 +216,9 @@ typedef struct {
 
 /* The discrete problem on one mesh: created by ProblemSetUp(), destroyed by ProblemDestroy(), one per grid level. */
 typedef struct {
-  PetscInt      level;      /* grid sequence level of the mesh (0: the mesh of the options) */
-  PetscReal     setup_time; /* set-up time of this problem, counted with its first solve */
-  PetscReal     h, eps;               /* the largest cell diameter, and eps = eps0 h^power / M for it (the node's: eps * eps_factor) */
+  PetscInt      level;                          /* grid sequence level of the mesh (0: the mesh of the options) */
+  PetscReal     setup_time;                     /* set-up time of this problem, counted with its first solve */
+  PetscReal     h, eps;                         /* the largest cell diameter, and eps = eps0 h^power / M for it (the node's: eps * eps_factor) */
   PetscReal     eps_factor_min, eps_factor_max; /* over the contact nodes (local eps on graded meshes), all ranks */
   DMLabel       face_sets;
   ContactSet    cset;

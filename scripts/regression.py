@@ -69,6 +69,8 @@ def compare_one(a, b, rtol, allow_added=False):
             diffs.append(f"/run {key}: {va} != {vb}")
     fa, fb = vertex_fields(a), vertex_fields(b)
     for key in sorted(set(fa) | set(fb)):
+        if allow_added and key not in fa:
+            continue
         if key not in fa or key not in fb or fa[key].shape != fb[key].shape:
             diffs.append(f"field {key}: missing or of another shape")
             continue
@@ -107,7 +109,7 @@ def main(argv=None):
     p_cmp.add_argument("a")
     p_cmp.add_argument("b")
     p_cmp.add_argument("--rtol", type=float, default=1e-12)
-    p_cmp.add_argument("--allow-added", action="store_true", help="attributes of /run that only B has are not differences")
+    p_cmp.add_argument("--allow-added", action="store_true", help="attributes of /run and vertex fields that only B has are not differences")
     args = parser.parse_args(argv)
     runs = load_runs(args.runs)
     if args.command == "run":

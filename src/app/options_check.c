@@ -48,7 +48,7 @@ PetscErrorCode OptionsCheckPrefixesUsed(MPI_Comm comm, const char prefixes[])
     const char *rest = prefixes;
 
     while (*rest) { /* one prefix at a time */
-      size_t len = strcspn(rest, " ");
+      size_t    len = strcspn(rest, " ");
       PetscBool match;
 
       PetscCall(PetscStrncpy(buf, rest + 1, PetscMin(len, sizeof(buf)))); /* without the dash: the names below have none */
@@ -66,5 +66,26 @@ PetscErrorCode OptionsCheckPrefixesUsed(MPI_Comm comm, const char prefixes[])
   PetscCall(PetscOptionsLeftRestore(NULL, &N, &names, &values));
   PetscCheck(nbad == 0, comm, PETSC_ERR_USER_INPUT,
              "%" PetscInt_FMT " option(s) given but never used (misspelled, or for a face set or obstacle not in use? see -help):%s", nbad, list);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -NAME as exactly dim finite reals (a point, a vector), inside the caller's PetscOptionsBegin() block; v keeps its value
+   when the option is not given. A longer list is refused, not cut to the array as PetscOptionsRealArray() would. */
+PetscErrorCode OptionsReadVector(CompatOptionItems PetscOptionsObject, MPI_Comm comm, const char name[], const char help[], PetscInt dim,
+                                 PetscReal v[], PetscBool *set)
+{
+  PetscInt n;
+
+  PetscFunctionBeginUser;
+  PetscCall(OptionsCountListValues(name, &n));
+  PetscCheck(n <= dim, comm, PETSC_ERR_USER_INPUT, "%s needs %" PetscInt_FMT " comma-separated values (one per coordinate), got %" PetscInt_FMT, name,
+             dim, n);
+  n = dim;
+  PetscCall(PetscOptionsRealArray(name, help, NULL, v, &n, set));
+  if (*set) {
+    PetscCheck(n == dim, comm, PETSC_ERR_USER_INPUT, "%s needs %" PetscInt_FMT " comma-separated values (one per coordinate), got %" PetscInt_FMT,
+               name, dim, n);
+    PetscCall(OptionsCheckFiniteArray(comm, name, dim, v));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -166,8 +166,8 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
     if (!cs->is_vertex[i]) continue;
     PetscCall(PetscSectionGetOffset(ssec, cs->point[i], &goff));
     goff -= srstart;
-    p[goff] = cs->pressure[i];
-    g[goff] = -ContactNodePenetration(&user->prob.cset, dim, i, x);
+    p[goff]  = cs->pressure[i];
+    g[goff]  = -ContactNodePenetration(&user->prob.cset, dim, i, x);
     m[goff]  = 1.0;
     fr[goff] = cs->reaction[i];
     ar[goff] = cs->weight[i];
@@ -370,7 +370,8 @@ static PetscErrorCode WriteSolves(MPI_Comm comm, const AppCtx *user, PetscViewer
 static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const char h5name[], PetscInt dim, PetscInt ncells, PetscInt ncorners,
                                 PetscInt nverts)
 {
-  const char    *fields[] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "contact_reaction", "contact_area", "exact_displacement", "error"};
+  const char    *fields[] = {"displacement",     "contact_pressure", "normal_gap",         "contact_boundary",
+                             "contact_reaction", "contact_area",     "exact_displacement", "error"};
   const PetscInt ncomp[]  = {dim, 1, 1, 1, 1, 1, dim, dim};
   const PetscInt nfields  = user->scene.exact ? 8 : 6;
   const char    *topo     = dim == 2 ? (ncorners == 3 ? "Triangle" : "Quadrilateral") : (ncorners == 4 ? "Tetrahedron" : "Hexahedron");

@@ -22,8 +22,10 @@ static int ReadPhysicalNames(const char filename[], GmshName names[], int *n)
   if (!f) return 1;
   while (fgets(line, sizeof(line), f)) {
     if (!in_section) {
-      if (!strncmp(line, "$PhysicalNames", 14)) in_section = 1;
-      else if (!strncmp(line, "$Nodes", 6) || !strncmp(line, "$Entities", 9)) break; /* no names: the large sections start */
+      if (!strncmp(line, "$PhysicalNames", 14))
+        in_section = 1;
+      else if (!strncmp(line, "$Nodes", 6) || !strncmp(line, "$Entities", 9))
+        break; /* no names: the large sections start */
       continue;
     }
     if (!strncmp(line, "$EndPhysicalNames", 17)) break;

@@ -110,9 +110,9 @@ PetscErrorCode BoundaryAddLoads(DM dm, AppCtx *user, Vec r0)
 }
 
 /* The reaction of each clamp and slip face set, the force its support exerts on the body: the sum, over the fixed
-   components of the points of its faces, of the residual K u - f (bulk and loads), which the support balances. Each cell adds to the local residual of one
-   rank only, so the local sums add up over the ranks. A point on two such face sets counts for the first listed.
-   reaction[i][c]: of the i-th boundary condition (zero for the loads). */
+   components of the points of its faces, of the residual K u - f (bulk and loads), which the support balances. Each cell adds to the local residual
+   of one rank only, so the local sums add up over the ranks. A point on two such face sets counts for the first listed. reaction[i][c]: of the i-th
+   boundary condition (zero for the loads). */
 PetscErrorCode BoundaryComputeReactions(DM dm, AppCtx *user, Vec u, PetscReal reaction[][3])
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
@@ -321,8 +321,9 @@ PetscErrorCode BoundaryCheckRigidMotions(DM dm, const Scene *scene)
       PetscReal      r[6];
 
       for (PetscInt m = 0; m < dim; ++m) r[m] = m == c ? 1.0 : 0.0; /* translations */
-      if (dim == 2) r[2] = c == 0 ? -y[1] : y[0];                     /* rotation (-y, x) */
-      else {                                                          /* rotations about x, y, z */
+      if (dim == 2)
+        r[2] = c == 0 ? -y[1] : y[0]; /* rotation (-y, x) */
+      else {                          /* rotations about x, y, z */
         const PetscReal rx[3] = {0.0, -y[2], y[1]}, ry[3] = {y[2], 0.0, -y[0]}, rz[3] = {-y[1], y[0], 0.0};
         r[3] = rx[c];
         r[4] = ry[c];
@@ -348,7 +349,8 @@ PetscErrorCode BoundaryCheckRigidMotions(DM dm, const Scene *scene)
     PetscCall(PetscStrlcat(which, dim == 2 ? names2[dominant] : names3[dominant], sizeof(which)));
   }
   PetscCheck(nfree == 0, comm, PETSC_ERR_USER_INPUT,
-             "Scene %s: the Dirichlet conditions leave %" PetscInt_FMT " rigid motion(s) free (mostly: %s). The body would be held by the contact "
+             "Scene %s: the Dirichlet conditions leave %" PetscInt_FMT
+             " rigid motion(s) free (mostly: %s). The body would be held by the contact "
              "alone, whose stiffness is zero until it touches, so the operator is singular: fix them with -bc_clamp or -bc_slip (a symmetry plane, "
              "a prescribed displacement of the loaded face instead of a load)",
              scene->name, nfree, which);

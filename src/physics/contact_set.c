@@ -81,31 +81,31 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
     PetscCall(VecZeroEntries(locH));
     PetscCall(VecGetArray(locH, &lh));
     for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
-    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces));
-    for (PetscInt i = 0; i < nf; ++i) {
-      PetscInt *closure = NULL, ncl;
+      PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces));
+      for (PetscInt i = 0; i < nf; ++i) {
+        PetscInt *closure = NULL, ncl;
 
-      const PetscInt *support;
-      PetscReal       diam;
+        const PetscInt *support;
+        PetscReal       diam;
 
-      PetscCall(DMPlexGetSupport(dm, faces[i], &support));
-      PetscCall(MeshCellDiameter(dm, support[0], &diam));
-      face_range[0] = PetscMin(face_range[0], ContactEpsFactor(user, diam));
-      face_range[1] = PetscMin(face_range[1], -ContactEpsFactor(user, diam));
-      PetscCall(DMPlexGetTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
-      for (PetscInt j = 0; j < ncl; ++j) {
-        PetscInt dof, off;
+        PetscCall(DMPlexGetSupport(dm, faces[i], &support));
+        PetscCall(MeshCellDiameter(dm, support[0], &diam));
+        face_range[0] = PetscMin(face_range[0], ContactEpsFactor(user, diam));
+        face_range[1] = PetscMin(face_range[1], -ContactEpsFactor(user, diam));
+        PetscCall(DMPlexGetTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
+        for (PetscInt j = 0; j < ncl; ++j) {
+          PetscInt dof, off;
 
-        PetscCall(PetscSectionGetDof(lsec, closure[2 * j], &dof));
-        PetscCall(PetscSectionGetOffset(lsec, closure[2 * j], &off));
-        for (PetscInt d = 0; d < dof; ++d) {
-          PetscCall(VecSetValue(locI, off + d, 1.0, INSERT_VALUES));
-          lh[off + d] = PetscMax(PetscRealPart(lh[off + d]), diam);
+          PetscCall(PetscSectionGetDof(lsec, closure[2 * j], &dof));
+          PetscCall(PetscSectionGetOffset(lsec, closure[2 * j], &off));
+          for (PetscInt d = 0; d < dof; ++d) {
+            PetscCall(VecSetValue(locI, off + d, 1.0, INSERT_VALUES));
+            lh[off + d] = PetscMax(PetscRealPart(lh[off + d]), diam);
+          }
         }
+        PetscCall(DMPlexRestoreTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
       }
-      PetscCall(DMPlexRestoreTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
-    }
-    PetscCall(PetscFree(faces));
+      PetscCall(PetscFree(faces));
     }
     PetscCall(DMGetGlobalVector(dm, &H)); /* the largest cell at each node's contact faces, over all ranks */
     PetscCall(VecZeroEntries(H));

@@ -156,9 +156,9 @@ PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user)
   PetscScalar c[CONST_SCENE_MAX];
 
   PetscFunctionBeginUser;
-  c[CONST_LAMBDA]          = user->opt.material.lambda;
-  c[CONST_MU]              = user->opt.material.mu;
-  c[CONST_PENALTY]         = (user->opt.contact.method == CONTACT_PENALTY) ? 1.0 / user->prob.eps : 0.0;
+  c[CONST_LAMBDA]  = user->opt.material.lambda;
+  c[CONST_MU]      = user->opt.material.mu;
+  c[CONST_PENALTY] = (user->opt.contact.method == CONTACT_PENALTY) ? 1.0 / user->prob.eps : 0.0;
   ObstaclePack(&user->scene.obstacle, &c[CONST_OBSTACLE]);
   for (PetscInt k = 0; k < 3; ++k) {
     c[CONST_BODY_FORCE + k] = user->scene.bcs.body_force[k];

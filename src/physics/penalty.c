@@ -123,7 +123,7 @@ PetscErrorCode PenaltySetUp(DM dm, AppCtx *user)
 
     PetscCall(PetscWeakFormSetIndexBdResidual(user->prob.wf_penalty, user->prob.face_sets, id, 0, PENALTY_PART_TERM, 0, f0_bd_penalty, 0, NULL));
     PetscCall(
-      PetscWeakFormSetIndexBdResidual(user->prob.wf_penalty, user->prob.face_sets, id, 0, PENALTY_PART_ENERGY, 0, f0_bd_penalty_energy, 0, NULL));
+        PetscWeakFormSetIndexBdResidual(user->prob.wf_penalty, user->prob.face_sets, id, 0, PENALTY_PART_ENERGY, 0, f0_bd_penalty_energy, 0, NULL));
     PetscCall(PetscWeakFormSetIndexBdJacobian(user->prob.wf_penalty, user->prob.face_sets, id, 0, 0, PENALTY_PART_TERM, 0, g0_bd_penalty, 0, NULL, 0,
                                               NULL, 0, NULL));
   }
@@ -237,7 +237,9 @@ PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J)
           rows[nfree++] = rstart + cs->dof[i * dim + c];
         }
       for (PetscInt a = 0; a < nfree; ++a)
-        for (PetscInt b = 0; b < nfree; ++b) block[a * nfree + b] = cs->weight[i] / ContactNodeEps(cs, user->prob.eps, i) * cs->normal[i * dim + comp[a]] * cs->normal[i * dim + comp[b]];
+        for (PetscInt b = 0; b < nfree; ++b)
+          block[a * nfree + b] =
+              cs->weight[i] / ContactNodeEps(cs, user->prob.eps, i) * cs->normal[i * dim + comp[a]] * cs->normal[i * dim + comp[b]];
       PetscCall(MatSetValues(J, nfree, rows, nfree, rows, block, ADD_VALUES));
     }
     PetscCall(VecRestoreArrayRead(X, &x));

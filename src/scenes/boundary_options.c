@@ -58,10 +58,11 @@ static PetscErrorCode ResolveFaceSet(DM dm, const char option[], const char toke
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(DMHasLabel(dm, token, &has));
-  PetscCheck(has, comm, PETSC_ERR_USER_INPUT,
-             "%s: '%s' is neither a \"Face Sets\" value nor the name of a physical group of faces of the mesh (names are read from a Gmsh .msh file's "
-             "$PhysicalNames)",
-             option, token);
+  PetscCheck(
+      has, comm, PETSC_ERR_USER_INPUT,
+      "%s: '%s' is neither a \"Face Sets\" value nor the name of a physical group of faces of the mesh (names are read from a Gmsh .msh file's "
+      "$PhysicalNames)",
+      option, token);
   PetscCall(DMGetLabel(dm, token, &label));
   PetscCall(DMLabelGetValueIS(label, &values));
   PetscCall(ISGetLocalSize(values, &n));
@@ -85,25 +86,6 @@ static PetscErrorCode ResolveFaceSet(DM dm, const char option[], const char toke
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* A vector of exactly dim reals (or, with scalar, one real) from -NAME; set says whether it was given. */
-static PetscErrorCode ReadVector(CompatOptionItems PetscOptionsObject, MPI_Comm comm, const char name[], const char help[], PetscInt dim, PetscReal v[], PetscBool *set)
-{
-  PetscInt n = dim;
-
-  PetscFunctionBeginUser;
-  PetscCall(OptionsCountListValues(name, &n)); /* all of them: a longer list would be cut silently to the array */
-  PetscCheck(n <= dim, comm, PETSC_ERR_USER_INPUT, "%s needs %" PetscInt_FMT " comma-separated values (one per coordinate), got %" PetscInt_FMT, name,
-             dim, n);
-  n = dim;
-  PetscCall(PetscOptionsRealArray(name, help, NULL, v, &n, set));
-  if (*set) {
-    PetscCheck(n == dim, comm, PETSC_ERR_USER_INPUT, "%s needs %" PetscInt_FMT " comma-separated values (one per coordinate), got %" PetscInt_FMT,
-               name, dim, n);
-    PetscCall(OptionsCheckFiniteArray(comm, name, dim, v));
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* The per-face options of a boundary condition: translations, components, loads. */
 static PetscErrorCode ReadFaceOptions(CompatOptionItems PetscOptionsObject, MPI_Comm comm, PetscInt dim, BoundaryCondition *bc)
 {
@@ -116,7 +98,8 @@ static PetscErrorCode ReadFaceOptions(CompatOptionItems PetscOptionsObject, MPI_
       bc->ncomp = dim;
       for (PetscInt c = 0; c < dim; ++c) bc->comps[c] = c;
       PetscCall(PetscSNPrintf(name, sizeof(name), "-bc_clamp_%s_translate", bc->token));
-      PetscCall(ReadVector(PetscOptionsObject, comm, name, "Prescribed displacement of the clamped face set (default 0)", dim, bc->value, &set));
+      PetscCall(
+          OptionsReadVector(PetscOptionsObject, comm, name, "Prescribed displacement of the clamped face set (default 0)", dim, bc->value, &set));
       if (set) bc->fn = NULL; /* the translation replaces a scene's own displacement */
       break;
     case BC_SLIP: {
@@ -137,11 +120,12 @@ static PetscErrorCode ReadFaceOptions(CompatOptionItems PetscOptionsObject, MPI_
                    "%s: component %" PetscInt_FMT " is outside 0..%" PetscInt_FMT, name, bc->comps[k], dim - 1);
       bc->ncomp = n;
       PetscCall(PetscSNPrintf(name, sizeof(name), "-bc_slip_%s_translate", bc->token));
-      PetscCall(ReadVector(PetscOptionsObject, comm, name, "Prescribed values of the fixed components (a vector of dim values; default 0)", dim, bc->value, &set));
+      PetscCall(OptionsReadVector(PetscOptionsObject, comm, name, "Prescribed values of the fixed components (a vector of dim values; default 0)",
+                                  dim, bc->value, &set));
     } break;
     case BC_TRACTION:
       PetscCall(PetscSNPrintf(name, sizeof(name), "-bc_traction_%s", bc->token));
-      PetscCall(ReadVector(PetscOptionsObject, comm, name, "Surface load on the face set, force per unit area", dim, bc->value, &set));
+      PetscCall(OptionsReadVector(PetscOptionsObject, comm, name, "Surface load on the face set, force per unit area", dim, bc->value, &set));
       PetscCheck(set, comm, PETSC_ERR_USER_INPUT, "-bc_traction %s needs %s tx,ty%s (force per unit area)", bc->token, name, dim == 3 ? ",tz" : "");
       break;
     case BC_PRESSURE:
@@ -211,7 +195,7 @@ PetscErrorCode SceneBoundaryGetOptions(DM dm, Scene *scene)
     PetscReal f[3] = {0.0, 0.0, 0.0};
 
     for (PetscInt c = 0; c < dim; ++c) f[c] = bcs->body_force[c];
-    PetscCall(ReadVector(PetscOptionsObject, comm, "-body_force", "Constant body force, force per unit volume", dim, f, &set));
+    PetscCall(OptionsReadVector(PetscOptionsObject, comm, "-body_force", "Constant body force, force per unit volume", dim, f, &set));
     for (PetscInt c = 0; c < dim; ++c) bcs->body_force[c] = f[c];
   }
   PetscOptionsEnd();

@@ -88,18 +88,18 @@ PetscErrorCode SceneCreate_MMS(DM dm, const Material *mat, Scene *scene)
     n[dim - 1] = -1.0;
     PetscCall(SceneSetObstaclePlane(scene, origin, n));
   }
-  PetscCall(SceneAddContactFaces(scene, 1));                          /* bottom, x_d = 0 */
+  PetscCall(SceneAddContactFaces(scene, 1));                                /* bottom, x_d = 0 */
   PetscCall(SceneAddBoundary(scene, BC_CLAMP, dim == 2 ? 3 : 2, MMSExact)); /* top, x_d = 1 */
-  scene->exact                    = MMSExact;
-  scene->exact_gradient           = MMSExactGradient;
-  scene->weak_data                = PETSC_TRUE;
-  scene->has_kink                 = PETSC_TRUE;
-  scene->kink_normal[0]           = 1.0;
-  scene->kink_offset              = a;
-  scene->num_constants            = MMS_NUM_CONSTANTS;
-  scene->constants[MMS_NU]        = nu;
-  scene->constants[MMS_A]         = a;
-  scene->constants[MMS_AMP_A]     = amp_a;
-  scene->constants[MMS_AMP_B]     = amp_b;
+  scene->exact                = MMSExact;
+  scene->exact_gradient       = MMSExactGradient;
+  scene->weak_data            = PETSC_TRUE;
+  scene->has_kink             = PETSC_TRUE;
+  scene->kink_normal[0]       = 1.0;
+  scene->kink_offset          = a;
+  scene->num_constants        = MMS_NUM_CONSTANTS;
+  scene->constants[MMS_NU]    = nu;
+  scene->constants[MMS_A]     = a;
+  scene->constants[MMS_AMP_A] = amp_a;
+  scene->constants[MMS_AMP_B] = amp_b;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

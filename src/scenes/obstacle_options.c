@@ -17,25 +17,15 @@ PetscErrorCode SceneSetObstaclePlane(Scene *scene, const PetscReal point[], cons
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* -NAME as dim reals; required: refuse its absence. The vector keeps its value when not given. */
-static PetscErrorCode ReadVector(CompatOptionItems PetscOptionsObject, MPI_Comm comm, const char name[], const char help[], PetscInt dim, PetscBool required, const char what[],
-                                 PetscReal v[])
+/* -NAME as dim reals (OptionsReadVector); required: refuse its absence (what: the option that needs it). */
+static PetscErrorCode ReadVector(CompatOptionItems PetscOptionsObject, MPI_Comm comm, const char name[], const char help[], PetscInt dim,
+                                 PetscBool required, const char what[], PetscReal v[])
 {
-  PetscInt  n = dim;
   PetscBool set;
 
   PetscFunctionBeginUser;
-  PetscCall(OptionsCountListValues(name, &n)); /* all of them: a longer list would be cut silently to the array */
-  PetscCheck(n <= dim, comm, PETSC_ERR_USER_INPUT, "%s needs %" PetscInt_FMT " comma-separated values (one per coordinate), got %" PetscInt_FMT, name,
-             dim, n);
-  n = dim;
-  PetscCall(PetscOptionsRealArray(name, help, NULL, v, &n, &set));
+  PetscCall(OptionsReadVector(PetscOptionsObject, comm, name, help, dim, v, &set));
   PetscCheck(set || !required, comm, PETSC_ERR_USER_INPUT, "%s needs %s (%" PetscInt_FMT " comma-separated values)", what, name, dim);
-  if (set) {
-    PetscCheck(n == dim, comm, PETSC_ERR_USER_INPUT, "%s needs %" PetscInt_FMT " comma-separated values (one per coordinate), got %" PetscInt_FMT,
-               name, dim, n);
-    PetscCall(OptionsCheckFiniteArray(comm, name, dim, v));
-  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -68,7 +58,8 @@ PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
   switch (obs->type) {
     case OBSTACLE_PLANE:
       PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_point", "A point of the plane", dim, PETSC_FALSE, what, obs->point));
-      PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_normal", "Normal of the plane, from the body into the obstacle", dim, PETSC_FALSE, what, obs->direction));
+      PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_normal", "Normal of the plane, from the body into the obstacle", dim, PETSC_FALSE,
+                           what, obs->direction));
       PetscCall(Normalize(comm, "-obstacle_normal", dim, obs->direction));
       break;
     case OBSTACLE_SPHERE:
@@ -77,7 +68,8 @@ PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
       const char     *kind     = obs->type == OBSTACLE_SPHERE ? "-obstacle sphere" : "-obstacle cylinder";
       PetscBool       set;
 
-      PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_center", "Center of the sphere or a point of the cylinder's axis", dim, required, kind, obs->point));
+      PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_center", "Center of the sphere or a point of the cylinder's axis", dim, required,
+                           kind, obs->point));
       PetscCall(PetscOptionsReal("-obstacle_radius", "Radius of the sphere or cylinder", NULL, obs->radius, &obs->radius, &set));
       PetscCall(OptionsCheckFinite(comm, "-obstacle_radius", obs->radius));
       PetscCheck(obs->radius > 0.0, comm, PETSC_ERR_USER_INPUT, "%s needs a positive -obstacle_radius, got %g", kind, (double)obs->radius);
@@ -87,8 +79,8 @@ PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
       }
     } break;
   }
-  PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_translate", "Rigid translation of the obstacle (an indenter driven by displacement)", dim, PETSC_FALSE, what,
-                       obs->translate));
+  PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_translate", "Rigid translation of the obstacle (an indenter driven by displacement)", dim,
+                       PETSC_FALSE, what, obs->translate));
   PetscOptionsEnd();
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -47,7 +47,7 @@ PetscErrorCode SceneCreate_Square(DM dm, const Material *mat, Scene *scene)
     n[dim - 1] = -PetscCosReal(tilt * PETSC_PI / 180.0);
     PetscCall(SceneSetObstaclePlane(scene, origin, n)); /* plane through the origin: x_d = 0 when not tilted */
   }
-  PetscCall(SceneAddContactFaces(scene, 1));                      /* bottom, x_d = 0, in 2D and 3D */
+  PetscCall(SceneAddContactFaces(scene, 1));                            /* bottom, x_d = 0, in 2D and 3D */
   PetscCall(SceneAddBoundary(scene, BC_CLAMP, dim == 2 ? 3 : 2, NULL)); /* top, x_d = 1 */
   scene->f0_body                = f0_body_square;
   scene->num_constants          = SQUARE_NUM_CONSTANTS;

@@ -30,7 +30,8 @@ PetscErrorCode ErrorNormsPressureVector(DM dm, AppCtx *user, Vec loc_p)
   PetscCall(VecGetArray(P, &p));
   for (PetscInt i = 0; i < user->prob.cset.n; ++i) /* fixed components stay 0 */
     for (PetscInt c = 0; c < dim; ++c)
-      if (user->prob.cset.dof[i * dim + c] >= 0) p[user->prob.cset.dof[i * dim + c]] = user->prob.cset.pressure[i] * user->prob.cset.normal[i * dim + c];
+      if (user->prob.cset.dof[i * dim + c] >= 0)
+        p[user->prob.cset.dof[i * dim + c]] = user->prob.cset.pressure[i] * user->prob.cset.normal[i * dim + c];
   PetscCall(VecRestoreArray(P, &p));
   PetscCall(VecZeroEntries(loc_p));
   PetscCall(DMGlobalToLocal(dm, P, INSERT_VALUES, loc_p));
@@ -94,55 +95,55 @@ static PetscErrorCode IntegrateContact(DM dm, AppCtx *user, CellQuadrature *cq, 
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(PetscMax(cq->Nb, 1), &elem));
   for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
-  PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces)); /* of this mesh, maybe a refinement of the run's */
-  for (PetscInt i = 0; i < nf; ++i) {
-    PetscScalar *uh = NULL, *ph = NULL, *pr = NULL;
+    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces)); /* of this mesh, maybe a refinement of the run's */
+    for (PetscInt i = 0; i < nf; ++i) {
+      PetscScalar *uh = NULL, *ph = NULL, *pr = NULL;
 
-    PetscCall(CellQuadratureSetFace(cq, faces[i]));
-    PetscCall(DMPlexVecGetClosure(dm, NULL, loc_uh, cq->cell, NULL, &uh));
-    if (loc_ph) PetscCall(DMPlexVecGetClosure(dm, NULL, loc_ph, cq->cell, NULL, &ph));
-    if (t && !t->scene) PetscCall(DMPlexVecGetClosure(dm, NULL, t->loc_pressure, cq->cell, NULL, &pr));
-    for (PetscInt b = 0; b < cq->Nb; ++b) elem[b] = 0.0;
-    for (PetscInt q = 0; q < cq->Nq; ++q) {
-      const PetscReal *x = &cq->x[q * dim];
-      PetscReal        u[3], v[3], n[3], d, p_h = 0.0, p_target = 0.0, R;
+      PetscCall(CellQuadratureSetFace(cq, faces[i]));
+      PetscCall(DMPlexVecGetClosure(dm, NULL, loc_uh, cq->cell, NULL, &uh));
+      if (loc_ph) PetscCall(DMPlexVecGetClosure(dm, NULL, loc_ph, cq->cell, NULL, &ph));
+      if (t && !t->scene) PetscCall(DMPlexVecGetClosure(dm, NULL, t->loc_pressure, cq->cell, NULL, &pr));
+      for (PetscInt b = 0; b < cq->Nb; ++b) elem[b] = 0.0;
+      for (PetscInt q = 0; q < cq->Nq; ++q) {
+        const PetscReal *x = &cq->x[q * dim];
+        PetscReal        u[3], v[3], n[3], d, p_h = 0.0, p_target = 0.0, R;
 
-      PetscCall(CellQuadratureInterpolate(cq, uh, q, u, NULL));
-      ObstacleGapNormalAt(&user->scene.obstacle, dim, x, n, &d);
-      d = -d;
-      for (PetscInt k = 0; k < dim; ++k) d += u[k] * n[k];
-      sums[1] += cq->w[q] * PetscSqr(PetscMax(d, 0.0));
-      *dmax = PetscMax(*dmax, d);
-      if (!t) continue;
-      if (ph) { /* the interpolated nodal pressure, stored as p n */
-        PetscCall(CellQuadratureInterpolate(cq, ph, q, v, NULL));
-        for (PetscInt k = 0; k < dim; ++k) p_h += v[k] * n[k];
-      } else
-        p_h = d > 0.0 ? d / user->prob.eps : 0.0;
-      if (t->scene) {
-        PetscReal sn;
+        PetscCall(CellQuadratureInterpolate(cq, uh, q, u, NULL));
+        ObstacleGapNormalAt(&user->scene.obstacle, dim, x, n, &d);
+        d = -d;
+        for (PetscInt k = 0; k < dim; ++k) d += u[k] * n[k];
+        sums[1] += cq->w[q] * PetscSqr(PetscMax(d, 0.0));
+        *dmax = PetscMax(*dmax, d);
+        if (!t) continue;
+        if (ph) { /* the interpolated nodal pressure, stored as p n */
+          PetscCall(CellQuadratureInterpolate(cq, ph, q, v, NULL));
+          for (PetscInt k = 0; k < dim; ++k) p_h += v[k] * n[k];
+        } else
+          p_h = d > 0.0 ? d / user->prob.eps : 0.0;
+        if (t->scene) {
+          PetscReal sn;
 
-        PetscCall(WeakDataExactNormalStress(user, dim, x, &sn));
-        p_target = -sn;
-      } else {
-        PetscCall(CellQuadratureInterpolate(cq, pr, q, v, NULL));
-        for (PetscInt k = 0; k < dim; ++k) p_target += v[k] * n[k];
+          PetscCall(WeakDataExactNormalStress(user, dim, x, &sn));
+          p_target = -sn;
+        } else {
+          PetscCall(CellQuadratureInterpolate(cq, pr, q, v, NULL));
+          for (PetscInt k = 0; k < dim; ++k) p_target += v[k] * n[k];
+        }
+        R = p_h - p_target; /* sigma_n(u) + p_h */
+        sums[0] += cq->w[q] * R * R;
+        for (PetscInt b = 0; b < cq->Nb; ++b) {
+          PetscReal vn = 0.0;
+
+          for (PetscInt k = 0; k < cq->Nc; ++k) vn += cq->B[(q * cq->Nb + b) * cq->Nc + k] * n[k];
+          elem[b] += cq->w[q] * R * vn;
+        }
       }
-      R = p_h - p_target; /* sigma_n(u) + p_h */
-      sums[0] += cq->w[q] * R * R;
-      for (PetscInt b = 0; b < cq->Nb; ++b) {
-        PetscReal vn = 0.0;
-
-        for (PetscInt k = 0; k < cq->Nc; ++k) vn += cq->B[(q * cq->Nb + b) * cq->Nc + k] * n[k];
-        elem[b] += cq->w[q] * R * vn;
-      }
+      if (t) PetscCall(DMPlexVecSetClosure(dm, NULL, loc_b, cq->cell, elem, ADD_VALUES));
+      PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc_uh, cq->cell, NULL, &uh));
+      if (ph) PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc_ph, cq->cell, NULL, &ph));
+      if (pr) PetscCall(DMPlexVecRestoreClosure(dm, NULL, t->loc_pressure, cq->cell, NULL, &pr));
     }
-    if (t) PetscCall(DMPlexVecSetClosure(dm, NULL, loc_b, cq->cell, elem, ADD_VALUES));
-    PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc_uh, cq->cell, NULL, &uh));
-    if (ph) PetscCall(DMPlexVecRestoreClosure(dm, NULL, loc_ph, cq->cell, NULL, &ph));
-    if (pr) PetscCall(DMPlexVecRestoreClosure(dm, NULL, t->loc_pressure, cq->cell, NULL, &pr));
-  }
-  PetscCall(PetscFree(faces));
+    PetscCall(PetscFree(faces));
   }
   PetscCall(PetscFree(elem));
   PetscFunctionReturn(PETSC_SUCCESS);

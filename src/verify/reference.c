@@ -343,7 +343,7 @@ static PetscErrorCode MatchReference(DM fine, const AppCtx *user, const Referenc
     PetscCall(PetscSectionGetOffset(csec, v, &coff));
     for (PetscInt d = 0; d < dim; ++d) x[d] = PetscRealPart(xc[coff + d]);
     ObstacleGapNormalAt(&user->scene.obstacle, dim, x, n, &gap);
-    i = ReferenceFindVertex(ref, x);
+    i                = ReferenceFindVertex(ref, x);
     vmap[v - vStart] = i;
     if (i < 0) {
       if (bad_vertex < 0) bad_vertex = v;
