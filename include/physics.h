@@ -7,6 +7,7 @@ PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degr
 PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user);
 PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user);
 PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace);
+PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, PetscReal mu, const PetscReal x[], PetscScalar Ke[]);
 
 /* contact_options.c, contact_set.c */
 PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts);

@@ -223,10 +223,11 @@ typedef struct {
   DMLabel       face_sets;
   ContactSet    cset;
   PetscWeakForm wf_penalty;         /* the penalty term on Gamma_C, kept out of the bulk weak form */
-  Vec           loc_bc;             /* local vector holding the Dirichlet values, zero elsewhere (penalty only) */
+  Vec           loc_bc;             /* local vector holding the Dirichlet values, zero elsewhere */
   AssemblyType  assembly;           /* how K is assembled: fe or p1 (-assembly auto resolved) */
   Mat           K;                  /* bulk elastic operator, assembled once */
   Vec           r0;                 /* bulk residual at u = 0 (loads and Dirichlet lifting) */
+  Vec           loc_r0;             /* the same, local, with the rows of the fixed components (for the supports' reactions) */
   Vec           xl, xu;             /* SNESVI bounds */
   PetscReal     load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
   PetscReal     displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */

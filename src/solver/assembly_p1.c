@@ -2,6 +2,7 @@
    the cell loop (DMPlex's adjacency-based preallocation is slow in 3.18) and closed-form element matrices B^T D B |T|.
    The result is the matrix of DMCreateMatrix() + DMPlexSNESComputeJacobianFEM(): same type, sizes, block size,
    local-to-global mapping, nonzero pattern and values; the rows and columns of constrained dofs are absent. */
+#include "physics.h"
 #include "solver.h"
 
 const char *const AssemblyTypes[] = {"auto", "fe", "p1", "AssemblyType", "ASSEMBLY_", NULL};
@@ -91,57 +92,6 @@ PetscErrorCode AssemblyResolve(DM dm, AppCtx *user)
   PetscCheck(!user->opt.assembly_check || !reason, comm, PETSC_ERR_USER_INPUT,
              "-assembly_check compares with the P1 assembly, which does not apply: %s", reason);
   if (user->prob.assembly == ASSEMBLY_AUTO) user->prob.assembly = reason ? ASSEMBLY_FE : ASSEMBLY_P1;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* Element stiffness of a P1 simplex with vertices x[(dim+1)*dim], dofs ordered vertex by vertex:
-   Ke[(a,c),(b,e)] = |T| (mu (g_a . g_b) delta_ce + mu g_a[e] g_b[c] + lambda g_a[c] g_b[e]), g_a = grad phi_a. */
-static PetscErrorCode AssemblyP1ElementStiffness(PetscInt dim, PetscReal lambda, PetscReal mu, const PetscReal x[], PetscScalar Ke[])
-{
-  const PetscInt nv = dim + 1, n = nv * dim;
-  PetscReal      J[9], inv[9], det, vol, g[4][3];
-
-  PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < dim; ++i) /* J[i][k] = d x_i / d xi_k = x_{k+1,i} - x_{0,i} */
-    for (PetscInt k = 0; k < dim; ++k) J[i * dim + k] = x[(k + 1) * dim + i] - x[i];
-  if (dim == 2) {
-    det    = J[0] * J[3] - J[1] * J[2];
-    inv[0] = J[3] / det;
-    inv[1] = -J[1] / det;
-    inv[2] = -J[2] / det;
-    inv[3] = J[0] / det;
-    vol    = PetscAbsReal(det) / 2.0;
-  } else {
-    det    = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
-    inv[0] = (J[4] * J[8] - J[5] * J[7]) / det;
-    inv[1] = (J[2] * J[7] - J[1] * J[8]) / det;
-    inv[2] = (J[1] * J[5] - J[2] * J[4]) / det;
-    inv[3] = (J[5] * J[6] - J[3] * J[8]) / det;
-    inv[4] = (J[0] * J[8] - J[2] * J[6]) / det;
-    inv[5] = (J[2] * J[3] - J[0] * J[5]) / det;
-    inv[6] = (J[3] * J[7] - J[4] * J[6]) / det;
-    inv[7] = (J[1] * J[6] - J[0] * J[7]) / det;
-    inv[8] = (J[0] * J[4] - J[1] * J[3]) / det;
-    vol    = PetscAbsReal(det) / 6.0;
-  }
-  PetscCheck(det != 0.0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Degenerate cell (zero volume)");
-  /* grad phi_{k+1} = J^-T e_k: row k of J^-1; grad phi_0 = -sum of the others */
-  for (PetscInt d = 0; d < dim; ++d) {
-    g[0][d] = 0.0;
-    for (PetscInt k = 0; k < dim; ++k) {
-      g[k + 1][d] = inv[k * dim + d];
-      g[0][d] -= inv[k * dim + d];
-    }
-  }
-  for (PetscInt a = 0; a < nv; ++a)
-    for (PetscInt b = 0; b < nv; ++b) {
-      PetscReal gab = 0.0;
-
-      for (PetscInt d = 0; d < dim; ++d) gab += g[a][d] * g[b][d];
-      for (PetscInt c = 0; c < dim; ++c)
-        for (PetscInt e = 0; e < dim; ++e)
-          Ke[(a * dim + c) * n + b * dim + e] = vol * ((c == e ? mu * gab : 0.0) + mu * g[a][e] * g[b][c] + lambda * g[a][c] * g[b][e]);
-    }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -381,7 +331,7 @@ PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K)
         x[a * dim + e]   = PetscRealPart(xa[off + e]);
       }
     }
-    PetscCall(AssemblyP1ElementStiffness(dim, user->opt.material.lambda, user->opt.material.mu, x, Ke));
+    PetscCall(ElasticityP1ElementStiffness(dim, user->opt.material.lambda, user->opt.material.mu, x, Ke));
     PetscCall(MatSetValues(*K, n, idx, n, idx, Ke, ADD_VALUES));
   }
   PetscCall(VecRestoreArrayRead(coords, &xa));

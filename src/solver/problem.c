@@ -40,6 +40,7 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes)
   PetscCall(SNESDestroy(snes));
   PetscCall(MatDestroy(&user->prob.K));
   PetscCall(VecDestroy(&user->prob.r0));
+  PetscCall(VecDestroy(&user->prob.loc_r0));
   PetscCall(VecDestroy(&user->prob.xl));
   PetscCall(VecDestroy(&user->prob.xu));
   PetscCall(VecDestroy(&user->prob.loc_bc));

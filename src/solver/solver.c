@@ -28,6 +28,8 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
   PetscCall(VecZeroEntries(user->prob.r0));
   PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, user->prob.r0));
+  PetscCall(VecDuplicate(locF, &user->prob.loc_r0)); /* with the fixed rows, which the global vector drops */
+  PetscCall(VecCopy(locF, user->prob.loc_r0));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscCall(DMRestoreLocalVector(dm, &locF));
   if (user->opt.degree == 1)
