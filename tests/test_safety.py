@@ -68,6 +68,23 @@ def start(d, np_=1, direct=True, new=NEW):
     return subprocess.Popen(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, bufsize=1)
 
 
+def wait_for_handler(p, sig, timeout=60):
+    """Waits until the process catches sig (its bit in SigCgt of /proc/PID/status): the solver installs its handler
+    after PetscInitialize, at the start of its set-up. A signal sent before that (a fixed 0.05 s after the start) could
+    land in Open MPI's start-up, which ignored a SIGINT in 2 of some 20 full runs."""
+    t0 = time.time()
+    while time.time() - t0 < timeout and p.poll() is None:
+        try:
+            with open(f"/proc/{p.pid}/status") as fh:
+                caught = next(int(line.split()[1], 16) for line in fh if line.startswith("SigCgt:"))
+        except (OSError, StopIteration):
+            return False
+        if caught >> (int(sig) - 1) & 1:
+            return True
+        time.sleep(0.001)
+    return False
+
+
 def wait_for_line(p, pattern, timeout=60):
     t0 = time.time()
     for line in p.stdout:
@@ -102,7 +119,7 @@ def test_sigterm_during_set_up_solve_and_write():
             d, h5, old = prepare(f"{stage}_{sig.name}")
             p = start(d)
             if stage == "set-up":
-                time.sleep(0.05)
+                assert wait_for_handler(p, sig), "the solver never installed its signal handler"
                 p.send_signal(sig)
             elif stage == "solve":
                 assert wait_for_line(p, r"^\s+1 contact: \|F\|"), "no Newton step seen"
