@@ -26,6 +26,7 @@ PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscB
 PetscErrorCode AssemblyResolve(DM dm, AppCtx *user);
 PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K);
 PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX);
+PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF);
 
 /* contact_monitor.c */
 PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx);

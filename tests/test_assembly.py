@@ -63,10 +63,13 @@ def test_assembly_p1_honours_the_matrix_type(mat_type, scene, dim, np_):
 
 
 @pytest.mark.parametrize("name,args,np_", (("square_2d", ["-options_file", "options/square.yaml", "-dm_plex_box_faces", "32,32"], 1),
-                                          ("mms_3d", ["-options_file", "options/mms.yaml"] + MESH[3], 2)), ids=("square_2d", "mms_3d"))
+                                          ("mms_3d", ["-options_file", "options/mms.yaml"] + MESH[3], 2),
+                                          ("square_3d_body_force", ["-options_file", "options/square.yaml", "-body_force", "0.1,0.2,-0.3"] + MESH[3], 2)),
+                         ids=("square_2d", "mms_3d", "square_3d_body_force"))
 def test_assembly_p1_solution_equals_fe(name, args, np_):
     """The solution with -assembly p1 is the -assembly fe one to solver tolerance (direct solves): 2D square on 1 rank,
-    3D mms on 2 ranks (inhomogeneous Dirichlet data), same Newton steps and active set."""
+    3D mms on 2 ranks (inhomogeneous Dirichlet data), 3D square with its body force and a constant one on 2 ranks; same
+    Newton steps and active set. The P1 path also assembles r0 itself (AssemblyP1Residual), with PetscFE's rule."""
     sol, attrs = {}, {}
     for asm in ("fe", "p1"):
         _, h5 = run(args + ["-contact_monitor", 0, "-assembly", asm], f"assembly_solution_{name}_{asm}", np_=np_)

@@ -384,3 +384,166 @@ PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX)
   PetscCall(MatDestroy(&Kp1));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* lambda[q * (dim + 1) + a]: the P1 basis functions (barycentric coordinates) of the closure-ordered vertices at the
+   points of PetscFE's quadrature rule, from PETSc's own map of the first cell (the same for every cell, whose closure
+   orders its vertices as the reference cell does). */
+static PetscErrorCode AssemblyP1QuadratureBasis(DM dm, PetscQuadrature q, PetscInt cell, PetscReal **lambda, PetscInt *nq, const PetscReal **w)
+{
+  PetscInt           dim, qdim, nc, *cl = NULL, ncl, nv = 0, vStart, vEnd;
+  const PetscReal   *pts;
+  PetscReal         *x, X[12];
+  DM                 cdm;
+  PetscSection       csec;
+  Vec                coords;
+  const PetscScalar *xc;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(PetscQuadratureGetData(q, &qdim, &nc, nq, &pts, w));
+  PetscCall(PetscMalloc1(*nq * dim, &x));
+  PetscCall(PetscMalloc1(*nq * (dim + 1), lambda));
+  PetscCall(DMPlexReferenceToCoordinates(dm, cell, *nq, pts, x));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(DMGetCoordinateDM(dm, &cdm));
+  PetscCall(DMGetLocalSection(cdm, &csec));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(VecGetArrayRead(coords, &xc));
+  PetscCall(DMPlexGetTransitiveClosure(dm, cell, PETSC_TRUE, &ncl, &cl));
+  for (PetscInt k = 0; k < ncl; ++k)
+    if (cl[2 * k] >= vStart && cl[2 * k] < vEnd) {
+      PetscInt off;
+
+      PetscCall(PetscSectionGetOffset(csec, cl[2 * k], &off));
+      for (PetscInt d = 0; d < dim; ++d) X[nv * dim + d] = PetscRealPart(xc[off + d]);
+      ++nv;
+    }
+  PetscCall(DMPlexRestoreTransitiveClosure(dm, cell, PETSC_TRUE, &ncl, &cl));
+  PetscCall(VecRestoreArrayRead(coords, &xc));
+  for (PetscInt i = 0; i < *nq; ++i) { /* solve x - X0 = sum_k lambda_{k+1} (X_{k+1} - X0) */
+    PetscReal A[9], b[3], l[3];
+
+    for (PetscInt d = 0; d < dim; ++d) {
+      b[d] = x[i * dim + d] - X[d];
+      for (PetscInt k = 0; k < dim; ++k) A[d * dim + k] = X[(k + 1) * dim + d] - X[d];
+    }
+    if (dim == 2) {
+      const PetscReal det = A[0] * A[3] - A[1] * A[2];
+      l[0]                = (A[3] * b[0] - A[1] * b[1]) / det;
+      l[1]                = (A[0] * b[1] - A[2] * b[0]) / det;
+    } else {
+      const PetscReal det = A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) + A[2] * (A[3] * A[7] - A[4] * A[6]);
+      l[0]                = (b[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (b[1] * A[8] - A[5] * b[2]) + A[2] * (b[1] * A[7] - A[4] * b[2])) / det;
+      l[1]                = (A[0] * (b[1] * A[8] - A[5] * b[2]) - b[0] * (A[3] * A[8] - A[5] * A[6]) + A[2] * (A[3] * b[2] - b[1] * A[6])) / det;
+      l[2]                = (A[0] * (A[4] * b[2] - b[1] * A[7]) - A[1] * (A[3] * b[2] - b[1] * A[6]) + b[0] * (A[3] * A[7] - A[4] * A[6])) / det;
+    }
+    (*lambda)[i * (dim + 1)] = 1.0;
+    for (PetscInt k = 0; k < dim; ++k) {
+      (*lambda)[i * (dim + 1) + k + 1] = l[k];
+      (*lambda)[i * (dim + 1)] -= l[k];
+    }
+  }
+  PetscCall(PetscFree(x));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* locF = the bulk residual at locX (the Dirichlet values inserted, zero elsewhere), as DMPlexSNESComputeResidualFEM()
+   gives it for P1 simplices, without PetscFE's all-cell buffers: the lifting K u_D, in closed form, on the cells with a
+   fixed component, and the body-force term int f0 . phi_a with the points and weights of PetscFE's own rule, on every
+   cell if the problem has a body force. The body-force kernels depend on x only (they get u = 0). */
+PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
+{
+  PetscDS            ds;
+  PetscPointFunc     f0, f1;
+  PetscSection       lsec, csec;
+  DM                 cdm;
+  Vec                coords;
+  PetscInt           dim, cStart, cEnd, vStart, vEnd, nconst, nq = 0, uOff[1] = {0}, uOff_x[1] = {0};
+  const PetscScalar *constants, *lx, *xc;
+  PetscScalar       *f, u0[3] = {0, 0, 0}, ux0[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+  PetscReal         *lambda = NULL, wref = 0.0;
+  const PetscReal   *w = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMGetDS(dm, &ds));
+  PetscCall(PetscDSGetResidual(ds, 0, &f0, &f1));
+  PetscCall(PetscDSGetConstants(ds, &nconst, &constants));
+  PetscCall(DMGetLocalSection(dm, &lsec));
+  PetscCall(DMGetCoordinateDM(dm, &cdm));
+  PetscCall(DMGetLocalSection(cdm, &csec));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  if (f0 && cEnd > cStart) {
+    PetscObject     obj;
+    PetscQuadrature q;
+
+    PetscCall(DMGetField(dm, 0, NULL, &obj));
+    PetscCall(PetscFEGetQuadrature((PetscFE)obj, &q));
+    PetscCall(AssemblyP1QuadratureBasis(dm, q, cStart, &lambda, &nq, &w));
+    for (PetscInt i = 0; i < nq; ++i) wref += w[i]; /* the volume of the reference cell */
+  }
+  PetscCall(VecZeroEntries(locF));
+  PetscCall(VecGetArrayRead(locX, &lx));
+  PetscCall(VecGetArrayRead(coords, &xc));
+  PetscCall(VecGetArray(locF, &f));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    PetscInt   *cl = NULL, ncl, nv = 0, off[4], fixed = 0;
+    PetscReal   X[12], vol, det;
+    PetscScalar ue[12], fe[12], Ke[144];
+
+    PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+    for (PetscInt k = 0; k < ncl; ++k) {
+      const PetscInt p = cl[2 * k];
+      PetscInt       coff, cdof;
+
+      if (p < vStart || p >= vEnd) continue;
+      PetscCall(PetscSectionGetOffset(csec, p, &coff));
+      PetscCall(PetscSectionGetOffset(lsec, p, &off[nv]));
+      PetscCall(PetscSectionGetConstraintDof(lsec, p, &cdof));
+      fixed += cdof;
+      for (PetscInt d = 0; d < dim; ++d) {
+        X[nv * dim + d]  = PetscRealPart(xc[coff + d]);
+        ue[nv * dim + d] = lx[off[nv] + d];
+      }
+      ++nv;
+    }
+    PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+    if (!fixed && !f0) continue;
+    for (PetscInt i = 0; i < nv * dim; ++i) fe[i] = 0.0;
+    if (fixed) {
+      PetscCall(ElasticityP1ElementStiffness(dim, user->opt.material.lambda, user->opt.material.mu, X, Ke));
+      for (PetscInt i = 0; i < nv * dim; ++i)
+        for (PetscInt j = 0; j < nv * dim; ++j) fe[i] += Ke[i * nv * dim + j] * ue[j];
+    }
+    if (f0) {
+      if (dim == 2)
+        det = (X[2] - X[0]) * (X[5] - X[1]) - (X[3] - X[1]) * (X[4] - X[0]);
+      else {
+        const PetscReal a[3] = {X[3] - X[0], X[4] - X[1], X[5] - X[2]}, b[3] = {X[6] - X[0], X[7] - X[1], X[8] - X[2]},
+                        e[3] = {X[9] - X[0], X[10] - X[1], X[11] - X[2]};
+        det                  = a[0] * (b[1] * e[2] - b[2] * e[1]) - a[1] * (b[0] * e[2] - b[2] * e[0]) + a[2] * (b[0] * e[1] - b[1] * e[0]);
+      }
+      vol = PetscAbsReal(det) / (dim == 2 ? 2.0 : 6.0);
+      for (PetscInt i = 0; i < nq; ++i) {
+        const PetscReal *l     = &lambda[i * (dim + 1)];
+        PetscReal        xq[3] = {0, 0, 0};
+        PetscScalar      f0q[3];
+
+        for (PetscInt a = 0; a < nv; ++a)
+          for (PetscInt d = 0; d < dim; ++d) xq[d] += l[a] * X[a * dim + d];
+        f0(dim, 1, 0, uOff, uOff_x, u0, NULL, ux0, NULL, NULL, NULL, NULL, NULL, 0.0, xq, nconst, constants, f0q);
+        for (PetscInt a = 0; a < nv; ++a)
+          for (PetscInt d = 0; d < dim; ++d) fe[a * dim + d] += w[i] * vol / wref * f0q[d] * l[a];
+      }
+    }
+    for (PetscInt a = 0; a < nv; ++a)
+      for (PetscInt d = 0; d < dim; ++d) f[off[a] + d] += fe[a * dim + d];
+  }
+  PetscCall(VecRestoreArray(locF, &f));
+  PetscCall(VecRestoreArrayRead(coords, &xc));
+  PetscCall(VecRestoreArrayRead(locX, &lx));
+  PetscCall(PetscFree(lambda));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

