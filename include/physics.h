@@ -8,6 +8,7 @@ PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user);
 PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user);
 PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace);
 PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, PetscReal mu, const PetscReal x[], PetscScalar Ke[]);
+PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Vec locU, Vec locF);
 
 /* contact_options.c, contact_set.c */
 PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts);
@@ -16,6 +17,7 @@ PetscErrorCode ContactComputeEps(AppCtx *user);
 PetscReal      ContactPenaltyModulus(const AppCtx *user);
 PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs);
 PetscErrorCode ContactSetDestroy(ContactSet *cs);
+PetscErrorCode ContactComputeBdResidual(DM dm, const AppCtx *user, PetscWeakForm wf, PetscInt part, Vec locX, Vec locF);
 PetscReal      ContactEpsFactor(const AppCtx *user, PetscReal h_local);
 PetscErrorCode ContactCountActive(AppCtx *user, Vec X, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left);
 

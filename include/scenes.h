@@ -16,5 +16,6 @@ PetscErrorCode SceneCreate_General(DM, const Material *, Scene *);
 PetscErrorCode SceneAddBoundary(Scene *scene, BoundaryKind kind, PetscInt id, ScenePointFn fn);
 PetscErrorCode SceneAddContactFaces(Scene *scene, PetscInt id);
 PetscErrorCode SceneSetObstaclePlane(Scene *scene, const PetscReal point[], const PetscReal n[]);
+PetscErrorCode SceneSetFoundation(Scene *scene, PetscInt dim);
 PetscErrorCode SceneBoundaryGetOptions(DM dm, Scene *scene);
 PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene);

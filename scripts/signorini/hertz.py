@@ -133,7 +133,7 @@ def measure(case, path):
             "balance": abs(obstacle + supports) / abs(obstacle), "contact_nodes": int(np.sum(force[boundary] > 0)),
             "converged": int(run.get("converged", 0)), "time_total": float(run.get("time_total", float("nan"))),
             "n_dofs": int(run.get("n_dofs", 0)), "eps_min": float(run.get("eps_min", 0.0)),
-            "radius_sq": r2[boundary], "pressure": traction, "pressure_law": pressure[boundary]}
+            "radius_sq": r2[boundary], "pressure": traction}
 
 
 def fit_profile(radius_sq, traction, a_h, inner=0.8):

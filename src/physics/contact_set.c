@@ -12,6 +12,22 @@ static void f0_bd_one(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt 
   for (PetscInt c = 0; c < dim; ++c) f0[c] = 1.0;
 }
 
+/* locF += the boundary residual of the part of wf over every contact face set (Gamma_C may be several). */
+PetscErrorCode ContactComputeBdResidual(DM dm, const AppCtx *user, PetscWeakForm wf, PetscInt part, Vec locX, Vec locF)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < user->scene.bcs.ncontact; ++i) {
+    PetscFormKey key;
+
+    key.label = user->prob.face_sets;
+    key.value = user->scene.bcs.contact_ids[i];
+    key.field = 0;
+    key.part  = part;
+    PetscCall(CompatComputeBdResidualSingle(dm, wf, key, locX, locF));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* m_i = integral over Gamma_C of the basis function of node i, in the global vector M. */
 static PetscErrorCode ContactLumpedMass(DM dm, AppCtx *user, Vec M)
 {
@@ -25,16 +41,9 @@ static PetscErrorCode ContactLumpedMass(DM dm, AppCtx *user, Vec M)
   PetscCall(DMGetLocalVector(dm, &locM));
   PetscCall(VecZeroEntries(locX));
   PetscCall(VecZeroEntries(locM));
-  for (PetscInt i = 0; i < user->scene.bcs.ncontact; ++i) {
-    PetscFormKey key;
-
-    key.label = user->prob.face_sets;
-    key.value = user->scene.bcs.contact_ids[i];
-    key.field = 0;
-    key.part  = 0;
-    PetscCall(PetscWeakFormSetIndexBdResidual(wf, key.label, key.value, 0, 0, 0, f0_bd_one, 0, NULL));
-    PetscCall(CompatComputeBdResidualSingle(dm, wf, key, locX, locM));
-  }
+  for (PetscInt i = 0; i < user->scene.bcs.ncontact; ++i)
+    PetscCall(PetscWeakFormSetIndexBdResidual(wf, user->prob.face_sets, user->scene.bcs.contact_ids[i], 0, 0, 0, f0_bd_one, 0, NULL));
+  PetscCall(ContactComputeBdResidual(dm, user, wf, 0, locX, locM));
   PetscCall(VecZeroEntries(M));
   PetscCall(DMLocalToGlobal(dm, locM, ADD_VALUES, M));
   PetscCall(DMRestoreLocalVector(dm, &locX));

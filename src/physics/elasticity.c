@@ -1,4 +1,5 @@
 /* Isotropic linear elasticity (plane strain in 2D): material options, pointwise kernels, discretization. */
+#include <petscbt.h>
 #include "app.h"
 #include "obstacle.h"
 #include "physics.h"
@@ -261,5 +262,75 @@ PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, Pets
         for (PetscInt e = 0; e < dim; ++e)
           Ke[(a * dim + c) * n + b * dim + e] = vol * ((c == e ? mu * gab : 0.0) + mu * g[a][e] * g[b][c] + lambda * g[a][c] * g[b][e]);
     }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* locF += K_T u_T on every P1 simplex T that has a fixed component (the cells at Gamma_D), with the closed-form element
+   stiffness: the lifting K u_D of the Dirichlet data when locU holds u_D (zero elsewhere), or the fixed rows of K u when it
+   holds the free part of u (zero on the fixed components). Only the star of the fixed vertices is visited. */
+PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Vec locU, Vec locF)
+{
+  PetscSection       lsec, csec;
+  DM                 cdm;
+  Vec                coords;
+  PetscInt           dim, vStart, vEnd, cStart, cEnd;
+  PetscBT            done;
+  const PetscScalar *lu, *xc;
+  PetscScalar       *f;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMGetLocalSection(dm, &lsec));
+  PetscCall(DMGetCoordinateDM(dm, &cdm));
+  PetscCall(DMGetLocalSection(cdm, &csec));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(PetscBTCreate(cEnd - cStart, &done));
+  PetscCall(VecGetArrayRead(locU, &lu));
+  PetscCall(VecGetArrayRead(coords, &xc));
+  PetscCall(VecGetArray(locF, &f));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    PetscInt *star = NULL, nstar, cdof;
+
+    PetscCall(PetscSectionGetConstraintDof(lsec, v, &cdof));
+    if (!cdof) continue;
+    PetscCall(DMPlexGetTransitiveClosure(dm, v, PETSC_FALSE, &nstar, &star));
+    for (PetscInt s = 0; s < nstar; ++s) {
+      const PetscInt c  = star[2 * s];
+      PetscInt      *cl = NULL, ncl, nv = 0, off[4];
+      PetscReal      x[12];
+      PetscScalar    ue[12], Ke[144];
+
+      if (c < cStart || c >= cEnd || PetscBTLookupSet(done, c - cStart)) continue;
+      PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+      for (PetscInt k = 0; k < ncl; ++k) {
+        const PetscInt p = cl[2 * k];
+        PetscInt       coff;
+
+        if (p < vStart || p >= vEnd) continue;
+        PetscCall(PetscSectionGetOffset(csec, p, &coff));
+        PetscCall(PetscSectionGetOffset(lsec, p, &off[nv]));
+        for (PetscInt d = 0; d < dim; ++d) {
+          x[nv * dim + d]  = PetscRealPart(xc[coff + d]);
+          ue[nv * dim + d] = lu[off[nv] + d];
+        }
+        ++nv;
+      }
+      PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+      PetscCall(ElasticityP1ElementStiffness(dim, mat->lambda, mat->mu, x, Ke));
+      for (PetscInt i = 0; i < nv * dim; ++i) {
+        PetscScalar sum = 0.0;
+
+        for (PetscInt j = 0; j < nv * dim; ++j) sum += Ke[i * nv * dim + j] * ue[j];
+        f[off[i / dim] + i % dim] += sum;
+      }
+    }
+    PetscCall(DMPlexRestoreTransitiveClosure(dm, v, PETSC_FALSE, &nstar, &star));
+  }
+  PetscCall(VecRestoreArray(locF, &f));
+  PetscCall(VecRestoreArrayRead(coords, &xc));
+  PetscCall(VecRestoreArrayRead(locU, &lu));
+  PetscCall(PetscBTDestroy(&done));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

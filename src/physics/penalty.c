@@ -160,15 +160,7 @@ static PetscErrorCode ComputePenaltyPartLocal(DM dm, AppCtx *user, PetscInt part
   PetscFunctionBeginUser;
   PetscCall(GetLocalSolution(dm, user, X, &locX));
   PetscCall(VecZeroEntries(locF));
-  for (PetscInt i = 0; i < user->scene.bcs.ncontact; ++i) {
-    PetscFormKey key;
-
-    key.label = user->prob.face_sets;
-    key.value = user->scene.bcs.contact_ids[i];
-    key.field = 0;
-    key.part  = part;
-    PetscCall(CompatComputeBdResidualSingle(dm, user->prob.wf_penalty, key, locX, locF));
-  }
+  PetscCall(ContactComputeBdResidual(dm, user, user->prob.wf_penalty, part, locX, locF));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

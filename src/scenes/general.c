@@ -5,13 +5,10 @@
 
 PetscErrorCode SceneCreate_General(DM dm, const Material *mat, Scene *scene)
 {
-  const PetscReal origin[3] = {0.0, 0.0, 0.0};
-  PetscReal       n[3]      = {0.0, 0.0, 0.0};
-  PetscInt        dim;
+  PetscInt dim;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
-  n[dim - 1] = -1.0;
-  PetscCall(SceneSetObstaclePlane(scene, origin, n));
+  PetscCall(SceneSetFoundation(scene, dim));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

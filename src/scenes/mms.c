@@ -81,13 +81,7 @@ PetscErrorCode SceneCreate_MMS(DM dm, const Material *mat, Scene *scene)
   PetscCheck(a > 0.0 && a < 1.0, comm, PETSC_ERR_USER_INPUT, "-mms_a must lie in (0, 1), got %g", (double)a);
   PetscCheck(amp_a > 0.0 && amp_b > 0.0, comm, PETSC_ERR_USER_INPUT, "-mms_amplitude_A and -mms_amplitude_B must be positive, got %g and %g",
              (double)amp_a, (double)amp_b);
-  {
-    const PetscReal origin[3] = {0.0, 0.0, 0.0};
-    PetscReal       n[3]      = {0.0, 0.0, 0.0};
-
-    n[dim - 1] = -1.0;
-    PetscCall(SceneSetObstaclePlane(scene, origin, n));
-  }
+  PetscCall(SceneSetFoundation(scene, dim));
   PetscCall(SceneAddContactFaces(scene, 1));                                /* bottom, x_d = 0 */
   PetscCall(SceneAddBoundary(scene, BC_CLAMP, dim == 2 ? 3 : 2, MMSExact)); /* top, x_d = 1 */
   scene->exact                = MMSExact;

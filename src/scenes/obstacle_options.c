@@ -17,6 +17,18 @@ PetscErrorCode SceneSetObstaclePlane(Scene *scene, const PetscReal point[], cons
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* A default of a scene: the foundation plane x_d = 0 below the body (normal -e_d), the built-in scenes' one. */
+PetscErrorCode SceneSetFoundation(Scene *scene, PetscInt dim)
+{
+  const PetscReal origin[3] = {0.0, 0.0, 0.0};
+  PetscReal       n[3]      = {0.0, 0.0, 0.0};
+
+  PetscFunctionBeginUser;
+  n[dim - 1] = -1.0;
+  PetscCall(SceneSetObstaclePlane(scene, origin, n));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* -NAME as dim reals (OptionsReadVector); required: refuse its absence (what: the option that needs it). */
 static PetscErrorCode ReadVector(CompatOptionItems PetscOptionsObject, MPI_Comm comm, const char name[], const char help[], PetscInt dim,
                                  PetscBool required, const char what[], PetscReal v[])

@@ -49,13 +49,7 @@ PetscErrorCode SceneCreate_Patch(DM dm, const Material *mat, Scene *scene)
   PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-patch_strain", strain));
   PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-patch_lift", lift));
   PetscCall(OptionsCheckFinite(PetscObjectComm((PetscObject)dm), "-patch_rotation", rotation));
-  {
-    const PetscReal origin[3] = {0.0, 0.0, 0.0};
-    PetscReal       n[3]      = {0.0, 0.0, 0.0};
-
-    n[dim - 1] = -1.0;
-    PetscCall(SceneSetObstaclePlane(scene, origin, n));
-  }
+  PetscCall(SceneSetFoundation(scene, dim));
   PetscCall(SceneAddContactFaces(scene, 1));
   for (PetscInt i = 0; i < 2 * dim - 1; ++i) PetscCall(SceneAddBoundary(scene, BC_CLAMP, i + 2, PatchExact)); /* every box face but the bottom */
   scene->exact                   = PatchExact;

@@ -449,8 +449,9 @@ static PetscErrorCode AssemblyP1QuadratureBasis(DM dm, PetscQuadrature q, PetscI
 
 /* locF = the bulk residual at locX (the Dirichlet values inserted, zero elsewhere), as DMPlexSNESComputeResidualFEM()
    gives it for P1 simplices, without PetscFE's all-cell buffers: the lifting K u_D, in closed form, on the cells with a
-   fixed component, and the body-force term int f0 . phi_a with the points and weights of PetscFE's own rule, on every
-   cell if the problem has a body force. The body-force kernels depend on x only (they get u = 0). */
+   fixed component (ElasticityP1AddFixedCellsStiffness), and the body-force term int f0 . phi_a with the points and weights
+   of PetscFE's own rule, on every cell if the problem has a body force. The body-force kernels depend on x only (they
+   get u = 0). */
 PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
 {
   PetscDS            ds;
@@ -458,92 +459,76 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
   PetscSection       lsec, csec;
   DM                 cdm;
   Vec                coords;
+  PetscObject        obj;
+  PetscQuadrature    q;
   PetscInt           dim, cStart, cEnd, vStart, vEnd, nconst, nq = 0, uOff[1] = {0}, uOff_x[1] = {0};
-  const PetscScalar *constants, *lx, *xc;
+  const PetscScalar *constants, *xc;
   PetscScalar       *f, u0[3] = {0, 0, 0}, ux0[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
   PetscReal         *lambda = NULL, wref = 0.0;
   const PetscReal   *w = NULL;
 
   PetscFunctionBeginUser;
-  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(VecZeroEntries(locF));
+  PetscCall(ElasticityP1AddFixedCellsStiffness(dm, &user->opt.material, locX, locF));
   PetscCall(DMGetDS(dm, &ds));
   PetscCall(PetscDSGetResidual(ds, 0, &f0, &f1));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  if (!f0 || cEnd == cStart) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(DMGetDimension(dm, &dim));
   PetscCall(PetscDSGetConstants(ds, &nconst, &constants));
   PetscCall(DMGetLocalSection(dm, &lsec));
   PetscCall(DMGetCoordinateDM(dm, &cdm));
   PetscCall(DMGetLocalSection(cdm, &csec));
   PetscCall(DMGetCoordinatesLocal(dm, &coords));
-  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  if (f0 && cEnd > cStart) {
-    PetscObject     obj;
-    PetscQuadrature q;
-
-    PetscCall(DMGetField(dm, 0, NULL, &obj));
-    PetscCall(PetscFEGetQuadrature((PetscFE)obj, &q));
-    PetscCall(AssemblyP1QuadratureBasis(dm, q, cStart, &lambda, &nq, &w));
-    for (PetscInt i = 0; i < nq; ++i) wref += w[i]; /* the volume of the reference cell */
-  }
-  PetscCall(VecZeroEntries(locF));
-  PetscCall(VecGetArrayRead(locX, &lx));
+  PetscCall(DMGetField(dm, 0, NULL, &obj));
+  PetscCall(PetscFEGetQuadrature((PetscFE)obj, &q));
+  PetscCall(AssemblyP1QuadratureBasis(dm, q, cStart, &lambda, &nq, &w));
+  for (PetscInt i = 0; i < nq; ++i) wref += w[i]; /* the volume of the reference cell */
   PetscCall(VecGetArrayRead(coords, &xc));
   PetscCall(VecGetArray(locF, &f));
   for (PetscInt c = cStart; c < cEnd; ++c) {
-    PetscInt   *cl = NULL, ncl, nv = 0, off[4], fixed = 0;
+    PetscInt   *cl = NULL, ncl, nv = 0, off[4];
     PetscReal   X[12], vol, det;
-    PetscScalar ue[12], fe[12], Ke[144];
+    PetscScalar fe[12];
 
     PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
     for (PetscInt k = 0; k < ncl; ++k) {
       const PetscInt p = cl[2 * k];
-      PetscInt       coff, cdof;
+      PetscInt       coff;
 
       if (p < vStart || p >= vEnd) continue;
       PetscCall(PetscSectionGetOffset(csec, p, &coff));
       PetscCall(PetscSectionGetOffset(lsec, p, &off[nv]));
-      PetscCall(PetscSectionGetConstraintDof(lsec, p, &cdof));
-      fixed += cdof;
-      for (PetscInt d = 0; d < dim; ++d) {
-        X[nv * dim + d]  = PetscRealPart(xc[coff + d]);
-        ue[nv * dim + d] = lx[off[nv] + d];
-      }
+      for (PetscInt d = 0; d < dim; ++d) X[nv * dim + d] = PetscRealPart(xc[coff + d]);
       ++nv;
     }
     PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
-    if (!fixed && !f0) continue;
     for (PetscInt i = 0; i < nv * dim; ++i) fe[i] = 0.0;
-    if (fixed) {
-      PetscCall(ElasticityP1ElementStiffness(dim, user->opt.material.lambda, user->opt.material.mu, X, Ke));
-      for (PetscInt i = 0; i < nv * dim; ++i)
-        for (PetscInt j = 0; j < nv * dim; ++j) fe[i] += Ke[i * nv * dim + j] * ue[j];
+    if (dim == 2)
+      det = (X[2] - X[0]) * (X[5] - X[1]) - (X[3] - X[1]) * (X[4] - X[0]);
+    else {
+      const PetscReal a[3] = {X[3] - X[0], X[4] - X[1], X[5] - X[2]}, b[3] = {X[6] - X[0], X[7] - X[1], X[8] - X[2]},
+                      e[3] = {X[9] - X[0], X[10] - X[1], X[11] - X[2]};
+      det                  = a[0] * (b[1] * e[2] - b[2] * e[1]) - a[1] * (b[0] * e[2] - b[2] * e[0]) + a[2] * (b[0] * e[1] - b[1] * e[0]);
     }
-    if (f0) {
-      if (dim == 2)
-        det = (X[2] - X[0]) * (X[5] - X[1]) - (X[3] - X[1]) * (X[4] - X[0]);
-      else {
-        const PetscReal a[3] = {X[3] - X[0], X[4] - X[1], X[5] - X[2]}, b[3] = {X[6] - X[0], X[7] - X[1], X[8] - X[2]},
-                        e[3] = {X[9] - X[0], X[10] - X[1], X[11] - X[2]};
-        det                  = a[0] * (b[1] * e[2] - b[2] * e[1]) - a[1] * (b[0] * e[2] - b[2] * e[0]) + a[2] * (b[0] * e[1] - b[1] * e[0]);
-      }
-      vol = PetscAbsReal(det) / (dim == 2 ? 2.0 : 6.0);
-      for (PetscInt i = 0; i < nq; ++i) {
-        const PetscReal *l     = &lambda[i * (dim + 1)];
-        PetscReal        xq[3] = {0, 0, 0};
-        PetscScalar      f0q[3];
+    vol = PetscAbsReal(det) / (dim == 2 ? 2.0 : 6.0);
+    for (PetscInt i = 0; i < nq; ++i) {
+      const PetscReal *l     = &lambda[i * (dim + 1)];
+      PetscReal        xq[3] = {0, 0, 0};
+      PetscScalar      f0q[3];
 
-        for (PetscInt a = 0; a < nv; ++a)
-          for (PetscInt d = 0; d < dim; ++d) xq[d] += l[a] * X[a * dim + d];
-        f0(dim, 1, 0, uOff, uOff_x, u0, NULL, ux0, NULL, NULL, NULL, NULL, NULL, 0.0, xq, nconst, constants, f0q);
-        for (PetscInt a = 0; a < nv; ++a)
-          for (PetscInt d = 0; d < dim; ++d) fe[a * dim + d] += w[i] * vol / wref * f0q[d] * l[a];
-      }
+      for (PetscInt a = 0; a < nv; ++a)
+        for (PetscInt d = 0; d < dim; ++d) xq[d] += l[a] * X[a * dim + d];
+      f0(dim, 1, 0, uOff, uOff_x, u0, NULL, ux0, NULL, NULL, NULL, NULL, NULL, 0.0, xq, nconst, constants, f0q);
+      for (PetscInt a = 0; a < nv; ++a)
+        for (PetscInt d = 0; d < dim; ++d) fe[a * dim + d] += w[i] * vol / wref * f0q[d] * l[a];
     }
     for (PetscInt a = 0; a < nv; ++a)
       for (PetscInt d = 0; d < dim; ++d) f[off[a] + d] += fe[a * dim + d];
   }
   PetscCall(VecRestoreArray(locF, &f));
   PetscCall(VecRestoreArrayRead(coords, &xc));
-  PetscCall(VecRestoreArrayRead(locX, &lx));
   PetscCall(PetscFree(lambda));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
