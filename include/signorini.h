@@ -182,6 +182,7 @@ typedef struct {
   PetscInt            continuation_stages;                  /* solves of the eps sequence before the target eps (0: none) */
   PetscInt            active_set_cycles;                    /* active-set cycles detected (and damped) in the Newton iterations */
   PetscInt            pc_builds;                            /* preconditioner (factorization) builds of the Newton steps */
+  PetscBool           ksp_ew;                               /* Eisenstat-Walker linear tolerances (-snes_ksp_ew) */
   PetscReal           condition_1norm;                      /* estimate of cond_1 of the final Jacobian, NaN if not computed */
   PetscReal           peak_memory_mb, peak_memory_total_mb; /* resident set size: maximum over ranks, and summed */
   PetscReal           time_setup, time_solve, time_total;

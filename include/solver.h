@@ -4,6 +4,8 @@
 #include "signorini.h"
 
 /* solver.c */
+/* the bound of Eisenstat-Walker's linear tolerances, the penalty method's default with an iterative preconditioner */
+#define SOLVER_EW_RTOL_MAX 0.01
 PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user);
 PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
 PetscErrorCode SolverComputeScales(DM dm, AppCtx *user);

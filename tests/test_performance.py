@@ -91,6 +91,22 @@ def test_preconditioner_reuse_changes_the_cost_not_the_answer():
     assert a["pc_builds"] <= c["pc_builds"] <= c["newton_its"], (a["pc_builds"], c["pc_builds"])
 
 
+@pytest.mark.parametrize("eps0", [1.0, 1e-6])
+def test_inexact_newton_default_gives_the_exact_newton_answer(eps0):
+    """Eisenstat-Walker's linear tolerances (bounded by 0.01) are the penalty method's default with GAMG: the answer is
+    the one of the fixed -ksp_rtol 1e-10 (-snes_ksp_ew 0, the default before) to solver tolerance, for fewer Krylov
+    iterations, also at eps = 1e-6 h where PETSc's own bound (0.9) made Newton cycle."""
+    args = SQUARE + ["-dm_plex_box_faces", "64,64", "-penalty_eps0", eps0, "-options_file", "options/solvers/gamg.yaml"]
+    _, ew = run(args, f"ew_default_{eps0}")
+    _, fixed = run(args + ["-snes_ksp_ew", "0"], f"ew_off_{eps0}")
+    a, _ = load(ew)
+    b, _ = load(fixed)
+    assert a["ksp_ew"] == 1 and b["ksp_ew"] == 0 and a["converged"] == b["converged"] == 1
+    assert max_diff(ew, fixed) < 1e-8
+    assert abs(a["contact_force"] - b["contact_force"]) <= 1e-8 * abs(b["contact_force"])
+    assert a["ksp_its_total"] < b["ksp_its_total"], (a["ksp_its_total"], b["ksp_its_total"])
+
+
 def test_gamg_converges_at_small_eps_and_agrees_with_mumps():
     args = SQUARE + ["-dm_plex_box_faces", "32,32", "-penalty_eps0", "1e-6"]
     _, gamg = run(args + ["-options_file", "options/solvers/gamg.yaml"], "gamg_eps1e-6")

@@ -309,6 +309,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));
   PetscCall(WriteIntAttr(v, "active_set_cycles", s->active_set_cycles));
   PetscCall(WriteIntAttr(v, "pc_builds", s->pc_builds));
+  PetscCall(WriteIntAttr(v, "ksp_ew", s->ksp_ew)); /* 1: the linear tolerances of Eisenstat-Walker */
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "partitioner", PETSC_STRING, MeshPartitionerTypes[s->partition.partitioner]));
   PetscCall(WriteIntAttr(v, "partition_edge_cut", s->partition.edge_cut));
   PetscCall(WriteRealAttr(v, "partition_imbalance", s->partition.imbalance));
