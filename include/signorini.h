@@ -172,6 +172,14 @@ typedef struct {
   PetscInt            cells_max; /* cells on the most loaded rank */
 } MeshPartitionStats;
 
+/* -perf_bandwidth (src/solver/bandwidth.c): achieved memory bandwidths in GB/s, summed over ranks. */
+typedef struct {
+  PetscBool measured;
+  PetscReal triad_gbs;              /* STREAM-like triad */
+  PetscReal matmult_gbs, matmult_s; /* MatMult with the final Jacobian, and its time */
+  PetscReal vcycle_gbs, vcycle_s;   /* one application of its preconditioner (a PCMG; NaN otherwise) */
+} Bandwidth;
+
 typedef struct {
   PetscInt            newton_its, ksp_its;             /* of the last solve (the finest mesh, the last eps) */
   PetscInt            newton_its_total, ksp_its_total; /* of all solves: grid sequence levels, continuation, eps sweep */
@@ -179,10 +187,11 @@ typedef struct {
   PetscBool           residual_reduced;                /* |F| <= rtol |F0|, or at round-off for the load, or below -snes_atol */
   SNESConvergedReason reason;
   PetscReal           residual_norm;
-  PetscInt            continuation_stages;                  /* solves of the eps sequence before the target eps (0: none) */
-  PetscInt            active_set_cycles;                    /* active-set cycles detected (and damped) in the Newton iterations */
-  PetscInt            pc_builds;                            /* preconditioner (factorization) builds of the Newton steps */
-  PetscBool           ksp_ew;                               /* Eisenstat-Walker linear tolerances (-snes_ksp_ew) */
+  PetscInt            continuation_stages; /* solves of the eps sequence before the target eps (0: none) */
+  PetscInt            active_set_cycles;   /* active-set cycles detected (and damped) in the Newton iterations */
+  PetscInt            pc_builds;           /* preconditioner (factorization) builds of the Newton steps */
+  PetscBool           ksp_ew;              /* Eisenstat-Walker linear tolerances (-snes_ksp_ew) */
+  Bandwidth           bandwidth;
   PetscReal           condition_1norm;                      /* estimate of cond_1 of the final Jacobian, NaN if not computed */
   PetscReal           peak_memory_mb, peak_memory_total_mb; /* resident set size: maximum over ranks, and summed */
   PetscReal           time_setup, time_solve, time_total;
@@ -212,6 +221,7 @@ typedef struct {
   VerifyOptions  verify;
   AssemblyType   assembly;       /* -assembly as given (auto, fe, p1) */
   PetscBool      assembly_check; /* -assembly_check: assemble K both ways and compare */
+  PetscBool      perf_bandwidth; /* -perf_bandwidth: measure the memory bandwidths after the solve */
   char           output[PETSC_MAX_PATH_LEN];
 } RunOptions;
 

@@ -30,5 +30,9 @@ PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K);
 PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX);
 PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF);
 
+/* bandwidth.c */
+PetscErrorCode BandwidthGetOptions(MPI_Comm comm, PetscBool *measure);
+PetscErrorCode BandwidthMeasure(SNES snes, AppCtx *user);
+
 /* contact_monitor.c */
 PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx);

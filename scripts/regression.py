@@ -3,9 +3,11 @@
 can show that it keeps every number.
 
   regression.py run DIR [--bin PATH] [--runs FILE]   runs them, writing DIR/<name>.h5
-  regression.py compare A B [--rtol R] [--allow-added]
+  regression.py compare A B [--rtol R] [--atol T] [--allow-added]
                                                      /run attributes and vertex fields of A/<name>.h5 and B/<name>.h5:
-                                                     reals to R relative (default 1e-12), integers and strings equal, the
+                                                     reals to R relative (default 1e-12)
+                                                     or T absolute (default 1e-14: a force or a
+                                                     reaction that is zero up to round-off), integers and strings equal, the
                                                      final residual (round-off) to 1e-12 of the load; timings, memory and
                                                      file names are not compared. Exit 1 on a difference.
 """
@@ -52,7 +54,7 @@ def run_all(directory, binary, runs):
     return 1 if failed else 0
 
 
-def compare_one(a, b, rtol, allow_added=False):
+def compare_one(a, b, rtol, allow_added=False, atol=1e-14):
     diffs = []
     ra, rb = read_run(a), read_run(b)
     for key in sorted(set(ra) | set(rb)):
@@ -62,7 +64,7 @@ def compare_one(a, b, rtol, allow_added=False):
         if key == "residual_norm" and "load_norm" in rb:  # a converged residual is round-off: compared to the load
             same = abs(va - vb) <= 1e-12 * rb["load_norm"]
         elif isinstance(va, float) and isinstance(vb, float):
-            same = va == vb or (np.isnan(va) and np.isnan(vb)) or abs(va - vb) <= rtol * max(abs(va), abs(vb))
+            same = va == vb or (np.isnan(va) and np.isnan(vb)) or abs(va - vb) <= max(rtol * max(abs(va), abs(vb)), atol)
         else:
             same = va == vb
         if not same:
@@ -81,7 +83,7 @@ def compare_one(a, b, rtol, allow_added=False):
     return diffs
 
 
-def compare_all(dir_a, dir_b, runs, rtol, allow_added=False):
+def compare_all(dir_a, dir_b, runs, rtol, allow_added=False, atol=1e-14):
     bad = 0
     for r in runs:
         a, b = os.path.join(dir_a, r["name"] + ".h5"), os.path.join(dir_b, r["name"] + ".h5")
@@ -89,7 +91,7 @@ def compare_all(dir_a, dir_b, runs, rtol, allow_added=False):
             print(f"{r['name']}: MISSING ({a if not os.path.exists(a) else b})")
             bad += 1
             continue
-        diffs = compare_one(a, b, rtol, allow_added)
+        diffs = compare_one(a, b, rtol, allow_added, atol)
         print(f"{r['name']}: {'same' if not diffs else 'DIFFERENT'}")
         for d in diffs:
             print(f"    {d}")
@@ -109,12 +111,13 @@ def main(argv=None):
     p_cmp.add_argument("a")
     p_cmp.add_argument("b")
     p_cmp.add_argument("--rtol", type=float, default=1e-12)
+    p_cmp.add_argument("--atol", type=float, default=1e-14, help="absolute tolerance of the /run reals (round-off zeros)")
     p_cmp.add_argument("--allow-added", action="store_true", help="attributes of /run and vertex fields that only B has are not differences")
     args = parser.parse_args(argv)
     runs = load_runs(args.runs)
     if args.command == "run":
         return run_all(args.directory, os.path.abspath(args.bin), runs)
-    return compare_all(args.a, args.b, runs, args.rtol, args.allow_added)
+    return compare_all(args.a, args.b, runs, args.rtol, args.allow_added, args.atol)
 
 
 if __name__ == "__main__":

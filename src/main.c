@@ -64,6 +64,12 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
     PetscCall(PetscPrintf(comm, "  condition number estimate (1-norm) of the Jacobian: %.3e\n", (double)s->condition_1norm));
   PetscCall(PetscPrintf(comm, "  time: setup %.3f s, solve %.3f s, total %.3f s; peak memory %.1f MB per rank (max), %.1f MB in all\n", s->time_setup,
                         s->time_solve, s->time_total, (double)s->peak_memory_mb, (double)s->peak_memory_total_mb));
+  if (s->bandwidth.measured)
+    PetscCall(PetscPrintf(comm, "  bandwidth: triad %.2f GB/s, MatMult %.2f GB/s (%.2f of it, %.2f ms), V-cycle %.2f GB/s (%.2f of it, %.2f ms)\n",
+                          (double)s->bandwidth.triad_gbs, (double)s->bandwidth.matmult_gbs,
+                          (double)(s->bandwidth.matmult_gbs / s->bandwidth.triad_gbs), (double)(1e3 * s->bandwidth.matmult_s),
+                          (double)s->bandwidth.vcycle_gbs, (double)(s->bandwidth.vcycle_gbs / s->bandwidth.triad_gbs),
+                          (double)(1e3 * s->bandwidth.vcycle_s)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -126,6 +132,7 @@ int main(int argc, char **argv)
   PetscCall(VerifyGetOptions(comm, &user.opt.verify));
   PetscCall(AssemblyGetOptions(comm, &user.opt.assembly, &user.opt.assembly_check));
   PetscCall(OutputGetOptions(comm, &user.opt));
+  PetscCall(BandwidthGetOptions(comm, &user.opt.perf_bandwidth));
 
   PetscCall(MeshCreate(comm, user.opt.contact.grid_sequence, &dm));
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition)); /* the partitioner; the final mesh's cut is taken after the solve */
@@ -148,6 +155,7 @@ int main(int argc, char **argv)
   PetscCall(PetscTime(&t1));
   user.rec.stats.time_total = t1 - t0;
   PetscCall(RecordPeakMemory(comm, &user.rec.stats));
+  PetscCall(BandwidthMeasure(snes, &user)); /* -perf_bandwidth: after the peak memory, which its vectors would raise */
   PetscCall(CheckAllOptionsUsed(comm));
   PetscCall(PrintSummary(dm, &user, u));
   PetscCall(OutputWriteHDF5(dm, &user, u));

@@ -146,3 +146,38 @@ def test_bench_script_tables_come_from_its_runs(outdir):
     cells = [c.strip() for c in line.strip("|").split("|")]
     assert abs(float(cells[3]) - t[("mumps", "penalty")] / t[("mumps", "elastic")]) <= 5e-3 * float(cells[3])  # printed to 3 digits
     assert abs(float(cells[5]) - t[("mumps", "sweep")] / t[("mumps", "penalty_gs")]) <= 5e-3 * float(cells[5])
+
+
+def test_getfem_side_by_side_script_agrees_with_getfem(outdir):
+    """scripts/bench_getfem.py on a 24 x 24 mesh: GetFEM's solution of the same problem on the mesh the script writes
+    equals bin/signorini's (MUMPS and GAMG) to solver tolerance, and the table's ratios are the ratios of its medians."""
+    p = subprocess.run(["/usr/bin/python3", "scripts/bench_getfem.py", "--faces", "24", "--pairs", "1", "--out", outdir], cwd=ROOT, env=ENV,
+                       stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert p.returncode == 0, p.stdout[-3000:]
+    with open(os.path.join(outdir, "getfem.csv")) as fh:
+        rows = {r["code"]: r for r in csv.DictReader(fh)}
+    assert set(rows) == {"signorini (MUMPS)", "signorini (GAMG)", "GetFEM (MUMPS)"}
+    g = float(rows["GetFEM (MUMPS)"]["wall_median_s"])
+    for name in ("signorini (MUMPS)", "signorini (GAMG)"):
+        r = rows[name]
+        assert float(r["max_rel_diff"]) < 1e-9, (name, r["max_rel_diff"])
+        assert abs(float(r["getfem_over_this"]) - g / float(r["wall_median_s"])) < 1e-9
+        assert int(r["dofs"]) == 2 * 25 * 25
+
+
+@pytest.mark.parametrize("solver", ["gamg", "mumps"])
+def test_bandwidth_measurement(solver):
+    """-perf_bandwidth records a triad, a MatMult and (for GAMG, a PCMG) a V-cycle bandwidth; the solution is the
+    same as without it; MUMPS has no V-cycle (NaN)."""
+    args = SQUARE + ["-dm_plex_box_faces", "32,32"] + (["-options_file", "options/solvers/gamg.yaml"] if solver == "gamg" else [])
+    out, h5 = run(args + ["-perf_bandwidth"], f"bandwidth_{solver}")
+    _, plain = run(args, f"bandwidth_off_{solver}")
+    a, _ = load(h5)
+    b, _ = load(plain)
+    assert "bandwidth: triad" in out
+    assert a["bandwidth_triad_gbs"] > 0 and a["bandwidth_matmult_gbs"] > 0 and a["time_matmult"] > 0
+    if solver == "gamg":
+        assert a["bandwidth_vcycle_gbs"] > 0 and a["time_vcycle"] > a["time_matmult"]
+    else:
+        assert np.isnan(a["bandwidth_vcycle_gbs"])
+    assert "bandwidth_triad_gbs" not in b and max_diff(h5, plain) == 0.0

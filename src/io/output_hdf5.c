@@ -310,6 +310,13 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteIntAttr(v, "active_set_cycles", s->active_set_cycles));
   PetscCall(WriteIntAttr(v, "pc_builds", s->pc_builds));
   PetscCall(WriteIntAttr(v, "ksp_ew", s->ksp_ew)); /* 1: the linear tolerances of Eisenstat-Walker */
+  if (s->bandwidth.measured) {                     /* -perf_bandwidth */
+    PetscCall(WriteRealAttr(v, "bandwidth_triad_gbs", s->bandwidth.triad_gbs));
+    PetscCall(WriteRealAttr(v, "bandwidth_matmult_gbs", s->bandwidth.matmult_gbs));
+    PetscCall(WriteRealAttr(v, "bandwidth_vcycle_gbs", s->bandwidth.vcycle_gbs));
+    PetscCall(WriteRealAttr(v, "time_matmult", s->bandwidth.matmult_s));
+    PetscCall(WriteRealAttr(v, "time_vcycle", s->bandwidth.vcycle_s));
+  }
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "partitioner", PETSC_STRING, MeshPartitionerTypes[s->partition.partitioner]));
   PetscCall(WriteIntAttr(v, "partition_edge_cut", s->partition.edge_cut));
   PetscCall(WriteRealAttr(v, "partition_imbalance", s->partition.imbalance));
