@@ -121,8 +121,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscCall(VecGetOwnershipRange(pressure, &srstart, NULL));
 
   PetscCall(DMGetLocalVector(dm, &locU));
-  PetscCall(VecZeroEntries(locU));
-  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, locU, 0.0, NULL, NULL, NULL));
+  PetscCall(VecCopy(user->prob.loc_bc, locU)); /* the Dirichlet values, inserted once by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, locU));
   PetscCall(VecGetArrayRead(locU, &lu));
   PetscCall(VecGetArrayRead(coords, &xc));
