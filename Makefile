@@ -86,12 +86,13 @@ hertz: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/hertz.py --check 0.01
 
-# Performance (README, "Performance"): bench/{bench,getfem,bandwidth}.{md,csv}, runs under bench/runs/
+# Performance (README, "Performance"): bench/{bench,getfem,bandwidth,targets}.{md,csv}, runs under bench/runs/
 bench: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/bench.py options/bench/bench.yaml
 	$(PYTHON) scripts/bench_getfem.py
 	$(PYTHON) scripts/bench_bandwidth.py
+	$(PYTHON) scripts/bench_targets.py
 
 study-%: deps
 	@$(MAKE) --no-print-directory $(BIN)

@@ -5,9 +5,11 @@ sets come from /usr/bin/time -v; ratios are of medians of runs alternated side b
 row reads bench/getfem.csv (scripts/bench_getfem.py). Writes bench/targets.md and bench/targets.csv."""
 import argparse
 import csv
+import json
 import os
 import statistics
 import sys
+import time
 
 import h5py
 
@@ -18,13 +20,14 @@ from signorini.paths import BIN, ROOT  # noqa: E402
 BASE = ["-options_file", "options/square.yaml", "-options_file", "options/solvers/gamg.yaml", "-contact_monitor", "0"]
 
 
-def solver(args, name, out, ranks=1):
-    """One whole-process run: (wall s, peak MB summed over ranks as /usr/bin/time sees mpiexec's children, /run attributes)."""
+def solver(args, name, out, ranks=1, may_fail=False):
+    """One whole-process run: (wall s, peak MB of the largest rank (/usr/bin/time on mpiexec), /run attributes).
+    A failed solve (exit 3, converged = 0 in its file) stops the bench unless may_fail: then its attributes say so."""
     h5 = os.path.join(out, name + ".h5")
-    wall, mem, log = run_timed(["mpiexec", "-n", str(ranks), BIN] + BASE + [str(a) for a in args] + ["-output", h5])
+    wall, mem, log = run_timed(["mpiexec", "-n", str(ranks), BIN] + BASE + [str(a) for a in args] + ["-output", h5], ok_codes=(0, 3) if may_fail else (0,))
     with h5py.File(h5, "r") as f:
         attrs = dict(f["run"].attrs)
-    if int(attrs["converged"]) != 1:
+    if int(attrs["converged"]) != 1 and not may_fail:
         raise RuntimeError(f"{name} did not converge:\n{log[-2000:]}")
     print(f"{name}: {wall:.2f} s, {mem:.0f} MB, {int(attrs['n_dofs'])} dofs, {int(attrs['newton_its'])} Newton, {int(attrs['ksp_its'])} Krylov", flush=True)
     return wall, mem, attrs
@@ -46,93 +49,124 @@ def row(target, measured, met, command):
     return {"target": target, "measured": measured, "met": "met" if met else "not met", "command": command}
 
 
-def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--pairs", type=int, default=3, help="runs of each command in the side-by-side ratios (default 3)")
-    ap.add_argument("--out", default=os.path.join(ROOT, "bench"))
-    ap.add_argument("--small", action="store_true", help="small meshes (a test of the script, not of the targets)")
-    args = ap.parse_args()
-    out = os.path.join(args.out, "runs", "targets")
-    os.makedirs(out, exist_ok=True)
-    s = 8 if args.small else 1  # mesh divisor
-    rows = []
-
-    # the default run against the elastic solve, 512 x 512, and nested iteration (64 x 64 refined 3 times by the sequence)
+def measure_default(out, s, pairs):
+    """The default run against the elastic solve, 512 x 512, nested iteration (64 x 64 refined 3 times by the sequence),
+    set-up, memory and the inexact Newton."""
     n = 512 // s
     box = ["-dm_plex_box_faces", f"{n},{n}"]
     r = side_by_side({"elastic": (box + ["-contact_method", "none"], 1), "penalty": (box, 1),
-                      "penalty_nested": (["-dm_plex_box_faces", f"{n // 8},{n // 8}", "-contact_grid_sequence", 3], 1)}, args.pairs, out)
+                      "penalty_nested": (["-dm_plex_box_faces", f"{n // 8},{n // 8}", "-contact_grid_sequence", 3], 1)}, pairs, out)
     e, p, g = r["elastic"], r["penalty"], r["penalty_nested"]
     cmd = f"bin/signorini {' '.join(BASE)} -dm_plex_box_faces {n},{n} [-contact_method none]"
-    rows.append(row(f"default penalty run / elastic solve <= 1.3 ({n} x {n}, 1 rank, whole process)", f"{p[0] / e[0]:.2f} ({p[0]:.1f} s / {e[0]:.1f} s)",
-                    p[0] / e[0] <= 1.3, cmd))
-    rows.append(row("with nested iteration <= 1.1", f"{g[0] / e[0]:.2f} ({g[0]:.1f} s)", g[0] / e[0] <= 1.1,
-                    f"... -dm_plex_box_faces {n // 8},{n // 8} -contact_grid_sequence 3"))
     dofs = int(e[2]["n_dofs"])
-    rows.append(row("set-up <= 1.5 s per million unknowns (2D)", f"{e[2]['time_setup'] / dofs * 1e6:.1f} s (set-up {e[2]['time_setup']:.2f} s, {dofs} unknowns)",
-                    e[2]["time_setup"] / dofs * 1e6 <= 1.5, cmd + " (time_setup in /run)"))
+    rows = [row(f"default penalty run / elastic solve <= 1.3 ({n} x {n}, 1 rank, whole process)", f"{p[0] / e[0]:.2f} ({p[0]:.1f} s / {e[0]:.1f} s)",
+                p[0] / e[0] <= 1.3, cmd),
+            row("with nested iteration <= 1.1", f"{g[0] / e[0]:.2f} ({g[0]:.1f} s)", g[0] / e[0] <= 1.1, f"... -dm_plex_box_faces {n // 8},{n // 8} -contact_grid_sequence 3"),
+            row("set-up <= 1.5 s per million unknowns (2D)", f"{e[2]['time_setup'] / dofs * 1e6:.1f} s (set-up {e[2]['time_setup']:.2f} s, {dofs} unknowns)",
+                e[2]["time_setup"] / dofs * 1e6 <= 1.5, cmd + " (time_setup in /run)")]
     for name, v in (("elastic", e), ("penalty", p)):
         kb = v[1] * 1e6 / dofs / 1e3
         rows.append(row(f"peak memory <= 1.2 KB per unknown in 2D, {name}", f"{kb:.2f} KB ({v[1]:.0f} MB whole process)", kb <= 1.2, cmd))
     rows.append(row("Newton: inexact linear solves (Eisenstat-Walker), final residual as tight", f"ksp_ew = {int(p[2]['ksp_ew'])}, {int(p[2]['ksp_its'])} CG iterations "
                     f"in {int(p[2]['newton_its'])} Newton steps, |F| = {p[2]['residual_norm']:.1e}", int(p[2]["ksp_ew"]) == 1, cmd))
+    return rows
 
-    # GAMG iterations of the elastic solve to rtol 1e-8 (true residual), 2D from 10k to 2M unknowns, 3D to 1M
+
+def measure_iterations(out, s, pairs):
+    """GAMG iterations of the elastic solve to rtol 1e-8 (true residual), 2D from 10k to 2M unknowns, 3D to 1M."""
     its = []
     for dim, faces, ranks in [(2, 72, 1), (2, 256, 1), (2, 1024, 2), (3, 16, 1), (3, 32, 2), (3, 68, 2)]:
         f = max(faces // s, 4)
-        w, m, a = solver(["-dm_plex_dim", dim, "-dm_plex_box_faces", ",".join([str(f)] * dim), "-contact_method", "none", "-ksp_rtol", "1e-8"],
+        _, _, a = solver(["-dm_plex_dim", dim, "-dm_plex_box_faces", ",".join([str(f)] * dim), "-contact_method", "none", "-ksp_rtol", "1e-8"],
                          f"gamg_its_{dim}d_{f}", out, ranks)
-        its.append(f"{dim}D {int(a['n_dofs'])}: {int(a['ksp_its'])}")
-    worst = max(int(t.split(": ")[1]) for t in its)
-    rows.append(row("elastic GAMG <= 20 CG iterations to rtol 1e-8, 10k to 2M unknowns in 2D, to 1M in 3D", "; ".join(its), worst <= 20,
-                    "bin/signorini ... -contact_method none -ksp_rtol 1e-8 -dm_plex_dim D -dm_plex_box_faces N,..."))
+        its.append((f"{dim}D {int(a['n_dofs'])}", int(a["ksp_its"])))
+    return [row("elastic GAMG <= 20 CG iterations to rtol 1e-8, 10k to 2M unknowns in 2D, to 1M in 3D", "; ".join(f"{k}: {v}" for k, v in its),
+                max(v for _, v in its) <= 20, "bin/signorini ... -contact_method none -ksp_rtol 1e-8 -dm_plex_dim D -dm_plex_box_faces N,...")]
 
-    # eps: the 8-value sweep against one penalty solve, and Krylov iterations per Newton step over eps
+
+def measure_eps(out, s, pairs):
+    """The 8-value sweep against one penalty solve, and the Krylov iterations per Newton step over eps."""
     n2 = 256 // s
     box2 = ["-dm_plex_box_faces", f"{n2},{n2}"]
     r = side_by_side({"one": (box2, 1), "sweep": (box2 + ["-penalty_eps0_sweep", "1,0.1,0.01,1e-3,1e-4,1e-5,1e-6,1e-7"], 1)}, 1, out)
     ratio = r["sweep"][0] / r["one"][0]
-    rows.append(row(f"8-value eps sweep (h to 1e-7 h) <= 2 penalty solves ({n2} x {n2})", f"{ratio:.2f}", ratio <= 2.0,
-                    f"... -dm_plex_box_faces {n2},{n2} [-penalty_eps0_sweep 1,0.1,...,1e-7]"))
-    per = []
+    rows = [row(f"8-value eps sweep (h to 1e-7 h) <= 2 penalty solves ({n2} x {n2})", f"{ratio:.2f}", ratio <= 2.0,
+                f"... -dm_plex_box_faces {n2},{n2} [-penalty_eps0_sweep 1,0.1,...,1e-7]")]
+    per, failed = [], []
     for eps0 in ["1e4", "1e2", "1", "1e-2", "1e-4", "1e-6", "1e-8"]:
-        _, _, a = solver(["-dm_plex_box_faces", "64,64", "-penalty_eps0", eps0], f"eps_{eps0}", out)
-        per.append((eps0, int(a["ksp_its"]) / max(int(a["newton_its"]), 1)))
-    spread = max(v for _, v in per) / min(v for _, v in per)
-    rows.append(row("GAMG Krylov iterations per Newton step within 2x over eps = 1e4 h to 1e-8 h (64 x 64)",
-                    ", ".join(f"{e}: {v:.1f}" for e, v in per) + f" (spread {spread:.1f})", spread <= 2.0, "... -dm_plex_box_faces 64,64 -penalty_eps0 E"))
+        _, _, a = solver(box2 + ["-penalty_eps0", eps0], f"eps_{eps0}", out, may_fail=True)
+        if int(a["converged"]) == 1:
+            per.append((eps0, f"{int(a['ksp_its']) / max(int(a['newton_its']), 1):.1f}"))
+        else:
+            failed.append(eps0)
+            reason = a["snes_reason"].decode() if isinstance(a["snes_reason"], bytes) else a["snes_reason"]
+            per.append((eps0, f"failed ({reason})"))
+    values = [float(v) for _, v in per if not v.startswith("failed")]
+    spread = max(values) / min(values)
+    rows.append(row(f"GAMG Krylov iterations per Newton step within 2x over eps = 1e4 h to 1e-8 h ({n2} x {n2})",
+                    ", ".join(f"{e} h: {v}" for e, v in per) + f" (spread {spread:.1f} over the converged)", spread <= 2.0 and not failed,
+                    f"... -dm_plex_box_faces {n2},{n2} -penalty_eps0 E"))
+    return rows
 
-    # 3D 1M unknowns on 2 ranks, and the speed-up of 2 ranks at 1M unknowns in 2D and 3D
+
+def measure_parallel(out, s, pairs):
+    """3D 1M unknowns on 2 ranks, and the speed-up of 2 ranks at 1M unknowns in 2D and 3D."""
     n3, n4 = 68 // s, 704 // s
     box3 = ["-dm_plex_dim", 3, "-dm_plex_box_faces", f"{n3},{n3},{n3}"]
     r3 = side_by_side({"3d_np2": (box3, 2), "3d_np1": (box3, 1)}, 1, out)
     d3 = int(r3["3d_np2"][2]["n_dofs"])
-    rows.append(row(f"3D penalty, eps = h, 1M unknowns on 2 ranks <= 30 s ({d3} unknowns)", f"{r3['3d_np2'][0]:.1f} s", r3["3d_np2"][0] <= 30.0,
-                    f"mpiexec -n 2 bin/signorini ... -dm_plex_dim 3 -dm_plex_box_faces {n3},{n3},{n3}"))
     box4 = ["-dm_plex_box_faces", f"{n4},{n4}"]
     r2 = side_by_side({"2d_np1": (box4, 1), "2d_np2": (box4, 2)}, 1, out)
     s2, s3 = r2["2d_np1"][0] / r2["2d_np2"][0], r3["3d_np1"][0] / r3["3d_np2"][0]
-    rows.append(row("mpiexec -n 2 speed-up >= 1.8 at 1M unknowns, 2D and 3D (default penalty run)", f"2D {s2:.2f}, 3D {s3:.2f}", min(s2, s3) >= 1.8,
-                    f"bin/signorini ... -dm_plex_box_faces {n4},{n4} on 1 and 2 ranks; 3D as above"))
+    return [row(f"3D penalty, eps = h, 1M unknowns on 2 ranks <= 30 s ({d3} unknowns)", f"{r3['3d_np2'][0]:.1f} s", r3["3d_np2"][0] <= 30.0,
+                f"mpiexec -n 2 bin/signorini ... -dm_plex_dim 3 -dm_plex_box_faces {n3},{n3},{n3}"),
+            row("mpiexec -n 2 speed-up >= 1.8 at 1M unknowns, 2D and 3D (default penalty run)",
+                f"2D {s2:.2f} ({r2['2d_np1'][0]:.1f} s / {r2['2d_np2'][0]:.1f} s), 3D {s3:.2f} ({r3['3d_np1'][0]:.1f} s / {r3['3d_np2'][0]:.1f} s)", min(s2, s3) >= 1.8,
+                f"bin/signorini ... -dm_plex_box_faces {n4},{n4} on 1 and 2 ranks; 3D as above")]
 
-    gcsv = os.path.join(args.out, "getfem.csv")
-    if os.path.exists(gcsv):
-        with open(gcsv) as fh:
-            g = {x["code"]: x for x in csv.DictReader(fh)}
-        best = max(float(g[c]["getfem_over_this"]) for c in g if c.startswith("signorini"))
-        rows.append(row(f"at least 20 times faster than GetFEM on the same problem and mesh ({g['GetFEM (MUMPS)']['dofs']} unknowns)",
-                        ", ".join(f"{c}: {float(g[c]['getfem_over_this']):.1f}" for c in g if c.startswith("signorini")), best >= 20.0,
-                        "scripts/bench_getfem.py (bench/getfem.md)"))
 
+def measure_getfem(out, s, pairs):
+    """The ratio of bench/getfem.csv (scripts/bench_getfem.py)."""
+    gcsv = os.path.join(os.path.dirname(os.path.dirname(out)), "getfem.csv")
+    with open(gcsv) as fh:
+        g = {x["code"]: x for x in csv.DictReader(fh)}
+    best = max(float(g[c]["getfem_over_this"]) for c in g if c.startswith("signorini"))
+    return [row(f"at least 20 times faster than GetFEM on the same problem and mesh ({g['GetFEM (MUMPS)']['dofs']} unknowns)",
+                ", ".join(f"{c}: {float(g[c]['getfem_over_this']):.1f}" for c in g if c.startswith("signorini")), best >= 20.0,
+                "scripts/bench_getfem.py (bench/getfem.md)")]
+
+
+SECTIONS = {"default": measure_default, "iterations": measure_iterations, "eps": measure_eps, "parallel": measure_parallel, "getfem": measure_getfem}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--pairs", type=int, default=3, help="runs of each command in the side-by-side ratios (default 3)")
+    ap.add_argument("--out", default=os.path.join(ROOT, "bench"))
+    ap.add_argument("--small", action="store_true", help="small meshes (a test of the script, not of the targets)")
+    ap.add_argument("--sections", default=",".join(SECTIONS),
+                    help="the sections to measure (default all); the rows of the others are kept from the last invocation (bench/runs/targets/rows.json)")
+    args = ap.parse_args()
+    out = os.path.join(args.out, "runs", "targets")
+    os.makedirs(out, exist_ok=True)
+    saved = os.path.join(out, "rows.json")
+    kept = json.load(open(saved)) if os.path.exists(saved) else {}
+    for name in args.sections.split(","):
+        if name not in SECTIONS:
+            sys.exit(f"unknown section '{name}' (known: {', '.join(SECTIONS)})")
+        kept[name] = {"date": time.strftime("%Y-%m-%d %H:%M"), "rows": SECTIONS[name](out, 8 if args.small else 1, args.pairs)}
+        with open(saved + ".part", "w") as fh:
+            json.dump(kept, fh, indent=1)
+        os.replace(saved + ".part", saved)
+    rows = [dict(r, section=k, date=kept[k]["date"]) for k in SECTIONS if k in kept for r in kept[k]["rows"]]
     with open(os.path.join(args.out, "targets.csv"), "w", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=list(rows[0]))
         w.writeheader()
         w.writerows(rows)
-    lines = ["# Performance targets", "", f"`/usr/bin/python3 scripts/bench_targets.py` (make bench), one rank unless said, GAMG (`options/solvers/gamg.yaml`), "
-             f"whole-process wall time and peak memory (`/usr/bin/time -v`), medians of {args.pairs} runs side by side for the first ratios.", "",
-             "| target | measured | | command |", "|---|---|---|---|"]
-    lines += [f"| {x['target']} | {x['measured']} | {x['met']} | `{x['command']}` |" for x in rows]
+    lines = ["# Performance targets", "", "`/usr/bin/python3 scripts/bench_targets.py` (make bench): one rank unless said, GAMG (`options/solvers/gamg.yaml`), "
+             f"whole-process wall time and peak memory (`/usr/bin/time -v`); the default-run ratios are medians of {args.pairs} runs of each command, alternated.",
+             "", "| target | measured | | command | measured on |", "|---|---|---|---|---|"]
+    lines += [f"| {x['target']} | {x['measured']} | {x['met']} | `{x['command']}` | {x['date']} |" for x in rows]
     with open(os.path.join(args.out, "targets.md"), "w") as fh:
         fh.write("\n".join(lines) + "\n")
     print("\n".join(lines))

@@ -181,3 +181,24 @@ def test_bandwidth_measurement(solver):
     else:
         assert np.isnan(a["bandwidth_vcycle_gbs"])
     assert "bandwidth_triad_gbs" not in b and max_diff(h5, plain) == 0.0
+
+
+def test_targets_script_rows_follow_from_its_runs(outdir):
+    """scripts/bench_targets.py on small meshes: the ratio of the default run is the ratio of the walls it prints, its
+    verdict follows from the figure, the eps row lists every eps (a failed one as failed) and the rows are kept."""
+    cmd = ["/usr/bin/python3", "scripts/bench_targets.py", "--small", "--pairs", "1", "--out", outdir]
+    p = subprocess.run(cmd + ["--sections", "default"], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert p.returncode == 0, p.stdout[-3000:]
+    p = subprocess.run(cmd + ["--sections", "eps"], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert p.returncode == 0, p.stdout[-3000:]
+    with open(os.path.join(outdir, "targets.csv")) as fh:
+        rows = list(csv.DictReader(fh))
+    assert {r["section"] for r in rows} == {"default", "eps"}  # the default section's rows kept from the first invocation
+    first = rows[0]
+    ratio, rest = first["measured"].split(" ", 1)
+    penalty, elastic = [float(x.split(" s")[0]) for x in rest.strip("()").split(" / ")]
+    assert abs(float(ratio) - penalty / elastic) < 0.01, first
+    assert first["met"] == ("met" if float(ratio) <= 1.3 else "not met")
+    eps_row = [r for r in rows if r["target"].startswith("GAMG Krylov iterations per Newton step")][0]
+    for e in ("1e4 h", "1e2 h", "1 h", "1e-2 h", "1e-4 h", "1e-6 h", "1e-8 h"):
+        assert e + ": " in eps_row["measured"], eps_row["measured"]
