@@ -197,7 +197,7 @@ def test_targets_script_rows_follow_from_its_runs(outdir):
     first = rows[0]
     ratio, rest = first["measured"].split(" ", 1)
     penalty, elastic = [float(x.split(" s")[0]) for x in rest.strip("()").split(" / ")]
-    assert abs(float(ratio) - penalty / elastic) < 0.01, first
+    assert abs(float(ratio) - penalty / elastic) <= 0.006, first  # the ratio to 2 decimals, the walls to 3
     assert first["met"] == ("met" if float(ratio) <= 1.3 else "not met")
     eps_row = [r for r in rows if r["target"].startswith("GAMG Krylov iterations per Newton step")][0]
     for e in ("1e4 h", "1e2 h", "1 h", "1e-2 h", "1e-4 h", "1e-6 h", "1e-8 h"):
