@@ -43,6 +43,10 @@ static inline PetscReal ContactNodeEps(const ContactSet *cs, PetscReal eps, Pets
 PetscErrorCode PenaltySetUp(DM dm, AppCtx *user);
 PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F);
 PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J);
+PetscErrorCode PenaltySaveBulkRows(DM dm, AppCtx *user);
+PetscErrorCode PenaltyFreeBulkRows(AppCtx *user);
+PetscErrorCode PenaltyJacobianInK(DM dm, AppCtx *user, Vec X);
+PetscErrorCode PenaltyBulkOperator(AppCtx *user, Mat *K);
 PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy);
 
 /* vi_bounds.c */

@@ -245,9 +245,15 @@ typedef struct {
   PetscReal     snes_scale;         /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
   Vec           work;               /* U x~: the displacement of the SNES iterate x~ */
   PcReuse       pc_reuse;
-  PetscReal     fnorm0;                          /* |F| at the start of the last SNESSolve, in the user's units */
-  PetscInt64    active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
-  PetscReal     fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */
+  /* The penalty Jacobian lives in K itself (one matrix; only the rows of the contact dofs differ): K's own values of
+     those rows are kept here, and put back before K is used as the bulk operator (PenaltyBulkOperator()). */
+  PetscBool    jacobian_in_K;                    /* K holds K + the penalty Jacobian in those rows */
+  PetscInt     nbulk_rows;                       /* owned rows of the contact dofs */
+  PetscInt    *bulk_rows, *bulk_ptr, *bulk_cols; /* their global numbers, and their columns in CSR form */
+  PetscScalar *bulk_vals;                        /* and K's values there */
+  PetscReal    fnorm0;                           /* |F| at the start of the last SNESSolve, in the user's units */
+  PetscInt64   active_history[CONTACT_HISTORY];  /* active-set hashes of the Newton steps of the current solve, */
+  PetscReal    fnorm_history[CONTACT_HISTORY];   /*   and their residual norms */
 } Problem;
 
 /* What the run produced: statistics, one row per solve, error norms; the summary and the writer only read it. */

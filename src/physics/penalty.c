@@ -273,3 +273,95 @@ PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy)
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* One matrix for the bulk operator and the penalty Jacobian: J = K + P differs from K only in the rows of the contact
+   dofs (P couples contact dofs only), so K's values in those rows are kept (a few hundred rows) and J is made in K
+   itself: those rows put back, P added. The residual and every later use of K ask for it through
+   PenaltyBulkOperator(), which puts the rows back first when K holds J. (A second matrix cost 90 MB at 512 x 512.) */
+PetscErrorCode PenaltySaveBulkRows(DM dm, AppCtx *user)
+{
+  const ContactSet *cs = &user->prob.cset;
+  Problem          *pb = &user->prob;
+  PetscInt          dim, rstart, n = 0, nnz = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PenaltyFreeBulkRows(user));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(MatGetOwnershipRange(pb->K, &rstart, NULL));
+  for (PetscInt i = 0; i < cs->n * dim; ++i) n += cs->dof[i] >= 0;
+  PetscCall(PetscMalloc2(n, &pb->bulk_rows, n + 1, &pb->bulk_ptr));
+  n = 0;
+  for (PetscInt i = 0; i < cs->n * dim; ++i)
+    if (cs->dof[i] >= 0) pb->bulk_rows[n++] = rstart + cs->dof[i];
+  pb->bulk_ptr[0] = 0;
+  for (PetscInt r = 0; r < n; ++r) {
+    PetscInt ncols;
+
+    PetscCall(MatGetRow(pb->K, pb->bulk_rows[r], &ncols, NULL, NULL));
+    nnz += ncols;
+    pb->bulk_ptr[r + 1] = nnz;
+    PetscCall(MatRestoreRow(pb->K, pb->bulk_rows[r], &ncols, NULL, NULL));
+  }
+  PetscCall(PetscMalloc2(nnz, &pb->bulk_cols, nnz, &pb->bulk_vals));
+  for (PetscInt r = 0; r < n; ++r) {
+    const PetscInt    *cols;
+    const PetscScalar *vals;
+    PetscInt           ncols;
+
+    PetscCall(MatGetRow(pb->K, pb->bulk_rows[r], &ncols, &cols, &vals));
+    PetscCall(PetscArraycpy(&pb->bulk_cols[pb->bulk_ptr[r]], cols, ncols));
+    PetscCall(PetscArraycpy(&pb->bulk_vals[pb->bulk_ptr[r]], vals, ncols));
+    PetscCall(MatRestoreRow(pb->K, pb->bulk_rows[r], &ncols, &cols, &vals));
+  }
+  pb->nbulk_rows    = n;
+  pb->jacobian_in_K = PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PenaltyFreeBulkRows(AppCtx *user)
+{
+  Problem *pb = &user->prob;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree2(pb->bulk_rows, pb->bulk_ptr));
+  PetscCall(PetscFree2(pb->bulk_cols, pb->bulk_vals));
+  pb->nbulk_rows    = 0;
+  pb->jacobian_in_K = PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* K's own values back in the rows of the contact dofs (collective: every rank holds the same jacobian_in_K). */
+static PetscErrorCode PenaltyRestoreBulkRows(AppCtx *user, MatAssemblyType type)
+{
+  Problem *pb = &user->prob;
+
+  PetscFunctionBeginUser;
+  for (PetscInt r = 0; r < pb->nbulk_rows; ++r)
+    PetscCall(MatSetValues(pb->K, 1, &pb->bulk_rows[r], pb->bulk_ptr[r + 1] - pb->bulk_ptr[r], &pb->bulk_cols[pb->bulk_ptr[r]],
+                           &pb->bulk_vals[pb->bulk_ptr[r]], INSERT_VALUES));
+  PetscCall(MatAssemblyBegin(pb->K, type));
+  PetscCall(MatAssemblyEnd(pb->K, type));
+  pb->jacobian_in_K = PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* K becomes the penalty Jacobian at X: its contact rows put back, the penalty term added. */
+PetscErrorCode PenaltyJacobianInK(DM dm, AppCtx *user, Vec X)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PenaltyRestoreBulkRows(user, MAT_FLUSH_ASSEMBLY)); /* INSERT_VALUES before the ADD_VALUES of the penalty */
+  PetscCall(PenaltyAddJacobian(dm, user, X, user->prob.K));
+  PetscCall(MatAssemblyBegin(user->prob.K, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(user->prob.K, MAT_FINAL_ASSEMBLY));
+  user->prob.jacobian_in_K = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* K as the bulk elastic operator (its contact rows put back if it holds the penalty Jacobian). */
+PetscErrorCode PenaltyBulkOperator(AppCtx *user, Mat *K)
+{
+  PetscFunctionBeginUser;
+  if (user->prob.jacobian_in_K) PetscCall(PenaltyRestoreBulkRows(user, MAT_FINAL_ASSEMBLY));
+  *K = user->prob.K;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -47,5 +47,6 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes)
   PetscCall(VecDestroy(&user->prob.work));
   PetscCall(PetscWeakFormDestroy(&user->prob.wf_penalty));
   PetscCall(ContactSetDestroy(&user->prob.cset));
+  PetscCall(PenaltyFreeBulkRows(user));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

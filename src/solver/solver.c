@@ -46,8 +46,11 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
 /* R = K X + r0: the residual of the elastic problem without the contact terms. */
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R)
 {
+  Mat K;
+
   PetscFunctionBeginUser;
-  PetscCall(MatMult(user->prob.K, X, R));
+  PetscCall(PenaltyBulkOperator(user, &K)); /* K's own contact rows, if it holds the penalty Jacobian */
+  PetscCall(MatMult(K, X, R));
   PetscCall(VecAXPY(R, 1.0, user->prob.r0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -101,10 +104,7 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
   PetscCall(SolverIterateDisplacement(user, X, &u));
   if (user->opt.contact.method == CONTACT_PENALTY) {
     PetscCall(PcReuseDecide(snes, dm, user, u));
-    PetscCall(MatCopy(user->prob.K, P, SAME_NONZERO_PATTERN));
-    PetscCall(PenaltyAddJacobian(dm, user, u, P));
-    PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
-    PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
+    PetscCall(PenaltyJacobianInK(dm, user, u)); /* P is K itself: one matrix */
   }
   if (J != P) {
     PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
@@ -152,7 +152,10 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
              (double)user->prob.load_norm);
   if (user->prob.load_norm > 0.0) {
     PetscCall(VecNorm(F, NORM_INFINITY, &finf));
-    PetscCall(MatMult(user->prob.K, F, KF));
+    Mat K;
+
+    PetscCall(PenaltyBulkOperator(user, &K));
+    PetscCall(MatMult(K, F, KF));
     PetscCall(VecDot(F, KF, &fkf));
     if (PetscRealPart(fkf) > 0.0) U = PetscSqr(user->prob.load_norm) / PetscRealPart(fkf) * finf;
     if (!(U > 0.0) || PetscIsInfOrNanReal(U)) U = 1.0;
@@ -228,16 +231,9 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscFunctionBeginUser;
   PetscCall(SNESCreate(comm, snes));
   PetscCall(SNESSetDM(*snes, dm));
-  if (user->opt.contact.method == CONTACT_PENALTY) {
-    MatNullSpace rigid;
-
-    PetscCall(MatDuplicate(user->prob.K, MAT_COPY_VALUES, &J));
-    PetscCall(MatGetNearNullSpace(user->prob.K, &rigid));
-    PetscCall(MatSetNearNullSpace(J, rigid));
-  } else {
-    J = user->prob.K; /* the Jacobian is K itself */
-    PetscCall(PetscObjectReference((PetscObject)J));
-  }
+  J = user->prob.K; /* the Jacobian is K itself: for the penalty method K + P in the contact rows (PenaltyJacobianInK()) */
+  PetscCall(PetscObjectReference((PetscObject)J));
+  if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltySaveBulkRows(dm, user));
   PetscCall(SNESSetFunction(*snes, NULL, FormFunction, user));
   PetscCall(SNESSetJacobian(*snes, J, J, FormJacobian, user));
   PetscCall(MatDestroy(&J));

@@ -230,20 +230,20 @@ PetscErrorCode ErrorNormsEvaluate(DM dm, AppCtx *user, Mat K, Vec loc_uh, Vec lo
 PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
 {
   Vec         loc_uh, loc_ph = NULL;
+  Mat         K;
   ErrorTarget exact = {&user->scene, NULL, NULL};
 
   PetscFunctionBeginUser;
   PetscCall(ErrorNormsReset(&user->rec.errors));
   PetscCall(DMGetLocalVector(dm, &loc_uh));
-  PetscCall(VecZeroEntries(loc_uh));
-  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, loc_uh, 0.0, NULL, NULL, NULL));
+  PetscCall(VecCopy(user->prob.loc_bc, loc_uh)); /* the Dirichlet values, inserted once by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc_uh));
   if (user->opt.contact.method != CONTACT_PENALTY) {
     PetscCall(DMGetLocalVector(dm, &loc_ph));
     PetscCall(ErrorNormsPressureVector(dm, user, loc_ph));
   }
-  PetscCall(
-      ErrorNormsEvaluate(dm, user, user->prob.K, loc_uh, loc_ph, user->scene.exact && user->scene.exact_gradient ? &exact : NULL, &user->rec.errors));
+  PetscCall(PenaltyBulkOperator(user, &K)); /* the elastic operator, not the penalty Jacobian */
+  PetscCall(ErrorNormsEvaluate(dm, user, K, loc_uh, loc_ph, user->scene.exact && user->scene.exact_gradient ? &exact : NULL, &user->rec.errors));
   if (loc_ph) PetscCall(DMRestoreLocalVector(dm, &loc_ph));
   PetscCall(DMRestoreLocalVector(dm, &loc_uh));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -6,6 +6,7 @@
 #include <petscviewerhdf5.h>
 #include "mesh.h"
 #include "obstacle.h"
+#include "physics.h"
 #include "verify.h"
 #include "io.h"
 
@@ -424,8 +425,8 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(MatchReference(fine, user, &ref, loc_uref, loc_pref));
   PetscCall(ReferenceDestroy(&ref));
 
-  if (levels == 0) { /* the same mesh: the run's operator */
-    K = user->prob.K;
+  if (levels == 0) {                          /* the same mesh: the run's operator */
+    PetscCall(PenaltyBulkOperator(user, &K)); /* the elastic operator, not the penalty Jacobian */
     PetscCall(PetscObjectReference((PetscObject)K));
   } else {
     Vec locX;
