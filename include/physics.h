@@ -47,6 +47,7 @@ PetscErrorCode PenaltySaveBulkRows(DM dm, AppCtx *user);
 PetscErrorCode PenaltyFreeBulkRows(AppCtx *user);
 PetscErrorCode PenaltyJacobianInK(DM dm, AppCtx *user, Vec X);
 PetscErrorCode PenaltyBulkOperator(AppCtx *user, Mat *K);
+PetscErrorCode PenaltyBulkMult(AppCtx *user, Vec X, Vec R);
 PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy);
 
 /* vi_bounds.c */

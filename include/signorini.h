@@ -251,9 +251,12 @@ typedef struct {
   PetscInt     nbulk_rows;                       /* owned rows of the contact dofs */
   PetscInt    *bulk_rows, *bulk_ptr, *bulk_cols; /* their global numbers, and their columns in CSR form */
   PetscScalar *bulk_vals;                        /* and K's values there */
-  PetscReal    fnorm0;                           /* |F| at the start of the last SNESSolve, in the user's units */
-  PetscInt64   active_history[CONTACT_HISTORY];  /* active-set hashes of the Newton steps of the current solve, */
-  PetscReal    fnorm_history[CONTACT_HISTORY];   /*   and their residual norms */
+  PetscInt    *bulk_lcols;                       /* each column's place in bulk_x */
+  VecScatter   bulk_scatter;                     /* the displacement at those columns (any rank's) into bulk_x */
+  Vec          bulk_x;
+  PetscReal    fnorm0;                          /* |F| at the start of the last SNESSolve, in the user's units */
+  PetscInt64   active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
+  PetscReal    fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */
 } Problem;
 
 /* What the run produced: statistics, one row per solve, error norms; the summary and the writer only read it. */

@@ -15,12 +15,7 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecDuplicate(u, &R));
-  {
-    Mat K;
-
-    PetscCall(PenaltyBulkOperator(user, &K)); /* not the penalty Jacobian */
-    PetscCall(MatMult(K, u, R));
-  }
+  PetscCall(PenaltyBulkMult(user, u, R)); /* K u, not the penalty Jacobian times u */
   PetscCall(VecDot(u, R, &uKu));
   PetscCall(VecDot(u, user->prob.r0, &r0u));
   PetscCall(VecAXPY(R, 1.0, user->prob.r0));

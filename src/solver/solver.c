@@ -46,11 +46,8 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
 /* R = K X + r0: the residual of the elastic problem without the contact terms. */
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R)
 {
-  Mat K;
-
   PetscFunctionBeginUser;
-  PetscCall(PenaltyBulkOperator(user, &K)); /* K's own contact rows, if it holds the penalty Jacobian */
-  PetscCall(MatMult(K, X, R));
+  PetscCall(PenaltyBulkMult(user, X, R)); /* K X, also while K holds the penalty Jacobian (which it leaves alone) */
   PetscCall(VecAXPY(R, 1.0, user->prob.r0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -104,7 +101,14 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
   PetscCall(SolverIterateDisplacement(user, X, &u));
   if (user->opt.contact.method == CONTACT_PENALTY) {
     PetscCall(PcReuseDecide(snes, dm, user, u));
-    PetscCall(PenaltyJacobianInK(dm, user, u)); /* P is K itself: one matrix */
+    if (P == user->prob.K)
+      PetscCall(PenaltyJacobianInK(dm, user, u)); /* P is K itself: one matrix */
+    else {                                        /* a copy of K (SBAIJ: no row access) */
+      PetscCall(MatCopy(user->prob.K, P, SAME_NONZERO_PATTERN));
+      PetscCall(PenaltyAddJacobian(dm, user, u, P));
+      PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
+      PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
+    }
   }
   if (J != P) {
     PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
@@ -231,9 +235,24 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscFunctionBeginUser;
   PetscCall(SNESCreate(comm, snes));
   PetscCall(SNESSetDM(*snes, dm));
-  J = user->prob.K; /* the Jacobian is K itself: for the penalty method K + P in the contact rows (PenaltyJacobianInK()) */
-  PetscCall(PetscObjectReference((PetscObject)J));
-  if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltySaveBulkRows(dm, user));
+  {
+    PetscBool sbaij;
+
+    /* the Jacobian is K itself: for the penalty method K + P in the contact rows (PenaltyJacobianInK()); a symmetric
+       block matrix gives no access to its rows below the diagonal, so there the penalty Jacobian is a copy of K */
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)user->prob.K, &sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
+    if (user->opt.contact.method == CONTACT_PENALTY && sbaij) {
+      MatNullSpace rigid;
+
+      PetscCall(MatDuplicate(user->prob.K, MAT_COPY_VALUES, &J));
+      PetscCall(MatGetNearNullSpace(user->prob.K, &rigid));
+      PetscCall(MatSetNearNullSpace(J, rigid));
+    } else {
+      J = user->prob.K;
+      PetscCall(PetscObjectReference((PetscObject)J));
+      if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltySaveBulkRows(dm, user));
+    }
+  }
   PetscCall(SNESSetFunction(*snes, NULL, FormFunction, user));
   PetscCall(SNESSetJacobian(*snes, J, J, FormJacobian, user));
   PetscCall(MatDestroy(&J));
