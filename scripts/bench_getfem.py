@@ -43,13 +43,13 @@ def main():
                 wall, mem, _ = run_timed(gs.signorini_cmd(mesh, eps, h5, solver))
             times[name].append(wall)
             mems[name].append(mem)
-            print(f"pair {p + 1}/{args.pairs}: {name} {wall:.2f} s, {mem:.0f} MB", flush=True)
+            print(f"pair {p + 1}/{args.pairs}: {name} {wall:.2f} s, {mem:.0f} MiB", flush=True)
     ref = np.load(os.path.join(runs, "getfem.npz"))
     u_ref = gs.sorted_by_position(ref["x"], ref["u"])
     rows = []
     for name, solver in codes.items():
         row = {"code": name, "dofs": 2 * (args.faces + 1) ** 2, "eps": eps, "wall_median_s": statistics.median(times[name]),
-               "walls_s": " ".join(f"{t:.2f}" for t in times[name]), "peak_memory_mb": statistics.median(mems[name])}
+               "walls_s": " ".join(f"{t:.2f}" for t in times[name]), "peak_memory_mib": statistics.median(mems[name])}
         if solver == "getfem":
             row.update(newton=int(ref["newton_its"]), max_rel_diff=0.0)
         else:
@@ -67,9 +67,9 @@ def main():
              "`/usr/bin/python3 scripts/bench_getfem.py` (make bench): the default scene `square` on one mesh written by this project "
              f"(`{os.path.relpath(mesh, ROOT)}`), nodal penalty, eps = h = {eps:.6g}, snes_rtol 1e-10 (GetFEM: max_res 1e-10 times the 1-norm of its residual at u = 0, the norm of its Newton).",
              f"Whole-process wall time (`/usr/bin/time -v`), median of {args.pairs} runs of each code, alternating; max diff = max |u - u_GetFEM| / max |u_GetFEM| over the vertices.",
-             "", "| code | wall s (median) | runs s | peak MB | Newton | max diff | GetFEM / this |", "|---|---|---|---|---|---|---|"]
+             "", "| code | wall s (median) | runs s | peak MiB | Newton | max diff | GetFEM / this |", "|---|---|---|---|---|---|---|"]
     for r in rows:
-        lines.append(f"| {r['code']} | {r['wall_median_s']:.2f} | {r['walls_s']} | {r['peak_memory_mb']:.0f} | {r['newton']} | {r['max_rel_diff']:.1e} | {r['getfem_over_this']:.1f} |")
+        lines.append(f"| {r['code']} | {r['wall_median_s']:.2f} | {r['walls_s']} | {r['peak_memory_mib']:.0f} | {r['newton']} | {r['max_rel_diff']:.1e} | {r['getfem_over_this']:.1f} |")
     with open(os.path.join(args.out, "getfem.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
     print("\n".join(lines))

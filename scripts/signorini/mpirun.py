@@ -87,7 +87,7 @@ def error_line(text):
 
 
 def run_timed(cmd, env=None, ok_codes=(0,)):
-    """(wall seconds, peak resident set in MB, stdout+stderr) of one whole process, by /usr/bin/time -v; an exit code
+    """(wall seconds, peak resident set in MiB, stdout+stderr) of one whole process, by /usr/bin/time -v; an exit code
     outside ok_codes raises."""
     p = subprocess.run(["/usr/bin/time", "-v"] + [str(c) for c in cmd], cwd=ROOT, env={**os.environ, **MPI_ENV, **(env or {})}, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                        text=True)
