@@ -11,6 +11,7 @@ PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
 PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam);
 PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id);
 PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count);
+PetscErrorCode MeshOwnedIndex(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt **index, PetscInt *nowned);
 PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **faces);
 PetscErrorCode MeshPointPosition(DM dm, PetscInt p, PetscReal x[]);
 

@@ -8,6 +8,8 @@ PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user);
 PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user);
 PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace);
 PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, PetscReal mu, const PetscReal x[], PetscScalar Ke[]);
+PetscErrorCode ElasticityP1CellVertices(DM dm, PetscSection csec, PetscSection lsec, const PetscScalar xc[], PetscInt c, PetscReal x[],
+                                        PetscInt off[], PetscInt *nv);
 PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Vec locU, Vec locF);
 
 /* contact_options.c, contact_set.c */

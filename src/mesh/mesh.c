@@ -275,6 +275,29 @@ PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *c
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The index of each point of [pStart, pEnd) of this rank among those it owns (in point order: for the vertices, the
+   order of /geometry/vertices), -1 for a point another rank owns (a leaf of the point SF); the caller frees index. */
+PetscErrorCode MeshOwnedIndex(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt **index, PetscInt *nowned)
+{
+  PetscSF         sf;
+  PetscInt        nleaves;
+  const PetscInt *ilocal;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscCalloc1(pEnd - pStart, index));
+  PetscCall(DMGetPointSF(dm, &sf));
+  PetscCall(PetscSFGetGraph(sf, NULL, &nleaves, &ilocal, NULL));
+  for (PetscInt l = 0; l < PetscMax(nleaves, 0); ++l) {
+    const PetscInt p = ilocal ? ilocal[l] : l;
+
+    if (p >= pStart && p < pEnd) (*index)[p - pStart] = -1;
+  }
+  *nowned = 0;
+  for (PetscInt i = 0; i < pEnd - pStart; ++i)
+    if ((*index)[i] == 0) (*index)[i] = (*nowned)++; /* 0: not a leaf, owned */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The faces of dm with "Face Sets" value id (local, height 1), in a new array the caller frees with PetscFree(). */
 PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **faces)
 {

@@ -268,6 +268,32 @@ PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, Pets
 /* locF += K_T u_T on every P1 simplex T that has a fixed component (the cells at Gamma_D), with the closed-form element
    stiffness: the lifting K u_D of the Dirichlet data when locU holds u_D (zero elsewhere), or the fixed rows of K u when it
    holds the free part of u (zero on the fixed components). Only the star of the fixed vertices is visited. */
+/* The vertices of cell c in closure order: their coordinates x[nv][dim] (from the local coordinates xc laid out by
+   csec) and their offsets off[nv] in the local section lsec. */
+PetscErrorCode ElasticityP1CellVertices(DM dm, PetscSection csec, PetscSection lsec, const PetscScalar xc[], PetscInt c, PetscReal x[],
+                                        PetscInt off[], PetscInt *nv)
+{
+  PetscInt *cl = NULL, ncl, dim, vStart, vEnd;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  *nv = 0;
+  PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+  for (PetscInt k = 0; k < ncl; ++k) {
+    const PetscInt p = cl[2 * k];
+    PetscInt       coff;
+
+    if (p < vStart || p >= vEnd) continue;
+    PetscCall(PetscSectionGetOffset(csec, p, &coff));
+    PetscCall(PetscSectionGetOffset(lsec, p, &off[*nv]));
+    for (PetscInt d = 0; d < dim; ++d) x[*nv * dim + d] = PetscRealPart(xc[coff + d]);
+    ++*nv;
+  }
+  PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Vec locU, Vec locF)
 {
   PetscSection       lsec, csec;
@@ -297,27 +323,15 @@ PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Ve
     if (!cdof) continue;
     PetscCall(DMPlexGetTransitiveClosure(dm, v, PETSC_FALSE, &nstar, &star));
     for (PetscInt s = 0; s < nstar; ++s) {
-      const PetscInt c  = star[2 * s];
-      PetscInt      *cl = NULL, ncl, nv = 0, off[4];
+      const PetscInt c = star[2 * s];
+      PetscInt       nv, off[4];
       PetscReal      x[12];
       PetscScalar    ue[12], Ke[144];
 
       if (c < cStart || c >= cEnd || PetscBTLookupSet(done, c - cStart)) continue;
-      PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
-      for (PetscInt k = 0; k < ncl; ++k) {
-        const PetscInt p = cl[2 * k];
-        PetscInt       coff;
-
-        if (p < vStart || p >= vEnd) continue;
-        PetscCall(PetscSectionGetOffset(csec, p, &coff));
-        PetscCall(PetscSectionGetOffset(lsec, p, &off[nv]));
-        for (PetscInt d = 0; d < dim; ++d) {
-          x[nv * dim + d]  = PetscRealPart(xc[coff + d]);
-          ue[nv * dim + d] = lu[off[nv] + d];
-        }
-        ++nv;
-      }
-      PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+      PetscCall(ElasticityP1CellVertices(dm, csec, lsec, xc, c, x, off, &nv));
+      for (PetscInt a = 0; a < nv; ++a)
+        for (PetscInt d = 0; d < dim; ++d) ue[a * dim + d] = lu[off[a] + d];
       PetscCall(ElasticityP1ElementStiffness(dim, mat->lambda, mat->mu, x, Ke));
       for (PetscInt i = 0; i < nv * dim; ++i) {
         PetscScalar sum = 0.0;

@@ -461,7 +461,7 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
   Vec                coords;
   PetscObject        obj;
   PetscQuadrature    q;
-  PetscInt           dim, cStart, cEnd, vStart, vEnd, nconst, nq = 0, uOff[1] = {0}, uOff_x[1] = {0};
+  PetscInt           dim, cStart, cEnd, nconst, nq = 0, uOff[1] = {0}, uOff_x[1] = {0};
   const PetscScalar *constants, *xc;
   PetscScalar       *f, u0[3] = {0, 0, 0}, ux0[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
   PetscReal         *lambda = NULL, wref = 0.0;
@@ -480,7 +480,6 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
   PetscCall(DMGetCoordinateDM(dm, &cdm));
   PetscCall(DMGetLocalSection(cdm, &csec));
   PetscCall(DMGetCoordinatesLocal(dm, &coords));
-  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
   PetscCall(DMGetField(dm, 0, NULL, &obj));
   PetscCall(PetscFEGetQuadrature((PetscFE)obj, &q));
   PetscCall(AssemblyP1QuadratureBasis(dm, q, cStart, &lambda, &nq, &w));
@@ -488,22 +487,11 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
   PetscCall(VecGetArrayRead(coords, &xc));
   PetscCall(VecGetArray(locF, &f));
   for (PetscInt c = cStart; c < cEnd; ++c) {
-    PetscInt   *cl = NULL, ncl, nv = 0, off[4];
+    PetscInt    nv, off[4];
     PetscReal   X[12], vol, det;
     PetscScalar fe[12];
 
-    PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
-    for (PetscInt k = 0; k < ncl; ++k) {
-      const PetscInt p = cl[2 * k];
-      PetscInt       coff;
-
-      if (p < vStart || p >= vEnd) continue;
-      PetscCall(PetscSectionGetOffset(csec, p, &coff));
-      PetscCall(PetscSectionGetOffset(lsec, p, &off[nv]));
-      for (PetscInt d = 0; d < dim; ++d) X[nv * dim + d] = PetscRealPart(xc[coff + d]);
-      ++nv;
-    }
-    PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+    PetscCall(ElasticityP1CellVertices(dm, csec, lsec, xc, c, X, off, &nv));
     for (PetscInt i = 0; i < nv * dim; ++i) fe[i] = 0.0;
     if (dim == 2)
       det = (X[2] - X[0]) * (X[5] - X[1]) - (X[3] - X[1]) * (X[4] - X[0]);
