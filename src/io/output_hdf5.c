@@ -62,7 +62,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  PetscCall(MeshOwnedIndex(dm, vStart, vEnd, &index, &nowned)); /* plain vectors over the owned vertices, no DM clone (94 MB at 512 x 512) */
+  PetscCall(MeshOwnedIndex(dm, vStart, vEnd, &index, &nowned)); /* plain vectors over the owned vertices, no DM clone */
   PetscCall(DMGetLocalSection(dm, &usec));
   PetscCall(DMGetCoordinateDM(dm, &cdm));
   PetscCall(DMGetLocalSection(cdm, &csec));
