@@ -113,6 +113,8 @@ typedef struct {
   PetscBool         cycle_damping;       /* damp the Newton step when the active set cycles */
   PetscBool         pc_reuse;            /* reuse the preconditioner/factorization while few contact nodes change */
   PetscInt          pc_reuse_changes;    /*   at most this many changed nodes since the build */
+  PetscBool         pc_update;           /* multigrid (GAMG): the coarse operators follow the Jacobian instead of rebuilds */
+  PetscBool         pc_update_check;     /*   and each update is compared with the full Galerkin products */
   PetscInt          grid_sequence;       /* solve on the mesh and on this many uniform refinements of it, each from the last */
   PetscReal        *eps0_sweep;          /* eps0 values solved in turn on the final mesh, each from the last solution (any number) */
   PetscInt          n_sweep;
@@ -126,6 +128,19 @@ typedef struct {
   PetscReal eps;             /* eps of the build */
   PetscInt  its_after_build; /* Krylov iterations of the first solve after the build (-1: not yet known) */
   PetscInt  builds;          /* builds so far */
+  /* -contact_pc_update: after the first build of a GAMG hierarchy, each new Jacobian changes the coarse operators by
+     the Galerkin products of its change, which lives in the contact rows only (the bulk matrix is constant) */
+  PetscBool    update;     /* the hierarchy exists and follows the Jacobian */
+  PetscBool    record;     /* the Jacobian being assembled is the one of a build: record its contact rows */
+  PetscBool    recorded;   /* they are (on every rank alike) */
+  PetscInt     updates;    /* updates so far */
+  PetscScalar *built_vals; /* the Jacobian's values in the contact rows (K's pattern, bulk_ptr) at the last build or update */
+  PetscScalar *dvals;      /* their change, the values of delta */
+  Mat          rlocal;     /* the finest prolongator's rows at the columns S of the contact rows (from any rank) */
+  Mat          dlocal;     /* the change of the Jacobian since then, on S x S (nonzero in the contact rows only) */
+  Mat          clocal;     /* this rank's part of its product on the first coarse level */
+  PetscInt     nlevels;
+  Mat         *dcoarse; /* [nlevels - 1]: the change on the coarser levels, coarsest first */
 } PcReuse;
 
 /* The nodes of Gamma_C owned by this rank with at least one free component: the unknowns the contact acts on. */
@@ -190,6 +205,7 @@ typedef struct {
   PetscInt            continuation_stages; /* solves of the eps sequence before the target eps (0: none) */
   PetscInt            active_set_cycles;   /* active-set cycles detected (and damped) in the Newton iterations */
   PetscInt            pc_builds;           /* preconditioner (factorization) builds of the Newton steps */
+  PetscInt            pc_updates;          /* updates of a GAMG hierarchy's coarse operators instead of builds (-contact_pc_update) */
   PetscBool           ksp_ew;              /* Eisenstat-Walker linear tolerances (-snes_ksp_ew) */
   Bandwidth           bandwidth;
   PetscReal           condition_1norm;                      /* estimate of cond_1 of the final Jacobian, NaN if not computed */

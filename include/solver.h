@@ -22,6 +22,8 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 
 /* pc_reuse.c */
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X);
+PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user);
+PetscErrorCode PcReuseDestroy(AppCtx *user);
 
 /* assembly_p1.c */
 PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscBool *check);

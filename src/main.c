@@ -32,9 +32,11 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
   }
   PetscCall(
       PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, h = %g, %d rank(s)\n", user->opt.degree, ndofs, (double)user->prob.h, size));
-  PetscCall(PetscPrintf(
-      comm, "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, %" PetscInt_FMT " preconditioner builds, |F| = %g\n",
-      SNESConvergedReasons[s->reason], s->newton_its, s->ksp_its, s->pc_builds, (double)s->residual_norm));
+  PetscCall(PetscPrintf(comm,
+                        "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, %" PetscInt_FMT " preconditioner builds",
+                        SNESConvergedReasons[s->reason], s->newton_its, s->ksp_its, s->pc_builds));
+  if (s->pc_updates) PetscCall(PetscPrintf(comm, " and %" PetscInt_FMT " coarse-level updates", s->pc_updates));
+  PetscCall(PetscPrintf(comm, ", |F| = %g\n", (double)s->residual_norm));
   PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g, contact force %g, energy %.10g\n",
                         s->active_vertices, (double)s->max_penetration, (double)s->contact_force, (double)s->energy));
   if (!PetscIsNanReal(user->rec.errors.h1))

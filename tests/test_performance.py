@@ -2,6 +2,7 @@
 small eps, and make bench (scripts/bench.py). Each compares solutions computed two ways, never timings."""
 import csv
 import os
+import re
 import subprocess
 
 import h5py
@@ -89,6 +90,25 @@ def test_preconditioner_reuse_changes_the_cost_not_the_answer():
     assert max_diff(reuse, fresh) < 1e-9 and max_diff(strict, fresh) < 1e-9
     assert b["pc_builds"] == b["newton_its"] and a["pc_builds"] < a["newton_its"], (a["pc_builds"], a["newton_its"])
     assert a["pc_builds"] <= c["pc_builds"] <= c["newton_its"], (a["pc_builds"], c["pc_builds"])
+
+
+@pytest.mark.parametrize("np_, eps0", [(1, 1.0), (2, 1e-6)])
+def test_gamg_hierarchy_update_is_the_rebuild(np_, eps0):
+    """-contact_pc_update (the default with GAMG): the hierarchy is built once, and each Newton step adds to every coarse
+    operator the Galerkin product of the Jacobian's change (in the contact rows only). -contact_pc_update_check compares
+    each updated coarse operator with R^T A_f R computed in full, as a rebuild does; and the answer is the one of a
+    rebuild at every changed step. eps = 1e-6 h goes through the continuation's changes of eps, on 2 ranks."""
+    args = SQUARE + ["-dm_plex_box_faces", "64,64", "-penalty_eps0", eps0, "-options_file", "options/solvers/gamg.yaml"]
+    out, upd = run(args + ["-contact_pc_update_check"], f"pc_update_{np_}_{eps0}", np_=np_)
+    _, rebuilt = run(args + ["-contact_pc_update", "0", "-contact_pc_reuse_changes", "0"], f"pc_rebuilt_{np_}_{eps0}", np_=np_)
+    a, _ = load(upd)
+    b, _ = load(rebuilt)
+    checks = [float(x) for x in re.findall(r"pc update check: update \d+, level \d+ of \d+: .* = (\S+)", out)]
+    assert a["converged"] == b["converged"] == 1
+    assert a["pc_builds"] == 1 and a["pc_updates"] >= 3 and b["pc_updates"] == 0 and b["pc_builds"] > 1, (a["pc_updates"], b["pc_builds"])
+    assert len(checks) >= 2 * a["pc_updates"], "one line per coarse level and update"
+    assert max(checks) < 1e-13, max(checks)
+    assert max_diff(upd, rebuilt) < 1e-8
 
 
 @pytest.mark.parametrize("eps0", [1.0, 1e-6])

@@ -57,6 +57,15 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   opts->pc_reuse_changes = 20;
   PetscCall(PetscOptionsInt("-contact_pc_reuse_changes", "Rebuild when more contact nodes than this changed state since the last build", NULL,
                             opts->pc_reuse_changes, &opts->pc_reuse_changes, NULL));
+  opts->pc_update = PETSC_TRUE;
+  PetscCall(PetscOptionsBool("-contact_pc_update",
+                             "Penalty with GAMG: build the hierarchy once and update its coarse operators by the Galerkin products of the "
+                             "Jacobian's change in the contact rows, instead of rebuilds",
+                             NULL, opts->pc_update, &opts->pc_update, NULL));
+  opts->pc_update_check = PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-contact_pc_update_check",
+                             "After each update, print each coarse operator's distance to the Galerkin product of the level above computed in full",
+                             NULL, opts->pc_update_check, &opts->pc_update_check, NULL));
   opts->grid_sequence = 0;
   PetscCall(PetscOptionsInt("-contact_grid_sequence",
                             "Nested iteration: solve on the mesh, then on N uniform refinements of it, each from the interpolated last solution",

@@ -2,7 +2,11 @@
    J = K + (1/eps) P_A changes only in the Gamma_C rows of the nodes whose contact state changed, so J_new - J_old has
    a rank of about the number of those nodes: a Krylov method preconditioned by the previous build converges in about
    that many more iterations (exactly, for a direct solver). The build is reused while few nodes changed, eps is the
-   same and the linear solves stay cheap; it is rebuilt otherwise. */
+   same and the linear solves stay cheap; it is rebuilt otherwise.
+   With GAMG (-contact_pc_update, the default) the hierarchy is built once and then follows the Jacobian: its change D
+   since the last step lives in the contact rows, and each coarse operator A_c = R A_f R^T changes by R D R^T, a
+   Galerkin product of a matrix with a few hundred nonzero rows. The hierarchy then equals a rebuild's (GAMG reuses its
+   prolongators on a rebuild) at the cost of a few sparse products instead of the products of the whole matrix. */
 #include "physics.h"
 #include "solver.h"
 
@@ -22,6 +26,222 @@ static PetscErrorCode CountChanges(AppCtx *user, PetscInt dim, const PetscScalar
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The levels of a GAMG hierarchy whose coarse operators can follow the Jacobian (0 if there is none yet, or if the
+   Jacobian is not K itself with its kept contact rows). */
+static PetscErrorCode HierarchyLevels(SNES snes, AppCtx *user, PC *pc, PetscInt *nlevels)
+{
+  KSP       ksp;
+  PetscBool is_gamg;
+
+  PetscFunctionBeginUser;
+  *nlevels = 0;
+  PetscCall(SNESGetKSP(snes, &ksp));
+  PetscCall(KSPGetPC(ksp, pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)*pc, PCGAMG, &is_gamg));
+  if (!is_gamg || !user->opt.contact.pc_update || !user->prob.bulk_ptr) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PCMGGetLevels(*pc, nlevels));
+  for (PetscInt l = 0; l < *nlevels; ++l) {
+    KSP smoother;
+    Mat A, B;
+
+    PetscCall(PCMGGetSmoother(*pc, l, &smoother));
+    PetscCall(KSPGetOperators(smoother, &A, &B));
+    if (A != B) *nlevels = 0; /* a level with its own preconditioning matrix: rebuild instead */
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The Jacobian's values in the contact rows into vals (collective only through the caller). */
+static PetscErrorCode ContactRowValues(AppCtx *user, PetscScalar vals[])
+{
+  Problem *pb = &user->prob;
+
+  PetscFunctionBeginUser;
+  for (PetscInt r = 0; r < pb->nbulk_rows; ++r) {
+    const PetscScalar *v;
+    PetscInt           ncols;
+
+    PetscCall(MatGetRow(pb->K, pb->bulk_rows[r], &ncols, NULL, &v));
+    PetscCheck(ncols == pb->bulk_ptr[r + 1] - pb->bulk_ptr[r], PETSC_COMM_SELF, PETSC_ERR_PLIB,
+               "the Jacobian's row %" PetscInt_FMT " left K's pattern", pb->bulk_rows[r]);
+    PetscCall(PetscArraycpy(&vals[pb->bulk_ptr[r]], v, ncols));
+    PetscCall(MatRestoreRow(pb->K, pb->bulk_rows[r], &ncols, NULL, &v));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The coarse products of the updates. */
+static PetscErrorCode DestroyProducts(PcReuse *r)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt l = 0; l < r->nlevels - 1 && r->dcoarse; ++l) PetscCall(MatDestroy(&r->dcoarse[l]));
+  PetscCall(PetscFree(r->dcoarse));
+  PetscCall(MatDestroy(&r->rlocal));
+  PetscCall(MatDestroy(&r->dlocal));
+  PetscCall(MatDestroy(&r->clocal));
+  r->nlevels = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The product on the finest level without matrices of its size: D is nonzero in the contact rows only, at the columns
+   S of those rows, so R^T D R = R_S^T D_S R_S with R_S the rows S of the prolongator (fetched from any rank) and D_S
+   the change restricted to S x S. Each rank computes its own part, and a COO matrix sums the parts. */
+static PetscErrorCode FinestProductSetUp(PC pc, AppCtx *user)
+{
+  PcReuse        *r   = &user->prob.pc_reuse;
+  Problem        *pb  = &user->prob;
+  const PetscInt  nnz = pb->bulk_ptr[pb->nbulk_rows];
+  PetscInt        nS  = nnz, N1, n1, *S, *coo_i, *coo_j, nrows;
+  const PetscInt *ia, *ja;
+  PetscBool       done;
+  PetscCount      ncoo;
+  IS              is_rows, is_cols;
+  Mat             R, *sub;
+
+  PetscFunctionBeginUser;
+  PetscCall(PCMGGetInterpolation(pc, r->nlevels - 1, &R));
+  PetscCall(MatGetSize(R, NULL, &N1));
+  PetscCall(MatGetLocalSize(R, NULL, &n1));
+  PetscCall(PetscMalloc1(nnz, &S));
+  PetscCall(PetscArraycpy(S, pb->bulk_cols, nnz));
+  PetscCall(PetscSortRemoveDupsInt(&nS, S)); /* the order of bulk_lcols */
+  PetscCall(ISCreateGeneral(PETSC_COMM_SELF, nS, S, PETSC_OWN_POINTER, &is_rows));
+  PetscCall(ISCreateStride(PETSC_COMM_SELF, N1, 0, 1, &is_cols));
+  PetscCall(MatCreateSubMatrices(R, 1, &is_rows, &is_cols, MAT_INITIAL_MATRIX, &sub));
+  r->rlocal = sub[0];
+  PetscCall(PetscFree(sub));
+  /* D_S in COO form: the contact rows' places in S, their columns' places (bulk_lcols) */
+  PetscCall(PetscMalloc2(nnz, &coo_i, nnz, &coo_j));
+  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
+    PetscInt at;
+
+    PetscCall(PetscFindInt(pb->bulk_rows[row], nS, S, &at));
+    PetscCheck(at >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "a contact row without its diagonal");
+    for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k) {
+      coo_i[k] = at;
+      coo_j[k] = pb->bulk_lcols[k];
+    }
+  }
+  PetscCall(MatCreate(PETSC_COMM_SELF, &r->dlocal));
+  PetscCall(MatSetSizes(r->dlocal, nS, nS, nS, nS));
+  PetscCall(MatSetType(r->dlocal, MATSEQAIJ));
+  PetscCall(MatSetPreallocationCOO(r->dlocal, nnz, coo_i, coo_j));
+  PetscCall(PetscFree2(coo_i, coo_j));
+  PetscCall(PetscArrayzero(r->dvals, nnz));
+  PetscCall(MatSetValuesCOO(r->dlocal, r->dvals, INSERT_VALUES));
+  PetscCall(MatPtAP(r->dlocal, r->rlocal, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &r->clocal));
+  /* the sum over the ranks, on the first coarse level's layout */
+  PetscCall(MatGetRowIJ(r->clocal, 0, PETSC_FALSE, PETSC_FALSE, &nrows, &ia, &ja, &done));
+  PetscCheck(done, PETSC_COMM_SELF, PETSC_ERR_PLIB, "no CSR access to the coarse product");
+  ncoo = ia[nrows];
+  PetscCall(PetscMalloc2(ncoo, &coo_i, ncoo, &coo_j));
+  for (PetscInt row = 0; row < nrows; ++row)
+    for (PetscInt k = ia[row]; k < ia[row + 1]; ++k) {
+      coo_i[k] = row;
+      coo_j[k] = ja[k];
+    }
+  PetscCall(MatRestoreRowIJ(r->clocal, 0, PETSC_FALSE, PETSC_FALSE, &nrows, &ia, &ja, &done));
+  PetscCall(MatCreate(PetscObjectComm((PetscObject)pc), &r->dcoarse[r->nlevels - 2]));
+  PetscCall(MatSetSizes(r->dcoarse[r->nlevels - 2], n1, n1, N1, N1));
+  PetscCall(MatSetType(r->dcoarse[r->nlevels - 2], MATAIJ));
+  PetscCall(MatSetPreallocationCOO(r->dcoarse[r->nlevels - 2], ncoo, coo_i, coo_j));
+  PetscCall(PetscFree2(coo_i, coo_j));
+  PetscCall(ISDestroy(&is_rows));
+  PetscCall(ISDestroy(&is_cols));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -contact_pc_update_check: each updated coarse operator against the Galerkin product of the level above, computed
+   in full (R^T A_f R, as a rebuild would). */
+static PetscErrorCode CheckHierarchy(PC pc, PetscInt nlevels, PetscInt update)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt l = nlevels - 1; l > 0; --l) {
+    Mat       R, Af, Ac, C;
+    KSP       smoother;
+    PetscReal norm, diff;
+
+    PetscCall(PCMGGetInterpolation(pc, l, &R));
+    PetscCall(PCMGGetSmoother(pc, l, &smoother));
+    PetscCall(KSPGetOperators(smoother, &Af, NULL));
+    PetscCall(PCMGGetSmoother(pc, l - 1, &smoother));
+    PetscCall(KSPGetOperators(smoother, &Ac, NULL));
+    PetscCall(MatPtAP(Af, R, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &C));
+    PetscCall(MatNorm(C, NORM_FROBENIUS, &norm));
+    PetscCall(MatAXPY(C, -1.0, Ac, DIFFERENT_NONZERO_PATTERN));
+    PetscCall(MatNorm(C, NORM_FROBENIUS, &diff));
+    PetscCall(MatDestroy(&C));
+    PetscCall(PetscPrintf(PetscObjectComm((PetscObject)pc),
+                          "pc update check: update %" PetscInt_FMT ", level %" PetscInt_FMT " of %" PetscInt_FMT
+                          ": ||A_c - R^T A_f R||_F / ||R^T A_f R||_F = %.3e\n",
+                          update, l - 1, nlevels, (double)(diff / norm)));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The change of the Jacobian since the last build or update, carried down the hierarchy: each coarse operator gets
+   R D R^T, D the change on the level above (the first product makes the patterns, the later ones reuse them). */
+static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
+{
+  PcReuse  *r    = &user->prob.pc_reuse;
+  Problem  *pb   = &user->prob;
+  PetscInt  nnz  = pb->bulk_ptr[pb->nbulk_rows];
+  PetscReal dmax = 0.0;
+
+  PetscFunctionBeginUser;
+  if (!r->dcoarse) {
+    r->nlevels = nlevels;
+    PetscCall(PetscCalloc1(nlevels, &r->dcoarse));
+    PetscCall(FinestProductSetUp(pc, user));
+  }
+  PetscCheck(r->nlevels == nlevels, PetscObjectComm((PetscObject)pc), PETSC_ERR_PLIB, "the multigrid hierarchy changed its levels");
+  PetscCall(ContactRowValues(user, r->dvals));
+  for (PetscInt k = 0; k < nnz; ++k) {
+    const PetscScalar now = r->dvals[k];
+
+    r->dvals[k]      = now - r->built_vals[k];
+    r->built_vals[k] = now;
+    dmax             = PetscMax(dmax, PetscAbsScalar(r->dvals[k]));
+  }
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &dmax, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)pc)));
+  if (dmax == 0.0) PetscFunctionReturn(PETSC_SUCCESS); /* the same Jacobian in the contact rows: nothing to carry */
+  /* the first coarse level: this rank's R_S^T D_S R_S, summed over the ranks */
+  PetscCall(MatSetValuesCOO(r->dlocal, r->dvals, INSERT_VALUES));
+  PetscCall(MatPtAP(r->dlocal, r->rlocal, MAT_REUSE_MATRIX, PETSC_DEFAULT, &r->clocal));
+  {
+    const PetscScalar *v;
+
+    PetscCall(MatSeqAIJGetArrayRead(r->clocal, &v));
+    PetscCall(MatSetValuesCOO(r->dcoarse[nlevels - 2], v, INSERT_VALUES));
+    PetscCall(MatSeqAIJRestoreArrayRead(r->clocal, &v));
+  }
+  for (PetscInt l = nlevels - 1; l > 0; --l) {
+    Mat R, A;
+    KSP smoother;
+
+    if (l < nlevels - 1) {
+      PetscCall(PCMGGetInterpolation(pc, l, &R));
+      PetscCall(MatPtAP(r->dcoarse[l], R, r->dcoarse[l - 1] ? MAT_REUSE_MATRIX : MAT_INITIAL_MATRIX, PETSC_DEFAULT, &r->dcoarse[l - 1]));
+    }
+    PetscCall(PCMGGetSmoother(pc, l - 1, &smoother));
+    PetscCall(KSPGetOperators(smoother, &A, NULL));
+    PetscCall(MatAXPY(A, 1.0, r->dcoarse[l - 1], SUBSET_NONZERO_PATTERN));
+  }
+  if (user->opt.contact.pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r->updates));
+  /* every level's operator is new: its Chebyshev smoother estimates its eigenvalues again, its Jacobi or LU sets up
+     again (KSPSetOperators() marks the new matrix, as a rebuild would) */
+  for (PetscInt l = 0; l < nlevels; ++l) {
+    KSP smoother;
+    Mat A;
+
+    PetscCall(PCMGGetSmoother(pc, l, &smoother));
+    PetscCall(KSPGetOperators(smoother, &A, NULL));
+    PetscCall(KSPSetOperators(smoother, A, A));
+  }
+  r->updates++;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Called by the Jacobian evaluation at X, before SNES sets up the preconditioner: sets the SNES preconditioner lag to
    rebuild (-2) or reuse (-1), and records the state of the build. */
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
@@ -37,6 +257,18 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
   if (!r->enabled) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(SNESGetKSP(snes, &ksp));
+  r->update = PETSC_FALSE;
+  if (r->built) {
+    PC       pc;
+    PetscInt nlevels;
+
+    PetscCall(HierarchyLevels(snes, user, &pc, &nlevels));
+    if (nlevels > 1 && r->recorded) { /* the hierarchy follows the Jacobian (PcReuseAfterJacobian()): no rebuild */
+      r->update = PETSC_TRUE;
+      PetscCall(SNESSetLagPreconditioner(snes, -1));
+      PetscFunctionReturn(PETSC_SUCCESS);
+    }
+  }
   PetscCall(VecGetArrayRead(X, &x));
   rebuild = (PetscBool)(!r->built || r->eps != user->prob.eps);
   if (!rebuild) {
@@ -53,11 +285,56 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
     r->eps             = user->prob.eps;
     r->its_after_build = -1; /* set by the next call */
     r->builds++;
+    r->record = PETSC_TRUE;
     PetscCall(SNESSetLagPreconditioner(snes, -2)); /* rebuild now, then reuse until told otherwise */
   } else {
     if (r->its_after_build < 0) r->its_after_build = its;
     PetscCall(SNESSetLagPreconditioner(snes, -1));
   }
   PetscCall(VecRestoreArrayRead(X, &x));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Called by the Jacobian evaluation once the Jacobian is assembled: records its contact rows for a build, or carries
+   their change down the hierarchy. */
+PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user)
+{
+  PcReuse *r  = &user->prob.pc_reuse;
+  Problem *pb = &user->prob;
+  PC       pc;
+  PetscInt nlevels;
+
+  PetscFunctionBeginUser;
+  if (!r->enabled || !user->opt.contact.pc_update || !pb->jacobian_in_K) PetscFunctionReturn(PETSC_SUCCESS);
+  if (r->update) {
+    PetscCall(HierarchyLevels(snes, user, &pc, &nlevels));
+    PetscCall(UpdateHierarchy(pc, nlevels, user));
+  } else if (r->record) {
+    PetscInt  nnz = pb->bulk_ptr[pb->nbulk_rows];
+    KSP       ksp;
+    PetscBool is_gamg;
+
+    r->record = PETSC_FALSE;
+    PetscCall(SNESGetKSP(snes, &ksp));
+    PetscCall(KSPGetPC(ksp, &pc));
+    PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &is_gamg));
+    if (!is_gamg) PetscFunctionReturn(PETSC_SUCCESS);
+    if (!r->recorded) PetscCall(PetscMalloc2(nnz, &r->built_vals, nnz, &r->dvals));
+    r->recorded = PETSC_TRUE;
+    PetscCall(ContactRowValues(user, r->built_vals));
+    PetscCall(DestroyProducts(r)); /* a rebuild may make new prolongators: new patterns */
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Frees the state of the updates (with the problem: the next mesh has its own rows and hierarchy). */
+PetscErrorCode PcReuseDestroy(AppCtx *user)
+{
+  PcReuse *r = &user->prob.pc_reuse;
+
+  PetscFunctionBeginUser;
+  PetscCall(DestroyProducts(r));
+  PetscCall(PetscFree2(r->built_vals, r->dvals));
+  PetscCall(PetscMemzero(r, sizeof(*r)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -27,7 +27,7 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
   PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0));
   PetscCall(SolverComputeScales(dm, user));
-  PetscCall(PetscMemzero(&user->prob.pc_reuse, sizeof(user->prob.pc_reuse)));
+  PetscCall(PcReuseDestroy(user));
   PetscCall(SolverCreateSNES(dm, user, snes));
   PetscCall(PetscTime(&t1));
   user->prob.setup_time = t1 - t0;
@@ -48,5 +48,6 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes)
   PetscCall(PetscWeakFormDestroy(&user->prob.wf_penalty));
   PetscCall(ContactSetDestroy(&user->prob.cset));
   PetscCall(PenaltyFreeBulkRows(user));
+  PetscCall(PcReuseDestroy(user));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

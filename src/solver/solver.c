@@ -110,6 +110,7 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
       PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
     }
   }
+  if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PcReuseAfterJacobian(snes, user));
   if (J != P) {
     PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
@@ -248,8 +249,18 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
       PetscCall(MatGetNearNullSpace(user->prob.K, &rigid));
       PetscCall(MatSetNearNullSpace(J, rigid));
     } else {
+      PetscBool is_aij;
+
       J = user->prob.K;
       PetscCall(PetscObjectReference((PetscObject)J));
+      /* K and K + the penalty Jacobian are symmetric positive definite (semi-definite at worst; CG needs it anyway):
+         PETSc then estimates eigenvalues by CG (Lanczos) rather than GMRES, as GAMG's Chebyshev smoothers do on the
+         finest level (GMRES kept 10 vectors of that size: 51 MB at 512 x 512) */
+      PetscCall(PetscObjectTypeCompareAny((PetscObject)J, &is_aij, MATSEQAIJ, MATMPIAIJ, ""));
+      if (user->opt.contact.method != CONTACT_VI && is_aij) { /* (BAIJ in 3.18 refuses MAT_SPD_ETERNAL) */
+        PetscCall(MatSetOption(J, MAT_SPD, PETSC_TRUE));
+        PetscCall(MatSetOption(J, MAT_SPD_ETERNAL, PETSC_TRUE));
+      }
       if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltySaveBulkRows(dm, user));
     }
   }
@@ -333,7 +344,8 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
                   user->rec.stats.residual_norm <= user->opt.contact.load_rtol * user->prob.load_norm || fnorm <= atol);
   user->rec.stats.converged = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
   PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
-  user->rec.stats.pc_builds = user->prob.pc_reuse.enabled ? user->prob.pc_reuse.builds : *newton; /* without reuse: one per Newton step */
+  user->rec.stats.pc_builds  = user->prob.pc_reuse.enabled ? user->prob.pc_reuse.builds : *newton; /* without reuse: one per Newton step */
+  user->rec.stats.pc_updates = user->prob.pc_reuse.updates;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -412,6 +424,7 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm)
   if (!warm) PetscCall(VecZeroEntries(u));
   PetscCall(PetscTime(&t0));
   user->prob.pc_reuse.builds          = 0; /* counted per solve */
+  user->prob.pc_reuse.updates         = 0;
   user->rec.stats.continuation_stages = 0;
   if (!warm && user->opt.contact.method == CONTACT_PENALTY && user->opt.contact.continuation && eps_target < eps_start) {
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= user->opt.contact.continuation_factor) {
