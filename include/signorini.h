@@ -135,7 +135,7 @@ typedef struct {
   PetscBool    recorded;   /* they are (on every rank alike) */
   PetscInt     updates;    /* updates so far */
   PetscScalar *built_vals; /* the Jacobian's values in the contact rows (K's pattern, bulk_ptr) at the last build or update */
-  PetscScalar *dvals;      /* their change, the values of delta */
+  PetscScalar *dvals;      /* their change since then, the values of dlocal */
   Mat          rlocal;     /* the finest prolongator's rows at the columns S of the contact rows (from any rank) */
   Mat          dlocal;     /* the change of the Jacobian since then, on S x S (nonzero in the contact rows only) */
   Mat          clocal;     /* this rank's part of its product on the first coarse level */

@@ -4,7 +4,8 @@
    that many more iterations (exactly, for a direct solver). The build is reused while few nodes changed, eps is the
    same and the linear solves stay cheap; it is rebuilt otherwise.
    With GAMG (-contact_pc_update, the default) the hierarchy is built once and then follows the Jacobian: its change D
-   since the last step lives in the contact rows, and each coarse operator A_c = R A_f R^T changes by R D R^T, a
+   since the last step lives in the contact rows, and each coarse operator A_c = R^T A_f R (R the prolongator)
+   changes by R^T D R, a
    Galerkin product of a matrix with a few hundred nonzero rows. The hierarchy then equals a rebuild's (GAMG reuses its
    prolongators on a rebuild) at the cost of a few sparse products instead of the products of the whole matrix. */
 #include "physics.h"
@@ -180,7 +181,7 @@ static PetscErrorCode CheckHierarchy(PC pc, PetscInt nlevels, PetscInt update)
 }
 
 /* The change of the Jacobian since the last build or update, carried down the hierarchy: each coarse operator gets
-   R D R^T, D the change on the level above (the first product makes the patterns, the later ones reuse them). */
+   R^T D R, D the change on the level above (the first product makes the patterns, the later ones reuse them). */
 static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
 {
   PcReuse  *r    = &user->prob.pc_reuse;
@@ -310,7 +311,6 @@ PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user)
     PetscCall(HierarchyLevels(snes, user, &pc, &nlevels));
     PetscCall(UpdateHierarchy(pc, nlevels, user));
   } else if (r->record) {
-    PetscInt  nnz = pb->bulk_ptr[pb->nbulk_rows];
     KSP       ksp;
     PetscBool is_gamg;
 
@@ -319,7 +319,7 @@ PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user)
     PetscCall(KSPGetPC(ksp, &pc));
     PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &is_gamg));
     if (!is_gamg) PetscFunctionReturn(PETSC_SUCCESS);
-    if (!r->recorded) PetscCall(PetscMalloc2(nnz, &r->built_vals, nnz, &r->dvals));
+    if (!r->recorded) PetscCall(PetscMalloc2(pb->bulk_ptr[pb->nbulk_rows], &r->built_vals, pb->bulk_ptr[pb->nbulk_rows], &r->dvals));
     r->recorded = PETSC_TRUE;
     PetscCall(ContactRowValues(user, r->built_vals));
     PetscCall(DestroyProducts(r)); /* a rebuild may make new prolongators: new patterns */

@@ -109,8 +109,8 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
       PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
       PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
     }
+    PetscCall(PcReuseAfterJacobian(snes, user)); /* records the build's contact rows, or updates the GAMG hierarchy */
   }
-  if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PcReuseAfterJacobian(snes, user));
   if (J != P) {
     PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
@@ -143,6 +143,7 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
   Vec         zero, F, KF;
   PetscScalar fkf;
   PetscReal   finf, U = 1.0;
+  Mat         K;
 
   PetscFunctionBeginUser;
   PetscCall(DMCreateGlobalVector(dm, &user->prob.work));
@@ -157,8 +158,6 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
              (double)user->prob.load_norm);
   if (user->prob.load_norm > 0.0) {
     PetscCall(VecNorm(F, NORM_INFINITY, &finf));
-    Mat K;
-
     PetscCall(PenaltyBulkOperator(user, &K));
     PetscCall(MatMult(K, F, KF));
     PetscCall(VecDot(F, KF, &fkf));
