@@ -51,6 +51,14 @@ PetscErrorCode PenaltyJacobianInK(DM dm, AppCtx *user, Vec X);
 PetscErrorCode PenaltyBulkOperator(AppCtx *user, Mat *K);
 PetscErrorCode PenaltyBulkMult(AppCtx *user, Vec X, Vec R);
 PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy);
+PetscErrorCode PenaltyCheckClosedForm(DM dm, AppCtx *user, Vec X);
+
+/* penalty_faces.c: the Gauss rule on P1 simplices in closed form */
+PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user);
+PetscErrorCode PenaltyFacesDestroy(PenaltyFaces *pf);
+PetscErrorCode PenaltyFacesResidual(DM dm, AppCtx *user, Vec locX, Vec locF);
+PetscErrorCode PenaltyFacesJacobian(DM dm, AppCtx *user, Vec locX, Mat J);
+PetscErrorCode PenaltyFacesEnergy(DM dm, AppCtx *user, Vec locX, PetscReal *energy);
 
 /* vi_bounds.c */
 PetscErrorCode VICreateBounds(DM dm, AppCtx *user);

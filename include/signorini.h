@@ -178,7 +178,7 @@ typedef struct {
 } ErrorNorms;
 
 /* How the mesh is distributed over the ranks (-partitioner), and the quality of the partition. */
-typedef enum { MESH_PARTITIONER_PTSCOTCH, MESH_PARTITIONER_METIS, MESH_PARTITIONER_SIMPLE } MeshPartitionerType;
+typedef enum { MESH_PARTITIONER_PTSCOTCH, MESH_PARTITIONER_METIS, MESH_PARTITIONER_SIMPLE, MESH_PARTITIONER_BOX } MeshPartitionerType;
 extern const char *const MeshPartitionerTypes[];
 typedef struct {
   MeshPartitionerType partitioner;
@@ -241,6 +241,18 @@ typedef struct {
   char           output[PETSC_MAX_PATH_LEN];
 } RunOptions;
 
+/* The contact faces of this rank for the Gauss rule of the penalty term in closed form (P1 simplices,
+   src/physics/penalty_faces.c): PETSc's face quadrature, mapped once. */
+typedef struct {
+  PetscBool  ready;
+  PetscInt   n, nv, nq;  /* faces, vertices per face (dim), quadrature points per face */
+  PetscInt  *loff;       /* [n][nv]: offset of each vertex's displacement in the local vector */
+  PetscInt  *gidx;       /* [n][nv][dim]: global index of each component, -1 if fixed */
+  PetscReal *x, *w;      /* [n][nq][dim] the quadrature points, [n][nq] their weights (face Jacobian included) */
+  PetscReal *inv_factor; /* [n]: 1 / the eps factor of the face's cell (local eps), NULL if eps is uniform */
+  PetscReal *lambda;     /* [nq][nv]: the face's P1 basis (barycentric coordinates) at the points */
+} PenaltyFaces;
+
 /* The discrete problem on one mesh: created by ProblemSetUp(), destroyed by ProblemDestroy(), one per grid level. */
 typedef struct {
   PetscInt      level;                          /* grid sequence level of the mesh (0: the mesh of the options) */
@@ -250,6 +262,7 @@ typedef struct {
   DMLabel       face_sets;
   ContactSet    cset;
   PetscWeakForm wf_penalty;         /* the penalty term on Gamma_C, kept out of the bulk weak form */
+  PenaltyFaces  penalty_faces;      /* the same term in closed form (P1 simplices, -assembly p1) */
   Vec           loc_bc;             /* local vector holding the Dirichlet values, zero elsewhere */
   AssemblyType  assembly;           /* how K is assembled: fe or p1 (-assembly auto resolved) */
   Mat           K;                  /* bulk elastic operator, assembled once */

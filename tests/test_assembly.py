@@ -1,7 +1,9 @@
-"""Assembly tests (make test): the P1 path of the bulk matrix K (-assembly p1) against PETSc's FE assembly (-assembly fe).
+"""Assembly tests (make test): the P1 path of the bulk matrix K and of the penalty term's Gauss rule (-assembly p1)
+against PETSc's FE assembly and boundary integration (-assembly fe).
 
 -assembly_check assembles K both ways and prints the relative Frobenius distance with the type, size, block size and
-number of nonzeros (used and allocated) of both; every assertion checks those numbers or the solver's output.
+number of nonzeros (used and allocated) of both; with the Gauss rule it also prints the penalty residual, Jacobian and
+energy at the solution both ways. Every assertion checks those numbers or the solver's output.
 """
 import glob
 import os
@@ -16,6 +18,8 @@ from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position
 CHECK = re.compile(r"assembly check: \|\|K_p1 - K_fe\|\|_F/\|\|K_fe\|\|_F = (\S+); size (\d+)x(\d+) \(p1\) (\d+)x(\d+) \(fe\); "
                    r"type (\S+) \(p1\) (\S+) \(fe\); block size (\d+) \(p1\) (\d+) \(fe\); nonzeros (\d+) \(p1\) (\d+) \(fe\); "
                    r"allocated (\d+) \(p1\) (\d+) \(fe\)")
+PENALTY_CHECK = re.compile(r"penalty check: \|F_p1 - F_fe\|/\|F_fe\| = (\S+) \(\|F_fe\| = (\S+)\); \|\|J_p1 - J_fe\|\|_F/\|\|J_fe\|\|_F = (\S+) "
+                           r"\((\S+)\); energy (\S+) \(p1\) (\S+) \(fe\)")
 MESH = {2: ["-dm_plex_dim", 2, "-dm_plex_box_faces", "12,12"], 3: ["-dm_plex_dim", 3, "-dm_plex_box_faces", "4,4,4"]}
 
 
@@ -38,6 +42,17 @@ def check_matrices(out, dim, mat_type=None):
     return rel
 
 
+def check_penalty(out):
+    """Parses the penalty check line: the Gauss rule's residual, Jacobian and energy at the solution, in closed form
+    and by PETSc's boundary integration, are the same to round-off, and not trivially (contact is active)."""
+    m = PENALTY_CHECK.search(out)
+    assert m, f"no penalty check line in:\n{out[-2000:]}"
+    rel_f, norm_f, rel_j, norm_j, e_p1, e_fe = (float(g) for g in m.groups())
+    assert norm_f > 0 and norm_j > 0 and e_fe > 0, (norm_f, norm_j, e_fe)
+    assert rel_f < 1e-12 and rel_j < 1e-12, (rel_f, rel_j)
+    assert abs(e_p1 - e_fe) <= 1e-12 * e_fe, (e_p1, e_fe)
+
+
 @pytest.mark.parametrize("np_", (1, 2), ids=("np1", "np2"))
 @pytest.mark.parametrize("scene", ("square", "mms"))
 @pytest.mark.parametrize("dim", (2, 3), ids=("2d", "3d"))
@@ -47,9 +62,36 @@ def test_assembly_p1_equals_fe(dim, scene, np_):
     out, h5 = run(["-options_file", f"options/{scene}.yaml", "-contact_monitor", 0, "-assembly_check"] + MESH[dim],
                   f"assembly_check_{scene}_{dim}d_np{np_}", np_=np_)
     check_matrices(out, dim)
+    check_penalty(out)
     a, _ = load(h5)
     assert a["assembly"] == "p1" and a["converged"] == 1, (a["assembly"], a["converged"])
     assert a["nprocs"] == np_
+
+
+@pytest.mark.parametrize("name,args", (
+    ("refined_3d", ["-options_file", "options/square.yaml", "-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3", "-dm_refine", 1]),
+    ("grid_sequence_2d", ["-options_file", "options/square.yaml", "-dm_plex_box_faces", "8,8", "-contact_grid_sequence", 2]),
+    ("sphere_refined_3d", ["-options_file", "options/square.yaml", "-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3", "-dm_refine", 1,
+                           "-obstacle", "sphere", "-obstacle_center", "0.5,0.5,-1", "-obstacle_radius", 1.05]),
+    ("graded_local_eps", "quarter_disk")), ids=("refined_3d", "grid_sequence_2d", "sphere_refined_3d", "graded_local_eps"))
+def test_penalty_gauss_closed_form_equals_petsc(name, args, tmp_path):
+    """The closed-form Gauss rule on faces that refinement made (3D -dm_refine, where faces have other orientations in
+    their cells, and 2D grid sequencing), under a curved obstacle, and on a graded Gmsh mesh with a local eps per face:
+    PETSc's boundary integration to round-off."""
+    if args == "quarter_disk":
+        import sys
+        sys.path.insert(0, os.path.join(ROOT, "scripts"))
+        from signorini import geometry
+        mesh = str(tmp_path / "quarter_disk.msh")
+        geometry.quarter_disk(mesh, h_near=0.01, h_far=0.1, width=0.3, near=0.05)
+        args = ["-dm_plex_filename", mesh, "-scene", "general", "-contact_faces", "contact", "-bc_slip", "top,symmetry_x",
+                "-bc_slip_top_components", "1", "-bc_slip_top_translate", "0,-0.002", "-bc_slip_symmetry_x_components", "0"]
+    out, h5 = run(args + ["-contact_monitor", 0, "-assembly_check"], f"penalty_closed_form_{name}")
+    check_penalty(out)
+    a, _ = load(h5)
+    assert a["converged"] == 1 and a["assembly"] == "p1"
+    if name == "graded_local_eps":
+        assert a["eps_min"] < 0.5 * a["eps_max"], (a["eps_min"], a["eps_max"])
 
 
 @pytest.mark.parametrize("mat_type,scene,dim,np_", (("baij", "mms", 3, 2), ("sbaij", "square", 2, 1)), ids=("baij", "sbaij"))
@@ -69,7 +111,8 @@ def test_assembly_p1_honours_the_matrix_type(mat_type, scene, dim, np_):
 def test_assembly_p1_solution_equals_fe(name, args, np_):
     """The solution with -assembly p1 is the -assembly fe one to solver tolerance (direct solves): 2D square on 1 rank,
     3D mms on 2 ranks (inhomogeneous Dirichlet data), 3D square with its body force and a constant one on 2 ranks; same
-    Newton steps and active set. The P1 path also assembles r0 itself (AssemblyP1Residual), with PetscFE's rule."""
+    Newton steps and active set. The P1 path also assembles r0 itself (AssemblyP1Residual), with PetscFE's rule, and the
+    penalty term's Gauss rule in closed form (src/physics/penalty_faces.c)."""
     sol, attrs = {}, {}
     for asm in ("fe", "p1"):
         _, h5 = run(args + ["-contact_monitor", 0, "-assembly", asm], f"assembly_solution_{name}_{asm}", np_=np_)

@@ -1,5 +1,6 @@
 """Mesh partitioning tests (make test): -partitioner metis|ptscotch|simple gives the serial answer on 2 and 3 ranks, for
-every kind of mesh (simplex box, tensor box, Gmsh and HDF5 files), and the recorded edge cut and load imbalance are right.
+every kind of mesh (simplex box, tensor box, Gmsh and HDF5 files), the simplex box built distributed (box, the default for
+it) gives it too, and the recorded edge cut and load imbalance are right.
 
 Every assertion checks numbers computed by the solver against a bound or an independent count that can fail.
 """
@@ -90,8 +91,50 @@ def test_partition_quality_is_recorded():
         a, _ = load(run(SQUARE + extra + ["-partitioner", "simple"], f"quality_simple{len(extra)}", np_=2)[1])
         assert a["partitioner"] == "simple" and a["partition_edge_cut"] == 32 and a["partition_imbalance"] == 1.0, (
             a["partition_edge_cut"], a["partition_imbalance"])
-    a, _ = load(run(SQUARE, "quality_default", np_=2)[1])
+    a, _ = load(run(SQUARE + ["-partitioner", "ptscotch"], "quality_ptscotch", np_=2)[1])
     assert a["partitioner"] == "ptscotch" and 0 < a["partition_edge_cut"] < 64 and 1.0 <= a["partition_imbalance"] <= 1.1
+
+
+def check_box_same_as_serial(args, name, nranks, cut2):
+    """The default partitioner of the project's simplex box: each rank builds a contiguous half of the cell numbering
+    (x fastest), so on 2 ranks the cut is the straight one, cut2 faces, with half the cells each; on every count of
+    ranks, the serial displacement to 1e-8 and the boundary's face sets intact (the same contact force)."""
+    ref_attrs, ref = load(run(args, f"{name}_serial")[1])
+    assert ref_attrs["converged"] == 1 and ref_attrs["partition_edge_cut"] == 0
+    for n in nranks:
+        a, f = load(run(args, f"{name}_box_{n}", np_=n)[1])
+        assert a["converged"] == 1 and a["nprocs"] == n and a["partitioner"] == "box", (a["converged"], a["nprocs"], a["partitioner"])
+        assert a["n_cells"] == ref_attrs["n_cells"] and a["n_dofs"] == ref_attrs["n_dofs"]
+        assert displacement_difference(f, ref) <= 1e-8, (n, displacement_difference(f, ref))
+        assert abs(a["contact_force"] - ref_attrs["contact_force"]) <= 1e-8 * abs(ref_attrs["contact_force"])
+        assert a["active_vertices"] == ref_attrs["active_vertices"]
+        if n == 2:
+            assert a["partition_edge_cut"] == cut2 and a["partition_imbalance"] == 1.0, (a["partition_edge_cut"], a["partition_imbalance"])
+        else:
+            assert 0 < a["partition_edge_cut"] <= 2 * (n - 1) * cut2 and 1.0 <= a["partition_imbalance"] <= 1.01, (
+                a["partition_edge_cut"], a["partition_imbalance"])
+
+
+def test_box_built_distributed_matches_serial():
+    """The 2D square (32 x 32, MUMPS) and the 3D manufactured solution (6^3 Kuhn tetrahedra) built distributed on 2 and 3
+    ranks: the serial answer; the 2-rank cut is the 32 edges of y = 1/2, and the 2 x 36 triangles of z = 1/2."""
+    check_box_same_as_serial(SQUARE, "box_square", (2, 3), 32)
+    check_box_same_as_serial(MMS3D, "box_mms3d", (2, 3), 72)
+
+
+def test_box_partitioner_refuses_other_meshes():
+    """-partitioner box with a tensor box or a mesh file: non-zero exit, a message naming the problem, no output file."""
+    msh = os.path.join(OUT, "box_refused.msh")
+    write_gmsh_square(msh, 4, quads=False)
+    for extra, what in ((["-dm_plex_simplex", 0], "a tensor box (-dm_plex_simplex 0)"),
+                        (["-dm_plex_filename", msh], "a mesh file (-dm_plex_filename)")):
+        out = os.path.join(OUT, "box_refused.h5")
+        cmd = ["mpiexec", "-n", "2", BIN, "-output", out] + SQUARE + extra + ["-partitioner", "box"]
+        p = subprocess.run([str(c) for c in cmd], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
+        assert p.returncode != 0, "-partitioner box accepted for " + what
+        message = "-partitioner box splits the project's simplex box as it builds it; " + what + " needs ptscotch, metis or simple"
+        assert message in p.stdout, f"'{message}' not in:\n{p.stdout[-2000:]}"
+        assert not os.path.exists(out) and not os.path.exists(out + ".part"), "output left behind"
 
 
 @pytest.mark.parametrize("n", (1, 2), ids=("np1", "np2"))
@@ -101,6 +144,6 @@ def test_bad_partitioner_is_refused(n):
     cmd = ["mpiexec", "-n", str(n), BIN, "-output", out] + SQUARE + ["-partitioner", "bogus"]
     p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
     assert p.returncode != 0, "bad -partitioner accepted"
-    message = "Unknown option bogus for -partitioner. Available options: ptscotch metis simple"
+    message = "Unknown option bogus for -partitioner. Available options: ptscotch metis simple box"
     assert message in p.stdout, f"'{message}' not in:\n{p.stdout[-2000:]}"
     assert not os.path.exists(out) and not os.path.exists(out + ".part"), "output left behind"

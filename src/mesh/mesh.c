@@ -74,12 +74,17 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
   PetscCall(PetscOptionsIntArray("-dm_plex_box_faces", "Number of cells along each side of the box", "DMPlexCreateBoxMesh", faces, &nfaces, NULL));
   PetscCall(PetscOptionsRealArray("-dm_plex_box_lower", "Lower corner of the box", "DMPlexCreateBoxMesh", lower, &nlower, NULL));
   PetscCall(PetscOptionsRealArray("-dm_plex_box_upper", "Upper corner of the box", "DMPlexCreateBoxMesh", upper, &nupper, NULL));
-  partitioner = MESH_PARTITIONER_PTSCOTCH; /* PETSc 3.18's default where it has PTScotch and no ParMETIS */
+  /* the project's simplex box is built distributed; anything else is distributed by PTScotch, PETSc 3.18's default
+     where it has PTScotch and no ParMETIS */
+  partitioner = !has_file && simplex ? MESH_PARTITIONER_BOX : MESH_PARTITIONER_PTSCOTCH;
   PetscCall(PetscOptionsEnum("-partitioner", "How the cells are distributed over the ranks", "MeshPartitionDistribute", MeshPartitionerTypes,
                              (PetscEnum)partitioner, (PetscEnum *)&partitioner, NULL));
   refine = 0;
   PetscCall(PetscOptionsRangeInt("-dm_refine", "Uniform refinements, after the distribution", "DMRefine", refine, &refine, NULL, 0, 12));
   PetscOptionsEnd();
+  PetscCheck(partitioner != MESH_PARTITIONER_BOX || (!has_file && simplex), comm, PETSC_ERR_USER_INPUT,
+             "-partitioner box splits the project's simplex box as it builds it; %s needs ptscotch, metis or simple",
+             has_file ? "a mesh file (-dm_plex_filename)" : "a tensor box (-dm_plex_simplex 0)");
   PetscCall(OptionsCheckFiniteArray(comm, "-dm_plex_box_lower", dim, lower));
   PetscCall(OptionsCheckFiniteArray(comm, "-dm_plex_box_upper", dim, upper));
   for (PetscInt d = 0; d < dim; ++d) {
@@ -143,7 +148,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
       }
     }
   } else if (simplex)
-    PetscCall(MeshCreateSimplexBox(comm, dim, faces, lower, upper, dm));
+    PetscCall(MeshCreateSimplexBox(comm, dim, faces, lower, upper, (PetscBool)(partitioner == MESH_PARTITIONER_BOX), dm));
   else
     PetscCall(CompatCreateBoxMesh(comm, dim, PETSC_FALSE, faces, lower, upper, NULL, PETSC_TRUE, dm));
   PetscCall(MeshPartitionDistribute(partitioner, dm));

@@ -2,79 +2,100 @@
    with the boundary faces labelled as PETSc labels its own box meshes. */
 #include "mesh.h"
 
-/* Signed measure of the simplex (v0, ..., vdim), times dim!. */
-static PetscReal SimplexOrientation(PetscInt dim, const PetscReal coords[], const PetscInt v[])
+/* Signed measure of the simplex with vertex coordinates x[0..dim], times dim!. */
+static PetscReal SimplexOrientation(PetscInt dim, const PetscReal x[])
 {
   PetscReal a[3][3];
 
   for (PetscInt i = 0; i < dim; ++i)
-    for (PetscInt d = 0; d < dim; ++d) a[i][d] = coords[v[i + 1] * dim + d] - coords[v[0] * dim + d];
+    for (PetscInt d = 0; d < dim; ++d) a[i][d] = x[(i + 1) * dim + d] - x[d];
   if (dim == 2) return a[0][0] * a[1][1] - a[0][1] * a[1][0];
   return a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1]) - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0]) +
          a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
 }
 
-PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[], DM *dm)
+/* The coordinates of vertex v of the (n[0]+1) x (n[1]+1) x (n[2]+1) grid of vertices, numbered x fastest. */
+static void BoxVertexCoordinates(PetscInt dim, const PetscInt n[], const PetscReal lower[], const PetscReal upper[], PetscInt v, PetscReal x[])
 {
-  /* PETSc's reference triangle is counterclockwise, its reference tetrahedron has negative orientation */
-  const PetscReal sign = dim == 2 ? 1.0 : -1.0;
-  const PetscInt  nx = faces[0], ny = faces[1], nz = dim == 3 ? faces[2] : 1;
+  PetscInt idx[3];
+
+  idx[0] = v % (n[0] + 1);
+  idx[1] = (v / (n[0] + 1)) % (n[1] + 1);
+  idx[2] = v / ((n[0] + 1) * (n[1] + 1));
+  for (PetscInt d = 0; d < dim; ++d) x[d] = lower[d] + (upper[d] - lower[d]) * idx[d] / (PetscReal)n[d];
+}
+
+/* The vertices of cell c of the box: the grid's boxes x fastest, each split into 2 triangles or 6 Kuhn tetrahedra,
+   oriented as PETSc's reference cell (counterclockwise triangle, negatively oriented tetrahedron). */
+static void BoxCell(PetscInt dim, const PetscInt n[], const PetscReal lower[], const PetscReal upper[], PetscInt c, PetscInt cell[])
+{
   const PetscInt  perms[6][3] = {{0, 1, 2}, {0, 2, 1}, {1, 0, 2}, {1, 2, 0}, {2, 0, 1}, {2, 1, 0}};
-  PetscInt       *cells = NULL, ncells = 0, nverts = 0, nc = dim + 1;
-  PetscReal      *coords = NULL;
-  PetscMPIInt     rank;
+  const PetscInt  per_box = dim == 2 ? 2 : 6, nc = dim + 1, nvx = n[0] + 1, nvy = n[1] + 1;
+  const PetscInt  box = c / per_box, t = c % per_box, i = box % n[0], j = (box / n[0]) % n[1], k = dim == 3 ? box / (n[0] * n[1]) : 0;
+  const PetscReal sign = dim == 2 ? 1.0 : -1.0;
+  PetscInt        corner[8];
+  PetscReal       x[4 * 3];
+
+  for (PetscInt b = 0; b < (dim == 2 ? 4 : 8); ++b) corner[b] = ((k + ((b >> 2) & 1)) * nvy + j + ((b >> 1) & 1)) * nvx + i + (b & 1);
+  if (dim == 2) {
+    const PetscInt tri[2][3] = {{corner[0], corner[1], corner[3]}, {corner[0], corner[3], corner[2]}};
+    for (PetscInt l = 0; l < 3; ++l) cell[l] = tri[t][l];
+  } else { /* Kuhn (Freudenthal) split: the 6 monotone paths from corner 0 to corner 7 */
+    const PetscInt b1 = 1 << perms[t][0], b2 = b1 | (1 << perms[t][1]);
+    cell[0] = corner[0];
+    cell[1] = corner[b1];
+    cell[2] = corner[b2];
+    cell[3] = corner[7];
+  }
+  for (PetscInt l = 0; l < nc; ++l) BoxVertexCoordinates(dim, n, lower, upper, cell[l], &x[l * dim]);
+  if (sign * SimplexOrientation(dim, x) < 0.0) {
+    const PetscInt tmp = cell[1];
+    cell[1]            = cell[2];
+    cell[2]            = tmp;
+  }
+}
+
+/* The simplex box: serial (on rank 0, for a partitioner to distribute), or, with distribute, built in parallel: each
+   rank makes a contiguous block of the cell numbering (slabs along the last axis) and the vertices it needs, and PETSc
+   interpolates the distributed mesh; nothing is built on one rank and moved. */
+PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],
+                                    PetscBool distribute, DM *dm)
+{
+  const PetscInt n[3] = {faces[0], faces[1], dim == 3 ? faces[2] : 1};
+  const PetscInt nc   = dim + 1;
+  PetscInt       ncells_total, nverts_total, c0 = 0, c1 = 0, v0 = 0, v1 = 0, *cells = NULL;
+  PetscReal     *coords = NULL;
+  PetscMPIInt    rank, size;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  if (rank == 0) {
-    const PetscInt nvx = nx + 1, nvy = ny + 1, nvz = dim == 3 ? nz + 1 : 1;
-
-    nverts = nvx * nvy * nvz;
-    ncells = (dim == 2 ? 2 : 6) * nx * ny * nz;
-    PetscCall(PetscMalloc2(nverts * dim, &coords, ncells * nc, &cells));
-    for (PetscInt k = 0; k < nvz; ++k)
-      for (PetscInt j = 0; j < nvy; ++j)
-        for (PetscInt i = 0; i < nvx; ++i) {
-          const PetscInt v      = (k * nvy + j) * nvx + i;
-          const PetscInt idx[3] = {i, j, k}, n[3] = {nx, ny, nz};
-          for (PetscInt d = 0; d < dim; ++d) coords[v * dim + d] = lower[d] + (upper[d] - lower[d]) * idx[d] / (PetscReal)n[d];
-        }
-    ncells = 0;
-    for (PetscInt k = 0; k < nz; ++k)
-      for (PetscInt j = 0; j < ny; ++j)
-        for (PetscInt i = 0; i < nx; ++i) {
-          PetscInt corner[8];
-
-          for (PetscInt b = 0; b < (dim == 2 ? 4 : 8); ++b) corner[b] = ((k + ((b >> 2) & 1)) * nvy + j + ((b >> 1) & 1)) * nvx + i + (b & 1);
-          if (dim == 2) {
-            const PetscInt tri[2][3] = {{corner[0], corner[1], corner[3]}, {corner[0], corner[3], corner[2]}};
-            for (PetscInt t = 0; t < 2; ++t, ++ncells)
-              for (PetscInt l = 0; l < 3; ++l) cells[ncells * nc + l] = tri[t][l];
-          } else {
-            /* Kuhn (Freudenthal) split: the 6 monotone paths from corner 0 to corner 7 */
-            for (PetscInt p = 0; p < 6; ++p, ++ncells) {
-              const PetscInt b1 = 1 << perms[p][0], b2 = b1 | (1 << perms[p][1]);
-              const PetscInt tet[4] = {corner[0], corner[b1], corner[b2], corner[7]};
-              for (PetscInt l = 0; l < 4; ++l) cells[ncells * nc + l] = tet[l];
-            }
-          }
-        }
-    for (PetscInt c = 0; c < ncells; ++c) {
-      if (sign * SimplexOrientation(dim, coords, &cells[c * nc]) < 0.0) {
-        const PetscInt tmp = cells[c * nc + 1];
-        cells[c * nc + 1]  = cells[c * nc + 2];
-        cells[c * nc + 2]  = tmp;
-      }
-    }
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  ncells_total = (dim == 2 ? 2 : 6) * n[0] * n[1] * n[2];
+  nverts_total = (n[0] + 1) * (n[1] + 1) * (dim == 3 ? n[2] + 1 : 1);
+  if (size == 1) distribute = PETSC_FALSE;
+  if (!distribute) size = 1; /* everything on rank 0 */
+  if (rank < size) {
+    c0 = (PetscInt)(((PetscInt64)ncells_total * rank) / size);
+    c1 = (PetscInt)(((PetscInt64)ncells_total * (rank + 1)) / size);
+    v0 = (PetscInt)(((PetscInt64)nverts_total * rank) / size);
+    v1 = (PetscInt)(((PetscInt64)nverts_total * (rank + 1)) / size);
   }
-  PetscCall(DMPlexCreateFromCellListPetsc(comm, dim, ncells, nverts, nc, PETSC_TRUE, cells, dim, coords, dm));
+  PetscCall(PetscMalloc2((v1 - v0) * dim, &coords, (c1 - c0) * nc, &cells));
+  for (PetscInt v = v0; v < v1; ++v) BoxVertexCoordinates(dim, n, lower, upper, v, &coords[(v - v0) * dim]);
+  for (PetscInt c = c0; c < c1; ++c) BoxCell(dim, n, lower, upper, c, &cells[(c - c0) * nc]);
+  if (distribute)
+    PetscCall(DMPlexCreateFromCellListParallelPetsc(comm, dim, c1 - c0, v1 - v0, nverts_total, nc, PETSC_TRUE, cells, dim, coords, NULL, NULL, dm));
+  else
+    PetscCall(DMPlexCreateFromCellListPetsc(comm, dim, c1 - c0, v1 - v0, nc, PETSC_TRUE, cells, dim, coords, dm));
   PetscCall(PetscFree2(coords, cells));
   PetscCall(MeshLabelBoxFaces(*dm, lower, upper));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* "Face Sets" with PETSc's box numbering (2D: bottom 1, right 2, top 3, left 4;
-   3D: bottom z=0 1, top 2, front y=0 3, back 4, right x=1 5, left x=0 6), and "marker" = 1 on the boundary. */
+   3D: bottom z=0 1, top 2, front y=0 3, back 4, right x=1 5, left x=0 6), and "marker" = 1 on the boundary. A face is on
+   the boundary when its centroid lies on a side of the box: on a distributed mesh, a face at a rank's border also has
+   one cell on that rank. */
 PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[])
 {
   const PetscInt ids2[2][2] = {{4, 2}, {1, 3}};
@@ -93,17 +114,22 @@ PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal
     PetscInt  support;
     PetscReal centroid[3];
 
+    PetscBool on_side = PETSC_FALSE;
+
     PetscCall(DMPlexGetSupportSize(dm, f, &support));
-    if (support != 1) continue;
+    if (support != 1) continue; /* interior; a face with one cell may still be interior, at a rank's border */
     PetscCall(DMPlexComputeCellGeometryFVM(dm, f, NULL, centroid, NULL));
-    PetscCall(DMLabelSetValue(marker, f, 1));
     for (PetscInt d = 0; d < dim; ++d) {
       const PetscReal tol = 1e-10 * (upper[d] - lower[d]);
       for (PetscInt s = 0; s < 2; ++s) {
         const PetscReal side = s ? upper[d] : lower[d];
-        if (PetscAbsReal(centroid[d] - side) < tol) PetscCall(DMLabelSetValue(face_sets, f, dim == 2 ? ids2[d][s] : ids3[d][s]));
+        if (PetscAbsReal(centroid[d] - side) < tol) {
+          PetscCall(DMLabelSetValue(face_sets, f, dim == 2 ? ids2[d][s] : ids3[d][s]));
+          on_side = PETSC_TRUE;
+        }
       }
     }
+    if (on_side) PetscCall(DMLabelSetValue(marker, f, 1));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -5,7 +5,7 @@
 #include <petscsf.h>
 #include "mesh.h"
 
-const char *const MeshPartitionerTypes[] = {"ptscotch", "metis", "simple", "MeshPartitionerType", "MESH_PARTITIONER_", NULL};
+const char *const MeshPartitionerTypes[] = {"ptscotch", "metis", "simple", "box", "MeshPartitionerType", "MESH_PARTITIONER_", NULL};
 
 #define MESH_PARTITION_STATS_KEY "MeshPartitionStats"
 
@@ -135,7 +135,7 @@ PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm)
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  if (size > 1) {
+  if (size > 1 && type != MESH_PARTITIONER_BOX) { /* box: built distributed (MeshCreateSimplexBox()) */
     PetscCall(PetscPartitionerCreate(comm, &part));
     switch (type) {
       case MESH_PARTITIONER_PTSCOTCH:
@@ -161,6 +161,8 @@ PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm)
         PetscCall(PetscPartitionerShellSetPartition(part, size, sizes, points));
         PetscCall(PetscFree2(sizes, points));
       } break;
+      case MESH_PARTITIONER_BOX:
+        break;
     }
     PetscCall(MeshPartitionApply(part, dm));
     PetscCall(PetscPartitionerDestroy(&part));

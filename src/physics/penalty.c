@@ -2,55 +2,9 @@
    with the obstacle's gap g and normal n at the undeformed position (include/obstacle.h).
    gauss: PetscFE boundary kernels with the face Gauss rule (the paper's L2 product);
    nodal: the same term with the vertex rule, node by node with the lumped boundary mass. */
-#include "obstacle.h"
 #include "mesh.h"
+#include "penalty_kernels.h"
 #include "physics.h"
-
-/* 1/eps at the face: 1/eps of the run (constants) over the face's eps factor, held inverted by the auxiliary field of the
-   local eps (a cellwise constant) when there is one. */
-static inline PetscReal Kappa(PetscInt NfAux, const PetscScalar a[], const PetscScalar constants[])
-{
-  return PetscRealPart(constants[CONST_PENALTY]) * (NfAux > 0 ? PetscRealPart(a[0]) : 1.0);
-}
-
-static void f0_bd_penalty(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
-                          const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
-                          const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[], const PetscReal n[],
-                          PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
-{
-  PetscReal       nu[3];
-  const PetscReal d = ObstaclePenetration(dim, &constants[CONST_OBSTACLE], x, u, nu);
-  const PetscReal p = d > 0.0 ? Kappa(NfAux, a, constants) * d : 0.0;
-
-  for (PetscInt c = 0; c < dim; ++c) f0[c] = p * nu[c];
-}
-
-/* The normal nu depends on the undeformed position only, so the Jacobian is exact: (1/eps) H(u . nu - g) nu nu^T. */
-static void g0_bd_penalty(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
-                          const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
-                          const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, PetscReal u_tShift, const PetscReal x[], const PetscReal n[],
-                          PetscInt numConstants, const PetscScalar constants[], PetscScalar g0[])
-{
-  PetscReal nu[3];
-
-  if (ObstaclePenetration(dim, &constants[CONST_OBSTACLE], x, u, nu) <= 0.0) return;
-  for (PetscInt c = 0; c < dim; ++c)
-    for (PetscInt e = 0; e < dim; ++e) g0[c * dim + e] = Kappa(NfAux, a, constants) * nu[c] * nu[e];
-}
-
-/* (1/2eps) [u_n - g]_+^2, the penalty energy density, in the first component: summed over the
-   entries of the local boundary residual it gives the integral (the basis is a partition of unity). */
-static void f0_bd_penalty_energy(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
-                                 const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[],
-                                 const PetscScalar a[], const PetscScalar a_t[], const PetscScalar a_x[], PetscReal t, const PetscReal x[],
-                                 const PetscReal n[], PetscInt numConstants, const PetscScalar constants[], PetscScalar f0[])
-{
-  PetscReal       nu[3];
-  const PetscReal d = ObstaclePenetration(dim, &constants[CONST_OBSTACLE], x, u, nu);
-
-  for (PetscInt c = 1; c < dim; ++c) f0[c] = 0.0;
-  f0[0] = d > 0.0 ? 0.5 * Kappa(NfAux, a, constants) * d * d : 0.0;
-}
 
 enum { PENALTY_PART_TERM, PENALTY_PART_ENERGY }; /* parts of the penalty weak form */
 
@@ -152,7 +106,8 @@ static PetscErrorCode GetLocalSolution(DM dm, AppCtx *user, Vec X, Vec *locX)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* locF = the local boundary residual of one part of the penalty weak form (Gauss rule), over every contact face set. */
+/* locF = the local boundary residual of one part of the penalty weak form (Gauss rule), over every contact face set,
+   by PETSc's boundary integration. */
 static PetscErrorCode ComputePenaltyPartLocal(DM dm, AppCtx *user, PetscInt part, Vec X, Vec locF)
 {
   Vec locX;
@@ -161,6 +116,50 @@ static PetscErrorCode ComputePenaltyPartLocal(DM dm, AppCtx *user, PetscInt part
   PetscCall(GetLocalSolution(dm, user, X, &locX));
   PetscCall(VecZeroEntries(locF));
   PetscCall(ContactComputeBdResidual(dm, user, user->prob.wf_penalty, part, locX, locF));
+  PetscCall(DMRestoreLocalVector(dm, &locX));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The Gauss rule's term (locF) or energy (this rank's part): in closed form with the P1 assembly, otherwise by PETSc
+   (closed form: use_fe false). */
+static PetscErrorCode GaussTermLocal(DM dm, AppCtx *user, PetscBool use_fe, Vec X, Vec locF, PetscReal *energy)
+{
+  PetscFunctionBeginUser;
+  if (use_fe) {
+    PetscCall(ComputePenaltyPartLocal(dm, user, energy ? PENALTY_PART_ENERGY : PENALTY_PART_TERM, X, locF));
+    if (energy) {
+      PetscScalar e;
+
+      PetscCall(VecSum(locF, &e)); /* the entries of a face's energy residual sum to its integral (partition of unity) */
+      *energy = PetscRealPart(e);
+    }
+  } else {
+    Vec locX;
+
+    PetscCall(GetLocalSolution(dm, user, X, &locX));
+    if (energy)
+      PetscCall(PenaltyFacesEnergy(dm, user, locX, energy));
+    else {
+      PetscCall(VecZeroEntries(locF));
+      PetscCall(PenaltyFacesResidual(dm, user, locX, locF));
+    }
+    PetscCall(DMRestoreLocalVector(dm, &locX));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* J += the Gauss rule's Jacobian, in closed form or by PETSc. */
+static PetscErrorCode GaussJacobian(DM dm, AppCtx *user, PetscBool use_fe, Vec X, Mat J)
+{
+  Vec locX;
+
+  PetscFunctionBeginUser;
+  PetscCall(GetLocalSolution(dm, user, X, &locX));
+  if (use_fe)
+    PetscCall(CompatComputeBdJacobianSingle(dm, user->prob.wf_penalty, user->prob.face_sets, user->scene.bcs.ncontact, user->scene.bcs.contact_ids,
+                                            locX, J));
+  else
+    PetscCall(PenaltyFacesJacobian(dm, user, locX, J));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -176,7 +175,7 @@ PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F)
     Vec locF;
 
     PetscCall(DMGetLocalVector(dm, &locF));
-    PetscCall(ComputePenaltyPartLocal(dm, user, PENALTY_PART_TERM, X, locF));
+    PetscCall(GaussTermLocal(dm, user, (PetscBool)(user->prob.assembly != ASSEMBLY_P1), X, locF, NULL));
     PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, F));
     PetscCall(DMRestoreLocalVector(dm, &locF));
   } else {
@@ -206,12 +205,7 @@ PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J)
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS) {
-    Vec locX;
-
-    PetscCall(GetLocalSolution(dm, user, X, &locX));
-    PetscCall(CompatComputeBdJacobianSingle(dm, user->prob.wf_penalty, user->prob.face_sets, user->scene.bcs.ncontact, user->scene.bcs.contact_ids,
-                                            locX, J));
-    PetscCall(DMRestoreLocalVector(dm, &locX));
+    PetscCall(GaussJacobian(dm, user, (PetscBool)(user->prob.assembly != ASSEMBLY_P1), X, J));
   } else {
     const PetscScalar *x;
     PetscInt           rstart, rows[3];
@@ -250,15 +244,14 @@ PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy)
   *energy = 0.0;
   if (user->opt.contact.method != CONTACT_PENALTY) PetscFunctionReturn(PETSC_SUCCESS);
   if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS) {
-    Vec         locE;
-    PetscScalar e;
+    Vec       locE;
+    PetscReal e;
 
     /* each face is integrated on one rank only, so the local sums add up to the integral */
     PetscCall(DMGetLocalVector(dm, &locE));
-    PetscCall(ComputePenaltyPartLocal(dm, user, PENALTY_PART_ENERGY, X, locE));
-    PetscCall(VecSum(locE, &e));
+    PetscCall(GaussTermLocal(dm, user, (PetscBool)(user->prob.assembly != ASSEMBLY_P1), X, locE, &e));
     PetscCall(DMRestoreLocalVector(dm, &locE));
-    PetscCall(MPIU_Allreduce(&e, energy, 1, MPIU_SCALAR, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
+    PetscCall(MPIU_Allreduce(&e, energy, 1, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
   } else {
     const PetscScalar *x;
     PetscReal          e = 0.0;
@@ -417,5 +410,55 @@ PetscErrorCode PenaltyBulkMult(AppCtx *user, Vec X, Vec R)
     PetscCall(VecRestoreArray(R, &r));
     PetscCall(VecRestoreArrayRead(pb->bulk_x, &x));
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -assembly_check with the Gauss rule: the penalty residual, Jacobian and energy at X by PETSc's boundary integration
+   and in closed form, and their relative differences. */
+PetscErrorCode PenaltyCheckClosedForm(DM dm, AppCtx *user, Vec X)
+{
+  MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
+  Vec       Ffe, Fp1, locF;
+  Mat       Jfe, Jp1;
+  PetscReal e[2], eg[2], nf, nd, jf, jd;
+
+  PetscFunctionBeginUser;
+  if (user->opt.contact.method != CONTACT_PENALTY || user->opt.contact.quadrature != PENALTY_QUADRATURE_GAUSS || user->prob.assembly != ASSEMBLY_P1)
+    PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(DMGetLocalVector(dm, &locF));
+  PetscCall(DMCreateGlobalVector(dm, &Ffe));
+  PetscCall(DMCreateGlobalVector(dm, &Fp1));
+  for (PetscInt k = 0; k < 2; ++k) {
+    Vec F = k ? Fp1 : Ffe;
+
+    PetscCall(GaussTermLocal(dm, user, (PetscBool)!k, X, locF, NULL));
+    PetscCall(VecZeroEntries(F));
+    PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, F));
+    PetscCall(GaussTermLocal(dm, user, (PetscBool)!k, X, locF, &e[k]));
+  }
+  PetscCall(DMRestoreLocalVector(dm, &locF));
+  PetscCall(MPIU_Allreduce(e, eg, 2, MPIU_REAL, MPIU_SUM, comm));
+  PetscCall(VecNorm(Ffe, NORM_2, &nf));
+  PetscCall(VecAXPY(Fp1, -1.0, Ffe));
+  PetscCall(VecNorm(Fp1, NORM_2, &nd));
+  PetscCall(DMCreateMatrix(dm, &Jfe));
+  PetscCall(DMCreateMatrix(dm, &Jp1));
+  PetscCall(GaussJacobian(dm, user, PETSC_TRUE, X, Jfe));
+  PetscCall(GaussJacobian(dm, user, PETSC_FALSE, X, Jp1));
+  PetscCall(MatAssemblyBegin(Jfe, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(Jfe, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyBegin(Jp1, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(Jp1, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatNorm(Jfe, NORM_FROBENIUS, &jf));
+  PetscCall(MatAXPY(Jp1, -1.0, Jfe, SAME_NONZERO_PATTERN));
+  PetscCall(MatNorm(Jp1, NORM_FROBENIUS, &jd));
+  PetscCall(PetscPrintf(comm,
+                        "  penalty check: |F_p1 - F_fe|/|F_fe| = %.3e (|F_fe| = %.3e); ||J_p1 - J_fe||_F/||J_fe||_F = %.3e (%.3e); energy %.15e (p1) "
+                        "%.15e (fe)\n",
+                        (double)(nf > 0.0 ? nd / nf : nd), (double)nf, (double)(jf > 0.0 ? jd / jf : jd), (double)jf, (double)eg[1], (double)eg[0]));
+  PetscCall(VecDestroy(&Ffe));
+  PetscCall(VecDestroy(&Fp1));
+  PetscCall(MatDestroy(&Jfe));
+  PetscCall(MatDestroy(&Jp1));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

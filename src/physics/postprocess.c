@@ -56,6 +56,7 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   user->rec.stats.contact_force   = global[1];
   PetscCall(ContactCountActive(user, u, PETSC_FALSE, &user->rec.stats.active_vertices, NULL, NULL));
   PetscCall(PenaltyEnergy(dm, user, u, &penalty_energy));
+  if (user->opt.assembly_check) PetscCall(PenaltyCheckClosedForm(dm, user, u));
   /* 1/2 a(u,u) - L(u) on the free unknowns (exact for homogeneous Dirichlet data) + penalty energy */
   user->rec.stats.energy = 0.5 * uKu + r0u + penalty_energy;
   PetscFunctionReturn(PETSC_SUCCESS);

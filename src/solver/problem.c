@@ -46,6 +46,7 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes)
   PetscCall(VecDestroy(&user->prob.loc_bc));
   PetscCall(VecDestroy(&user->prob.work));
   PetscCall(PetscWeakFormDestroy(&user->prob.wf_penalty));
+  PetscCall(PenaltyFacesDestroy(&user->prob.penalty_faces));
   PetscCall(ContactSetDestroy(&user->prob.cset));
   PetscCall(PenaltyFreeBulkRows(user));
   PetscCall(PcReuseDestroy(user));
