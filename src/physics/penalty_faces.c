@@ -157,7 +157,7 @@ static inline void FaceDisplacement(const PenaltyFaces *pf, PetscInt dim, PetscI
     for (PetscInt c = 0; c < dim; ++c) u[c] += pf->lambda[q * pf->nv + k] * x[pf->loff[e * pf->nv + k] + c];
 }
 
-/* What the kernels need besides u and x: the constants of the discretization, and the face's 1/eps factor. */
+/* What the kernels need besides u, x and the face's 1/eps factor: the dimension and the constants of the discretization. */
 static PetscErrorCode FaceKernelData(DM dm, PetscInt *dim, PetscInt *ncst, const PetscScalar **cst)
 {
   PetscDS ds;
@@ -169,8 +169,8 @@ static PetscErrorCode FaceKernelData(DM dm, PetscInt *dim, PetscInt *ncst, const
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* locF += the penalty term at the local solution locX (energy: no; the term f0_bd_penalty); with energy, *energy =
-   this rank's integral of the energy density instead and locF is not touched. */
+/* Without energy: locF += the penalty term (f0_bd_penalty) at the local solution locX. With energy: *energy = this
+   rank's integral of the energy density (f0_bd_penalty_energy), and locF is not touched. */
 static PetscErrorCode PenaltyFacesIntegrate(DM dm, const AppCtx *user, Vec locX, Vec locF, PetscReal *energy)
 {
   const PenaltyFaces *pf       = &user->prob.penalty_faces;
