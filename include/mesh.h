@@ -15,6 +15,7 @@ PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *c
 PetscErrorCode MeshOwnedIndex(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt **index, PetscInt *nowned);
 PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **faces);
 PetscErrorCode MeshPointPosition(DM dm, PetscInt p, PetscReal x[]);
+PetscErrorCode MeshPointGlobalIndices(PetscSection lsec, PetscSection gsec, PetscInt p, PetscInt dim, PetscInt idx[]);
 
 /* mesh_gmsh_names.c */
 PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[]);

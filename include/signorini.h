@@ -244,7 +244,6 @@ typedef struct {
 /* The contact faces of this rank for the Gauss rule of the penalty term in closed form (P1 simplices,
    src/physics/penalty_faces.c): PETSc's face quadrature, mapped once. */
 typedef struct {
-  PetscBool  ready;
   PetscInt   n, nv, nq;  /* faces, vertices per face (dim), quadrature points per face */
   PetscInt  *loff;       /* [n][nv]: offset of each vertex's displacement in the local vector */
   PetscInt  *gidx;       /* [n][nv][dim]: global index of each component, -1 if fixed */

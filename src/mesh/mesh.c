@@ -331,6 +331,29 @@ PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The global index of each of the dim components of point p, as DMPlex's closure indices give them: -1 for a
+   constrained component, otherwise the point's offset in the global section (the owner's, for a ghost) plus the free
+   components before it. lsec holds the constraints, gsec the global offsets. */
+PetscErrorCode MeshPointGlobalIndices(PetscSection lsec, PetscSection gsec, PetscInt p, PetscInt dim, PetscInt idx[])
+{
+  const PetscInt *cind = NULL;
+  PetscInt        off, cdof, k = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSectionGetOffset(gsec, p, &off));
+  PetscCall(PetscSectionGetConstraintDof(lsec, p, &cdof));
+  if (cdof) PetscCall(PetscSectionGetConstraintIndices(lsec, p, &cind));
+  off = off < 0 ? -(off + 1) : off;
+  for (PetscInt c = 0; c < dim; ++c) {
+    if (k < cdof && cind[k] == c) {
+      idx[c] = -1;
+      ++k;
+    } else
+      idx[c] = off + c - k;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Position of a node: the vertex itself, or the centroid of the edge/face that carries it (Lagrange P2/Q2). */
 PetscErrorCode MeshPointPosition(DM dm, PetscInt p, PetscReal x[])
 {

@@ -1,6 +1,7 @@
 /* The penalty term on Gamma_C: (1/eps) int [u . n - g]_+ v . n and its generalized Jacobian (1/eps) H(u . n - g) n n^T,
    with the obstacle's gap g and normal n at the undeformed position (include/obstacle.h).
-   gauss: PetscFE boundary kernels with the face Gauss rule (the paper's L2 product);
+   gauss: the face Gauss rule (the paper's L2 product), in closed form on P1 simplices with -assembly p1
+          (src/physics/penalty_faces.c), otherwise by PetscFE's boundary integration of the same kernels;
    nodal: the same term with the vertex rule, node by node with the lumped boundary mass. */
 #include "mesh.h"
 #include "penalty_kernels.h"

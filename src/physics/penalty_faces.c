@@ -38,7 +38,8 @@ static PetscErrorCode ReferenceFaceVertices(PetscInt dim, PetscInt ref_face[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The faces of every contact face set (a face in two sets counts twice, as in PETSc's integration per set). */
+/* The faces of every contact face set (a face in two sets counts twice, as in PETSc's integration per set), mapped
+   once per mesh; nothing unless the penalty term has the Gauss rule and K the P1 assembly (the closed form's cases). */
 PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user)
 {
   PenaltyFaces    *pf        = &user->prob.penalty_faces;
@@ -52,6 +53,8 @@ PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user)
 
   PetscFunctionBeginUser;
   PetscCall(PenaltyFacesDestroy(pf));
+  if (user->opt.contact.method != CONTACT_PENALTY || user->opt.contact.quadrature != PENALTY_QUADRATURE_GAUSS || user->prob.assembly != ASSEMBLY_P1)
+    PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMGetLocalSection(dm, &lsec));
   PetscCall(DMGetGlobalSection(dm, &gsec));
@@ -109,23 +112,10 @@ PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user)
       PetscCall(DMPlexRestoreTransitiveClosure(dm, support[0], PETSC_TRUE, &ncl, &cl));
       PetscCheck(nv == dim + 1, PETSC_COMM_SELF, PETSC_ERR_PLIB, "cell %" PetscInt_FMT " is not a simplex", support[0]);
       for (PetscInt k = 0; k < dim; ++k) {
-        const PetscInt  p    = cellv[ref_face[li * dim + k]];
-        const PetscInt *cind = NULL;
-        PetscInt        off, goff, cdof, m = 0;
+        const PetscInt p = cellv[ref_face[li * dim + k]];
 
-        PetscCall(PetscSectionGetOffset(lsec, p, &off));
-        PetscCall(PetscSectionGetOffset(gsec, p, &goff));
-        PetscCall(PetscSectionGetConstraintDof(lsec, p, &cdof));
-        if (cdof) PetscCall(PetscSectionGetConstraintIndices(lsec, p, &cind));
-        goff                  = goff < 0 ? -(goff + 1) : goff; /* a ghost: the owner's offset */
-        pf->loff[e * dim + k] = off;
-        for (PetscInt c = 0; c < dim; ++c) { /* the free components are numbered in order, as in DMPlex's closure indices */
-          if (m < cdof && cind[m] == c) {
-            pf->gidx[(e * dim + k) * dim + c] = -1;
-            ++m;
-          } else
-            pf->gidx[(e * dim + k) * dim + c] = goff + c - m;
-        }
+        PetscCall(PetscSectionGetOffset(lsec, p, &pf->loff[e * dim + k]));
+        PetscCall(MeshPointGlobalIndices(lsec, gsec, p, dim, &pf->gidx[(e * dim + k) * dim]));
       }
       if (local_eps) {
         PetscReal diam;
@@ -136,7 +126,6 @@ PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user)
     }
   for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) PetscCall(PetscFree(faces[s]));
   PetscCall(PetscFree2(faces, nf));
-  pf->ready = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -218,7 +207,6 @@ static PetscErrorCode PenaltyFacesIntegrate(DM dm, const AppCtx *user, Vec locX,
 PetscErrorCode PenaltyFacesResidual(DM dm, AppCtx *user, Vec locX, Vec locF)
 {
   PetscFunctionBeginUser;
-  if (!user->prob.penalty_faces.ready) PetscCall(PenaltyFacesSetUp(dm, user));
   PetscCall(PenaltyFacesIntegrate(dm, user, locX, locF, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -226,7 +214,6 @@ PetscErrorCode PenaltyFacesResidual(DM dm, AppCtx *user, Vec locX, Vec locF)
 PetscErrorCode PenaltyFacesEnergy(DM dm, AppCtx *user, Vec locX, PetscReal *energy)
 {
   PetscFunctionBeginUser;
-  if (!user->prob.penalty_faces.ready) PetscCall(PenaltyFacesSetUp(dm, user));
   PetscCall(PenaltyFacesIntegrate(dm, user, locX, NULL, energy));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -242,7 +229,6 @@ PetscErrorCode PenaltyFacesJacobian(DM dm, AppCtx *user, Vec locX, Mat J)
   PetscInt            dim, ncst;
 
   PetscFunctionBeginUser;
-  if (!pf->ready) PetscCall(PenaltyFacesSetUp(dm, user));
   PetscCall(FaceKernelData(dm, &dim, &ncst, &cst));
   PetscCall(VecGetArrayRead(locX, &x));
   for (PetscInt e = 0; e < pf->n; ++e) {

@@ -2,6 +2,7 @@
    the cell loop (DMPlex's adjacency-based preallocation is slow in 3.18) and closed-form element matrices B^T D B |T|.
    The result is the matrix of DMCreateMatrix() + DMPlexSNESComputeJacobianFEM(): same type, sizes, block size,
    local-to-global mapping, nonzero pattern and values; the rows and columns of constrained dofs are absent. */
+#include "mesh.h"
 #include "physics.h"
 #include "solver.h"
 
@@ -95,8 +96,7 @@ PetscErrorCode AssemblyResolve(DM dm, AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Global index of each dof of each local vertex, as DMPlex's closure indices give them: -1 for a constrained dof,
-   otherwise the offset of the point in the global section (owner's, for a ghost) plus the free dofs before it. */
+/* Global index of each dof of each local vertex, as DMPlex's closure indices give them (MeshPointGlobalIndices()). */
 static PetscErrorCode AssemblyP1VertexIndices(DM dm, PetscInt **vidx)
 {
   PetscSection section, gsection;
@@ -108,22 +108,7 @@ static PetscErrorCode AssemblyP1VertexIndices(DM dm, PetscInt **vidx)
   PetscCall(DMGetLocalSection(dm, &section));
   PetscCall(DMGetGlobalSection(dm, &gsection));
   PetscCall(PetscMalloc1((vEnd - vStart) * dim, vidx));
-  for (PetscInt v = vStart; v < vEnd; ++v) {
-    const PetscInt *cind = NULL;
-    PetscInt        off, cdof, k = 0;
-
-    PetscCall(PetscSectionGetOffset(gsection, v, &off));
-    PetscCall(PetscSectionGetConstraintDof(section, v, &cdof));
-    if (cdof) PetscCall(PetscSectionGetConstraintIndices(section, v, &cind));
-    off = off < 0 ? -(off + 1) : off;
-    for (PetscInt c = 0; c < dim; ++c) {
-      if (k < cdof && cind[k] == c) {
-        (*vidx)[(v - vStart) * dim + c] = -1;
-        ++k;
-      } else
-        (*vidx)[(v - vStart) * dim + c] = off + c - k;
-    }
-  }
+  for (PetscInt v = vStart; v < vEnd; ++v) PetscCall(MeshPointGlobalIndices(section, gsection, v, dim, &(*vidx)[(v - vStart) * dim]));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

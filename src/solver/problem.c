@@ -24,6 +24,7 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(ContactSetCreate(dm, user, &user->prob.cset));
   if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, user));
   PetscCall(SolverAssembleBulk(dm, user));
+  PetscCall(PenaltyFacesSetUp(dm, user)); /* with -assembly p1, resolved by SolverAssembleBulk() */
   PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
   PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0));
   PetscCall(SolverComputeScales(dm, user));
