@@ -6,7 +6,7 @@
 PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm);
 PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[]);
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],
-                                    PetscBool distribute, DM *dm);
+                                    PetscBool distribute, PetscBool petsc_interpolate, PetscBool check, DM *dm);
 PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[]);
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
 PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam);
@@ -16,6 +16,10 @@ PetscErrorCode MeshOwnedIndex(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt **
 PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **faces);
 PetscErrorCode MeshPointPosition(DM dm, PetscInt p, PetscReal x[]);
 PetscErrorCode MeshPointGlobalIndices(PetscSection lsec, PetscSection gsec, PetscInt p, PetscInt dim, PetscInt idx[]);
+
+/* mesh_interpolate.c */
+PetscErrorCode MeshCreateInterpolatedSimplices(MPI_Comm comm, PetscInt dim, PetscInt ncells, PetscInt nverts, const PetscInt cells[], DM *dm);
+PetscErrorCode MeshCompareTopology(DM a, DM b, PetscInt *differences, PetscInt *compared);
 
 /* mesh_gmsh_names.c */
 PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[]);

@@ -57,7 +57,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
 {
   PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
   PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
-  PetscBool           simplex, has_file, dim_set, parallel_read = PETSC_FALSE;
+  PetscBool           simplex, has_file, dim_set, parallel_read = PETSC_FALSE, petsc_interpolate, check_interpolation;
   char                filename[PETSC_MAX_PATH_LEN] = "";
   MeshPartitionerType partitioner;
 
@@ -79,6 +79,13 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
   partitioner = !has_file && simplex ? MESH_PARTITIONER_BOX : MESH_PARTITIONER_PTSCOTCH;
   PetscCall(PetscOptionsEnum("-partitioner", "How the cells are distributed over the ranks", "MeshPartitionDistribute", MeshPartitionerTypes,
                              (PetscEnum)partitioner, (PetscEnum *)&partitioner, NULL));
+  petsc_interpolate = PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-box_petsc_interpolate",
+                             "Interpolate the simplex box (faces, edges) with DMPlexInterpolate(), not the project's direct build",
+                             "MeshCreateInterpolatedSimplices", petsc_interpolate, &petsc_interpolate, NULL));
+  check_interpolation = PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-box_interpolation_check", "Build the serial simplex box both ways and print how their topologies differ",
+                             "MeshCompareTopology", check_interpolation, &check_interpolation, NULL));
   refine = 0;
   PetscCall(PetscOptionsRangeInt("-dm_refine", "Uniform refinements, after the distribution", "DMRefine", refine, &refine, NULL, 0, 12));
   PetscOptionsEnd();
@@ -148,7 +155,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
       }
     }
   } else if (simplex)
-    PetscCall(MeshCreateSimplexBox(comm, dim, faces, lower, upper, (PetscBool)(partitioner == MESH_PARTITIONER_BOX), dm));
+    PetscCall(MeshCreateSimplexBox(comm, dim, faces, lower, upper, (PetscBool)(partitioner == MESH_PARTITIONER_BOX), petsc_interpolate,
+                                   check_interpolation, dm));
   else
     PetscCall(CompatCreateBoxMesh(comm, dim, PETSC_FALSE, faces, lower, upper, NULL, PETSC_TRUE, dm));
   PetscCall(MeshPartitionDistribute(partitioner, dm));

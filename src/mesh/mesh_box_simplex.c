@@ -59,7 +59,7 @@ static void BoxCell(PetscInt dim, const PetscInt n[], const PetscReal lower[], c
    rank makes a contiguous block of the cell numbering (slabs along the last axis) and the vertices it needs, and PETSc
    interpolates the distributed mesh; nothing is built on one rank and moved. */
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],
-                                    PetscBool distribute, DM *dm)
+                                    PetscBool distribute, PetscBool petsc_interpolate, PetscBool check, DM *dm)
 {
   const PetscInt n[3] = {faces[0], faces[1], dim == 3 ? faces[2] : 1};
   const PetscInt nc   = dim + 1;
@@ -85,8 +85,23 @@ PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt 
   for (PetscInt c = c0; c < c1; ++c) BoxCell(dim, n, lower, upper, c, &cells[(c - c0) * nc]);
   if (distribute)
     PetscCall(DMPlexCreateFromCellListParallelPetsc(comm, dim, c1 - c0, v1 - v0, nverts_total, nc, PETSC_TRUE, cells, dim, coords, NULL, NULL, dm));
-  else
+  else if (petsc_interpolate)
     PetscCall(DMPlexCreateFromCellListPetsc(comm, dim, c1 - c0, v1 - v0, nc, PETSC_TRUE, cells, dim, coords, dm));
+  else {
+    PetscCall(MeshCreateInterpolatedSimplices(comm, dim, c1 - c0, v1 - v0, cells, dm));
+    PetscCall(DMPlexBuildCoordinatesFromCellList(*dm, dim, coords));
+  }
+  if (check && !distribute) {
+    DM       ref;
+    PetscInt mismatches, compared;
+
+    PetscCall(DMPlexCreateFromCellListPetsc(comm, dim, c1 - c0, v1 - v0, nc, PETSC_TRUE, cells, dim, coords, &ref));
+    PetscCall(MeshCompareTopology(ref, *dm, &mismatches, &compared));
+    PetscCall(PetscPrintf(comm,
+                          "box interpolation check: %" PetscInt_FMT " differences from DMPlexInterpolate() in %" PetscInt_FMT " compared entries\n",
+                          mismatches, compared));
+    PetscCall(DMDestroy(&ref));
+  }
   PetscCall(PetscFree2(coords, cells));
   PetscCall(MeshLabelBoxFaces(*dm, lower, upper));
   PetscFunctionReturn(PETSC_SUCCESS);

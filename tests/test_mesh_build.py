@@ -1,0 +1,47 @@
+"""The simplex box's interpolated topology, built directly by the project (src/mesh/mesh_interpolate.c), is PETSc's:
+the same points, cones, orientations, supports, cell types, depths and coordinates as DMPlexInterpolate() gives, and the
+same numbers in the output, to the last bit.
+
+Every assertion checks what the code computes against PETSc's own construction of the same mesh, in the same run or in
+a run with -box_petsc_interpolate.
+"""
+import re
+
+import numpy as np
+import pytest
+
+from harness import load, run
+
+SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "false"]
+
+
+@pytest.mark.parametrize("dim,faces", ((2, "7,5"), (2, "32,32"), (3, "3,4,5"), (3, "8,8,8")))
+def test_direct_interpolation_is_petscs(dim, faces):
+    """-box_interpolation_check builds the box both ways and counts the entries that differ; -dm_plex_check_all runs
+    PETSc's own consistency checks (symmetry, skeleton, faces, geometry) on the directly built mesh."""
+    log, h5 = run(SQUARE + ["-dm_plex_dim", dim, "-dm_plex_box_faces", faces, "-box_interpolation_check", "-dm_plex_check_all"],
+                  f"mesh_build_check_{dim}d_{faces.replace(',', 'x')}")
+    m = re.findall(r"box interpolation check: (\d+) differences from DMPlexInterpolate\(\) in (\d+) compared entries", log)
+    assert len(m) == 1, log[-2000:]
+    differences, compared = int(m[0][0]), int(m[0][1])
+    n = [int(f) for f in faces.split(",")]
+    cells = (2 if dim == 2 else 6) * int(np.prod(n))
+    assert compared > 4 * cells, (compared, cells)  # every point's cone, support, type and depth, and the coordinates
+    assert differences == 0, (differences, compared)
+    assert load(h5)[0]["converged"] == 1
+
+
+@pytest.mark.parametrize("extra,name", ((["-dm_plex_box_faces", "24,24", "-dm_refine", 1], "2d_refined"),
+                                        (["-dm_plex_dim", 3, "-dm_plex_box_faces", "5,5,5", "-penalty_quadrature", "gauss"], "3d_gauss")))
+def test_direct_interpolation_gives_the_same_bits(extra, name):
+    """A whole run on the directly built box and on PETSc's interpolation: every field and every /run number equal to the
+    last bit (the serial build is the same mesh, so nothing may change, not even round-off)."""
+    a_attrs, a = load(run(SQUARE + extra, f"mesh_build_direct_{name}")[1])
+    b_attrs, b = load(run(SQUARE + extra + ["-box_petsc_interpolate"], f"mesh_build_petsc_{name}")[1])
+    assert a_attrs["converged"] == b_attrs["converged"] == 1
+    for key in a:
+        assert np.array_equal(a[key], b[key]), key
+    assert sorted(a_attrs) == sorted(b_attrs)
+    for key in a_attrs:
+        if not key.startswith(("time_", "peak_memory")):  # the only entries that may differ: what the runs cost
+            assert np.array_equal(a_attrs[key], b_attrs[key]), (key, a_attrs[key], b_attrs[key])
