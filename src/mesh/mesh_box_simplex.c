@@ -55,6 +55,30 @@ static void BoxCell(PetscInt dim, const PetscInt n[], const PetscReal lower[], c
   }
 }
 
+typedef struct {
+  PetscInt dim, n[3];
+} BoxGrid;
+
+/* Whether the face of vertices gid[0 .. nv-1] (global numbers) lies on a side of the box: all its vertices have grid
+   index 0, or all have n[d], in some direction d. */
+static PetscBool BoxFaceOnBoundary(PetscInt nv, const PetscInt gid[], void *ctx)
+{
+  const BoxGrid *g = (const BoxGrid *)ctx;
+
+  for (PetscInt d = 0; d < g->dim; ++d)
+    for (PetscInt side = 0; side < 2; ++side) {
+      PetscBool all = PETSC_TRUE;
+
+      for (PetscInt i = 0; i < nv && all; ++i) {
+        const PetscInt idx[3] = {gid[i] % (g->n[0] + 1), (gid[i] / (g->n[0] + 1)) % (g->n[1] + 1), gid[i] / ((g->n[0] + 1) * (g->n[1] + 1))};
+
+        all = (PetscBool)(idx[d] == (side ? g->n[d] : 0));
+      }
+      if (all) return PETSC_TRUE;
+    }
+  return PETSC_FALSE;
+}
+
 /* The simplex box: serial (on rank 0, for a partitioner to distribute), or, with distribute, built in parallel: each
    rank makes a contiguous block of the cell numbering (slabs along the last axis) and the vertices it needs, and PETSc
    interpolates the distributed mesh; nothing is built on one rank and moved. */
@@ -83,12 +107,16 @@ PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt 
   PetscCall(PetscMalloc2((v1 - v0) * dim, &coords, (c1 - c0) * nc, &cells));
   for (PetscInt v = v0; v < v1; ++v) BoxVertexCoordinates(dim, n, lower, upper, v, &coords[(v - v0) * dim]);
   for (PetscInt c = c0; c < c1; ++c) BoxCell(dim, n, lower, upper, c, &cells[(c - c0) * nc]);
-  if (distribute)
+  if (distribute && petsc_interpolate)
     PetscCall(DMPlexCreateFromCellListParallelPetsc(comm, dim, c1 - c0, v1 - v0, nverts_total, nc, PETSC_TRUE, cells, dim, coords, NULL, NULL, dm));
-  else if (petsc_interpolate)
+  else if (distribute) {
+    BoxGrid grid = {dim, {n[0], n[1], n[2]}};
+
+    PetscCall(MeshCreateInterpolatedSimplicesParallel(comm, dim, c1 - c0, v1 - v0, nverts_total, cells, coords, BoxFaceOnBoundary, &grid, dm));
+  } else if (petsc_interpolate)
     PetscCall(DMPlexCreateFromCellListPetsc(comm, dim, c1 - c0, v1 - v0, nc, PETSC_TRUE, cells, dim, coords, dm));
   else {
-    PetscCall(MeshCreateInterpolatedSimplices(comm, dim, c1 - c0, v1 - v0, cells, dm));
+    PetscCall(MeshCreateInterpolatedSimplices(comm, dim, c1 - c0, v1 - v0, cells, NULL, dm));
     PetscCall(DMPlexBuildCoordinatesFromCellList(*dm, dim, coords));
   }
   if (check && !distribute) {

@@ -3,6 +3,8 @@
    meet them, each face's cone the first cell's raw face, edges after faces. PETSc 3.18 finds faces through a generic hash
    table and a cell-type label lookup per point; here a face is found among the few faces whose smallest vertex is the
    same (a bucket per vertex), which makes this several times cheaper. */
+#include <stdlib.h>
+#include <petscsf.h>
 #include "mesh.h"
 
 /* The raw faces of a triangle (segments) and of a tetrahedron (triangles), as DMPlexGetRawFaces_Internal() lists them. */
@@ -23,12 +25,13 @@ static void SortKey(PetscInt n, PetscInt k[])
    src[s * (fs + 1) .. ] of a simplex of fs + 1 vertices, get their fs + 1 faces of fs vertices (the vertices are points
    vbase .. vbase + nv - 1). Out: the number of new faces, their vertex cones (first met), and per source its faces
    (numbered from first) and their orientations. */
-static PetscErrorCode InterpolateStep(PetscInt nsrc, PetscInt fs, const PetscInt src[], PetscInt vbase, PetscInt nv, PetscInt first, PetscInt *nnew,
-                                      PetscInt **new_cones, PetscInt face[], PetscInt ornt[])
+static PetscErrorCode InterpolateStep(PetscInt nsrc, PetscInt fs, const PetscInt src[], PetscInt vbase, PetscInt nv, PetscInt first,
+                                      const MeshInterface *itf, PetscBool edges, PetscInt *nnew, PetscInt **new_cones, PetscInt face[],
+                                      PetscInt ornt[])
 {
   const PetscInt       nf = fs + 1;
   const DMPolytopeType ft = fs == 2 ? DM_POLYTOPE_SEGMENT : DM_POLYTOPE_TRIANGLE;
-  PetscInt            *start, *fill, *bkey, *bid, *cones, n = 0;
+  PetscInt            *start, *fill, *bkey, *bid, *cones, *met, n = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PetscCalloc2(nv + 1, &start, nv, &fill));
@@ -63,7 +66,38 @@ static PetscErrorCode InterpolateStep(PetscInt nsrc, PetscInt fs, const PetscInt
         for (PetscInt i = 0; i < fs; ++i) cones[id * fs + i] = raw[i];
       }
       face[s * nf + lf] = first + id;
-      PetscCall(DMPolytopeGetVertexOrientation(ft, &cones[id * fs], raw, &ornt[s * nf + lf]));
+    }
+  /* On a distributed mesh, a face that may be shared with another rank gets the same cone on every rank: its vertices
+     ordered by global number. Those are the faces met by one local cell, with all their vertices shared, that are not on
+     the domain's boundary (where the first cell's raw face, PETSc's choice, is kept: it fixes where PETSc evaluates a
+     boundary integral); and, in 3D, every edge of shared vertices. */
+  if (itf) {
+    PetscCall(PetscCalloc1(n, &met));
+    for (PetscInt i = 0; i < nsrc * nf; ++i) ++met[face[i] - first];
+    for (PetscInt id = 0; id < n; ++id) {
+      PetscInt *c          = &cones[id * fs], g[3];
+      PetscBool all_shared = PETSC_TRUE;
+
+      for (PetscInt i = 0; i < fs; ++i) {
+        all_shared = (PetscBool)(all_shared && itf->shared[c[i] - vbase]);
+        g[i]       = itf->gid[c[i] - vbase];
+      }
+      if (!all_shared || (!edges && (met[id] != 1 || itf->on_boundary(fs, g, itf->ctx)))) continue;
+      for (PetscInt i = 1; i < fs; ++i) /* sort the cone by global vertex number */
+        for (PetscInt j = i; j > 0 && itf->gid[c[j - 1] - vbase] > itf->gid[c[j] - vbase]; --j) {
+          const PetscInt t = c[j];
+          c[j]             = c[j - 1];
+          c[j - 1]         = t;
+        }
+    }
+    PetscCall(PetscFree(met));
+  }
+  for (PetscInt s = 0; s < nsrc; ++s)
+    for (PetscInt lf = 0; lf < nf; ++lf) {
+      PetscInt raw[3];
+
+      for (PetscInt i = 0; i < fs; ++i) raw[i] = src[s * nf + (fs == 2 ? tri_faces[lf][i] : tet_faces[lf][i])];
+      PetscCall(DMPolytopeGetVertexOrientation(ft, &cones[(face[s * nf + lf] - first) * fs], raw, &ornt[s * nf + lf]));
     }
   PetscCall(PetscFree2(start, fill));
   PetscCall(PetscMalloc1(n * fs, new_cones));
@@ -76,7 +110,8 @@ static PetscErrorCode InterpolateStep(PetscInt nsrc, PetscInt fs, const PetscInt
 /* The interpolated DMPlex (topology and cell types, no coordinates) of ncells simplices of dimension dim (2 or 3) on
    vertices 0 .. nverts - 1, cells[c * (dim + 1) + i] the vertices of cell c: cells are points 0 .. ncells - 1, vertices
    follow, then faces, then (3D) edges, as DMPlexCreateFromCellListPetsc() with interpolation numbers them. */
-PetscErrorCode MeshCreateInterpolatedSimplices(MPI_Comm comm, PetscInt dim, PetscInt ncells, PetscInt nverts, const PetscInt cells[], DM *dm)
+PetscErrorCode MeshCreateInterpolatedSimplices(MPI_Comm comm, PetscInt dim, PetscInt ncells, PetscInt nverts, const PetscInt cells[],
+                                               const MeshInterface *itf, DM *dm)
 {
   const PetscInt nc = dim + 1, vbase = ncells;
   PetscInt      *src, *cell_face, *cell_ornt, *faces_v = NULL, *face_edge = NULL, *face_ornt = NULL, *edges_v = NULL;
@@ -88,11 +123,11 @@ PetscErrorCode MeshCreateInterpolatedSimplices(MPI_Comm comm, PetscInt dim, Pets
   PetscCall(PetscMalloc3(ncells * nc, &src, ncells * nc, &cell_face, ncells * nc, &cell_ornt));
   for (PetscInt i = 0; i < ncells * nc; ++i) src[i] = cells[i] + vbase;
   fbase = ncells + nverts;
-  PetscCall(InterpolateStep(ncells, dim, src, vbase, nverts, fbase, &nfaces, &faces_v, cell_face, cell_ornt));
+  PetscCall(InterpolateStep(ncells, dim, src, vbase, nverts, fbase, itf, PETSC_FALSE, &nfaces, &faces_v, cell_face, cell_ornt));
   ebase = fbase + nfaces;
   if (dim == 3) {
     PetscCall(PetscMalloc2(nfaces * 3, &face_edge, nfaces * 3, &face_ornt));
-    PetscCall(InterpolateStep(nfaces, 2, faces_v, vbase, nverts, ebase, &nedges, &edges_v, face_edge, face_ornt));
+    PetscCall(InterpolateStep(nfaces, 2, faces_v, vbase, nverts, ebase, itf, PETSC_TRUE, &nedges, &edges_v, face_edge, face_ornt));
   }
   npoints = ebase + nedges;
 
@@ -192,5 +227,181 @@ PetscErrorCode MeshCompareTopology(DM a, DM b, PetscInt *differences, PetscInt *
   }
   *differences = n;
   *compared    = m;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* A point shared with other ranks, by the sorted global numbers of its vertices. */
+typedef struct {
+  PetscInt key[3], point;
+} SharedCandidate;
+
+static int CompareCandidates(const void *a, const void *b)
+{
+  const SharedCandidate *x = (const SharedCandidate *)a, *y = (const SharedCandidate *)b;
+
+  for (PetscInt i = 0; i < 3; ++i)
+    if (x->key[i] != y->key[i]) return x->key[i] < y->key[i] ? -1 : 1;
+  return 0;
+}
+
+/* The faces and edges of the distributed mesh dm (vertices vStart .. vEnd - 1, gid their global numbers, shared: on
+   other ranks too) that another rank also has, found by their vertices' global numbers: each rank sends its candidates
+   (points of shared vertices only) to all; the lowest rank holding a point owns it. Out: the point SF, the vertices' SF
+   sfvert (udm numbering, the same for vertices) plus those points. */
+static PetscErrorCode InterfacePointSF(DM dm, PetscSF sfvert, const PetscInt gid[], const PetscBool shared[], PetscSF *sf)
+{
+  MPI_Comm           comm;
+  PetscMPIInt        rank, size, *counts, *displs;
+  PetscInt           vStart, vEnd, pStart, pEnd, ncand = 0, nall, nvleaves, nleaves = 0, *owner_rank, *owner_point, *ilocal;
+  const PetscInt    *vlocal;
+  const PetscSFNode *vremote;
+  PetscSFNode       *iremote;
+  SharedCandidate   *cand, *all;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectGetComm((PetscObject)dm, &comm));
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+  PetscCall(PetscMalloc1(pEnd - vEnd, &cand));
+  for (PetscInt p = vEnd; p < pEnd; ++p) { /* faces and edges */
+    PetscInt       *cl = NULL, ncl, nv = 0;
+    SharedCandidate c          = {{-1, -1, -1}, p};
+    PetscBool       all_shared = PETSC_TRUE;
+
+    PetscCall(DMPlexGetTransitiveClosure(dm, p, PETSC_TRUE, &ncl, &cl));
+    for (PetscInt k = 0; k < ncl; ++k) {
+      const PetscInt q = cl[2 * k];
+
+      if (q < vStart || q >= vEnd) continue;
+      all_shared  = (PetscBool)(all_shared && shared[q - vStart]);
+      c.key[nv++] = gid[q - vStart];
+    }
+    PetscCall(DMPlexRestoreTransitiveClosure(dm, p, PETSC_TRUE, &ncl, &cl));
+    if (!all_shared) continue;
+    SortKey(nv, c.key);
+    cand[ncand++] = c;
+  }
+  PetscCall(PetscMalloc2(size, &counts, size, &displs));
+  {
+    PetscMPIInt n = (PetscMPIInt)(ncand * 4);
+
+    PetscCallMPI(MPI_Allgather(&n, 1, MPI_INT, counts, 1, MPI_INT, comm));
+  }
+  displs[0] = 0;
+  for (PetscMPIInt r = 1; r < size; ++r) displs[r] = displs[r - 1] + counts[r - 1];
+  nall = (displs[size - 1] + counts[size - 1]) / 4;
+  PetscCall(PetscMalloc1(nall, &all));
+  PetscCallMPI(MPI_Allgatherv(cand, (PetscMPIInt)(ncand * 4), MPIU_INT, all, counts, displs, MPIU_INT, comm));
+  qsort(cand, (size_t)ncand, sizeof(SharedCandidate), CompareCandidates);
+  PetscCall(PetscMalloc2(ncand, &owner_rank, ncand, &owner_point));
+  for (PetscInt k = 0; k < ncand; ++k) {
+    owner_rank[k]  = rank;
+    owner_point[k] = cand[k].point;
+  }
+  for (PetscMPIInt r = 0; r < rank; ++r) /* only a lower rank can own one of this rank's points */
+    for (PetscInt j = displs[r] / 4; j < (displs[r] + counts[r]) / 4; ++j) {
+      const SharedCandidate *hit = (const SharedCandidate *)bsearch(&all[j], cand, (size_t)ncand, sizeof(SharedCandidate), CompareCandidates);
+
+      if (hit && owner_rank[hit - cand] > r) {
+        owner_rank[hit - cand]  = r;
+        owner_point[hit - cand] = all[j].point;
+      }
+    }
+  PetscCall(PetscSFGetGraph(sfvert, NULL, &nvleaves, &vlocal, &vremote));
+  for (PetscInt k = 0; k < ncand; ++k) nleaves += owner_rank[k] != rank;
+  PetscCall(PetscMalloc1(nvleaves + nleaves, &ilocal));
+  PetscCall(PetscMalloc1(nvleaves + nleaves, &iremote));
+  for (PetscInt l = 0; l < nvleaves; ++l) {
+    ilocal[l]  = vlocal ? vlocal[l] : l;
+    iremote[l] = vremote[l];
+  }
+  nleaves = nvleaves;
+  for (PetscInt k = 0; k < ncand; ++k)
+    if (owner_rank[k] != rank) {
+      ilocal[nleaves]        = cand[k].point;
+      iremote[nleaves].rank  = owner_rank[k];
+      iremote[nleaves].index = owner_point[k];
+      ++nleaves;
+    }
+  {
+    PetscSFNode swap;
+
+    PetscCall(PetscSortIntWithDataArray(nleaves, ilocal, iremote, sizeof(PetscSFNode), &swap));
+  }
+  PetscCall(PetscSFCreate(comm, sf));
+  PetscCall(PetscSFSetGraph(*sf, pEnd - pStart, nleaves, ilocal, PETSC_OWN_POINTER, iremote, PETSC_OWN_POINTER));
+  PetscCall(PetscFree2(owner_rank, owner_point));
+  PetscCall(PetscFree2(counts, displs));
+  PetscCall(PetscFree(all));
+  PetscCall(PetscFree(cand));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The distributed interpolated mesh of the simplices cells[] (global vertex numbers; this rank's block of the cells) on
+   nverts_total vertices, of which this rank holds the block of nverts_owned coordinates coords[]: PETSc numbers the local
+   vertices and links them (DMPlexBuildFromCellListParallel()), the faces and edges are built here, with the same cone
+   on every rank for a shared one, and the point SF gets the shared faces and edges. on_boundary says whether a face
+   lies on the domain's boundary. */
+PetscErrorCode MeshCreateInterpolatedSimplicesParallel(MPI_Comm comm, PetscInt dim, PetscInt ncells, PetscInt nverts_owned, PetscInt nverts_total,
+                                                       const PetscInt cells[], const PetscReal                             coords[],
+                                                       PetscBool (*on_boundary)(PetscInt, const PetscInt[], void *), void *ctx, DM *dm)
+{
+  DM              udm;
+  PetscSF         sfvert, sfpoint, sf;
+  PetscInt       *gid = NULL, *lcells, vStart, vEnd, nroots, nleaves, *cones;
+  const PetscInt *ilocal, *degree;
+  PetscBool      *shared;
+  MeshInterface   itf;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexCreateFromCellListParallelPetsc(comm, dim, ncells, nverts_owned, nverts_total, dim + 1, PETSC_FALSE, cells, dim, coords, &sfvert,
+                                                  NULL, &udm));
+  PetscCall(DMPlexGetDepthStratum(udm, 0, &vStart, &vEnd));
+  { /* the local vertices' global numbers: the owner's first vertex plus the index in its block (sfvert: roots the owned
+       blocks, leaves the local vertices in order; PETSc 3.18 crashes when asked for them) */
+    PetscMPIInt        size;
+    PetscInt          *first, nl, v0;
+    const PetscInt    *il;
+    const PetscSFNode *ir;
+
+    PetscCallMPI(MPI_Comm_size(comm, &size));
+    PetscCall(PetscMalloc1(size, &first));
+    PetscCallMPI(MPI_Scan(&nverts_owned, &v0, 1, MPIU_INT, MPI_SUM, comm));
+    v0 -= nverts_owned;
+    PetscCallMPI(MPI_Allgather(&v0, 1, MPIU_INT, first, 1, MPIU_INT, comm));
+    PetscCall(PetscSFGetGraph(sfvert, NULL, &nl, &il, &ir));
+    PetscCheck(nl == vEnd - vStart, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Expected a leaf per local vertex");
+    PetscCall(PetscMalloc1(nl, &gid));
+    for (PetscInt l = 0; l < nl; ++l) gid[il ? il[l] : l] = first[ir[l].rank] + ir[l].index;
+    PetscCall(PetscFree(first));
+  }
+  PetscCheck(vStart == ncells, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Expected the vertices after the %" PetscInt_FMT " cells, not from %" PetscInt_FMT,
+             ncells, vStart);
+  PetscCall(PetscMalloc2(ncells * (dim + 1), &lcells, vEnd - vStart, &shared));
+  PetscCall(DMPlexGetCones(udm, &cones));
+  for (PetscInt i = 0; i < ncells * (dim + 1); ++i) lcells[i] = cones[i] - vStart;
+  PetscCall(DMGetPointSF(udm, &sfpoint));
+  PetscCall(PetscSFGetGraph(sfpoint, &nroots, &nleaves, &ilocal, NULL));
+  PetscCall(PetscArrayzero(shared, vEnd - vStart));
+  for (PetscInt l = 0; l < nleaves; ++l) shared[(ilocal ? ilocal[l] : l) - vStart] = PETSC_TRUE;
+  PetscCall(PetscSFComputeDegreeBegin(sfpoint, &degree));
+  PetscCall(PetscSFComputeDegreeEnd(sfpoint, &degree));
+  for (PetscInt v = vStart; v < vEnd; ++v)
+    if (degree[v]) shared[v - vStart] = PETSC_TRUE;
+  itf.gid         = gid;
+  itf.shared      = shared;
+  itf.on_boundary = on_boundary;
+  itf.ctx         = ctx;
+  PetscCall(MeshCreateInterpolatedSimplices(comm, dim, ncells, vEnd - vStart, lcells, &itf, dm));
+  PetscCall(InterfacePointSF(*dm, sfpoint, gid, shared, &sf));
+  PetscCall(DMSetPointSF(*dm, sf));
+  PetscCall(PetscSFDestroy(&sf));
+  PetscCall(DMPlexBuildCoordinatesFromCellListParallel(*dm, dim, sfvert, coords));
+  PetscCall(PetscSFDestroy(&sfvert));
+  PetscCall(PetscFree2(lcells, shared));
+  PetscCall(PetscFree(gid));
+  PetscCall(DMDestroy(&udm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
