@@ -4,6 +4,7 @@
 
 /* mesh.c, mesh_box_simplex.c */
 PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm);
+PetscErrorCode MeshIndexCellTypes(DM dm);
 PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[]);
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],
                                     PetscBool distribute, PetscBool petsc_interpolate, PetscBool check, DM *dm);

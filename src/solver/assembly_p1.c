@@ -119,6 +119,7 @@ static PetscErrorCode AssemblyP1CellVertices(DM dm, PetscInt **cverts)
   PetscInt dim, cStart, cEnd, vStart, vEnd;
 
   PetscFunctionBeginUser;
+  PetscCall(MeshIndexCellTypes(dm)); /* a closure per cell follows */
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
@@ -468,6 +469,7 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
   PetscCall(DMGetField(dm, 0, NULL, &obj));
   PetscCall(PetscFEGetQuadrature((PetscFE)obj, &q));
   PetscCall(AssemblyP1QuadratureBasis(dm, q, cStart, &lambda, &nq, &w));
+  PetscCall(MeshIndexCellTypes(dm));              /* a closure per cell follows */
   for (PetscInt i = 0; i < nq; ++i) wref += w[i]; /* the volume of the reference cell */
   PetscCall(VecGetArrayRead(coords, &xc));
   PetscCall(VecGetArray(locF, &f));

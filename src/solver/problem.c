@@ -21,6 +21,7 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(DMCreateLocalVector(dm, &user->prob.loc_bc)); /* the Dirichlet values, zero elsewhere */
   PetscCall(VecZeroEntries(user->prob.loc_bc));
   PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, user->prob.loc_bc, 0.0, NULL, NULL, NULL));
+  PetscCall(MeshIndexCellTypes(dm)); /* before the set-up's closure loops (contact set, penalty, assembly) */
   PetscCall(ContactSetCreate(dm, user, &user->prob.cset));
   if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, user));
   PetscCall(SolverAssembleBulk(dm, user));
