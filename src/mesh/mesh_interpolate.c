@@ -266,19 +266,30 @@ static PetscErrorCode InterfacePointSF(DM dm, PetscSF sfvert, const PetscInt gid
   PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
   PetscCall(PetscMalloc1(pEnd - vEnd, &cand));
   for (PetscInt p = vEnd; p < pEnd; ++p) { /* faces and edges */
-    PetscInt       *cl = NULL, ncl, nv = 0;
+    const PetscInt *cone;
+    PetscInt        ncone, nv = 0;
     SharedCandidate c          = {{-1, -1, -1}, p};
     PetscBool       all_shared = PETSC_TRUE;
 
-    PetscCall(DMPlexGetTransitiveClosure(dm, p, PETSC_TRUE, &ncl, &cl));
-    for (PetscInt k = 0; k < ncl; ++k) {
-      const PetscInt q = cl[2 * k];
+    PetscCall(DMPlexGetConeSize(dm, p, &ncone));
+    PetscCall(DMPlexGetCone(dm, p, &cone));
+    for (PetscInt i = 0; i < ncone && all_shared; ++i) { /* the vertices: the cone, or the cones of a face's edges */
+      const PetscInt *sub  = &cone[i];
+      PetscInt        nsub = 1;
 
-      if (q < vStart || q >= vEnd) continue;
-      all_shared  = (PetscBool)(all_shared && shared[q - vStart]);
-      c.key[nv++] = gid[q - vStart];
+      if (cone[i] < vStart || cone[i] >= vEnd) {
+        PetscCall(DMPlexGetCone(dm, cone[i], &sub));
+        nsub = 2;
+      }
+      for (PetscInt j = 0; j < nsub; ++j) {
+        const PetscInt q    = sub[j];
+        PetscBool      seen = PETSC_FALSE;
+
+        all_shared = (PetscBool)(all_shared && shared[q - vStart]);
+        for (PetscInt k = 0; k < nv; ++k) seen = (PetscBool)(seen || c.key[k] == gid[q - vStart]);
+        if (!seen && nv < 3) c.key[nv++] = gid[q - vStart];
+      }
     }
-    PetscCall(DMPlexRestoreTransitiveClosure(dm, p, PETSC_TRUE, &ncl, &cl));
     if (!all_shared) continue;
     SortKey(nv, c.key);
     cand[ncand++] = c;
