@@ -119,7 +119,6 @@ static PetscErrorCode AssemblyP1CellVertices(DM dm, PetscInt **cverts)
   PetscInt dim, cStart, cEnd, vStart, vEnd;
 
   PetscFunctionBeginUser;
-  PetscCall(MeshIndexCellTypes(dm)); /* a closure per cell follows */
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
@@ -190,13 +189,61 @@ static PetscErrorCode AssemblyP1BlockSize(DM dm, PetscInt *bs)
    per vertex when bs = dim), which also counts the entries of rows owned by other ranks. Its pattern, filled into a
    helper matrix of blocks, gives the exact counts of blocks per block row, in and off the diagonal part and on and above
    the diagonal (for sbaij). */
+/* On one rank with a block per vertex, the same counts from the edges: two vertices of a simplex mesh share a cell
+   exactly when an edge joins them, so a block row holds its vertex and the free neighbours along its edges. */
+static PetscErrorCode AssemblyP1PreallocateFromEdges(DM dm, PetscInt bs, PetscInt nlocal, const PetscInt vidx[], Mat K, PetscBool *done)
+{
+  PetscMPIInt size;
+  PetscInt    dim, depth, vStart, vEnd, eStart, eEnd, nb = nlocal / bs, *dnz, *dnzu, *onz;
+
+  PetscFunctionBeginUser;
+  *done = PETSC_FALSE;
+  PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)dm), &size));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetDepth(dm, &depth));
+  if (size > 1 || bs != dim || depth != dim) PetscFunctionReturn(PETSC_SUCCESS); /* MATPREALLOCATOR then */
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 1, &eStart, &eEnd));
+  PetscCall(PetscCalloc3(nb, &dnz, nb, &dnzu, nb, &onz));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    const PetscInt i = vidx[(v - vStart) * dim];
+
+    if (i < 0) continue; /* fully constrained: no row */
+    ++dnz[i / bs];
+    ++dnzu[i / bs];
+  }
+  for (PetscInt e = eStart; e < eEnd; ++e) {
+    const PetscInt *cone;
+    PetscInt        a, b;
+
+    PetscCall(DMPlexGetCone(dm, e, &cone));
+    a = vidx[(cone[0] - vStart) * dim];
+    b = vidx[(cone[1] - vStart) * dim];
+    if (a < 0 || b < 0) continue;
+    a /= bs;
+    b /= bs;
+    ++dnz[a];
+    ++dnz[b];
+    ++dnzu[PetscMin(a, b)];
+  }
+  PetscCall(MatXAIJSetPreallocation(K, bs, dnz, onz, dnzu, onz));
+  PetscCall(MatSetOption(K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  PetscCall(PetscFree3(dnz, dnzu, onz));
+  *done = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode AssemblyP1Preallocate(DM dm, PetscInt bs, PetscInt nlocal, const PetscInt vidx[], const PetscInt cverts[], Mat K)
 {
   MPI_Comm comm = PetscObjectComm((PetscObject)dm);
   Mat      pre, H;
   PetscInt dim, cStart, cEnd, vStart, vEnd, nb = nlocal / bs, rstart, rend, *dnz, *onz, *dnzu, *onzu;
 
+  PetscBool done;
+
   PetscFunctionBeginUser;
+  PetscCall(AssemblyP1PreallocateFromEdges(dm, bs, nlocal, vidx, K, &done));
+  if (done) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
