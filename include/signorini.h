@@ -258,6 +258,7 @@ typedef struct {
   PetscReal     setup_time;                     /* set-up time of this problem, counted with its first solve */
   PetscReal     h, eps;                         /* the largest cell diameter, and eps = eps0 h^power / M for it (the node's: eps * eps_factor) */
   PetscReal     eps_factor_min, eps_factor_max; /* over the contact nodes (local eps on graded meshes), all ranks */
+  PetscBool     eps_local;                      /* the factors differ by more than rounding (1e-12 relative): eps per face */
   DMLabel       face_sets;
   ContactSet    cset;
   PetscWeakForm wf_penalty;         /* the penalty term on Gamma_C, kept out of the bulk weak form */

@@ -25,7 +25,7 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
   PetscCall(PetscPrintf(comm, "scene %s, %" PetscInt_FMT "D, method %s", user->scene.name, dim, ContactMethods[user->opt.contact.method]));
   if (user->opt.contact.method == CONTACT_PENALTY) {
     PetscCall(PetscPrintf(comm, " (%s quadrature, eps = %g", PenaltyQuadratures[user->opt.contact.quadrature], (double)user->prob.eps));
-    if (user->prob.eps_factor_min != user->prob.eps_factor_max)
+    if (user->prob.eps_local)
       PetscCall(PetscPrintf(comm, ", local %g to %g", (double)(user->prob.eps * user->prob.eps_factor_min),
                             (double)(user->prob.eps * user->prob.eps_factor_max)));
     PetscCall(PetscPrintf(comm, ")"));

@@ -69,7 +69,7 @@ static PetscErrorCode PenaltySetUpLocalEps(DM dm, AppCtx *user)
 PetscErrorCode PenaltySetUp(DM dm, AppCtx *user)
 {
   PetscFunctionBeginUser;
-  if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS && user->prob.eps_factor_min != user->prob.eps_factor_max)
+  if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS && user->prob.eps_local)
     PetscCall(PenaltySetUpLocalEps(dm, user)); /* a graded mesh: eps varies along Gamma_C */
   PetscCall(PetscWeakFormCreate(PetscObjectComm((PetscObject)dm), &user->prob.wf_penalty));
   PetscCall(PetscWeakFormSetNumFields(user->prob.wf_penalty, 1));

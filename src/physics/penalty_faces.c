@@ -43,7 +43,7 @@ static PetscErrorCode ReferenceFaceVertices(PetscInt dim, PetscInt ref_face[])
 PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user)
 {
   PenaltyFaces    *pf        = &user->prob.penalty_faces;
-  const PetscBool  local_eps = (PetscBool)(user->prob.eps_factor_min != user->prob.eps_factor_max);
+  const PetscBool  local_eps = user->prob.eps_local;
   PetscSection     lsec, gsec;
   PetscObject      fe;
   PetscQuadrature  quad;
