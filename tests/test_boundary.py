@@ -120,6 +120,13 @@ def test_local_eps(outdir, quarter_disk):
     _, c = run(["-dm_plex_box_faces", "8,8", "-penalty_quadrature", "nodal"], "uniform", output=os.path.join(outdir, "uniform.h5"))
     rc = load(c)[0]
     assert abs(rc["eps_min"] / rc["eps"] - 1) < 1e-12 and abs(rc["eps_max"] / rc["eps"] - 1) < 1e-12
+    # the tetrahedra of a 3D box differ in diameter by rounding only: one eps (the graded mesh's log names its range)
+    log_a, _ = run(["-dm_plex_filename", quarter_disk] + HERTZ_2D, "local_log", output=os.path.join(outdir, "local_log.h5"))
+    log_d, d = run(["-dm_plex_dim", 3, "-dm_plex_box_faces", "5,5,5", "-penalty_quadrature", "gauss"], "uniform3d",
+                   output=os.path.join(outdir, "uniform3d.h5"))
+    rd = load(d)[0]
+    assert ", local " in log_a and ", local " not in log_d, log_d[:400]
+    assert rd["eps_min"] != rd["eps_max"] and abs(rd["eps_max"] / rd["eps_min"] - 1) < 1e-12  # rounding, but not equal
 
 
 BAD = [  # (options after a valid general set-up on the unit square, a fragment of the message)
