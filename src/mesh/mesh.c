@@ -169,8 +169,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
 
 /* PETSc 3.18 looks a point's cell type up in the "celltype" label (DMPlexGetCellType(), called for every point of every
    DMPlexGetTransitiveClosure()). Its DMPlexGetGhostCellStratum(), which the section's creation and the insertion of
-   Dirichlet values call, turns every stratum of that label into a hash set, meant as a faster lookup: here a lookup
-   then costs about 120 ns on a 512 x 512 mesh, against 20 ns on the sorted (here contiguous) lists PETSc makes of them
+   Dirichlet values call, turns every stratum of that label into a hash set after reading it: a lookup then costs about
+   120 ns on a 512 x 512 mesh, against 20 ns on the sorted (here contiguous) lists PETSc makes of them
    on request. This asks for each stratum, so that the closure loops that follow get the fast lookup. The label's
    content is unchanged. */
 PetscErrorCode MeshIndexCellTypes(DM dm)
