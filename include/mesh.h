@@ -21,17 +21,18 @@ PetscErrorCode MeshPointGlobalIndices(PetscSection lsec, PetscSection gsec, Pets
 /* mesh_interpolate.c */
 /* The local vertices' global numbers, which are shared with other ranks, and whether a face (its vertices' global
    numbers) lies on the domain's boundary: what the direct build of a distributed mesh needs. */
+typedef PetscBool (*MeshOnBoundary)(PetscInt n, const PetscInt gid[], void *ctx);
 typedef struct {
   const PetscInt  *gid;
   const PetscBool *shared;
-  PetscBool (*on_boundary)(PetscInt n, const PetscInt gid[], void *ctx);
-  void *ctx;
+  MeshOnBoundary   on_boundary;
+  void            *ctx;
 } MeshInterface;
 PetscErrorCode MeshCreateInterpolatedSimplices(MPI_Comm comm, PetscInt dim, PetscInt ncells, PetscInt nverts, const PetscInt cells[],
                                                const MeshInterface *itf, DM *dm);
 PetscErrorCode MeshCreateInterpolatedSimplicesParallel(MPI_Comm comm, PetscInt dim, PetscInt ncells, PetscInt nverts_owned, PetscInt nverts_total,
-                                                       const PetscInt cells[], const PetscReal                             coords[],
-                                                       PetscBool (*on_boundary)(PetscInt, const PetscInt[], void *), void *ctx, DM *dm);
+                                                       const PetscInt cells[], const PetscReal coords[], MeshOnBoundary on_boundary, void *ctx,
+                                                       DM *dm);
 PetscErrorCode MeshCompareTopology(DM a, DM b, PetscInt *differences, PetscInt *compared);
 
 /* mesh_gmsh_names.c */

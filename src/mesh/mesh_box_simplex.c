@@ -14,14 +14,20 @@ static PetscReal SimplexOrientation(PetscInt dim, const PetscReal x[])
          a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]);
 }
 
-/* The coordinates of vertex v of the (n[0]+1) x (n[1]+1) x (n[2]+1) grid of vertices, numbered x fastest. */
+/* The grid indices of vertex v of the (n[0]+1) x (n[1]+1) x (n[2]+1) grid of vertices, numbered x fastest. */
+static void BoxVertexIndex(const PetscInt n[], PetscInt v, PetscInt idx[])
+{
+  idx[0] = v % (n[0] + 1);
+  idx[1] = (v / (n[0] + 1)) % (n[1] + 1);
+  idx[2] = v / ((n[0] + 1) * (n[1] + 1));
+}
+
+/* The coordinates of vertex v of the grid. */
 static void BoxVertexCoordinates(PetscInt dim, const PetscInt n[], const PetscReal lower[], const PetscReal upper[], PetscInt v, PetscReal x[])
 {
   PetscInt idx[3];
 
-  idx[0] = v % (n[0] + 1);
-  idx[1] = (v / (n[0] + 1)) % (n[1] + 1);
-  idx[2] = v / ((n[0] + 1) * (n[1] + 1));
+  BoxVertexIndex(n, v, idx);
   for (PetscInt d = 0; d < dim; ++d) x[d] = lower[d] + (upper[d] - lower[d]) * idx[d] / (PetscReal)n[d];
 }
 
@@ -70,8 +76,9 @@ static PetscBool BoxFaceOnBoundary(PetscInt nv, const PetscInt gid[], void *ctx)
       PetscBool all = PETSC_TRUE;
 
       for (PetscInt i = 0; i < nv && all; ++i) {
-        const PetscInt idx[3] = {gid[i] % (g->n[0] + 1), (gid[i] / (g->n[0] + 1)) % (g->n[1] + 1), gid[i] / ((g->n[0] + 1) * (g->n[1] + 1))};
+        PetscInt idx[3];
 
+        BoxVertexIndex(g->n, gid[i], idx);
         all = (PetscBool)(idx[d] == (side ? g->n[d] : 0));
       }
       if (all) return PETSC_TRUE;
@@ -80,8 +87,9 @@ static PetscBool BoxFaceOnBoundary(PetscInt nv, const PetscInt gid[], void *ctx)
 }
 
 /* The simplex box: serial (on rank 0, for a partitioner to distribute), or, with distribute, built in parallel: each
-   rank makes a contiguous block of the cell numbering (slabs along the last axis) and the vertices it needs, and PETSc
-   interpolates the distributed mesh; nothing is built on one rank and moved. */
+   rank makes a contiguous block of the cell numbering (slabs along the last axis) and the vertices it needs, and its faces
+   and edges are built directly (src/mesh/mesh_interpolate.c; with petsc_interpolate by PETSc's interpolation); nothing is
+   built on one rank and moved. check (one rank): print how the direct build differs from DMPlexInterpolate()'s. */
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],
                                     PetscBool distribute, PetscBool petsc_interpolate, PetscBool check, DM *dm)
 {

@@ -246,9 +246,9 @@ static int CompareCandidates(const void *a, const void *b)
 
 /* The faces and edges of the distributed mesh dm (vertices vStart .. vEnd - 1, gid their global numbers, shared: on
    other ranks too) that another rank also has, found by their vertices' global numbers: each rank sends its candidates
-   (points of shared vertices only) to all; the lowest rank holding a point owns it. Out: the point SF, the vertices' SF
-   sfvert (udm numbering, the same for vertices) plus those points. */
-static PetscErrorCode InterfacePointSF(DM dm, PetscSF sfvert, const PetscInt gid[], const PetscBool shared[], PetscSF *sf)
+   (points of shared vertices only) to all; the lowest rank holding a point owns it. Out: the point SF, the leaves of the
+   uninterpolated mesh's point SF vsf (its vertices, numbered as in dm) plus those points. */
+static PetscErrorCode InterfacePointSF(DM dm, PetscSF vsf, const PetscInt gid[], const PetscBool shared[], PetscSF *sf)
 {
   MPI_Comm           comm;
   PetscMPIInt        rank, size, *counts, *displs;
@@ -320,7 +320,7 @@ static PetscErrorCode InterfacePointSF(DM dm, PetscSF sfvert, const PetscInt gid
         owner_point[hit - cand] = all[j].point;
       }
     }
-  PetscCall(PetscSFGetGraph(sfvert, NULL, &nvleaves, &vlocal, &vremote));
+  PetscCall(PetscSFGetGraph(vsf, NULL, &nvleaves, &vlocal, &vremote));
   for (PetscInt k = 0; k < ncand; ++k) nleaves += owner_rank[k] != rank;
   PetscCall(PetscMalloc1(nvleaves + nleaves, &ilocal));
   PetscCall(PetscMalloc1(nvleaves + nleaves, &iremote));
@@ -356,12 +356,12 @@ static PetscErrorCode InterfacePointSF(DM dm, PetscSF sfvert, const PetscInt gid
    on every rank for a shared one, and the point SF gets the shared faces and edges. on_boundary says whether a face
    lies on the domain's boundary. */
 PetscErrorCode MeshCreateInterpolatedSimplicesParallel(MPI_Comm comm, PetscInt dim, PetscInt ncells, PetscInt nverts_owned, PetscInt nverts_total,
-                                                       const PetscInt cells[], const PetscReal                             coords[],
-                                                       PetscBool (*on_boundary)(PetscInt, const PetscInt[], void *), void *ctx, DM *dm)
+                                                       const PetscInt cells[], const PetscReal coords[], MeshOnBoundary on_boundary, void *ctx,
+                                                       DM *dm)
 {
   DM              udm;
   PetscSF         sfvert, sfpoint, sf;
-  PetscInt       *gid = NULL, *lcells, vStart, vEnd, nroots, nleaves, *cones;
+  PetscInt       *gid = NULL, *lcells, vStart, vEnd, nleaves, *cones;
   const PetscInt *ilocal, *degree;
   PetscBool      *shared;
   MeshInterface   itf;
@@ -370,6 +370,8 @@ PetscErrorCode MeshCreateInterpolatedSimplicesParallel(MPI_Comm comm, PetscInt d
   PetscCall(DMPlexCreateFromCellListParallelPetsc(comm, dim, ncells, nverts_owned, nverts_total, dim + 1, PETSC_FALSE, cells, dim, coords, &sfvert,
                                                   NULL, &udm));
   PetscCall(DMPlexGetDepthStratum(udm, 0, &vStart, &vEnd));
+  PetscCheck(vStart == ncells, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Expected the vertices after the %" PetscInt_FMT " cells, not from %" PetscInt_FMT,
+             ncells, vStart);
   { /* the local vertices' global numbers: the owner's first vertex plus the index in its block (sfvert: roots the owned
        blocks, leaves the local vertices in order; PETSc 3.18 crashes when asked for them) */
     PetscMPIInt        size;
@@ -388,13 +390,11 @@ PetscErrorCode MeshCreateInterpolatedSimplicesParallel(MPI_Comm comm, PetscInt d
     for (PetscInt l = 0; l < nl; ++l) gid[il ? il[l] : l] = first[ir[l].rank] + ir[l].index;
     PetscCall(PetscFree(first));
   }
-  PetscCheck(vStart == ncells, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Expected the vertices after the %" PetscInt_FMT " cells, not from %" PetscInt_FMT,
-             ncells, vStart);
   PetscCall(PetscMalloc2(ncells * (dim + 1), &lcells, vEnd - vStart, &shared));
   PetscCall(DMPlexGetCones(udm, &cones));
   for (PetscInt i = 0; i < ncells * (dim + 1); ++i) lcells[i] = cones[i] - vStart;
   PetscCall(DMGetPointSF(udm, &sfpoint));
-  PetscCall(PetscSFGetGraph(sfpoint, &nroots, &nleaves, &ilocal, NULL));
+  PetscCall(PetscSFGetGraph(sfpoint, NULL, &nleaves, &ilocal, NULL));
   PetscCall(PetscArrayzero(shared, vEnd - vStart));
   for (PetscInt l = 0; l < nleaves; ++l) shared[(ilocal ? ilocal[l] : l) - vStart] = PETSC_TRUE;
   PetscCall(PetscSFComputeDegreeBegin(sfpoint, &degree));

@@ -1,5 +1,6 @@
-/* The bulk elastic matrix K for P1 on simplices, without PetscFE: the preallocation by a MATPREALLOCATOR dry run of
-   the cell loop (DMPlex's adjacency-based preallocation is slow in 3.18) and closed-form element matrices B^T D B |T|.
+/* The bulk elastic matrix K for P1 on simplices, without PetscFE: the preallocation from the mesh's edges (one rank, a
+   block per vertex) or by a MATPREALLOCATOR dry run of the cell loop (DMPlex's adjacency-based preallocation is slow in
+   3.18), and closed-form element matrices B^T D B |T|.
    The result is the matrix of DMCreateMatrix() + DMPlexSNESComputeJacobianFEM(): same type, sizes, block size,
    local-to-global mapping, nonzero pattern and values; the rows and columns of constrained dofs are absent. */
 #include "mesh.h"
@@ -185,12 +186,9 @@ static PetscErrorCode AssemblyP1BlockSize(DM dm, PetscInt *bs)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Preallocates K by a dry run of the cell loop into a MATPREALLOCATOR whose rows and columns are blocks of bs dofs (one
-   per vertex when bs = dim), which also counts the entries of rows owned by other ranks. Its pattern, filled into a
-   helper matrix of blocks, gives the exact counts of blocks per block row, in and off the diagonal part and on and above
-   the diagonal (for sbaij). */
-/* On one rank with a block per vertex, the same counts from the edges: two vertices of a simplex mesh share a cell
-   exactly when an edge joins them, so a block row holds its vertex and the free neighbours along its edges. */
+/* The exact preallocation of K on one rank with a block per vertex, from the edges: two vertices of a simplex mesh
+   share a cell exactly when an edge joins them, so a block row holds its vertex and the free neighbours along its
+   edges. */
 static PetscErrorCode AssemblyP1PreallocateFromEdges(DM dm, PetscInt bs, PetscInt nlocal, const PetscInt vidx[], Mat K, PetscBool *done)
 {
   PetscMPIInt size;
@@ -233,12 +231,15 @@ static PetscErrorCode AssemblyP1PreallocateFromEdges(DM dm, PetscInt bs, PetscIn
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Preallocates K by a dry run of the cell loop into a MATPREALLOCATOR whose rows and columns are blocks of bs dofs (one
+   per vertex when bs = dim), which also counts the entries of rows owned by other ranks. Its pattern, filled into a
+   helper matrix of blocks, gives the exact counts of blocks per block row, in and off the diagonal part and on and above
+   the diagonal (for sbaij); AssemblyP1PreallocateFromEdges() is tried first. */
 static PetscErrorCode AssemblyP1Preallocate(DM dm, PetscInt bs, PetscInt nlocal, const PetscInt vidx[], const PetscInt cverts[], Mat K)
 {
-  MPI_Comm comm = PetscObjectComm((PetscObject)dm);
-  Mat      pre, H;
-  PetscInt dim, cStart, cEnd, vStart, vEnd, nb = nlocal / bs, rstart, rend, *dnz, *onz, *dnzu, *onzu;
-
+  MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
+  Mat       pre, H;
+  PetscInt  dim, cStart, cEnd, vStart, vEnd, nb = nlocal / bs, rstart, rend, *dnz, *onz, *dnzu, *onzu;
   PetscBool done;
 
   PetscFunctionBeginUser;
