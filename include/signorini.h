@@ -115,6 +115,7 @@ typedef struct {
   PetscInt          pc_reuse_changes;    /*   at most this many changed nodes since the build */
   PetscBool         pc_update;           /* multigrid (GAMG): the coarse operators follow the Jacobian instead of rebuilds */
   PetscBool         pc_update_check;     /*   and each update is compared with the full Galerkin products */
+  PetscBool         pc_update_esteig;    /*   and the finest smoother estimates its eigenvalues again at each update */
   PetscInt          grid_sequence;       /* solve on the mesh and on this many uniform refinements of it, each from the last */
   PetscReal        *eps0_sweep;          /* eps0 values solved in turn on the final mesh, each from the last solution (any number) */
   PetscInt          n_sweep;
@@ -141,6 +142,14 @@ typedef struct {
   Mat          clocal;     /* this rank's part of its product on the first coarse level */
   PetscInt     nlevels;
   Mat         *dcoarse; /* [nlevels - 1]: the change on the coarser levels, coarsest first */
+  /* the finest level's Chebyshev interval, bounded instead of estimated again at each update (BoundFinestSmoother()) */
+  PetscBool built_on_K;       /* the build's Jacobian was K itself in the contact rows (no penalty term yet) */
+  PetscBool bound_set;        /* the build's estimate has been read, and the bound applies */
+  PetscBool bound_read;       /* ... has been looked for */
+  PetscReal est_min, est_max; /* the build's Chebyshev estimate of the extreme eigenvalues of diag(K)^-1 K */
+  PetscInt  est_steps;        /* the steps of its estimator */
+  PetscReal tform[4];         /* Chebyshev's transform of estimates into its interval (-ksp_chebyshev_esteig) */
+  Vec       pdiag, pcols;     /* the penalty term's diagonal, and its values at the contact rows' columns */
 } PcReuse;
 
 /* The nodes of Gamma_C owned by this rank with at least one free component: the unknowns the contact acts on. */

@@ -24,6 +24,7 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X);
 PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user);
 PetscErrorCode PcReuseDestroy(AppCtx *user);
+PetscErrorCode SmootherBoundFinest(PC pc, PetscInt nlevels, AppCtx *user, const PetscScalar jvals[], PetscBool check);
 
 /* assembly_p1.c */
 PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscBool *check);

@@ -111,6 +111,33 @@ def test_gamg_hierarchy_update_is_the_rebuild(np_, eps0):
     assert max_diff(upd, rebuilt) < 1e-8
 
 
+@pytest.mark.parametrize(
+    "np_, extra",
+    [
+        (1, ["-dm_plex_box_faces", "64,64"]),
+        (2, ["-dm_plex_box_faces", "48,48", "-penalty_quadrature", "nodal", "-penalty_eps0", "1e-6"]),
+        (2, ["-dm_plex_dim", "3", "-dm_plex_box_faces", "8,8,8"]),
+    ],
+)
+def test_finest_smoother_interval_is_bounded_not_estimated(np_, extra):
+    """With the updates, the finest level's Chebyshev interval comes from the build's estimate on K and a Gershgorin
+    bound of the penalty term (src/solver/smoother_bound.c), not from a new estimate. -contact_pc_update_check
+    estimates afresh on every updated Jacobian: the interval's top stays above 1.1 times that estimate (what PETSc's
+    own re-estimate would give, to 1%), and the answer is the one of the re-estimates (-contact_pc_update_esteig)."""
+    args = SQUARE + extra + ["-options_file", "options/solvers/gamg.yaml"]
+    tag = f"smoother_bound_{np_}_{len(extra)}"
+    out, bounded = run(args + ["-contact_pc_update_check"], tag, np_=np_)
+    _, estimated = run(args + ["-contact_pc_update_esteig"], tag + "_esteig", np_=np_)
+    a, _ = load(bounded)
+    b, _ = load(estimated)
+    ratios = [float(x) for x in re.findall(r"pc update check: finest level: .* interval top / fresh estimate = (\S+)", out)]
+    assert a["converged"] == b["converged"] == 1 and a["pc_updates"] >= 2
+    assert len(ratios) == a["pc_updates"], (len(ratios), a["pc_updates"])
+    assert min(ratios) >= 1.1 * 0.99, ratios
+    assert a["newton_its"] == b["newton_its"]
+    assert max_diff(bounded, estimated) < 1e-8
+
+
 @pytest.mark.parametrize("eps0", [1.0, 1e-6])
 def test_inexact_newton_default_gives_the_exact_newton_answer(eps0):
     """Eisenstat-Walker's linear tolerances (bounded by 0.01) are the penalty method's default with GAMG: the answer is

@@ -66,6 +66,11 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscCall(PetscOptionsBool("-contact_pc_update_check",
                              "After each update, print each coarse operator's distance to the Galerkin product of the level above computed in full",
                              NULL, opts->pc_update_check, &opts->pc_update_check, NULL));
+  opts->pc_update_esteig = PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-contact_pc_update_esteig",
+                             "With the updates: the finest level's Chebyshev smoother estimates its eigenvalues again at each update, "
+                             "instead of keeping the build's interval when the penalty term provably does not raise them",
+                             NULL, opts->pc_update_esteig, &opts->pc_update_esteig, NULL));
   opts->grid_sequence = 0;
   PetscCall(PetscOptionsInt("-contact_grid_sequence",
                             "Nested iteration: solve on the mesh, then on N uniform refinements of it, each from the interpolated last solution",

@@ -239,6 +239,8 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
     PetscCall(KSPGetOperators(smoother, &A, NULL));
     PetscCall(KSPSetOperators(smoother, A, A));
   }
+  /* except the finest level's Chebyshev interval, which a bound keeps (smoother_bound.c) */
+  if (!user->opt.contact.pc_update_esteig) PetscCall(SmootherBoundFinest(pc, nlevels, user, r->built_vals, user->opt.contact.pc_update_check));
   r->updates++;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -322,6 +324,14 @@ PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user)
     if (!r->recorded) PetscCall(PetscMalloc2(pb->bulk_ptr[pb->nbulk_rows], &r->built_vals, pb->bulk_ptr[pb->nbulk_rows], &r->dvals));
     r->recorded = PETSC_TRUE;
     PetscCall(ContactRowValues(user, r->built_vals));
+    {
+      const PetscInt nnz  = pb->bulk_ptr[pb->nbulk_rows];
+      PetscBool      on_K = PETSC_TRUE;
+
+      PetscCheck(!r->bound_set, PetscObjectComm((PetscObject)pc), PETSC_ERR_PLIB, "a rebuild after the finest smoother's interval was bounded");
+      for (PetscInt k = 0; k < nnz && on_K; ++k) on_K = (PetscBool)(r->built_vals[k] == pb->bulk_vals[k]);
+      PetscCall(MPIU_Allreduce(&on_K, &r->built_on_K, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)pc)));
+    }
     PetscCall(DestroyProducts(r)); /* a rebuild may make new prolongators: new patterns */
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -335,6 +345,8 @@ PetscErrorCode PcReuseDestroy(AppCtx *user)
   PetscFunctionBeginUser;
   PetscCall(DestroyProducts(r));
   PetscCall(PetscFree2(r->built_vals, r->dvals));
+  PetscCall(VecDestroy(&r->pdiag));
+  PetscCall(VecDestroy(&r->pcols));
   PetscCall(PetscMemzero(r, sizeof(*r)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
