@@ -142,7 +142,7 @@ typedef struct {
   Mat          clocal;     /* this rank's part of its product on the first coarse level */
   PetscInt     nlevels;
   Mat         *dcoarse; /* [nlevels - 1]: the change on the coarser levels, coarsest first */
-  /* the finest level's Chebyshev interval, bounded instead of estimated again at each update (BoundFinestSmoother()) */
+  /* the finest level's Chebyshev interval, bounded instead of estimated again at each update (SmootherBoundFinest(), smoother_bound.c) */
   PetscBool built_on_K;       /* the build's Jacobian was K itself in the contact rows (no penalty term yet) */
   PetscBool bound_set;        /* the build's estimate has been read, and the bound applies */
   PetscBool bound_read;       /* ... has been looked for */
