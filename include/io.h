@@ -16,3 +16,5 @@ PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, cha
 /* output_hdf5.c */
 PetscErrorCode OutputGetOptions(MPI_Comm comm, RunOptions *opt);
 PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u);
+/* output_mesh.c */
+PetscErrorCode OutputViewMesh(DM dm, PetscViewer viewer);

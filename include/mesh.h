@@ -35,6 +35,21 @@ PetscErrorCode MeshCreateInterpolatedSimplicesParallel(MPI_Comm comm, PetscInt d
                                                        DM *dm);
 PetscErrorCode MeshCompareTopology(DM a, DM b, PetscInt *differences, PetscInt *compared);
 
+/* mesh_closure.c: DMPlexGetTransitiveClosure() without the cell-type lookups, where each depth has one cell type */
+typedef struct {
+  DM             dm;
+  PetscInt       dim, vstart, vend; /* the vertices */
+  PetscInt       depth, start[4], end[4];
+  DMPolytopeType type[4];    /* the type of every point of each depth */
+  PetscBool      by_depth;   /* else DMPlexGetTransitiveClosure() */
+  PetscInt       max_points; /* of a closure or star */
+  PetscInt      *points, *fifo;
+} MeshClosure;
+PetscErrorCode MeshClosureCreate(DM dm, MeshClosure *mc);
+PetscErrorCode MeshClosureDestroy(MeshClosure *mc);
+PetscErrorCode MeshClosureGet(MeshClosure *mc, PetscInt p, PetscBool use_cone, PetscInt *n, const PetscInt **points);
+PetscErrorCode MeshClosureCheck(DM dm, PetscInt *differences, PetscBool *by_depth);
+
 /* mesh_gmsh_names.c */
 PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[]);
 

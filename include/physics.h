@@ -1,6 +1,7 @@
 /* Physics: linear elasticity, the contact set, the penalty term, the SNESVI bounds, the contact quantities after the solve (src/physics/). */
 #pragma once
 #include "signorini.h"
+#include "mesh.h" /* MeshClosure */
 
 /* elasticity.c */
 PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degree);
@@ -8,7 +9,7 @@ PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user);
 PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user);
 PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace);
 PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, PetscReal mu, const PetscReal x[], PetscScalar Ke[]);
-PetscErrorCode ElasticityP1CellVertices(DM dm, PetscSection csec, PetscSection lsec, const PetscScalar xc[], PetscInt c, PetscReal x[],
+PetscErrorCode ElasticityP1CellVertices(MeshClosure *mc, PetscSection csec, PetscSection lsec, const PetscScalar xc[], PetscInt c, PetscReal x[],
                                         PetscInt off[], PetscInt *nv);
 PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Vec locU, Vec locF);
 

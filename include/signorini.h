@@ -248,6 +248,7 @@ typedef struct {
   PetscBool      assembly_check; /* -assembly_check: assemble K both ways and compare */
   PetscBool      perf_bandwidth; /* -perf_bandwidth: measure the memory bandwidths after the solve */
   char           output[PETSC_MAX_PATH_LEN];
+  PetscBool      output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
 } RunOptions;
 
 /* The contact faces of this rank for the Gauss rule of the penalty term in closed form (P1 simplices,

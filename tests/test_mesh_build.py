@@ -66,3 +66,27 @@ def test_distributed_direct_build_gives_petscs_answer(np_, extra, name):
     for key in ("active_vertices", "newton_its", "n_cells", "n_dofs"):
         assert a_attrs[key] == b_attrs[key], (key, a_attrs[key], b_attrs[key])
     assert abs(a_attrs["contact_force"] - b_attrs["contact_force"]) <= 1e-10 * abs(b_attrs["contact_force"])
+
+
+@pytest.mark.parametrize("np_,extra,name", (
+    (1, ["-dm_plex_box_faces", "9,7"], "tri"),
+    (1, ["-dm_plex_dim", 3, "-dm_plex_box_faces", "3,4,2"], "tet"),
+    (1, ["-dm_plex_simplex", 0, "-dm_plex_box_faces", "6,5"], "quad"),
+    (1, ["-dm_plex_dim", 3, "-dm_plex_simplex", 0, "-dm_plex_box_faces", "3,2,3"], "hex"),
+    (1, ["-dm_plex_filename", "options/meshes/square8.msh"], "gmsh"),
+    (2, ["-dm_plex_dim", 3, "-dm_plex_box_faces", "4,3,5", "-dm_refine", 1], "tet_np2"),
+    (2, ["-dm_plex_dim", 3, "-dm_plex_box_faces", "4,3,5", "-box_petsc_interpolate", "-partitioner", "ptscotch"], "tet_np2_petsc")))
+def test_closure_walk_is_petscs(np_, extra, name):
+    """-mesh_closure_check walks every point's closure and star by depth (src/mesh/mesh_closure.c: the cell type of each
+    depth instead of a label lookup per point) and compares it with DMPlexGetTransitiveClosure(), point, orientation
+    and order. The walk by depth must serve on every rank of these meshes (one cell type per depth), so the comparison
+    is between the two codes, not of PETSc with itself."""
+    log, h5 = run(SQUARE + extra + ["-mesh_closure_check"], f"mesh_closure_{name}", np_=np_)
+    m = re.findall(r"closure check: (\d+) differences from DMPlexGetTransitiveClosure\(\) in (\d+) closures and stars; walk by depth on (\d+) rank",
+                   log)
+    assert len(m) == 1, log[-2000:]
+    differences, compared, by_depth = (int(v) for v in m[0])
+    assert by_depth == np_
+    assert compared > 0 and compared % 2 == 0
+    assert differences == 0, (differences, compared)
+    assert load(h5)[0]["converged"] == 1

@@ -7,6 +7,8 @@ import sys
 import xml.etree.ElementTree as ET
 
 import h5py
+import numpy as np
+import pytest
 
 from harness import ENV, OUT, ROOT, load, read_runs, run, write_gmsh_square
 
@@ -73,3 +75,36 @@ def test_gmsh_mesh_matches_builtin_box(outdir):
     assert a_msh["converged"] == 1 and a_msh["n_cells"] == a_box["n_cells"]
     for key in ("contact_force", "energy", "max_penetration"):
         assert abs(a_msh[key] - a_box[key]) <= 1e-10 * abs(a_box[key]), f"{key}: {a_msh[key]} vs {a_box[key]}"
+
+
+@pytest.mark.parametrize("np_,extra,name", (
+    (1, ["-dm_plex_box_faces", "9,7"], "tri"),
+    (1, ["-dm_plex_dim", 3, "-dm_plex_box_faces", "3,4,2"], "tet"),
+    (1, ["-dm_plex_simplex", 0, "-dm_plex_box_faces", "6,5"], "quad"),
+    (1, ["-dm_plex_dim", 3, "-dm_plex_simplex", 0, "-dm_plex_box_faces", "3,2,3"], "hex"),
+    (2, ["-dm_plex_box_faces", "9,7"], "tri_np2"),
+    (3, ["-dm_plex_dim", 3, "-dm_plex_box_faces", "4,3,5"], "tet_np3"),
+    (2, ["-dm_plex_dim", 3, "-dm_plex_simplex", 0, "-dm_plex_box_faces", "3,2,3"], "hex_np2"),
+    (2, ["-dm_plex_filename", "options/meshes/square8.msh"], "gmsh_np2")))
+def test_mesh_datasets_are_dmviews(np_, extra, name):
+    """The project writes /geometry/vertices and /viz/topology/cells itself (src/io/output_mesh.c); -output_dmview has
+    PETSc's DMView() write them. Both files must hold the same datasets, with the same shapes, types, attributes and
+    values to the last bit (and on one rank every other dataset too, the times aside)."""
+    files = []
+    for how, flag in (("own", []), ("dmview", ["-output_dmview"])):
+        _, h5 = run(["-options_file", "options/square.yaml", "-contact_monitor", "0"] + extra + flag, f"mesh_view_{name}_{how}", np_=np_)
+        files.append(h5)
+    with h5py.File(files[0], "r") as a, h5py.File(files[1], "r") as b:
+        names_a, names_b = [], []
+        a.visit(names_a.append)
+        b.visit(names_b.append)
+        assert sorted(names_a) == sorted(names_b)
+        for key in ("geometry/vertices", "viz/topology/cells"):
+            assert a[key].shape == b[key].shape and a[key].dtype == b[key].dtype, key
+            assert np.array_equal(a[key][...], b[key][...]), key
+            assert dict(a[key].attrs) == dict(b[key].attrs), key
+        assert a["viz/topology/cells"].shape[0] == a["run"].attrs["n_cells"]
+        if np_ == 1:
+            for key in names_a:
+                if isinstance(a[key], h5py.Dataset) and not key.startswith("solves/time"):
+                    assert np.array_equal(a[key][...], b[key][...]), key

@@ -18,6 +18,9 @@ PetscErrorCode OutputGetOptions(MPI_Comm comm, RunOptions *opt)
   PetscOptionsBegin(comm, NULL, "Output", "Signorini");
   PetscCall(PetscSNPrintf(opt->output, sizeof(opt->output), "output/%s.h5", opt->scene_name));
   PetscCall(PetscOptionsString("-output", "HDF5 output file (default output/<scene>.h5)", NULL, opt->output, opt->output, sizeof(opt->output), &set));
+  opt->output_dmview = PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-output_dmview", "Write the mesh with PETSc's DMView() (the same datasets, slower)", "OutputViewMesh",
+                             opt->output_dmview, &opt->output_dmview, NULL));
   PetscOptionsEnd();
   PetscCall(OutputFileCheckTarget(comm, opt->output, (PetscBool)!set)); /* the default directory is created; a user's must exist */
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -402,7 +405,10 @@ static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, const char h5
 
   PetscCall(PetscViewerHDF5Open(comm, h5tmp, FILE_MODE_WRITE, &viewer));
   PetscCall(PetscViewerPushFormat(viewer, PETSC_VIEWER_HDF5_VIZ));
-  PetscCall(DMView(dm, viewer));
+  if (user->opt.output_dmview)
+    PetscCall(DMView(dm, viewer));
+  else
+    PetscCall(OutputViewMesh(dm, viewer)); /* DMView() without its closures per cell */
   PetscCall(WriteVertexFields(dm, user, u, viewer));
   PetscCall(PetscViewerPopFormat(viewer));
   PetscCall(WriteRunMetadata(dm, user, u, viewer, ncells, nverts));

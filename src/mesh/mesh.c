@@ -57,7 +57,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
 {
   PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
   PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
-  PetscBool           simplex, has_file, dim_set, parallel_read = PETSC_FALSE, petsc_interpolate, check_interpolation;
+  PetscBool           simplex, has_file, dim_set, parallel_read = PETSC_FALSE, petsc_interpolate, check_interpolation, check_closures;
   char                filename[PETSC_MAX_PATH_LEN] = "";
   MeshPartitionerType partitioner;
 
@@ -86,6 +86,10 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
   check_interpolation = PETSC_FALSE;
   PetscCall(PetscOptionsBool("-box_interpolation_check", "Build the serial simplex box both ways and print how their topologies differ",
                              "MeshCompareTopology", check_interpolation, &check_interpolation, NULL));
+  check_closures = PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-mesh_closure_check",
+                             "Compare every point's closure and star with DMPlexGetTransitiveClosure() and print the differences", "MeshClosureCheck",
+                             check_closures, &check_closures, NULL));
   refine = 0;
   PetscCall(PetscOptionsRangeInt("-dm_refine", "Uniform refinements, after the distribution", "DMRefine", refine, &refine, NULL, 0, 12));
   PetscOptionsEnd();
@@ -164,6 +168,20 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
   PetscCall(DMSetFromOptions(*dm)); /* -dm_refine on all ranks, -dm_mat_type, PETSc's checks */
   PetscCall(PetscObjectSetName((PetscObject)*dm, "mesh"));
   PetscCall(DMViewFromOptions(*dm, NULL, "-dm_view"));
+  if (check_closures) {
+    PetscInt  counts[3], pStart, pEnd;
+    PetscBool by_depth;
+
+    PetscCall(MeshClosureCheck(*dm, &counts[0], &by_depth));
+    PetscCall(DMPlexGetChart(*dm, &pStart, &pEnd));
+    counts[1] = 2 * (pEnd - pStart);
+    counts[2] = by_depth ? 1 : 0;
+    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, counts, 3, MPIU_INT, MPI_SUM, comm));
+    PetscCall(PetscPrintf(comm,
+                          "  closure check: %" PetscInt_FMT " differences from DMPlexGetTransitiveClosure() in %" PetscInt_FMT
+                          " closures and stars; walk by depth on %" PetscInt_FMT " rank(s)\n",
+                          counts[0], counts[1], counts[2]));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -265,21 +265,17 @@ PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, Pets
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* locF += K_T u_T on every P1 simplex T that has a fixed component (the cells at Gamma_D), with the closed-form element
-   stiffness: the lifting K u_D of the Dirichlet data when locU holds u_D (zero elsewhere), or the fixed rows of K u when it
-   holds the free part of u (zero on the fixed components). Only the star of the fixed vertices is visited. */
 /* The vertices of cell c in closure order: their coordinates x[nv][dim] (from the local coordinates xc laid out by
    csec) and their offsets off[nv] in the local section lsec. */
-PetscErrorCode ElasticityP1CellVertices(DM dm, PetscSection csec, PetscSection lsec, const PetscScalar xc[], PetscInt c, PetscReal x[],
+PetscErrorCode ElasticityP1CellVertices(MeshClosure *mc, PetscSection csec, PetscSection lsec, const PetscScalar xc[], PetscInt c, PetscReal x[],
                                         PetscInt off[], PetscInt *nv)
 {
-  PetscInt *cl = NULL, ncl, dim, vStart, vEnd;
+  const PetscInt *cl, dim = mc->dim, vStart = mc->vstart, vEnd = mc->vend;
+  PetscInt        ncl;
 
   PetscFunctionBeginUser;
-  PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
   *nv = 0;
-  PetscCall(DMPlexGetTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
+  PetscCall(MeshClosureGet(mc, c, PETSC_TRUE, &ncl, &cl));
   for (PetscInt k = 0; k < ncl; ++k) {
     const PetscInt p = cl[2 * k];
     PetscInt       coff;
@@ -290,10 +286,12 @@ PetscErrorCode ElasticityP1CellVertices(DM dm, PetscSection csec, PetscSection l
     for (PetscInt d = 0; d < dim; ++d) x[*nv * dim + d] = PetscRealPart(xc[coff + d]);
     ++*nv;
   }
-  PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &ncl, &cl));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* locF += K_T u_T on every P1 simplex T that has a fixed component (the cells at Gamma_D), with the closed-form element
+   stiffness: the lifting K u_D of the Dirichlet data when locU holds u_D (zero elsewhere), or the fixed rows of K u when it
+   holds the free part of u (zero on the fixed components). Only the star of the fixed vertices is visited. */
 PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Vec locU, Vec locF)
 {
   PetscSection       lsec, csec;
@@ -301,6 +299,7 @@ PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Ve
   Vec                coords;
   PetscInt           dim, vStart, vEnd, cStart, cEnd;
   PetscBT            done;
+  MeshClosure        mc;
   const PetscScalar *lu, *xc;
   PetscScalar       *f;
 
@@ -313,23 +312,27 @@ PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Ve
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(PetscBTCreate(cEnd - cStart, &done));
+  PetscCall(MeshClosureCreate(dm, &mc));
   PetscCall(VecGetArrayRead(locU, &lu));
   PetscCall(VecGetArrayRead(coords, &xc));
   PetscCall(VecGetArray(locF, &f));
   for (PetscInt v = vStart; v < vEnd; ++v) {
-    PetscInt *star = NULL, nstar, cdof;
+    const PetscInt *star;
+    PetscInt        nstar, cdof, *cells;
 
     PetscCall(PetscSectionGetConstraintDof(lsec, v, &cdof));
     if (!cdof) continue;
-    PetscCall(DMPlexGetTransitiveClosure(dm, v, PETSC_FALSE, &nstar, &star));
+    PetscCall(MeshClosureGet(&mc, v, PETSC_FALSE, &nstar, &star));
+    PetscCall(DMGetWorkArray(dm, nstar, MPIU_INT, &cells)); /* the star's buffer serves the cells' closures below */
+    for (PetscInt s = 0; s < nstar; ++s) cells[s] = star[2 * s];
     for (PetscInt s = 0; s < nstar; ++s) {
-      const PetscInt c = star[2 * s];
+      const PetscInt c = cells[s];
       PetscInt       nv, off[4];
       PetscReal      x[12];
       PetscScalar    ue[12], Ke[144];
 
       if (c < cStart || c >= cEnd || PetscBTLookupSet(done, c - cStart)) continue;
-      PetscCall(ElasticityP1CellVertices(dm, csec, lsec, xc, c, x, off, &nv));
+      PetscCall(ElasticityP1CellVertices(&mc, csec, lsec, xc, c, x, off, &nv));
       for (PetscInt a = 0; a < nv; ++a)
         for (PetscInt d = 0; d < dim; ++d) ue[a * dim + d] = lu[off[a] + d];
       PetscCall(ElasticityP1ElementStiffness(dim, mat->lambda, mat->mu, x, Ke));
@@ -340,11 +343,12 @@ PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Ve
         f[off[i / dim] + i % dim] += sum;
       }
     }
-    PetscCall(DMPlexRestoreTransitiveClosure(dm, v, PETSC_FALSE, &nstar, &star));
+    PetscCall(DMRestoreWorkArray(dm, nstar, MPIU_INT, &cells));
   }
   PetscCall(VecRestoreArray(locF, &f));
   PetscCall(VecRestoreArrayRead(coords, &xc));
   PetscCall(VecRestoreArrayRead(locU, &lu));
   PetscCall(PetscBTDestroy(&done));
+  PetscCall(MeshClosureDestroy(&mc));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -500,6 +500,7 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
   PetscScalar       *f, u0[3] = {0, 0, 0}, ux0[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
   PetscReal         *lambda = NULL, wref = 0.0;
   const PetscReal   *w = NULL;
+  MeshClosure        mc;
 
   PetscFunctionBeginUser;
   PetscCall(VecZeroEntries(locF));
@@ -517,7 +518,7 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
   PetscCall(DMGetField(dm, 0, NULL, &obj));
   PetscCall(PetscFEGetQuadrature((PetscFE)obj, &q));
   PetscCall(AssemblyP1QuadratureBasis(dm, q, cStart, &lambda, &nq, &w));
-  PetscCall(MeshIndexCellTypes(dm));              /* a closure per cell follows */
+  PetscCall(MeshClosureCreate(dm, &mc));          /* a closure per cell follows */
   for (PetscInt i = 0; i < nq; ++i) wref += w[i]; /* the volume of the reference cell */
   PetscCall(VecGetArrayRead(coords, &xc));
   PetscCall(VecGetArray(locF, &f));
@@ -526,7 +527,7 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
     PetscReal   X[12], vol, det;
     PetscScalar fe[12];
 
-    PetscCall(ElasticityP1CellVertices(dm, csec, lsec, xc, c, X, off, &nv));
+    PetscCall(ElasticityP1CellVertices(&mc, csec, lsec, xc, c, X, off, &nv));
     for (PetscInt i = 0; i < nv * dim; ++i) fe[i] = 0.0;
     if (dim == 2)
       det = (X[2] - X[0]) * (X[5] - X[1]) - (X[3] - X[1]) * (X[4] - X[0]);
@@ -552,6 +553,7 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
   }
   PetscCall(VecRestoreArray(locF, &f));
   PetscCall(VecRestoreArrayRead(coords, &xc));
+  PetscCall(MeshClosureDestroy(&mc));
   PetscCall(PetscFree(lambda));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

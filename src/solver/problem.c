@@ -21,11 +21,12 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(DMCreateLocalVector(dm, &user->prob.loc_bc)); /* the Dirichlet values, zero elsewhere */
   PetscCall(VecZeroEntries(user->prob.loc_bc));
   PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, user->prob.loc_bc, 0.0, NULL, NULL, NULL));
-  PetscCall(MeshIndexCellTypes(dm)); /* before the set-up's closure loops (contact set, penalty, assembly) */
+  PetscCall(AssemblyResolve(dm, user));                                      /* -assembly auto: fe or p1 for this mesh */
+  if (user->prob.assembly == ASSEMBLY_FE) PetscCall(MeshIndexCellTypes(dm)); /* before PetscFE's closure per cell */
   PetscCall(ContactSetCreate(dm, user, &user->prob.cset));
   if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, user));
   PetscCall(SolverAssembleBulk(dm, user));
-  PetscCall(PenaltyFacesSetUp(dm, user)); /* with -assembly p1, resolved by SolverAssembleBulk() */
+  PetscCall(PenaltyFacesSetUp(dm, user)); /* with -assembly p1, resolved above */
   PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
   PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0));
   PetscCall(SolverComputeScales(dm, user));

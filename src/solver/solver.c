@@ -10,7 +10,6 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   MatNullSpace rigid;
 
   PetscFunctionBeginUser;
-  PetscCall(AssemblyResolve(dm, user)); /* -assembly auto: fe or p1 for this mesh */
   if (user->prob.assembly == ASSEMBLY_P1)
     PetscCall(AssemblyP1CreateMatrix(dm, user, &user->prob.K));
   else

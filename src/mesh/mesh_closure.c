@@ -1,0 +1,170 @@
+/* Closures and stars without PETSc 3.18's cell-type lookups. DMPlexGetTransitiveClosure() asks the "celltype" label for
+   the type of every point it meets, and PETSc keeps that label's strata as hash sets during most of the set-up: about
+   100 ns a lookup, which made the closure per cell the largest cost of the P1 residual at 512 x 512. In a mesh whose
+   points of each depth all have one type (simplices, or tensor cells, interpolated), the type follows from the depth,
+   and this is PETSc's breadth-first walk with the same arrangements and orientations, so it lists the same points in
+   the same order. Any other mesh takes DMPlexGetTransitiveClosure() itself. */
+#include "mesh.h"
+
+/* One cell type per depth, each of that depth's dimension, and an interpolated mesh (depth = dimension). */
+static PetscErrorCode MeshClosureTypesByDepth(DM dm, MeshClosure *mc)
+{
+  DMLabel  ct_label;
+  PetscInt dim, local = 1;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetDepth(dm, &mc->depth));
+  PetscCall(DMPlexGetCellTypeLabel(dm, &ct_label));
+  if (mc->depth != dim || dim > 3) local = 0;
+  for (PetscInt d = 0; local && d <= mc->depth; ++d) {
+    PetscInt pStart, pEnd, n;
+
+    PetscCall(DMPlexGetDepthStratum(dm, d, &pStart, &pEnd));
+    mc->start[d] = pStart;
+    mc->end[d]   = pEnd;
+    if (pEnd == pStart) continue; /* an empty rank: no type to fix */
+    PetscCall(DMPlexGetCellType(dm, pStart, &mc->type[d]));
+    PetscCall(DMLabelGetStratumSize(ct_label, (PetscInt)mc->type[d], &n));
+    if (n != pEnd - pStart || DMPolytopeTypeGetDim(mc->type[d]) != d) local = 0;
+    switch (mc->type[d]) {
+      case DM_POLYTOPE_POINT:
+      case DM_POLYTOPE_SEGMENT:
+      case DM_POLYTOPE_TRIANGLE:
+      case DM_POLYTOPE_QUADRILATERAL:
+      case DM_POLYTOPE_TETRAHEDRON:
+      case DM_POLYTOPE_HEXAHEDRON:
+        break;
+      default:
+        local = 0;
+    }
+  }
+  mc->by_depth = local ? PETSC_TRUE : PETSC_FALSE; /* per rank: both paths list the same points */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode MeshClosureCreate(DM dm, MeshClosure *mc)
+{
+  PetscInt max_cone, max_support, cone_series, support_series;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(mc, sizeof(*mc)));
+  mc->dm = dm;
+  PetscCall(DMGetDimension(dm, &mc->dim));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &mc->vstart, &mc->vend));
+  PetscCall(MeshClosureTypesByDepth(dm, mc));
+  PetscCall(DMPlexGetMaxSizes(dm, &max_cone, &max_support));
+  cone_series    = max_cone > 1 ? (PetscPowInt(max_cone, mc->depth + 1) - 1) / (max_cone - 1) : mc->depth + 1;
+  support_series = max_support > 1 ? (PetscPowInt(max_support, mc->depth + 1) - 1) / (max_support - 1) : mc->depth + 1;
+  mc->max_points = PetscMax(cone_series, support_series); /* PETSc's bound */
+  PetscCall(PetscMalloc2(2 * mc->max_points, &mc->points, 3 * mc->max_points, &mc->fifo));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode MeshClosureDestroy(MeshClosure *mc)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree2(mc->points, mc->fifo));
+  PetscCall(PetscMemzero(mc, sizeof(*mc)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscInt MeshClosureDepthOf(const MeshClosure *mc, PetscInt p)
+{
+  for (PetscInt d = 0; d <= mc->depth; ++d)
+    if (p >= mc->start[d] && p < mc->end[d]) return d;
+  return -1;
+}
+
+/* The closure (use_cone) or star of p as DMPlexGetTransitiveClosure() gives it: *n points, (point, orientation) pairs
+   in *points, which stays valid until the next call on mc. */
+PetscErrorCode MeshClosureGet(MeshClosure *mc, PetscInt p, PetscBool use_cone, PetscInt *n, const PetscInt **points)
+{
+  DM        dm      = mc->dm;
+  PetscInt *closure = mc->points, *fifo = mc->fifo, size = 0, head = 0, tail = 0;
+
+  PetscFunctionBeginUser;
+  if (!mc->by_depth) {
+    PetscInt *cl = NULL;
+
+    PetscCall(DMPlexGetTransitiveClosure(dm, p, use_cone, n, &cl));
+    PetscCheck(*n <= mc->max_points, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Closure of %" PetscInt_FMT " has %" PetscInt_FMT " points", p, *n);
+    PetscCall(PetscArraycpy(closure, cl, 2 * *n));
+    PetscCall(DMPlexRestoreTransitiveClosure(dm, p, use_cone, n, &cl));
+    *points = closure;
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  closure[size++] = p;
+  closure[size++] = 0;
+  fifo[tail++]    = p;
+  fifo[tail++]    = 0;
+  fifo[tail++]    = MeshClosureDepthOf(mc, p);
+  while (tail > head) {
+    const PetscInt  q = fifo[head++], o = fifo[head++], qd = fifo[head++], cd = use_cone ? qd - 1 : qd + 1;
+    const PetscInt *qarr = DMPolytopeTypeGetArrangment(mc->type[qd], o), *tmp, *tmp_o = NULL;
+    PetscInt        ntmp;
+
+    if (cd < 0 || cd > mc->depth) continue;
+    if (use_cone) {
+      PetscCall(DMPlexGetConeSize(dm, q, &ntmp));
+      PetscCall(DMPlexGetCone(dm, q, &tmp));
+      PetscCall(DMPlexGetConeOrientation(dm, q, &tmp_o));
+    } else {
+      PetscCall(DMPlexGetSupportSize(dm, q, &ntmp));
+      PetscCall(DMPlexGetSupport(dm, q, &tmp));
+    }
+    for (PetscInt t = 0; t < ntmp; ++t) {
+      const PetscInt ip = use_cone && qarr ? qarr[t * 2] : t, io = use_cone && qarr ? qarr[t * 2 + 1] : 0, cp = tmp[ip];
+      const PetscInt co = tmp_o ? DMPolytopeTypeComposeOrientation(mc->type[cd], io, tmp_o[ip]) : 0;
+      PetscInt       c;
+
+      for (c = 0; c < size; c += 2)
+        if (closure[c] == cp) break;
+      if (c < size) continue;
+      PetscCheck(size / 2 < mc->max_points, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Closure of %" PetscInt_FMT " exceeds %" PetscInt_FMT " points", p,
+                 mc->max_points);
+      closure[size++] = cp;
+      closure[size++] = co;
+      fifo[tail++]    = cp;
+      fifo[tail++]    = co;
+      fifo[tail++]    = cd;
+    }
+  }
+  *n      = size / 2;
+  *points = closure;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Compares MeshClosureGet() with DMPlexGetTransitiveClosure() on every point, closure and star: the number of points
+   that differ (0 on any mesh), and whether the walk by depth served (else both are PETSc's). */
+PetscErrorCode MeshClosureCheck(DM dm, PetscInt *differences, PetscBool *by_depth)
+{
+  MeshClosure mc;
+  PetscInt    pStart, pEnd;
+
+  PetscFunctionBeginUser;
+  *differences = 0;
+  PetscCall(MeshClosureCreate(dm, &mc));
+  *by_depth = mc.by_depth;
+  PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+  for (PetscInt p = pStart; p < pEnd; ++p)
+    for (PetscInt k = 0; k < 2; ++k) {
+      const PetscBool use_cone = k ? PETSC_FALSE : PETSC_TRUE;
+      const PetscInt *mine;
+      PetscInt       *ref = NULL, n_mine, n_ref;
+
+      PetscCall(MeshClosureGet(&mc, p, use_cone, &n_mine, &mine));
+      PetscCall(DMPlexGetTransitiveClosure(dm, p, use_cone, &n_ref, &ref));
+      if (n_mine != n_ref)
+        ++*differences;
+      else
+        for (PetscInt i = 0; i < 2 * n_ref; ++i)
+          if (mine[i] != ref[i]) {
+            ++*differences;
+            break;
+          }
+      PetscCall(DMPlexRestoreTransitiveClosure(dm, p, use_cone, &n_ref, &ref));
+    }
+  PetscCall(MeshClosureDestroy(&mc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
