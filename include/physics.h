@@ -72,6 +72,7 @@ void ElasticStress(PetscInt dim, const Material *mat, const PetscReal grad[], Pe
 
 /* boundary.c */
 PetscErrorCode BoundaryAddDirichlet(DM dm, AppCtx *user);
+PetscErrorCode BoundaryInsertDirichlet(DM dm, const AppCtx *user, Vec loc);
 PetscErrorCode BoundaryAddLoads(DM dm, AppCtx *user, Vec r0);
 PetscErrorCode BoundaryAddLoadsLocal(DM dm, AppCtx *user, Vec locF);
 PetscErrorCode BoundaryComputeReactions(DM dm, AppCtx *user, Vec u, PetscReal reaction[][3]);

@@ -49,11 +49,13 @@ static PetscErrorCode AssemblyP1Applies(DM dm, const AppCtx *user, const char **
   nc = 0;
   if (nf == 1) PetscCall(PetscSectionGetFieldComponents(section, 0, &nc));
   if (dim != 2 && dim != 3) code = 1;
-  for (PetscInt c = cStart; c < cEnd && !code; ++c) {
-    DMPolytopeType ct;
+  if (!code) { /* the type of dimension dim is only a cell's: all cells are simplices if that many points are */
+    DMLabel  ct_label;
+    PetscInt nsimplices;
 
-    PetscCall(DMPlexGetCellType(dm, c, &ct));
-    if (ct != (dim == 2 ? DM_POLYTOPE_TRIANGLE : DM_POLYTOPE_TETRAHEDRON)) code = 2;
+    PetscCall(DMPlexGetCellTypeLabel(dm, &ct_label));
+    PetscCall(DMLabelGetStratumSize(ct_label, dim == 2 ? DM_POLYTOPE_TRIANGLE : DM_POLYTOPE_TETRAHEDRON, &nsimplices));
+    if (nsimplices != cEnd - cStart) code = 2;
   }
   if (!code && user->opt.degree != 1) code = 3;
   if (!code && (nf != 1 || nc != dim || size != (vEnd - vStart) * dim)) code = 4;
@@ -64,7 +66,6 @@ static PetscErrorCode AssemblyP1Applies(DM dm, const AppCtx *user, const char **
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* -assembly and -assembly_check; resolves auto into fe or p1. */
 /* -assembly and -assembly_check, read once before any set-up. */
 PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscBool *check)
 {
@@ -420,64 +421,26 @@ PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX)
 }
 
 /* lambda[q * (dim + 1) + a]: the P1 basis functions (barycentric coordinates) of the closure-ordered vertices at the
-   points of PetscFE's quadrature rule, from PETSc's own map of the first cell (the same for every cell, whose closure
-   orders its vertices as the reference cell does). */
-static PetscErrorCode AssemblyP1QuadratureBasis(DM dm, PetscQuadrature q, PetscInt cell, PetscReal **lambda, PetscInt *nq, const PetscReal **w)
+   points of PetscFE's quadrature rule. PETSc's reference simplex has the vertices (-1, -1), (1, -1), (-1, 1) (in 3D
+   (-1, -1, -1), (1, -1, -1), (-1, 1, -1), (-1, -1, 1)), and its affine map of a cell sends vertex k to the k-th vertex of
+   the cell's closure (x = v0 + J (xi + 1), the columns of J (v_k - v0) / 2): lambda_k = (xi_{k-1} + 1) / 2 for k >= 1. */
+static PetscErrorCode AssemblyP1QuadratureBasis(PetscInt dim, PetscQuadrature q, PetscReal **lambda, PetscInt *nq, const PetscReal **w)
 {
-  PetscInt           dim, qdim, nc, *cl = NULL, ncl, nv = 0, vStart, vEnd;
-  const PetscReal   *pts;
-  PetscReal         *x, X[12];
-  DM                 cdm;
-  PetscSection       csec;
-  Vec                coords;
-  const PetscScalar *xc;
+  PetscInt         qdim, nc;
+  const PetscReal *pts;
 
   PetscFunctionBeginUser;
-  PetscCall(DMGetDimension(dm, &dim));
   PetscCall(PetscQuadratureGetData(q, &qdim, &nc, nq, &pts, w));
-  PetscCall(PetscMalloc1(*nq * dim, &x));
+  PetscCheck(qdim == dim, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Quadrature of dimension %" PetscInt_FMT " on a mesh of dimension %" PetscInt_FMT, qdim,
+             dim);
   PetscCall(PetscMalloc1(*nq * (dim + 1), lambda));
-  PetscCall(DMPlexReferenceToCoordinates(dm, cell, *nq, pts, x));
-  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  PetscCall(DMGetCoordinateDM(dm, &cdm));
-  PetscCall(DMGetLocalSection(cdm, &csec));
-  PetscCall(DMGetCoordinatesLocal(dm, &coords));
-  PetscCall(VecGetArrayRead(coords, &xc));
-  PetscCall(DMPlexGetTransitiveClosure(dm, cell, PETSC_TRUE, &ncl, &cl));
-  for (PetscInt k = 0; k < ncl; ++k)
-    if (cl[2 * k] >= vStart && cl[2 * k] < vEnd) {
-      PetscInt off;
-
-      PetscCall(PetscSectionGetOffset(csec, cl[2 * k], &off));
-      for (PetscInt d = 0; d < dim; ++d) X[nv * dim + d] = PetscRealPart(xc[off + d]);
-      ++nv;
-    }
-  PetscCall(DMPlexRestoreTransitiveClosure(dm, cell, PETSC_TRUE, &ncl, &cl));
-  PetscCall(VecRestoreArrayRead(coords, &xc));
-  for (PetscInt i = 0; i < *nq; ++i) { /* solve x - X0 = sum_k lambda_{k+1} (X_{k+1} - X0) */
-    PetscReal A[9], b[3], l[3];
-
-    for (PetscInt d = 0; d < dim; ++d) {
-      b[d] = x[i * dim + d] - X[d];
-      for (PetscInt k = 0; k < dim; ++k) A[d * dim + k] = X[(k + 1) * dim + d] - X[d];
-    }
-    if (dim == 2) {
-      const PetscReal det = A[0] * A[3] - A[1] * A[2];
-      l[0]                = (A[3] * b[0] - A[1] * b[1]) / det;
-      l[1]                = (A[0] * b[1] - A[2] * b[0]) / det;
-    } else {
-      const PetscReal det = A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) + A[2] * (A[3] * A[7] - A[4] * A[6]);
-      l[0]                = (b[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (b[1] * A[8] - A[5] * b[2]) + A[2] * (b[1] * A[7] - A[4] * b[2])) / det;
-      l[1]                = (A[0] * (b[1] * A[8] - A[5] * b[2]) - b[0] * (A[3] * A[8] - A[5] * A[6]) + A[2] * (A[3] * b[2] - b[1] * A[6])) / det;
-      l[2]                = (A[0] * (A[4] * b[2] - b[1] * A[7]) - A[1] * (A[3] * b[2] - b[1] * A[6]) + b[0] * (A[3] * A[7] - A[4] * A[6])) / det;
-    }
+  for (PetscInt i = 0; i < *nq; ++i) {
     (*lambda)[i * (dim + 1)] = 1.0;
     for (PetscInt k = 0; k < dim; ++k) {
-      (*lambda)[i * (dim + 1) + k + 1] = l[k];
-      (*lambda)[i * (dim + 1)] -= l[k];
+      (*lambda)[i * (dim + 1) + k + 1] = 0.5 * (pts[i * dim + k] + 1.0);
+      (*lambda)[i * (dim + 1)] -= (*lambda)[i * (dim + 1) + k + 1];
     }
   }
-  PetscCall(PetscFree(x));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -517,7 +480,7 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
   PetscCall(DMGetCoordinatesLocal(dm, &coords));
   PetscCall(DMGetField(dm, 0, NULL, &obj));
   PetscCall(PetscFEGetQuadrature((PetscFE)obj, &q));
-  PetscCall(AssemblyP1QuadratureBasis(dm, q, cStart, &lambda, &nq, &w));
+  PetscCall(AssemblyP1QuadratureBasis(dim, q, &lambda, &nq, &w));
   PetscCall(MeshClosureCreate(dm, &mc));          /* a closure per cell follows */
   for (PetscInt i = 0; i < nq; ++i) wref += w[i]; /* the volume of the reference cell */
   PetscCall(VecGetArrayRead(coords, &xc));

@@ -20,7 +20,7 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(BoundaryCheckRigidMotions(dm, &user->scene));
   PetscCall(DMCreateLocalVector(dm, &user->prob.loc_bc)); /* the Dirichlet values, zero elsewhere */
   PetscCall(VecZeroEntries(user->prob.loc_bc));
-  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, user->prob.loc_bc, 0.0, NULL, NULL, NULL));
+  PetscCall(BoundaryInsertDirichlet(dm, user, user->prob.loc_bc));
   PetscCall(AssemblyResolve(dm, user));                                      /* -assembly auto: fe or p1 for this mesh */
   if (user->prob.assembly == ASSEMBLY_FE) PetscCall(MeshIndexCellTypes(dm)); /* before PetscFE's closure per cell */
   PetscCall(ContactSetCreate(dm, user, &user->prob.cset));

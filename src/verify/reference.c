@@ -411,7 +411,7 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   nvec = user->opt.contact.method == CONTACT_PENALTY ? 1 : 2;
   PetscCall(DMCreateLocalVector(dm, &loc[0]));
   PetscCall(VecZeroEntries(loc[0]));
-  PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, loc[0], 0.0, NULL, NULL, NULL));
+  PetscCall(BoundaryInsertDirichlet(dm, user, loc[0]));
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc[0]));
   if (nvec == 2) {
     PetscCall(DMCreateLocalVector(dm, &loc[1]));
