@@ -75,25 +75,39 @@ static PetscErrorCode ViewCells(DM dm, MeshClosure *mc, DMPolytopeType ct, Petsc
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* /geometry/vertices: the global coordinate vector, scaled to PETSc's unit of length. */
-static PetscErrorCode ViewVertices(DM dm, PetscViewer viewer)
+/* /geometry/vertices: the coordinates of the owned vertices in point order, rank after rank (the global coordinate
+   vector, which DMGetCoordinates() would build by a scatter), scaled to PETSc's unit of length. */
+static PetscErrorCode ViewVertices(DM dm, const MeshClosure *mc, PetscViewer viewer)
 {
-  Vec       coords, copy;
-  PetscReal scale;
-  PetscInt  m, M, bs;
+  Vec                coords, copy;
+  PetscSection       csec;
+  PetscReal          scale;
+  PetscInt          *owned, nowned, cdim;
+  const PetscScalar *xc;
+  PetscScalar       *y;
 
   PetscFunctionBeginUser;
   PetscCall(DMPlexGetScale(dm, PETSC_UNIT_LENGTH, &scale));
-  PetscCall(DMGetCoordinates(dm, &coords));
-  PetscCall(VecGetSize(coords, &M));
-  PetscCall(VecGetLocalSize(coords, &m));
-  PetscCall(VecGetBlockSize(coords, &bs));
-  PetscCall(VecCreate(PetscObjectComm((PetscObject)coords), &copy)); /* no DM: a plain dataset, not DMPlex's field layout */
-  PetscCall(VecSetSizes(copy, m, M));
-  PetscCall(VecSetBlockSize(copy, bs));
+  PetscCall(DMGetCoordinateDim(dm, &cdim));
+  PetscCall(DMGetCoordinateSection(dm, &csec));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(MeshOwnedIndex(dm, mc->vstart, mc->vend, &owned, &nowned));
+  PetscCall(VecCreate(PetscObjectComm((PetscObject)dm), &copy)); /* no DM: a plain dataset, not DMPlex's field layout */
+  PetscCall(VecSetSizes(copy, nowned * cdim, PETSC_DETERMINE));
+  PetscCall(VecSetBlockSize(copy, cdim));
   PetscCall(VecSetType(copy, VECSTANDARD));
-  PetscCall(VecCopy(coords, copy));
-  PetscCall(VecScale(copy, scale));
+  PetscCall(VecGetArrayRead(coords, &xc));
+  PetscCall(VecGetArray(copy, &y));
+  for (PetscInt v = mc->vstart; v < mc->vend; ++v) {
+    PetscInt off;
+
+    if (owned[v - mc->vstart] < 0) continue;
+    PetscCall(PetscSectionGetOffset(csec, v, &off));
+    for (PetscInt d = 0; d < cdim; ++d) y[owned[v - mc->vstart] * cdim + d] = scale * xc[off + d];
+  }
+  PetscCall(VecRestoreArray(copy, &y));
+  PetscCall(VecRestoreArrayRead(coords, &xc));
+  PetscCall(PetscFree(owned));
   PetscCall(PetscObjectSetName((PetscObject)copy, "vertices"));
   PetscCall(PetscViewerHDF5PushGroup(viewer, "/geometry"));
   PetscCall(PetscViewerPushFormat(viewer, PETSC_VIEWER_NATIVE));
@@ -126,7 +140,7 @@ PetscErrorCode OutputViewMesh(DM dm, PetscViewer viewer)
   if (!v[2] && v[0] >= 0 && v[0] == -v[1]) {
     const DMPolytopeType ct = (DMPolytopeType)v[0];
 
-    PetscCall(ViewVertices(dm, viewer));
+    PetscCall(ViewVertices(dm, &mc, viewer));
     PetscCall(ViewCells(dm, &mc, ct, DMPolytopeTypeGetNumVertices(ct), viewer));
   } else
     PetscCall(DMView(dm, viewer));

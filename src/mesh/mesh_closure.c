@@ -45,7 +45,8 @@ static PetscErrorCode MeshClosureTypesByDepth(DM dm, MeshClosure *mc)
 
 PetscErrorCode MeshClosureCreate(DM dm, MeshClosure *mc)
 {
-  PetscInt max_cone, max_support, cone_series, support_series;
+  PetscInt   max_cone, max_support, pStart, pEnd;
+  PetscInt64 series[2] = {1, 1}, term[2] = {1, 1};
 
   PetscFunctionBeginUser;
   PetscCall(PetscMemzero(mc, sizeof(*mc)));
@@ -54,9 +55,14 @@ PetscErrorCode MeshClosureCreate(DM dm, MeshClosure *mc)
   PetscCall(DMPlexGetDepthStratum(dm, 0, &mc->vstart, &mc->vend));
   PetscCall(MeshClosureTypesByDepth(dm, mc));
   PetscCall(DMPlexGetMaxSizes(dm, &max_cone, &max_support));
-  cone_series    = max_cone > 1 ? (PetscPowInt(max_cone, mc->depth + 1) - 1) / (max_cone - 1) : mc->depth + 1;
-  support_series = max_support > 1 ? (PetscPowInt(max_support, mc->depth + 1) - 1) / (max_support - 1) : mc->depth + 1;
-  mc->max_points = PetscMax(cone_series, support_series); /* PETSc's bound */
+  PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+  for (PetscInt d = 1; d <= mc->depth; ++d) { /* PETSc's bound, 1 + m + ... + m^depth, in 64 bits (m^4 overflows 32) */
+    term[0] = PetscMin(term[0] * PetscMax(max_cone, 1), (PetscInt64)pEnd);
+    term[1] = PetscMin(term[1] * PetscMax(max_support, 1), (PetscInt64)pEnd);
+    series[0] += term[0];
+    series[1] += term[1];
+  }
+  mc->max_points = (PetscInt)PetscMin(PetscMax(series[0], series[1]), (PetscInt64)PetscMax(pEnd - pStart, 1)); /* at most every point */
   PetscCall(PetscMalloc2(2 * mc->max_points, &mc->points, 3 * mc->max_points, &mc->fifo));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

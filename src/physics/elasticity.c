@@ -58,60 +58,68 @@ static PetscErrorCode CreateRigidBodyModes(DM dm, PetscInt origField, PetscInt f
 PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace)
 {
   const PetscInt nmodes[4] = {0, 1, 3, 6};
-  PetscInt       dim, vStart, vEnd, n;
-  PetscSection   sec, csec;
-  Vec            coords, mode[6], loc;
+  PetscInt       dim, vStart, vEnd, n, rstart;
+  PetscSection   sec, gsec, csec;
+  Vec            coords, mode[6];
   DM             cdm;
+  PetscScalar   *a[6];
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   n = nmodes[dim];
   PetscCall(DMGetLocalSection(dm, &sec));
+  PetscCall(DMGetGlobalSection(dm, &gsec));
   PetscCall(DMGetCoordinateDM(dm, &cdm));
   PetscCall(DMGetLocalSection(cdm, &csec));
   PetscCall(DMGetCoordinatesLocal(dm, &coords));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  PetscCall(DMGetLocalVector(dm, &loc));
-  for (PetscInt m = 0; m < n; ++m) {
+  PetscCall(DMCreateGlobalVector(dm, &mode[0]));
+  PetscCall(VecGetOwnershipRange(mode[0], &rstart, NULL));
+  for (PetscInt m = 0; m < n; ++m) { /* written straight into the global vectors: the free components of the owned vertices */
+    if (m) PetscCall(VecDuplicate(mode[0], &mode[m]));
+    PetscCall(VecZeroEntries(mode[m]));
+    PetscCall(VecGetArray(mode[m], &a[m]));
+  }
+  {
     const PetscScalar *x;
-    PetscScalar       *a;
 
-    PetscCall(VecZeroEntries(loc));
     PetscCall(VecGetArrayRead(coords, &x));
-    PetscCall(VecGetArray(loc, &a));
     for (PetscInt v = vStart; v < vEnd; ++v) {
-      PetscInt  off, coff, ndof;
-      PetscReal p[3] = {0.0, 0.0, 0.0}, r[3] = {0.0, 0.0, 0.0};
+      PetscInt  coff, ndof, gdof, idx[3];
+      PetscReal p[3] = {0.0, 0.0, 0.0};
 
       PetscCall(PetscSectionGetDof(sec, v, &ndof));
-      if (ndof < dim) continue;
-      PetscCall(PetscSectionGetOffset(sec, v, &off));
+      PetscCall(PetscSectionGetDof(gsec, v, &gdof));
+      if (ndof < dim || gdof < 0) continue; /* no displacement here, or another rank's vertex */
+      PetscCall(MeshPointGlobalIndices(sec, gsec, v, dim, idx));
       PetscCall(PetscSectionGetOffset(csec, v, &coff));
       for (PetscInt d = 0; d < dim; ++d) p[d] = PetscRealPart(x[coff + d]);
-      if (m < dim)
-        r[m] = 1.0; /* translations */
-      else if (dim == 2) {
-        r[0] = -p[1];
-        r[1] = p[0];
-      } /* rotation about z */
-      else if (m == 3) {
-        r[0] = -p[1];
-        r[1] = p[0];
-      } else if (m == 4) {
-        r[1] = -p[2];
-        r[2] = p[1];
-      } else {
-        r[0] = p[2];
-        r[2] = -p[0];
+      for (PetscInt m = 0; m < n; ++m) {
+        PetscReal r[3] = {0.0, 0.0, 0.0};
+
+        if (m < dim)
+          r[m] = 1.0; /* translations */
+        else if (dim == 2) {
+          r[0] = -p[1];
+          r[1] = p[0];
+        } /* rotation about z */
+        else if (m == 3) {
+          r[0] = -p[1];
+          r[1] = p[0];
+        } else if (m == 4) {
+          r[1] = -p[2];
+          r[2] = p[1];
+        } else {
+          r[0] = p[2];
+          r[2] = -p[0];
+        }
+        for (PetscInt d = 0; d < dim; ++d)
+          if (idx[d] >= 0) a[m][idx[d] - rstart] = r[d];
       }
-      for (PetscInt d = 0; d < dim; ++d) a[off + d] = r[d];
     }
-    PetscCall(VecRestoreArray(loc, &a));
     PetscCall(VecRestoreArrayRead(coords, &x));
-    PetscCall(DMCreateGlobalVector(dm, &mode[m]));
-    PetscCall(DMLocalToGlobal(dm, loc, INSERT_VALUES, mode[m]));
   }
-  PetscCall(DMRestoreLocalVector(dm, &loc));
+  for (PetscInt m = 0; m < n; ++m) PetscCall(VecRestoreArray(mode[m], &a[m]));
   for (PetscInt m = 0; m < n; ++m) { /* modified Gram-Schmidt: MatNullSpaceCreate wants an orthonormal basis */
     PetscScalar dots[6];
 
