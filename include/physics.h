@@ -3,8 +3,11 @@
 #include "signorini.h"
 #include "mesh.h" /* MeshClosure */
 
+/* section.c */
+PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user);
+
 /* elasticity.c */
-PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degree);
+PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degree, PetscBool *section_check);
 PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user);
 PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user);
 PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace);

@@ -241,7 +241,8 @@ typedef struct {
 typedef struct {
   char           scene_name[64];
   Material       material;
-  PetscInt       degree; /* of the displacement, -displacement_petscspace_degree */
+  PetscInt       degree;        /* of the displacement, -displacement_petscspace_degree */
+  PetscBool      section_check; /* -section_check: the P1 section compared with PETSc's */
   ContactOptions contact;
   VerifyOptions  verify;
   AssemblyType   assembly;       /* -assembly as given (auto, fe, p1) */

@@ -129,7 +129,7 @@ int main(int argc, char **argv)
   PetscCall(OutputFileInstallCleanup());
   PetscCall(SceneRegisterAll());
   PetscCall(SceneGetOptions(comm, user.opt.scene_name, sizeof(user.opt.scene_name)));
-  PetscCall(ElasticityGetOptions(comm, &user.opt.material, &user.opt.degree));
+  PetscCall(ElasticityGetOptions(comm, &user.opt.material, &user.opt.degree, &user.opt.section_check));
   PetscCall(ContactGetOptions(comm, &user.opt.contact));
   PetscCall(VerifyGetOptions(comm, &user.opt.verify));
   PetscCall(AssemblyGetOptions(comm, &user.opt.assembly, &user.opt.assembly_check));

@@ -176,3 +176,19 @@ def test_cylinder_options_file(outdir, quarter_disk):
     attrs = load(h5)[0]
     assert attrs["converged"] == 1 and attrs["active_vertices"] > 2 and attrs["obstacle"] == "plane"
     assert abs(attrs["contact_force_y"] + attrs["reaction_slip_top_y"]) < 1e-10 * attrs["contact_force_y"]
+
+
+@pytest.mark.parametrize("np_", [1, 2])
+@pytest.mark.parametrize("case", ["slips_2d", "slips_3d", "clamp_quads", "clamp_hexes", "mms", "disk_names"])
+def test_p1_section_is_petscs(outdir, quarter_disk, case, np_):
+    """src/physics/section.c builds the P1/Q1 section itself (the Dirichlet components constrained face set by face set,
+    several on one vertex at the corners); -section_check also has DMCreateLocalSection() build it and compares the two
+    with PetscSectionCompare() (dofs, offsets, constraint counts and indices, the field's too)."""
+    args = {"slips_2d": patch_args(2, "traction", 0.05, 0.01), "slips_3d": patch_args(3, "pressure", 0.05, 0.01),
+            "clamp_quads": ["-dm_plex_simplex", 0, "-dm_plex_box_faces", "5,4"],
+            "clamp_hexes": ["-dm_plex_dim", 3, "-dm_plex_simplex", 0, "-dm_plex_box_faces", "2,3,2"],
+            "mms": ["-scene", "mms", "-dm_plex_box_faces", "6,5"],
+            "disk_names": HERTZ_2D + ["-dm_plex_filename", quarter_disk]}[case]
+    log, h5 = run(args + ["-section_check"], f"section_{case}_np{np_}", np_=np_, output=os.path.join(outdir, f"section_{case}_np{np_}.h5"))
+    assert log.count("section check: the P1 section is equal to DMCreateLocalSection()'s") == 1, log[-2000:]
+    assert load(h5)[0]["converged"] == 1

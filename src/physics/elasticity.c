@@ -136,13 +136,16 @@ PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace)
 }
 
 /* The material and the degree of the displacement (-displacement_petscspace_degree, PETSc's name for it, default 1). */
-PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degree)
+PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degree, PetscBool *section_check)
 {
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, NULL, "Linear elastic material and its discretization", "Signorini");
   *degree = 1;
   PetscCall(PetscOptionsRangeInt("-displacement_petscspace_degree", "Degree of the Lagrange displacement space (P1/Q1 by default)", NULL, *degree,
                                  degree, NULL, 1, 8));
+  *section_check = PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-section_check", "Build the P1 section both ways (the project's and DMCreateLocalSection()) and compare them",
+                             "SectionSetUpP1", *section_check, section_check, NULL));
   mat->young_modulus = 1.0;
   PetscCall(PetscOptionsReal("-young_modulus", "Young's modulus E", NULL, mat->young_modulus, &mat->young_modulus, NULL));
   mat->poisson_ratio = 0.3;
