@@ -3,12 +3,13 @@
 #include "signorini.h"
 
 /* mesh.c, mesh_box_simplex.c */
-PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm);
+PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, MeshBox *box, DM *dm);
 PetscErrorCode MeshIndexCellTypes(DM dm);
 PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[]);
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],
                                     PetscBool distribute, PetscBool petsc_interpolate, PetscBool check, DM *dm);
 PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[]);
+PetscErrorCode MeshCreateBoxLevel(DM coarse, const MeshBox *box, PetscInt level, DM *fine, PetscInt **vertex_source);
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
 PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam);
 PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id);

@@ -187,6 +187,13 @@ typedef struct {
 } ErrorNorms;
 
 /* How the mesh is distributed over the ranks (-partitioner), and the quality of the partition. */
+/* The simplex box of the options, when the mesh is one (MeshCreate()): the grid sequence builds its finer levels directly. */
+typedef struct {
+  PetscBool is_box; /* a 2D simplex box, on one rank, not refined by -dm_refine */
+  PetscInt  dim, faces[3];
+  PetscReal lower[3], upper[3];
+} MeshBox;
+
 typedef enum { MESH_PARTITIONER_PTSCOTCH, MESH_PARTITIONER_METIS, MESH_PARTITIONER_SIMPLE, MESH_PARTITIONER_BOX } MeshPartitionerType;
 extern const char *const MeshPartitionerTypes[];
 typedef struct {
@@ -250,6 +257,7 @@ typedef struct {
   PetscBool      perf_bandwidth; /* -perf_bandwidth: measure the memory bandwidths after the solve */
   char           output[PETSC_MAX_PATH_LEN];
   PetscBool      output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
+  MeshBox        box;           /* the box of the mesh options, if the mesh is one */
 } RunOptions;
 
 /* The contact faces of this rank for the Gauss rule of the penalty term in closed form (P1 simplices,

@@ -136,7 +136,7 @@ int main(int argc, char **argv)
   PetscCall(OutputGetOptions(comm, &user.opt));
   PetscCall(BandwidthGetOptions(comm, &user.opt.perf_bandwidth));
 
-  PetscCall(MeshCreate(comm, user.opt.contact.grid_sequence, &dm));
+  PetscCall(MeshCreate(comm, user.opt.contact.grid_sequence, &user.opt.box, &dm));
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition)); /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(user.opt.scene_name, dm, &user.opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(ProblemSetUp(dm, &user, &snes));

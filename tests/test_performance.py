@@ -249,3 +249,18 @@ def test_targets_script_rows_follow_from_its_runs(outdir):
     eps_row = [r for r in rows if r["target"].startswith("GAMG Krylov iterations per Newton step")][0]
     for e in ("1e4 h", "1e2 h", "1 h", "1e-2 h", "1e-4 h", "1e-6 h", "1e-8 h"):
         assert e + ": " in eps_row["measured"], eps_row["measured"]
+
+
+def test_grid_sequence_builds_2d_box_levels_as_refinements():
+    """On one rank the 2D box's finer levels are built directly as boxes of twice the cells (MeshCreateBoxLevel), every
+    fine vertex taking a coarse vertex or edge midpoint as its source; on two ranks PETSc refines each level. Both must
+    give the direct solution on the refined mesh (-dm_refine) and on the box of that many cells, on a box of unequal
+    sides, and the finest level needs few Newton steps from the interpolated guess."""
+    base = SQUARE + ["-dm_plex_box_faces", "3,5"]
+    _, seq = run(base + ["-contact_grid_sequence", 2], "gs_box_levels")
+    _, seq2 = run(base + ["-contact_grid_sequence", 2], "gs_box_levels_np2", np_=2)
+    _, refined = run(base + ["-dm_refine", 2], "gs_box_levels_refined")
+    _, box = run(SQUARE + ["-dm_plex_box_faces", "12,20"], "gs_box_levels_box")
+    assert max_diff(seq, refined) < 1e-10 and max_diff(seq, box) < 1e-10 and max_diff(seq2, seq) < 1e-10
+    attrs = load(seq)[0]
+    assert attrs["converged"] == 1 and attrs["n_cells"] == 2 * 12 * 20 and attrs["newton_its"] <= 3

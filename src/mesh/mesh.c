@@ -53,7 +53,7 @@ static PetscErrorCode MeshReadFile(MPI_Comm comm, const char filename[], DM *dm)
 /* Creates the mesh from PETSc's own options; simplex boxes, which PETSc 3.18 cannot generate
    without Triangle/CTetGen, come from MeshCreateSimplexBox(). later_refinements: uniform refinements the run will
    still make (grid sequencing), counted in the size check. */
-PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
+PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, MeshBox *box, DM *dm)
 {
   PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
   PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
@@ -163,6 +163,19 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, DM *dm)
                                    check_interpolation, dm));
   else
     PetscCall(CompatCreateBoxMesh(comm, dim, PETSC_FALSE, faces, lower, upper, NULL, PETSC_TRUE, dm));
+  {
+    PetscMPIInt size;
+
+    PetscCallMPI(MPI_Comm_size(comm, &size));
+    PetscCall(PetscMemzero(box, sizeof(*box)));
+    box->is_box = (PetscBool)(!has_file && simplex && refine == 0 && size == 1 && dim == 2); /* 3D: Kuhn boxes do not nest as refinements */
+    box->dim    = dim;
+    for (PetscInt d = 0; d < dim; ++d) {
+      box->faces[d] = faces[d];
+      box->lower[d] = lower[d];
+      box->upper[d] = upper[d];
+    }
+  }
   PetscCall(MeshPartitionDistribute(partitioner, dm));
   PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
   PetscCall(DMSetFromOptions(*dm)); /* -dm_refine on all ranks, -dm_mat_type, PETSc's checks */

@@ -21,7 +21,11 @@ static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *
   PetscCall(DMGlobalToLocal(*dm, *u, INSERT_VALUES, loc));
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
-  PetscCall(MeshRefineRegular(*dm, 1, &fine, &parent, &vertex_source));
+  if (user->opt.box.is_box && user->opt.degree == 1) { /* the box of twice as many cells, built directly */
+    parent = NULL;
+    PetscCall(MeshCreateBoxLevel(*dm, &user->opt.box, user->prob.level, &fine, &vertex_source));
+  } else
+    PetscCall(MeshRefineRegular(*dm, 1, &fine, &parent, &vertex_source));
   user->prob.level++;
   PetscCall(ProblemSetUp(fine, user, snes));
   if (user->opt.degree == 1)
