@@ -100,6 +100,7 @@ PetscErrorCode MeshClosureGet(MeshClosure *mc, PetscInt p, PetscBool use_cone, P
     *points = closure;
     PetscFunctionReturn(PETSC_SUCCESS);
   }
+  PetscCheck(MeshClosureDepthOf(mc, p) >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Point %" PetscInt_FMT " is in no depth stratum", p);
   closure[size++] = p;
   closure[size++] = 0;
   fifo[tail++]    = p;

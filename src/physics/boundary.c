@@ -89,7 +89,7 @@ PetscErrorCode BoundaryInsertDirichlet(DM dm, const AppCtx *user, Vec loc)
     const PetscInt          *points;
     PetscInt                 n;
 
-    if (bc->kind != (k < bcs->n ? BC_SLIP : BC_CLAMP)) continue; /* the order of BoundaryAddDirichlet() */
+    if (bc->kind != (k < bcs->n ? BC_SLIP : BC_CLAMP) || !user->prob.face_sets) continue; /* the order of BoundaryAddDirichlet() */
     PetscCall(DMLabelGetStratumIS(user->prob.face_sets, bc->id, &is));
     if (!is) continue;
     PetscCall(ISGetLocalSize(is, &n));
