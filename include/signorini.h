@@ -186,7 +186,6 @@ typedef struct {
   PetscReal penetration_l2, penetration_max; /* of [u_h,n - g]_+ on Gamma_C */
 } ErrorNorms;
 
-/* How the mesh is distributed over the ranks (-partitioner), and the quality of the partition. */
 /* The simplex box of the options, when the mesh is one (MeshCreate()): the grid sequence builds its finer levels directly. */
 typedef struct {
   PetscBool is_box; /* a 2D simplex box, on one rank, not refined by -dm_refine */
@@ -194,6 +193,7 @@ typedef struct {
   PetscReal lower[3], upper[3];
 } MeshBox;
 
+/* How the mesh is distributed over the ranks (-partitioner), and the quality of the partition. */
 typedef enum { MESH_PARTITIONER_PTSCOTCH, MESH_PARTITIONER_METIS, MESH_PARTITIONER_SIMPLE, MESH_PARTITIONER_BOX } MeshPartitionerType;
 extern const char *const MeshPartitionerTypes[];
 typedef struct {

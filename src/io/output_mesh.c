@@ -11,12 +11,15 @@
    rank after rank. */
 static PetscErrorCode GlobalVertexNumbers(DM dm, PetscInt vStart, PetscInt vEnd, PetscInt **gnum)
 {
-  PetscSF   sf;
-  PetscInt *owned, nowned, offset = 0, pStart, pEnd, *all;
+  PetscSF     sf;
+  PetscInt   *owned, nowned, offset = 0, pStart, pEnd, *all;
+  PetscMPIInt rank;
 
   PetscFunctionBeginUser;
   PetscCall(MeshOwnedIndex(dm, vStart, vEnd, &owned, &nowned));
   PetscCallMPI(MPI_Exscan(&nowned, &offset, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
+  PetscCallMPI(MPI_Comm_rank(PetscObjectComm((PetscObject)dm), &rank));
+  if (rank == 0) offset = 0; /* MPI leaves rank 0's result undefined */
   PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
   PetscCall(PetscMalloc1(pEnd - pStart, &all)); /* over the chart, as the point SF's roots and leaves are */
   for (PetscInt p = pStart; p < pEnd; ++p) all[p - pStart] = -1;

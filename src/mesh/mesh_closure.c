@@ -87,7 +87,7 @@ static PetscInt MeshClosureDepthOf(const MeshClosure *mc, PetscInt p)
 PetscErrorCode MeshClosureGet(MeshClosure *mc, PetscInt p, PetscBool use_cone, PetscInt *n, const PetscInt **points)
 {
   DM        dm      = mc->dm;
-  PetscInt *closure = mc->points, *fifo = mc->fifo, size = 0, head = 0, tail = 0;
+  PetscInt *closure = mc->points, *fifo = mc->fifo, size = 0, head = 0, tail = 0, depth;
 
   PetscFunctionBeginUser;
   if (!mc->by_depth) {
@@ -100,12 +100,13 @@ PetscErrorCode MeshClosureGet(MeshClosure *mc, PetscInt p, PetscBool use_cone, P
     *points = closure;
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCheck(MeshClosureDepthOf(mc, p) >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Point %" PetscInt_FMT " is in no depth stratum", p);
+  depth = MeshClosureDepthOf(mc, p);
+  PetscCheck(depth >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Point %" PetscInt_FMT " is in no depth stratum", p);
   closure[size++] = p;
   closure[size++] = 0;
   fifo[tail++]    = p;
   fifo[tail++]    = 0;
-  fifo[tail++]    = MeshClosureDepthOf(mc, p);
+  fifo[tail++]    = depth;
   while (tail > head) {
     const PetscInt  q = fifo[head++], o = fifo[head++], qd = fifo[head++], cd = use_cone ? qd - 1 : qd + 1;
     const PetscInt *qarr = DMPolytopeTypeGetArrangment(mc->type[qd], o), *tmp, *tmp_o = NULL;

@@ -34,20 +34,37 @@ static void f0_bd_pressure(PetscInt dim, PetscInt Nf, PetscInt NfAux, const Pets
 
 /* The clamps and slips as essential conditions, one per face set. PETSc inserts them in this order, the later value
    winning at a node two face sets share: the slips first, then the clamps, so a clamp's value holds at its edge. */
-PetscErrorCode BoundaryAddDirichlet(DM dm, AppCtx *user)
+/* The k-th essential condition in that order (k < 2 n: the slips, then the clamps), NULL if the k-th slot holds another
+   kind, with its value function and context. */
+static PetscErrorCode DirichletInOrder(const AppCtx *user, PetscInt k, const BoundaryCondition **bc, ScenePointFn *fn, void **ctx)
 {
-  BoundarySet *bcs = &user->scene.bcs;
+  const BoundarySet *bcs = &user->scene.bcs;
 
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < 2 * bcs->n; ++k) {
-    BoundaryCondition *bc = &bcs->bc[k % bcs->n];
-    char               name[96];
+  *bc = &bcs->bc[k % bcs->n];
+  if ((*bc)->kind != (k < bcs->n ? BC_SLIP : BC_CLAMP))
+    *bc = NULL;
+  else {
+    *fn  = (*bc)->fn ? (*bc)->fn : ConstantVector;
+    *ctx = (*bc)->fn ? (void *)user->scene.constants : (void *)(*bc)->value;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
-    if (bc->kind != (k < bcs->n ? BC_SLIP : BC_CLAMP)) continue;
+PetscErrorCode BoundaryAddDirichlet(DM dm, AppCtx *user)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < 2 * user->scene.bcs.n; ++k) {
+    const BoundaryCondition *bc;
+    ScenePointFn             fn;
+    void                    *ctx;
+    char                     name[96];
+
+    PetscCall(DirichletInOrder(user, k, &bc, &fn, &ctx));
+    if (!bc) continue;
     PetscCall(PetscSNPrintf(name, sizeof(name), "%s %s", BoundaryKinds[bc->kind], bc->token));
     PetscCall(DMAddBoundary(dm, DM_BC_ESSENTIAL, name, user->prob.face_sets, 1, &bc->id, 0, bc->kind == BC_SLIP ? bc->ncomp : 0,
-                            bc->kind == BC_SLIP ? bc->comps : NULL, (void (*)(void))(bc->fn ? bc->fn : ConstantVector), NULL,
-                            bc->fn ? (void *)user->scene.constants : (void *)bc->value, NULL));
+                            bc->kind == BC_SLIP ? bc->comps : NULL, (void (*)(void))fn, NULL, ctx, NULL));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -60,7 +77,6 @@ PetscErrorCode BoundaryAddDirichlet(DM dm, AppCtx *user)
    512 x 512). Higher degrees take DMPlexInsertBoundaryValues(). */
 PetscErrorCode BoundaryInsertDirichlet(DM dm, const AppCtx *user, Vec loc)
 {
-  const BoundarySet *bcs = &user->scene.bcs;
   PetscSection       lsec, csec;
   Vec                coords;
   const PetscScalar *xc;
@@ -80,16 +96,19 @@ PetscErrorCode BoundaryInsertDirichlet(DM dm, const AppCtx *user, Vec loc)
   PetscCall(MeshClosureCreate(dm, &mc));
   PetscCall(VecGetArrayRead(coords, &xc));
   PetscCall(VecGetArray(loc, &a));
-  for (PetscInt k = 0; k < 2 * bcs->n; ++k) {
-    const BoundaryCondition *bc     = &bcs->bc[k % bcs->n];
-    const PetscInt           all[3] = {0, 1, 2}, *comps = bc->kind == BC_SLIP ? bc->comps : all, ncomp = bc->kind == BC_SLIP ? bc->ncomp : dim;
-    const ScenePointFn       fn  = bc->fn ? bc->fn : ConstantVector;
-    void                    *ctx = bc->fn ? (void *)user->scene.constants : (void *)bc->value;
+  for (PetscInt k = 0; k < 2 * user->scene.bcs.n; ++k) {
+    const PetscInt           all[3] = {0, 1, 2};
+    const BoundaryCondition *bc;
+    const PetscInt          *comps, *points;
+    ScenePointFn             fn;
+    void                    *ctx;
     IS                       is;
-    const PetscInt          *points;
-    PetscInt                 n;
+    PetscInt                 n, ncomp;
 
-    if (bc->kind != (k < bcs->n ? BC_SLIP : BC_CLAMP) || !user->prob.face_sets) continue; /* the order of BoundaryAddDirichlet() */
+    PetscCall(DirichletInOrder(user, k, &bc, &fn, &ctx)); /* the order of BoundaryAddDirichlet() */
+    if (!bc || !user->prob.face_sets) continue;
+    comps = bc->kind == BC_SLIP ? bc->comps : all;
+    ncomp = bc->kind == BC_SLIP ? bc->ncomp : dim;
     PetscCall(DMLabelGetStratumIS(user->prob.face_sets, bc->id, &is));
     if (!is) continue;
     PetscCall(ISGetLocalSize(is, &n));

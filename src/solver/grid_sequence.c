@@ -4,7 +4,6 @@
    from the coarse solution it needs only a few on each level. A failed level ends the sequence: the output is that
    level's, flagged as not converged. */
 #include "mesh.h"
-#include "physics.h"
 #include "solver.h"
 
 /* Replaces the problem on *dm by the problem on its uniform refinement, with *u interpolated as the initial guess. */
@@ -16,8 +15,7 @@ static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *
 
   PetscFunctionBeginUser;
   PetscCall(DMCreateLocalVector(*dm, &loc));
-  PetscCall(VecZeroEntries(loc));
-  PetscCall(BoundaryInsertDirichlet(*dm, user, loc));
+  PetscCall(VecCopy(user->prob.loc_bc, loc)); /* the Dirichlet values, inserted by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(*dm, *u, INSERT_VALUES, loc));
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));

@@ -410,8 +410,7 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   /* the run's displacement and, without the penalty law, its nodal pressure, on the refined mesh */
   nvec = user->opt.contact.method == CONTACT_PENALTY ? 1 : 2;
   PetscCall(DMCreateLocalVector(dm, &loc[0]));
-  PetscCall(VecZeroEntries(loc[0]));
-  PetscCall(BoundaryInsertDirichlet(dm, user, loc[0]));
+  PetscCall(VecCopy(user->prob.loc_bc, loc[0])); /* the Dirichlet values, inserted by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc[0]));
   if (nvec == 2) {
     PetscCall(DMCreateLocalVector(dm, &loc[1]));
