@@ -117,6 +117,8 @@ typedef struct {
   PetscBool         pc_update_check;     /*   and each update is compared with the full Galerkin products */
   PetscBool         pc_update_esteig;    /*   and the finest smoother estimates its eigenvalues again at each update */
   PetscInt          grid_sequence;       /* solve on the mesh and on this many uniform refinements of it, each from the last */
+  PetscInt          coarse_levels;       /* nested iteration to the mesh: this many coarser boxes solved first (-1: automatic) */
+  PetscReal         coarse_rtol;         /*   Newton's relative tolerance there */
   PetscReal        *eps0_sweep;          /* eps0 values solved in turn on the final mesh, each from the last solution (any number) */
   PetscInt          n_sweep;
   PetscReal         load_rtol; /* Newton also stops when |F| <= load_rtol ||F(0)||: the residual is at round-off for the load */
@@ -188,8 +190,9 @@ typedef struct {
 
 /* The simplex box of the options, when the mesh is one (MeshCreate()): the grid sequence builds its finer levels directly. */
 typedef struct {
-  PetscBool is_box; /* a 2D simplex box, on one rank, not refined by -dm_refine */
-  PetscInt  dim, faces[3];
+  PetscBool is_box;        /* a 2D simplex box, on one rank, not refined by -dm_refine */
+  PetscInt  dim, faces[3]; /* faces: of the mesh built first, the coarsest box when coarse_levels > 0 */
+  PetscInt  coarse_levels; /* the mesh of the options is this many box doublings above the one built first */
   PetscReal lower[3], upper[3];
 } MeshBox;
 
@@ -273,7 +276,7 @@ typedef struct {
 
 /* The discrete problem on one mesh: created by ProblemSetUp(), destroyed by ProblemDestroy(), one per grid level. */
 typedef struct {
-  PetscInt      level;                          /* grid sequence level of the mesh (0: the mesh of the options) */
+  PetscInt      level;                          /* grid sequence level of the mesh (0: the mesh built first) */
   PetscReal     setup_time;                     /* set-up time of this problem, counted with its first solve */
   PetscReal     h, eps;                         /* the largest cell diameter, and eps = eps0 h^power / M for it (the node's: eps * eps_factor) */
   PetscReal     eps_factor_min, eps_factor_max; /* over the contact nodes (local eps on graded meshes), all ranks */
@@ -303,6 +306,7 @@ typedef struct {
   VecScatter   bulk_scatter;                     /* the displacement at those columns (any rank's) into bulk_x */
   Vec          bulk_x;
   PetscReal    fnorm0;                          /* |F| at the start of the last SNESSolve, in the user's units */
+  PetscBool    warm;                            /* the last SolverSolve() started from a given guess, not from zero */
   PetscInt64   active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
   PetscReal    fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */
 } Problem;

@@ -17,6 +17,7 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
 /* problem.c, grid_sequence.c, eps_sweep.c */
 PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes);
 PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, const RunOptions *opt, PetscInt *request);
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 

@@ -56,25 +56,29 @@ def row(target, measured, met, command):
 
 
 def measure_default(out, s, pairs):
-    """The default run against the elastic solve, 512 x 512, nested iteration (64 x 64 refined 3 times by the sequence),
-    set-up, memory and the inexact Newton."""
+    """The default run against the elastic solve, 512 x 512: the default nests (-contact_coarse_levels -1: 64, 128 and
+    256 cells per side first), so it is the nested run too; the direct solve (-contact_coarse_levels 0, the default
+    before) is measured alongside. Set-up, memory and the inexact Newton."""
     n = 512 // s
     box = ["-dm_plex_box_faces", f"{n},{n}"]
     r = side_by_side({"elastic": (box + ["-contact_method", "none"], 1), "penalty": (box, 1),
-                      "penalty_nested": (["-dm_plex_box_faces", f"{n // 8},{n // 8}", "-contact_grid_sequence", 3], 1)}, pairs, out)
-    e, p, g = r["elastic"], r["penalty"], r["penalty_nested"]
+                      "penalty_direct": (box + ["-contact_coarse_levels", 0], 1)}, pairs, out)
+    e, p, g = r["elastic"], r["penalty"], r["penalty_direct"]
     cmd = f"bin/signorini {' '.join(BASE)} -dm_plex_box_faces {n},{n} [-contact_method none]"
     dofs = int(e[2]["n_dofs"])
     rows = [row(f"default penalty run / elastic solve <= 1.3 ({n} x {n}, 1 rank, whole process)", f"{p[0] / e[0]:.3f} ({p[0]:.3f} s / {e[0]:.3f} s; {pair_range(p, e)})",
                 p[0] / e[0] <= 1.3, cmd),
-            row("with nested iteration <= 1.1", f"{g[0] / e[0]:.3f} ({g[0]:.3f} s; {pair_range(g, e)})", g[0] / e[0] <= 1.1, f"... -dm_plex_box_faces {n // 8},{n // 8} -contact_grid_sequence 3"),
+            row("with nested iteration <= 1.1", f"{p[0] / e[0]:.3f} (the default run, {int(p[2]['coarse_levels'])} coarser boxes first; "
+                f"without them, -contact_coarse_levels 0: {g[0] / e[0]:.3f}, {g[0]:.3f} s, {pair_range(g, e)})", p[0] / e[0] <= 1.1, cmd),
             row("set-up <= 1.5 s per million unknowns (2D)", f"{e[2]['time_setup'] / dofs * 1e6:.1f} s (set-up {e[2]['time_setup']:.2f} s, {dofs} unknowns)",
                 e[2]["time_setup"] / dofs * 1e6 <= 1.5, cmd + " (time_setup in /run)")]
     for name, v in (("elastic", e), ("penalty", p)):
         kb = v[1] * 2**20 / dofs / 1e3  # MiB from /usr/bin/time, KB of 1000 bytes
         rows.append(row(f"peak memory <= 1.2 KB per unknown in 2D, {name}", f"{kb:.2f} KB ({v[1]:.0f} MiB whole process)", kb <= 1.2, cmd))
     rows.append(row("Newton: inexact linear solves (Eisenstat-Walker), final residual as tight", f"ksp_ew = {int(p[2]['ksp_ew'])}, {int(p[2]['ksp_its'])} CG iterations "
-                    f"in {int(p[2]['newton_its'])} Newton steps, |F| = {p[2]['residual_norm']:.1e}", int(p[2]["ksp_ew"]) == 1, cmd))
+                    f"in {int(p[2]['newton_its'])} Newton steps on the final box, |F| = {p[2]['residual_norm']:.1e} (without nesting: "
+                    f"{int(g[2]['ksp_its'])} in {int(g[2]['newton_its'])}, |F| = {g[2]['residual_norm']:.1e})",
+                    int(p[2]["ksp_ew"]) == 1 and p[2]["residual_norm"] <= max(g[2]["residual_norm"], 1e-8 * p[2]["load_norm"]), cmd))
     return rows
 
 

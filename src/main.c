@@ -136,7 +136,12 @@ int main(int argc, char **argv)
   PetscCall(OutputGetOptions(comm, &user.opt));
   PetscCall(BandwidthGetOptions(comm, &user.opt.perf_bandwidth));
 
-  PetscCall(MeshCreate(comm, user.opt.contact.grid_sequence, &user.opt.box, &dm));
+  {
+    PetscInt coarse_request;
+
+    PetscCall(GridSequenceCoarseRequest(comm, &user.opt, &coarse_request));
+    PetscCall(MeshCreate(comm, user.opt.contact.grid_sequence, coarse_request, &user.opt.box, &dm));
+  }
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition)); /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(user.opt.scene_name, dm, &user.opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(ProblemSetUp(dm, &user, &snes));
@@ -147,7 +152,7 @@ int main(int argc, char **argv)
   PetscCall(PetscTime(&t1));
   user.rec.stats.time_setup = t1 - t0;
 
-  PetscCall(GridSequenceSolve(&dm, &user, &snes, &u)); /* one solve without -contact_grid_sequence */
+  PetscCall(GridSequenceSolve(&dm, &user, &snes, &u)); /* one solve without nested iteration */
   PetscCall(EpsSweepSolve(dm, &user, snes, u));
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));

@@ -33,6 +33,11 @@ BAD_INPUTS = {
     "vi_with_newtonls": (["-contact_method", "vi", "-snes_type", "newtonls"], "does not fit -contact_method vi"),
     "vi_with_gamg": (["-contact_method", "vi", "-pc_type", "gamg"], "-pc_type gamg cannot follow"),
     "missing_options_file": (["-options_file", "tests/out/missing.yaml"], "Unable to open YAML option file"),
+    "coarse_levels_range": (["-contact_coarse_levels", -2], "-contact_coarse_levels must lie in [-1, 8]"),
+    "coarse_rtol": (["-contact_coarse_rtol", 0], "-contact_coarse_rtol must lie in (0, 1)"),
+    "coarse_levels_not_divisible": (["-dm_plex_box_faces", "12,20", "-contact_coarse_levels", 3], "-dm_plex_box_faces 12 is not divisible by 2^3"),
+    "coarse_levels_quads": (["-dm_plex_simplex", 0, "-contact_coarse_levels", 1], "-contact_coarse_levels 1 needs the 2D simplex box"),
+    "coarse_levels_p2": (["-displacement_petscspace_degree", 2, "-contact_coarse_levels", 1], "-contact_coarse_levels 1 needs P1 displacements"),
     "bad_output_dir": (["-output", "/nonexistent_dir/x.h5"], "Output directory '/nonexistent_dir' (-output /nonexistent_dir/x.h5) does not exist"),
 }
 

@@ -197,15 +197,16 @@ def test_bench_script_tables_come_from_its_runs(outdir):
 
 def test_getfem_side_by_side_script_agrees_with_getfem(outdir):
     """scripts/bench_getfem.py on a 24 x 24 mesh: GetFEM's solution of the same problem on the mesh the script writes
-    equals bin/signorini's (MUMPS and GAMG) to solver tolerance, and the table's ratios are the ratios of its medians."""
+    equals bin/signorini's (MUMPS and GAMG, on the file and on the box it builds itself, which is that mesh) to solver
+    tolerance, and the table's ratios are the ratios of its medians."""
     p = subprocess.run(["/usr/bin/python3", "scripts/bench_getfem.py", "--faces", "24", "--pairs", "1", "--out", outdir], cwd=ROOT, env=ENV,
                        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
     assert p.returncode == 0, p.stdout[-3000:]
     with open(os.path.join(outdir, "getfem.csv")) as fh:
         rows = {r["code"]: r for r in csv.DictReader(fh)}
-    assert set(rows) == {"signorini (MUMPS)", "signorini (GAMG)", "GetFEM (MUMPS)"}
+    assert set(rows) == {"signorini (MUMPS)", "signorini (GAMG)", "signorini (GAMG, its own box)", "GetFEM (MUMPS)"}
     g = float(rows["GetFEM (MUMPS)"]["wall_median_s"])
-    for name in ("signorini (MUMPS)", "signorini (GAMG)"):
+    for name in ("signorini (MUMPS)", "signorini (GAMG)", "signorini (GAMG, its own box)"):
         r = rows[name]
         assert float(r["max_rel_diff"]) < 1e-9, (name, r["max_rel_diff"])
         assert abs(float(r["getfem_over_this"]) - g / float(r["wall_median_s"])) < 1e-9
@@ -264,3 +265,43 @@ def test_grid_sequence_builds_2d_box_levels_as_refinements():
     assert max_diff(seq, refined) < 1e-10 and max_diff(seq, box) < 1e-10 and max_diff(seq2, seq) < 1e-10
     attrs = load(seq)[0]
     assert attrs["converged"] == 1 and attrs["n_cells"] == 2 * 12 * 20 and attrs["newton_its"] <= 3
+
+
+def test_nested_iteration_is_the_default_on_the_2d_box_and_keeps_the_answer():
+    """The default penalty run on a 2D box of at least 128 cells per side solves first on coarser boxes (here one, of
+    128 x 64 cells, to -contact_coarse_rtol), then on the box of the options from the interpolated guess. The final mesh
+    is the direct build's, vertex for vertex, and the answer is the old default's (-contact_coarse_levels 0) to the
+    solver's tolerance, with a final residual as tight."""
+    base = SQUARE + ["-dm_plex_box_faces", "256,128", "-options_file", "options/solvers/gamg.yaml", "-snes_rtol", "1e-9"]
+    _, nested = run(base, "nested_default")
+    _, direct = run(base + ["-contact_coarse_levels", 0], "nested_direct")
+    a, fa = load(nested)
+    b, fb = load(direct)
+    assert a["coarse_levels"] == 1 and b["coarse_levels"] == 0
+    assert np.array_equal(fa["x"], fb["x"])
+    with h5py.File(nested, "r") as f, h5py.File(direct, "r") as g:
+        assert np.array_equal(f["viz/topology/cells"][:], g["viz/topology/cells"][:])
+    assert np.abs(fa["displacement"] - fb["displacement"]).max() / np.abs(fb["displacement"]).max() < 1e-8
+    assert a["converged"] == 1 and a["residual_norm"] <= 1e-9 * a["load_norm"] and a["load_norm"] == b["load_norm"]
+    s = solves(nested)
+    assert list(s["level"]) == [0, 1] and s["n_dofs"][-1] == a["n_dofs"] and 3.9 < s["n_dofs"][1] / s["n_dofs"][0] < 4.1
+    assert np.all(s["converged"] == 1)
+    assert a["newton_its"] <= 4 and a["newton_its"] < b["newton_its"], (a["newton_its"], b["newton_its"])
+    assert a["active_vertices"] == b["active_vertices"] and abs(a["contact_force"] - b["contact_force"]) <= 1e-8 * abs(b["contact_force"])
+
+
+@pytest.mark.parametrize("extra, levels", [([], 2), (["-contact_coarse_levels", 2], 2), (["-contact_method", "none"], 0),
+                                           (["-contact_method", "vi", "-options_file", "options/solvers/mumps.yaml"], 0),
+                                           (["-dm_plex_box_faces", "256,100"], 0), (["-dm_plex_box_faces", "12,20", "-contact_coarse_levels", 2], 2)])
+def test_nested_iteration_levels(extra, levels):
+    """Where the default nests (the penalty method on the 2D P1 box, halved while 64 cells per side remain) and where it
+    does not; an explicit count nests any box it divides, and the answer is the direct solve's."""
+    solver = [] if "vi" in extra else ["-options_file", "options/solvers/gamg.yaml"]
+    base = SQUARE + ["-dm_plex_box_faces", "256,256"] + solver + extra
+    _, h5 = run(base, "nested_levels")
+    a, fa = load(h5)
+    assert a["coarse_levels"] == levels and a["converged"] == 1
+    assert len(solves(h5)["level"]) == levels + 1
+    if levels:
+        _, direct = run(base + ["-contact_coarse_levels", 0], "nested_levels_direct")
+        assert max_diff(h5, direct) < 1e-8

@@ -82,9 +82,11 @@ def sorted_by_position(x, u):
     return u[order]
 
 
-def signorini_cmd(mesh_path, eps, output, solver_file=None):
-    cmd = ["mpiexec", "-n", "1", BIN, "-options_file", "options/square.yaml", "-contact_monitor", "0", "-dm_plex_filename", mesh_path,
-                        "-penalty_quadrature", "nodal", "-penalty_eps", repr(eps), "-output", output]
+def signorini_cmd(mesh_path, eps, output, solver_file=None, box_faces=None):
+    """bin/signorini on the mesh file, or (box_faces) on the box it builds itself, the very mesh write_box_mesh() writes."""
+    mesh = ["-dm_plex_box_faces", f"{box_faces},{box_faces}"] if box_faces else ["-dm_plex_filename", mesh_path]
+    cmd = ["mpiexec", "-n", "1", BIN, "-options_file", "options/square.yaml", "-contact_monitor", "0"] + mesh + [
+        "-penalty_quadrature", "nodal", "-penalty_eps", repr(eps), "-output", output]
     if solver_file:
         cmd += ["-options_file", solver_file]
     return cmd

@@ -50,18 +50,27 @@ static PetscErrorCode MeshReadFile(MPI_Comm comm, const char filename[], DM *dm)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The coarsest box of nested iteration to the box of the options (-contact_coarse_levels -1) has at least this many cells per side. */
+#define MESH_COARSE_MIN_FACES 64
+
 /* Creates the mesh from PETSc's own options; simplex boxes, which PETSc 3.18 cannot generate
    without Triangle/CTetGen, come from MeshCreateSimplexBox(). later_refinements: uniform refinements the run will
-   still make (grid sequencing), counted in the size check. */
-PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, MeshBox *box, DM *dm)
+   still make (grid sequencing), counted in the size check. coarse_request: nested iteration to the box of the options
+   (-1: as many levels as keep MESH_COARSE_MIN_FACES cells per side, where the box nests; 0: none; k: k levels, or an
+   error): the box built is then the coarsest, and box->coarse_levels says how many doublings lead to the one asked for. */
+
+PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt coarse_request, MeshBox *box, DM *dm)
 {
   PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
   PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
   PetscBool           simplex, has_file, dim_set, parallel_read = PETSC_FALSE, petsc_interpolate, check_interpolation, check_closures;
   char                filename[PETSC_MAX_PATH_LEN] = "";
   MeshPartitionerType partitioner;
+  PetscMPIInt         size;
+  PetscInt            coarse = 0;
 
   PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscOptionsBegin(comm, NULL, "Mesh options (PETSc's names, and -partitioner)", "DMPLEX");
   PetscCall(PetscOptionsString("-dm_plex_filename", "Mesh file (Gmsh, ExodusII, HDF5)", "DMPlexCreateFromFile", filename, filename, sizeof(filename),
                                &has_file));
@@ -117,6 +126,27 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, MeshBox *bo
     PetscCall(PetscSNPrintf(what, sizeof(what), "-dm_plex_box_faces with %" PetscInt_FMT " refinement(s)", refine + later_refinements));
     PetscCall(MeshCheckSize(comm, dim, ncells, what));
   }
+  { /* nested iteration to the box of the options: the box built first has 2^coarse times fewer cells per side */
+    const PetscBool nests = (PetscBool)(!has_file && simplex && refine == 0 && size == 1 && dim == 2); /* 3D: Kuhn boxes do not nest */
+
+    if (coarse_request > 0) {
+      PetscCheck(nests, comm, PETSC_ERR_USER_INPUT,
+                 "-contact_coarse_levels %" PetscInt_FMT " needs the 2D simplex box (-dm_plex_box_faces) on one rank without -dm_refine",
+                 coarse_request);
+      for (PetscInt d = 0; d < dim; ++d)
+        PetscCheck(faces[d] % (1 << coarse_request) == 0, comm, PETSC_ERR_USER_INPUT,
+                   "-contact_coarse_levels %" PetscInt_FMT ": -dm_plex_box_faces %" PetscInt_FMT " is not divisible by 2^%" PetscInt_FMT,
+                   coarse_request, faces[d], coarse_request);
+      coarse = coarse_request;
+    } else if (coarse_request < 0 && nests) {
+      for (PetscBool halves = PETSC_TRUE; halves && coarse < 8;) {
+        for (PetscInt d = 0; d < dim; ++d)
+          halves = (PetscBool)(halves && faces[d] % (2 << coarse) == 0 && faces[d] >> (coarse + 1) >= MESH_COARSE_MIN_FACES);
+        if (halves) ++coarse;
+      }
+    }
+    for (PetscInt d = 0; d < dim; ++d) faces[d] >>= coarse;
+  }
   /* The serial mesh on rank 0 (a file, the project's simplex box, PETSc's tensor box), distributed by
      MeshPartitionDistribute() with the partitioner of -partitioner; PETSc's own DM options are applied to the
      distributed mesh last (DMSetFromOptions()), so that -dm_refine refines it on all ranks (at 1M unknowns a serial
@@ -164,12 +194,10 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, MeshBox *bo
   else
     PetscCall(CompatCreateBoxMesh(comm, dim, PETSC_FALSE, faces, lower, upper, NULL, PETSC_TRUE, dm));
   {
-    PetscMPIInt size;
-
-    PetscCallMPI(MPI_Comm_size(comm, &size));
     PetscCall(PetscMemzero(box, sizeof(*box)));
-    box->is_box = (PetscBool)(!has_file && simplex && refine == 0 && size == 1 && dim == 2); /* 3D: Kuhn boxes do not nest as refinements */
-    box->dim    = dim;
+    box->is_box        = (PetscBool)(!has_file && simplex && refine == 0 && size == 1 && dim == 2); /* 3D: Kuhn boxes do not nest as refinements */
+    box->coarse_levels = coarse;
+    box->dim           = dim;
     for (PetscInt d = 0; d < dim; ++d) {
       box->faces[d] = faces[d];
       box->lower[d] = lower[d];

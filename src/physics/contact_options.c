@@ -75,6 +75,17 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscCall(PetscOptionsInt("-contact_grid_sequence",
                             "Nested iteration: solve on the mesh, then on N uniform refinements of it, each from the interpolated last solution",
                             NULL, opts->grid_sequence, &opts->grid_sequence, NULL));
+  opts->coarse_levels = -1;
+  PetscCall(PetscOptionsInt("-contact_coarse_levels",
+                            "Nested iteration to the mesh of the options: solve first on this many coarser boxes, each with half the cells per "
+                            "side of the next, each from the last; -1: as many as keep 64 cells per side, where the mesh is the 2D P1 simplex box "
+                            "on one rank and the method penalty, else 0",
+                            NULL, opts->coarse_levels, &opts->coarse_levels, NULL));
+  opts->coarse_rtol = 1e-4;
+  PetscCall(PetscOptionsReal("-contact_coarse_rtol",
+                             "Newton's relative tolerance on the coarser boxes of -contact_coarse_levels (their solutions are only initial guesses; "
+                             "the final mesh keeps -snes_rtol)",
+                             NULL, opts->coarse_rtol, &opts->coarse_rtol, NULL));
   PetscCall(OptionsCountListValues("-penalty_eps0_sweep", &opts->n_sweep));
   PetscCall(PetscMalloc1(opts->n_sweep + 1, &opts->eps0_sweep));
   PetscCall(PetscOptionsRealArray("-penalty_eps0_sweep", "eps0 values solved in turn on the final mesh, each from the last solution", NULL,
@@ -86,8 +97,9 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
                              opts->load_rtol, &opts->load_rtol, NULL));
   PetscOptionsEnd();
   {
-    const char *names[]  = {"-penalty_eps0", "-penalty_eps_power", "-penalty_eps", "-penalty_continuation_factor", "-contact_load_rtol"};
-    PetscReal   values[] = {opts->eps0, opts->eps_power, opts->eps_fixed, opts->continuation_factor, opts->load_rtol};
+    const char *names[]  = {"-penalty_eps0",      "-penalty_eps_power",  "-penalty_eps", "-penalty_continuation_factor",
+                            "-contact_load_rtol", "-contact_coarse_rtol"};
+    PetscReal   values[] = {opts->eps0, opts->eps_power, opts->eps_fixed, opts->continuation_factor, opts->load_rtol, opts->coarse_rtol};
 
     for (size_t i = 0; i < sizeof(values) / sizeof(values[0]); ++i) PetscCall(OptionsCheckFinite(comm, names[i], values[i]));
     PetscCall(OptionsCheckFiniteArray(comm, "-penalty_eps0_sweep", opts->n_sweep, opts->eps0_sweep));
@@ -96,6 +108,10 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
              (double)opts->load_rtol);
   PetscCheck(opts->grid_sequence >= 0 && opts->grid_sequence <= 8, comm, PETSC_ERR_USER_INPUT,
              "-contact_grid_sequence must lie in [0, 8], got %" PetscInt_FMT, opts->grid_sequence);
+  PetscCheck(opts->coarse_levels >= -1 && opts->coarse_levels <= 8, comm, PETSC_ERR_USER_INPUT,
+             "-contact_coarse_levels must lie in [-1, 8] (-1: automatic), got %" PetscInt_FMT, opts->coarse_levels);
+  PetscCheck(opts->coarse_rtol > 0.0 && opts->coarse_rtol < 1.0, comm, PETSC_ERR_USER_INPUT, "-contact_coarse_rtol must lie in (0, 1), got %g",
+             (double)opts->coarse_rtol);
   PetscCheck(!sweep_set || opts->n_sweep > 0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep needs a comma-separated list of values");
   for (PetscInt k = 0; k < opts->n_sweep; ++k)
     PetscCheck(opts->eps0_sweep[k] > 0.0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep: every value must be positive, got %g",

@@ -1,5 +1,7 @@
-/* Nested iteration (-contact_grid_sequence N): the problem is solved on the mesh of the options, then on N uniform
+/* Nested iteration. -contact_grid_sequence N: the problem is solved on the mesh of the options, then on N uniform
    refinements of it, each level from the interpolation of the solution of the level below (exact for nested P1/Q1).
+   -contact_coarse_levels K (by default where the 2D P1 box allows it): the mesh of the options is the last of K box
+   doublings from a coarser box, each solved to the looser -contact_coarse_rtol; the final mesh is the direct build's.
    From a zero guess, semismooth Newton needs more steps as h falls (the active set moves about a cell per step);
    from the coarse solution it needs only a few on each level. A failed level ends the sequence: the output is that
    level's, flagged as not converged. */
@@ -42,19 +44,53 @@ static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Newton's relative tolerance on a box below the one of the options (-contact_coarse_levels): -contact_coarse_rtol where
+   looser than -snes_rtol. Its solution is only the next level's initial guess, whose own error is of the order of h. */
+static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
+{
+  PetscReal atol, rtol, stol;
+  PetscInt  maxit, maxf;
+
+  PetscFunctionBeginUser;
+  if (user->prob.level >= user->opt.box.coarse_levels) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
+  if (user->opt.contact.coarse_rtol > rtol) PetscCall(SNESSetTolerances(snes, atol, user->opt.contact.coarse_rtol, stol, maxit, maxf));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, const RunOptions *opt, PetscInt *request)
+{
+  const PetscInt k = opt->contact.coarse_levels;
+
+  PetscFunctionBeginUser;
+  PetscCheck(k <= 0 || opt->degree == 1, comm, PETSC_ERR_USER_INPUT,
+             "-contact_coarse_levels %" PetscInt_FMT " needs P1 displacements, got -displacement_petscspace_degree %" PetscInt_FMT, k, opt->degree);
+  *request = (k < 0 && (opt->contact.method != CONTACT_PENALTY || opt->degree != 1)) ? 0 : k;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
 {
-  PetscFunctionBeginUser;
-  PetscCall(SolverSolve(*snes, user, *u, PETSC_FALSE));
-  for (PetscInt l = 1; l <= user->opt.contact.grid_sequence && user->rec.stats.converged; ++l) {
-    PetscLogDouble t0, t1;
+  const PetscInt nlevels = user->opt.box.coarse_levels + user->opt.contact.grid_sequence;
 
+  PetscFunctionBeginUser;
+  PetscCall(GridSequenceSetTolerance(*snes, user));
+  PetscCall(SolverSolve(*snes, user, *u, PETSC_FALSE));
+  for (PetscInt l = 1; l <= nlevels; ++l) {
+    const PetscBool failed = (PetscBool)!user->rec.stats.converged;
+    PetscLogDouble  t0, t1;
+
+    if (failed && user->prob.level >= user->opt.box.coarse_levels) break; /* a failed level of -contact_grid_sequence ends it */
+    if (failed)
+      PetscCall(PetscPrintf(PetscObjectComm((PetscObject)*dm), "  nested iteration: level %" PetscInt_FMT " failed (%s), the next starts from zero\n",
+                            user->prob.level, SNESConvergedReasons[user->rec.stats.reason]));
     PetscCall(PetscTime(&t0));
     PetscCall(GridSequenceRefine(dm, user, snes, u));
     PetscCall(PetscTime(&t1));
     user->prob.setup_time = t1 - t0; /* refinement, set-up and interpolation */
     user->rec.stats.time_setup += t1 - t0;
-    PetscCall(SolverSolve(*snes, user, *u, PETSC_TRUE));
+    PetscCall(GridSequenceSetTolerance(*snes, user));
+    PetscCall(SolverSolve(*snes, user, *u, (PetscBool)!failed));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

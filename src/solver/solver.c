@@ -119,7 +119,9 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
 
 /* Newton stops, converged, when PETSc's tests say so (|F| fell by -snes_rtol, ...) or when |F| <= -contact_load_rtol
    ||F(0)||: at round-off for the load, which a warm start (eps sweep, grid sequence) may reach before any reduction
-   by -snes_rtol. Every norm here is relative, so the test is the same in any units. */
+   by -snes_rtol. A warm start whose first residual exceeds the load (an interpolated guess, whose error is of the order
+   of h) must also bring |F| below -snes_rtol ||F(0)||: its final residual is as tight as a start from zero would give.
+   Every norm here is relative, so the test is the same in any units. */
 static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm, SNESConvergedReason *reason,
                                       void *ctx)
 {
@@ -129,6 +131,13 @@ static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, P
   PetscFunctionBeginUser;
   PetscCall(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, NULL));
   if (it == 0) user->prob.fnorm0 = f;
+  if (*reason == SNES_CONVERGED_FNORM_RELATIVE && user->prob.warm) {
+    PetscReal atol, rtol, stol;
+    PetscInt  maxit, maxf;
+
+    PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
+    if (f > rtol * user->prob.load_norm) *reason = SNES_CONVERGED_ITERATING;
+  }
   if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->opt.contact.load_rtol * user->prob.load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -338,7 +347,7 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   user->rec.stats.ksp_its       = *ksp;
   user->rec.stats.residual_norm = fnorm * user->prob.displacement_scale; /* the SNES saw F/U */
   user->rec.stats.residual_reduced =
-      (PetscBool)(user->rec.stats.residual_norm <= rtol * user->prob.fnorm0 ||
+      (PetscBool)(user->rec.stats.residual_norm <= rtol * (user->prob.warm ? PetscMin(user->prob.fnorm0, user->prob.load_norm) : user->prob.fnorm0) ||
                   user->rec.stats.residual_norm <= user->opt.contact.load_rtol * user->prob.load_norm || fnorm <= atol);
   user->rec.stats.converged = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
   PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
@@ -420,6 +429,7 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm)
   PetscFunctionBeginUser;
   PetscCall(SNESGetDM(snes, &dm));
   if (!warm) PetscCall(VecZeroEntries(u));
+  user->prob.warm = warm;
   PetscCall(PetscTime(&t0));
   user->prob.pc_reuse.builds          = 0; /* counted per solve */
   user->prob.pc_reuse.updates         = 0;
