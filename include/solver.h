@@ -34,6 +34,11 @@ PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K);
 PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX);
 PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF);
 
+/* assembly_p1_csr.c */
+PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
+                                      PetscBool *done);
+PetscErrorCode AssemblyP1CSRAllocated(Mat K, PetscLogDouble *nz);
+
 /* bandwidth.c */
 PetscErrorCode BandwidthGetOptions(MPI_Comm comm, PetscBool *measure);
 PetscErrorCode BandwidthMeasure(SNES snes, AppCtx *user);
