@@ -119,6 +119,7 @@ typedef struct {
   PetscInt          grid_sequence;       /* solve on the mesh and on this many uniform refinements of it, each from the last */
   PetscInt          coarse_levels;       /* nested iteration to the mesh: this many coarser boxes solved first (-1: automatic) */
   PetscReal         coarse_rtol;         /*   Newton's relative tolerance there */
+  PetscReal         ew_guard;            /* Eisenstat-Walker's terms no smaller than this times Newton's target / |F| */
   PetscReal        *eps0_sweep;          /* eps0 values solved in turn on the final mesh, each from the last solution (any number) */
   PetscInt          n_sweep;
   PetscReal         load_rtol; /* Newton also stops when |F| <= load_rtol ||F(0)||: the residual is at round-off for the load */
@@ -274,6 +275,13 @@ typedef struct {
   PetscReal *lambda;     /* [nq][nv]: the face's P1 basis (barycentric coordinates) at the points */
 } PenaltyFaces;
 
+/* The forcing terms of the inexact Newton (ew_forcing.c): Eisenstat-Walker's, with the guard against oversolving. */
+typedef struct {
+  SNES      snes;  /* the problem's SNES (not referenced) */
+  PetscReal guard; /* -contact_ew_guard: no linear solve below guard * Newton's target / |F| (0: none) */
+  PetscReal norm_first, norm_last, rtol_last;
+} SolverForcing;
+
 /* The discrete problem on one mesh: created by ProblemSetUp(), destroyed by ProblemDestroy(), one per grid level. */
 typedef struct {
   PetscInt      level;                          /* grid sequence level of the mesh (0: the mesh built first) */
@@ -296,6 +304,7 @@ typedef struct {
   PetscReal     snes_scale;         /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
   Vec           work;               /* U x~: the displacement of the SNES iterate x~ */
   PcReuse       pc_reuse;
+  SolverForcing forcing;
   /* The penalty Jacobian lives in K itself (one matrix; only the rows of the contact dofs differ): K's own values of
      those rows are kept here, and put back before K is used as the bulk operator (PenaltyBulkOperator()). */
   PetscBool    jacobian_in_K;                    /* K holds K + the penalty Jacobian in those rows */

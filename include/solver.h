@@ -21,6 +21,9 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, const RunOptions *opt, P
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 
+/* ew_forcing.c */
+PetscErrorCode SolverForcingSetUp(SNES snes, AppCtx *user);
+
 /* pc_reuse.c */
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X);
 PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user);

@@ -86,6 +86,11 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
                              "Newton's relative tolerance on the coarser boxes of -contact_coarse_levels (their solutions are only initial guesses; "
                              "the final mesh keeps -snes_rtol)",
                              NULL, opts->coarse_rtol, &opts->coarse_rtol, NULL));
+  opts->ew_guard = 0.5;
+  PetscCall(PetscOptionsReal("-contact_ew_guard",
+                             "Inexact Newton (Eisenstat-Walker, version 2): no linear solve tighter than this times Newton's stopping residual / |F| "
+                             "(the guard against oversolving; 0: PETSc's terms)",
+                             NULL, opts->ew_guard, &opts->ew_guard, NULL));
   PetscCall(OptionsCountListValues("-penalty_eps0_sweep", &opts->n_sweep));
   PetscCall(PetscMalloc1(opts->n_sweep + 1, &opts->eps0_sweep));
   PetscCall(PetscOptionsRealArray("-penalty_eps0_sweep", "eps0 values solved in turn on the final mesh, each from the last solution", NULL,
@@ -97,9 +102,10 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
                              opts->load_rtol, &opts->load_rtol, NULL));
   PetscOptionsEnd();
   {
-    const char *names[]  = {"-penalty_eps0",      "-penalty_eps_power",  "-penalty_eps", "-penalty_continuation_factor",
-                            "-contact_load_rtol", "-contact_coarse_rtol"};
-    PetscReal   values[] = {opts->eps0, opts->eps_power, opts->eps_fixed, opts->continuation_factor, opts->load_rtol, opts->coarse_rtol};
+    const char *names[]  = {"-penalty_eps0",      "-penalty_eps_power",   "-penalty_eps",     "-penalty_continuation_factor",
+                            "-contact_load_rtol", "-contact_coarse_rtol", "-contact_ew_guard"};
+    PetscReal   values[] = {opts->eps0,      opts->eps_power,   opts->eps_fixed, opts->continuation_factor,
+                            opts->load_rtol, opts->coarse_rtol, opts->ew_guard};
 
     for (size_t i = 0; i < sizeof(values) / sizeof(values[0]); ++i) PetscCall(OptionsCheckFinite(comm, names[i], values[i]));
     PetscCall(OptionsCheckFiniteArray(comm, "-penalty_eps0_sweep", opts->n_sweep, opts->eps0_sweep));
@@ -110,6 +116,8 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
              "-contact_grid_sequence must lie in [0, 8], got %" PetscInt_FMT, opts->grid_sequence);
   PetscCheck(opts->coarse_levels >= -1 && opts->coarse_levels <= 8, comm, PETSC_ERR_USER_INPUT,
              "-contact_coarse_levels must lie in [-1, 8] (-1: automatic), got %" PetscInt_FMT, opts->coarse_levels);
+  PetscCheck(opts->ew_guard >= 0.0 && opts->ew_guard <= 1.0, comm, PETSC_ERR_USER_INPUT, "-contact_ew_guard must lie in [0, 1], got %g",
+             (double)opts->ew_guard);
   PetscCheck(opts->coarse_rtol > 0.0 && opts->coarse_rtol < 1.0, comm, PETSC_ERR_USER_INPUT, "-contact_coarse_rtol must lie in (0, 1), got %g",
              (double)opts->coarse_rtol);
   PetscCheck(!sweep_set || opts->n_sweep > 0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep needs a comma-separated list of values");

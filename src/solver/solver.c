@@ -321,6 +321,7 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     user->prob.pc_reuse.enabled = (PetscBool)(user->opt.contact.method == CONTACT_PENALTY && user->opt.contact.pc_reuse && !is_preonly);
   }
   PetscCall(SolverSetIterativeDefaults(*snes, user));
+  PetscCall(SolverForcingSetUp(*snes, user)); /* Eisenstat-Walker's terms with the oversolving guard */
   PetscCheck(is_vi == (user->opt.contact.method == CONTACT_VI), comm, PETSC_ERR_USER_INPUT,
              "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type,
              ContactMethods[user->opt.contact.method]);
