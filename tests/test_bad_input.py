@@ -34,6 +34,7 @@ BAD_INPUTS = {
     "vi_with_gamg": (["-contact_method", "vi", "-pc_type", "gamg"], "-pc_type gamg cannot follow"),
     "missing_options_file": (["-options_file", "tests/out/missing.yaml"], "Unable to open YAML option file"),
     "coarse_levels_range": (["-contact_coarse_levels", -2], "-contact_coarse_levels must lie in [-1, 8]"),
+    "ew_guard": (["-contact_ew_guard", 2], "-contact_ew_guard must lie in [0, 1]"),
     "coarse_rtol": (["-contact_coarse_rtol", 0], "-contact_coarse_rtol must lie in (0, 1)"),
     "coarse_levels_not_divisible": (["-dm_plex_box_faces", "12,20", "-contact_coarse_levels", 3], "-dm_plex_box_faces 12 is not divisible by 2^3"),
     "coarse_levels_quads": (["-dm_plex_simplex", 0, "-contact_coarse_levels", 1], "-contact_coarse_levels 1 needs the 2D simplex box"),

@@ -305,3 +305,18 @@ def test_nested_iteration_levels(extra, levels):
     if levels:
         _, direct = run(base + ["-contact_coarse_levels", 0], "nested_levels_direct")
         assert max_diff(h5, direct) < 1e-8
+
+
+def test_ew_guard_loosens_only_the_last_solves_and_keeps_the_answer():
+    """-contact_ew_guard (default 0.5) only loosens Eisenstat-Walker's terms near the solution: the answer is the one
+    of PETSc's terms (-contact_ew_guard 0) to solver tolerance, with no more CG iterations, and the final residual is
+    still below -snes_rtol times the load."""
+    base = SQUARE + ["-dm_plex_box_faces", "128,128", "-options_file", "options/solvers/gamg.yaml", "-contact_coarse_levels", 0]
+    _, guarded = run(base, "ew_guard")
+    _, plain = run(base + ["-contact_ew_guard", 0], "ew_guard_off")
+    a, _ = load(guarded)
+    b, _ = load(plain)
+    assert a["converged"] == 1 and b["converged"] == 1 and a["ksp_ew"] == 1
+    assert max_diff(guarded, plain) < 1e-7
+    assert a["ksp_its"] <= b["ksp_its"], (a["ksp_its"], b["ksp_its"])
+    assert a["residual_norm"] <= 1e-8 * a["load_norm"]
