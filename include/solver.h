@@ -38,6 +38,7 @@ PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX);
 PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF);
 
 /* assembly_p1_csr.c */
+PetscErrorCode AssemblyP1BlockPattern(DM dm, PetscInt bs, PetscInt nb, const PetscInt vidx[], PetscInt **bptr, PetscInt **bcol);
 PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
                                       PetscBool *done);
 PetscErrorCode AssemblyP1CSRAllocated(Mat K, PetscLogDouble *nz);

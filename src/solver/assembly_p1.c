@@ -187,13 +187,13 @@ static PetscErrorCode AssemblyP1BlockSize(DM dm, PetscInt *bs)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The exact preallocation of K on one rank with a block per vertex, from the edges: two vertices of a simplex mesh
-   share a cell exactly when an edge joins them, so a block row holds its vertex and the free neighbours along its
-   edges. */
+/* The exact preallocation of K on one rank with a block per vertex, from its block pattern (AssemblyP1BlockPattern():
+   a block row holds its vertex and the free neighbours along its edges); for the matrix types the CSR build of
+   AssemblyP1CreateSeqAIJ() does not take (BAIJ, SBAIJ, -mat_type). */
 static PetscErrorCode AssemblyP1PreallocateFromEdges(DM dm, PetscInt bs, PetscInt nlocal, const PetscInt vidx[], Mat K, PetscBool *done)
 {
   PetscMPIInt size;
-  PetscInt    dim, depth, vStart, vEnd, eStart, eEnd, nb = nlocal / bs, *dnz, *dnzu, *onz;
+  PetscInt    dim, depth, nb = nlocal / bs, *bptr, *bcol, *dnz, *dnzu, *onz;
 
   PetscFunctionBeginUser;
   *done = PETSC_FALSE;
@@ -201,33 +201,17 @@ static PetscErrorCode AssemblyP1PreallocateFromEdges(DM dm, PetscInt bs, PetscIn
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetDepth(dm, &depth));
   if (size > 1 || bs != dim || depth != dim) PetscFunctionReturn(PETSC_SUCCESS); /* MATPREALLOCATOR then */
-  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  PetscCall(DMPlexGetDepthStratum(dm, 1, &eStart, &eEnd));
+  PetscCall(AssemblyP1BlockPattern(dm, bs, nb, vidx, &bptr, &bcol));
   PetscCall(PetscCalloc3(nb, &dnz, nb, &dnzu, nb, &onz));
-  for (PetscInt v = vStart; v < vEnd; ++v) {
-    const PetscInt i = vidx[(v - vStart) * dim];
-
-    if (i < 0) continue; /* fully constrained: no row */
-    ++dnz[i / bs];
-    ++dnzu[i / bs];
-  }
-  for (PetscInt e = eStart; e < eEnd; ++e) {
-    const PetscInt *cone;
-    PetscInt        a, b;
-
-    PetscCall(DMPlexGetCone(dm, e, &cone));
-    a = vidx[(cone[0] - vStart) * dim];
-    b = vidx[(cone[1] - vStart) * dim];
-    if (a < 0 || b < 0) continue;
-    a /= bs;
-    b /= bs;
-    ++dnz[a];
-    ++dnz[b];
-    ++dnzu[PetscMin(a, b)];
+  for (PetscInt r = 0; r < nb; ++r) {
+    dnz[r] = bptr[r + 1] - bptr[r];
+    for (PetscInt k = bptr[r]; k < bptr[r + 1]; ++k) dnzu[r] += bcol[k] >= r;
   }
   PetscCall(MatXAIJSetPreallocation(K, bs, dnz, onz, dnzu, onz));
   PetscCall(MatSetOption(K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
   PetscCall(PetscFree3(dnz, dnzu, onz));
+  PetscCall(PetscFree(bptr));
+  PetscCall(PetscFree(bcol));
   *done = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

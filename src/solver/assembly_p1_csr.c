@@ -25,11 +25,12 @@ static PetscErrorCode AssemblyCSRDestroy(void *ctx)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The block pattern: block row r (a free vertex) holds the blocks bcol[bptr[r] .. bptr[r + 1]), sorted: itself and
-   its free neighbours along the edges. */
-static PetscErrorCode AssemblyCSRBlockPattern(DM dm, PetscInt bs, PetscInt nb, const PetscInt vidx[], PetscInt **bptr, PetscInt **bcol)
+/* The block pattern of K on one rank with a block of bs = dim dofs per vertex: block row r (a free vertex) holds the
+   blocks bcol[bptr[r] .. bptr[r + 1]), sorted: itself and its free neighbours along the edges (two vertices of a
+   simplex mesh share a cell exactly when an edge joins them). Counted in a first pass, filled in a second. */
+PetscErrorCode AssemblyP1BlockPattern(DM dm, PetscInt bs, PetscInt nb, const PetscInt vidx[], PetscInt **bptr, PetscInt **bcol)
 {
-  PetscInt dim, vStart, vEnd, eStart, eEnd, *fill;
+  PetscInt dim, vStart, vEnd, eStart, eEnd, *fill = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
@@ -43,39 +44,40 @@ static PetscErrorCode AssemblyCSRBlockPattern(DM dm, PetscInt bs, PetscInt nb, c
     for (PetscInt e = 0; e < dim; ++e)
       PetscCheck(g[e] == g[0] + e && g[0] % bs == 0 && g[0] / bs < nb, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Vertex %" PetscInt_FMT " is not one block",
                  v);
-    ++(*bptr)[g[0] / bs + 1];
   }
-  for (PetscInt e = eStart; e < eEnd; ++e) {
-    const PetscInt *cone;
-    PetscInt        a, b;
+  for (PetscInt pass = 0; pass < 2; ++pass) {
+    if (pass) { /* offsets from the counts */
+      for (PetscInt r = 0; r < nb; ++r) (*bptr)[r + 1] += (*bptr)[r];
+      PetscCall(PetscMalloc1((*bptr)[nb], bcol));
+      PetscCall(PetscCalloc1(nb, &fill));
+    }
+    for (PetscInt v = vStart; v < vEnd; ++v) {
+      const PetscInt a = vidx[(v - vStart) * dim];
 
-    PetscCall(DMPlexGetCone(dm, e, &cone));
-    a = vidx[(cone[0] - vStart) * dim];
-    b = vidx[(cone[1] - vStart) * dim];
-    if (a < 0 || b < 0) continue;
-    ++(*bptr)[a / bs + 1];
-    ++(*bptr)[b / bs + 1];
-  }
-  for (PetscInt r = 0; r < nb; ++r) (*bptr)[r + 1] += (*bptr)[r];
-  PetscCall(PetscMalloc1((*bptr)[nb], bcol));
-  PetscCall(PetscCalloc1(nb, &fill));
-  for (PetscInt v = vStart; v < vEnd; ++v) {
-    const PetscInt a = vidx[(v - vStart) * dim];
+      if (a < 0) continue;
+      if (pass)
+        (*bcol)[(*bptr)[a / bs] + fill[a / bs]++] = a / bs;
+      else
+        ++(*bptr)[a / bs + 1];
+    }
+    for (PetscInt e = eStart; e < eEnd; ++e) {
+      const PetscInt *cone;
+      PetscInt        a, b;
 
-    if (a >= 0) (*bcol)[(*bptr)[a / bs] + fill[a / bs]++] = a / bs;
-  }
-  for (PetscInt e = eStart; e < eEnd; ++e) {
-    const PetscInt *cone;
-    PetscInt        a, b;
-
-    PetscCall(DMPlexGetCone(dm, e, &cone));
-    a = vidx[(cone[0] - vStart) * dim];
-    b = vidx[(cone[1] - vStart) * dim];
-    if (a < 0 || b < 0) continue;
-    a /= bs;
-    b /= bs;
-    (*bcol)[(*bptr)[a] + fill[a]++] = b;
-    (*bcol)[(*bptr)[b] + fill[b]++] = a;
+      PetscCall(DMPlexGetCone(dm, e, &cone));
+      a = vidx[(cone[0] - vStart) * dim];
+      b = vidx[(cone[1] - vStart) * dim];
+      if (a < 0 || b < 0) continue;
+      a /= bs;
+      b /= bs;
+      if (pass) {
+        (*bcol)[(*bptr)[a] + fill[a]++] = b;
+        (*bcol)[(*bptr)[b] + fill[b]++] = a;
+      } else {
+        ++(*bptr)[a + 1];
+        ++(*bptr)[b + 1];
+      }
+    }
   }
   for (PetscInt r = 0; r < nb; ++r) PetscCall(PetscSortInt((*bptr)[r + 1] - (*bptr)[r], &(*bcol)[(*bptr)[r]]));
   PetscCall(PetscFree(fill));
@@ -112,7 +114,7 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   PetscCall(PetscOptionsHasName(NULL, NULL, "-mat_type", &type_set)); /* MatSetFromOptions() would convert K */
   if (size > 1 || bs != dim || depth != dim || !aij || type_set) PetscFunctionReturn(PETSC_SUCCESS);
   nb = nlocal / bs;
-  PetscCall(AssemblyCSRBlockPattern(dm, bs, nb, vidx, &bptr, &bcol));
+  PetscCall(AssemblyP1BlockPattern(dm, bs, nb, vidx, &bptr, &bcol));
   PetscCall(PetscNew(&csr));
   PetscCall(PetscMalloc1(nlocal + 1, &csr->i));
   PetscCall(PetscMalloc1(bs * bs * bptr[nb], &csr->j));
