@@ -320,3 +320,15 @@ def test_ew_guard_loosens_only_the_last_solves_and_keeps_the_answer():
     assert max_diff(guarded, plain) < 1e-7
     assert a["ksp_its"] <= b["ksp_its"], (a["ksp_its"], b["ksp_its"])
     assert a["residual_norm"] <= 1e-8 * a["load_norm"]
+
+
+def test_a_failed_coarser_box_still_solves_the_mesh_of_the_options():
+    """With one Newton step allowed every level fails: each failed coarser box is reported and the next level starts
+    from zero, and the output is the mesh of the options (256 x 128), flagged as not converged."""
+    out, h5 = run(SQUARE + ["-dm_plex_box_faces", "256,128", "-options_file", "options/solvers/gamg.yaml", "-snes_max_it", 1], "nested_failed",
+                  expect_rc=3)
+    a, _ = load(h5)
+    assert "nested iteration: level 0 failed (DIVERGED_MAX_IT), the next starts from zero" in out
+    assert a["converged"] == 0 and a["coarse_levels"] == 1 and a["n_cells"] == 2 * 256 * 128
+    s = solves(h5)
+    assert list(s["level"]) == [0, 1] and list(s["converged"]) == [0, 0]

@@ -58,7 +58,6 @@ static PetscErrorCode MeshReadFile(MPI_Comm comm, const char filename[], DM *dm)
    still make (grid sequencing), counted in the size check. coarse_request: nested iteration to the box of the options
    (-1: as many levels as keep MESH_COARSE_MIN_FACES cells per side, where the box nests; 0: none; k: k levels, or an
    error): the box built is then the coarsest, and box->coarse_levels says how many doublings lead to the one asked for. */
-
 PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt coarse_request, MeshBox *box, DM *dm)
 {
   PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;

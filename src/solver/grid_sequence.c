@@ -3,8 +3,9 @@
    -contact_coarse_levels K (by default where the 2D P1 box allows it): the mesh of the options is the last of K box
    doublings from a coarser box, each solved to the looser -contact_coarse_rtol; the final mesh is the direct build's.
    From a zero guess, semismooth Newton needs more steps as h falls (the active set moves about a cell per step);
-   from the coarse solution it needs only a few on each level. A failed level ends the sequence: the output is that
-   level's, flagged as not converged. */
+   from the coarse solution it needs only a few on each level. A failed level of -contact_grid_sequence ends the
+   sequence: the output is that level's, flagged as not converged. A failed coarser box of -contact_coarse_levels is
+   reported and the next level starts from zero: the mesh of the options is always solved. */
 #include "mesh.h"
 #include "solver.h"
 
