@@ -277,9 +277,9 @@ typedef struct {
 
 /* The forcing terms of the inexact Newton (ew_forcing.c): Eisenstat-Walker's, with the guard against oversolving. */
 typedef struct {
-  SNES      snes;  /* the problem's SNES (not referenced) */
-  PetscReal guard; /* -contact_ew_guard: no linear solve below guard * Newton's target / |F| (0: none) */
-  PetscReal norm_first, norm_last, rtol_last;
+  SNES      snes;                 /* the problem's SNES (not referenced) */
+  PetscReal guard;                /* -contact_ew_guard: no linear solve below guard * Newton's target / |F| (0: none) */
+  PetscReal norm_last, rtol_last; /* |F| and the linear tolerance of the last step */
 } SolverForcing;
 
 /* The discrete problem on one mesh: created by ProblemSetUp(), destroyed by ProblemDestroy(), one per grid level. */

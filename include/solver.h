@@ -11,6 +11,9 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
 PetscErrorCode SolverComputeScales(DM dm, AppCtx *user);
 PetscErrorCode SolverIterateDisplacement(AppCtx *user, Vec X, Vec *u);
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm);
+/* |F| (user's units) that -snes_rtol is relative to in the current solve: its first, or for a warm start the smaller of
+   its first and the load ||F(0)||, so that a warm start ends as tight as a start from zero */
+PetscErrorCode SolverStopReference(const AppCtx *user, PetscReal *ref);
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
 PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
 

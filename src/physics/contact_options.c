@@ -116,10 +116,10 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
              "-contact_grid_sequence must lie in [0, 8], got %" PetscInt_FMT, opts->grid_sequence);
   PetscCheck(opts->coarse_levels >= -1 && opts->coarse_levels <= 8, comm, PETSC_ERR_USER_INPUT,
              "-contact_coarse_levels must lie in [-1, 8] (-1: automatic), got %" PetscInt_FMT, opts->coarse_levels);
-  PetscCheck(opts->ew_guard >= 0.0 && opts->ew_guard <= 1.0, comm, PETSC_ERR_USER_INPUT, "-contact_ew_guard must lie in [0, 1], got %g",
-             (double)opts->ew_guard);
   PetscCheck(opts->coarse_rtol > 0.0 && opts->coarse_rtol < 1.0, comm, PETSC_ERR_USER_INPUT, "-contact_coarse_rtol must lie in (0, 1), got %g",
              (double)opts->coarse_rtol);
+  PetscCheck(opts->ew_guard >= 0.0 && opts->ew_guard <= 1.0, comm, PETSC_ERR_USER_INPUT, "-contact_ew_guard must lie in [0, 1], got %g",
+             (double)opts->ew_guard);
   PetscCheck(!sweep_set || opts->n_sweep > 0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep needs a comma-separated list of values");
   for (PetscInt k = 0; k < opts->n_sweep; ++k)
     PetscCheck(opts->eps0_sweep[k] > 0.0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep: every value must be positive, got %g",

@@ -290,46 +290,24 @@ static PetscErrorCode AssemblyP1Preallocate(DM dm, PetscInt bs, PetscInt nlocal,
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Creates and assembles K by the P1 path; the near-null space is left to the caller. */
-PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K)
+/* K of any type on any number of ranks: preallocated (AssemblyP1Preallocate()), then filled cell by cell through
+   MatSetValues(), which also sends the entries of rows owned by other ranks. Ends the preallocation's log event. */
+static PetscErrorCode AssemblyP1CreateAnyMatrix(DM dm, AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[],
+                                                ISLocalToGlobalMapping ltog, Mat *K)
 {
-  MPI_Comm               comm = PetscObjectComm((PetscObject)dm);
-  PetscSection           gsection, csection;
-  ISLocalToGlobalMapping ltog;
-  Vec                    coords;
-  const PetscScalar     *xa;
-  MatType                mtype;
-  PetscInt               dim, cStart, cEnd, vStart, vEnd, nlocal, bs = 1, *vidx, *cverts;
-  PetscBool              is_sbaij, done;
+  PetscSection       csection;
+  Vec                coords;
+  const PetscScalar *xa;
+  MatType            mtype;
+  PetscInt           dim, cStart, cEnd, vStart, vEnd;
+  PetscBool          is_sbaij;
 
   PetscFunctionBeginUser;
-  if (!ASSEMBLY_P1_Fill) {
-    PetscCall(PetscLogEventRegister("AssemblyP1Prealloc", DM_CLASSID, &ASSEMBLY_P1_Preallocate));
-    PetscCall(PetscLogEventRegister("AssemblyP1Fill", DM_CLASSID, &ASSEMBLY_P1_Fill));
-  }
-  PetscCall(PetscLogEventBegin(ASSEMBLY_P1_Preallocate, dm, 0, 0, 0));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  PetscCall(DMGetGlobalSection(dm, &gsection));
-  PetscCall(PetscSectionGetConstrainedStorageSize(gsection, &nlocal));
   PetscCall(DMGetMatType(dm, &mtype));
-  PetscCall(AssemblyP1BlockSize(dm, &bs));
-  PetscCall(AssemblyP1VertexIndices(dm, &vidx));
-  PetscCall(AssemblyP1CellVertices(dm, &cverts));
-  PetscCall(DMGetLocalToGlobalMapping(dm, &ltog));
-  PetscCall(AssemblyP1CreateSeqAIJ(dm, user, nlocal, bs, vidx, cverts, K, &done)); /* one rank, AIJ: its own CSR arrays */
-  if (done) {
-    PetscCall(MatSetLocalToGlobalMapping(*K, ltog, ltog));
-    PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
-    PetscCall(MatSetDM(*K, dm));
-    PetscCall(PetscFree(vidx));
-    PetscCall(PetscFree(cverts));
-    PetscCall(PetscLogEventEnd(ASSEMBLY_P1_Preallocate, dm, 0, 0, 0));
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-
-  PetscCall(MatCreate(comm, K));
+  PetscCall(MatCreate(PetscObjectComm((PetscObject)dm), K));
   PetscCall(MatSetSizes(*K, nlocal, nlocal, PETSC_DETERMINE, PETSC_DETERMINE));
   PetscCall(MatSetType(*K, mtype));
   PetscCall(MatSetBlockSize(*K, bs));
@@ -366,10 +344,40 @@ PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K)
   PetscCall(VecRestoreArrayRead(coords, &xa));
   PetscCall(MatAssemblyBegin(*K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(*K, MAT_FINAL_ASSEMBLY));
+  PetscCall(PetscLogEventEnd(ASSEMBLY_P1_Fill, dm, 0, 0, 0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Creates and assembles K by the P1 path; the near-null space is left to the caller. */
+PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K)
+{
+  PetscSection           gsection;
+  ISLocalToGlobalMapping ltog;
+  PetscInt               nlocal, bs = 1, *vidx, *cverts;
+  PetscBool              done;
+
+  PetscFunctionBeginUser;
+  if (!ASSEMBLY_P1_Fill) {
+    PetscCall(PetscLogEventRegister("AssemblyP1Prealloc", DM_CLASSID, &ASSEMBLY_P1_Preallocate));
+    PetscCall(PetscLogEventRegister("AssemblyP1Fill", DM_CLASSID, &ASSEMBLY_P1_Fill));
+  }
+  PetscCall(PetscLogEventBegin(ASSEMBLY_P1_Preallocate, dm, 0, 0, 0));
+  PetscCall(DMGetGlobalSection(dm, &gsection));
+  PetscCall(PetscSectionGetConstrainedStorageSize(gsection, &nlocal));
+  PetscCall(AssemblyP1BlockSize(dm, &bs));
+  PetscCall(AssemblyP1VertexIndices(dm, &vidx));
+  PetscCall(AssemblyP1CellVertices(dm, &cverts));
+  PetscCall(DMGetLocalToGlobalMapping(dm, &ltog));
+  PetscCall(AssemblyP1CreateSeqAIJ(dm, user, nlocal, bs, vidx, cverts, K, &done)); /* one rank, AIJ: its own CSR arrays */
+  if (done) {
+    PetscCall(MatSetLocalToGlobalMapping(*K, ltog, ltog));
+    PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+    PetscCall(PetscLogEventEnd(ASSEMBLY_P1_Preallocate, dm, 0, 0, 0));
+  } else
+    PetscCall(AssemblyP1CreateAnyMatrix(dm, user, nlocal, bs, vidx, cverts, ltog, K));
   PetscCall(MatSetDM(*K, dm));
   PetscCall(PetscFree(vidx));
   PetscCall(PetscFree(cverts));
-  PetscCall(PetscLogEventEnd(ASSEMBLY_P1_Fill, dm, 0, 0, 0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

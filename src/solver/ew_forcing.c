@@ -13,32 +13,31 @@ static PetscErrorCode ForcingPreSolve(KSP ksp, Vec b, Vec x, void *ctx)
   AppCtx        *user = (AppCtx *)ctx;
   SolverForcing *fc   = &user->prob.forcing;
   SNES           snes = fc->snes;
-  PetscInt       it, version;
-  PetscReal      norm, rtol, rtol_0, rtol_max, gamma, alpha, alpha2, threshold, srtol, atol, stol;
+  PetscInt       it;
+  PetscReal      norm, rtol, rtol_0, rtol_max, gamma, alpha, threshold, srtol, atol, stol;
   PetscInt       maxit, maxf;
   PetscBool      ew;
 
   PetscFunctionBeginUser;
   PetscCall(SNESKSPGetUseEW(snes, &ew));
   if (!ew) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(SNESKSPGetParametersEW(snes, &version, &rtol_0, &rtol_max, &gamma, &alpha, &alpha2, &threshold));
+  PetscCall(SNESKSPGetParametersEW(snes, NULL, &rtol_0, &rtol_max, &gamma, &alpha, NULL, &threshold));
   PetscCall(SNESGetIterationNumber(snes, &it));
   PetscCall(SNESGetFunctionNorm(snes, &norm));
-  if (!it) {
-    rtol           = rtol_0;
-    fc->norm_first = norm;
-  } else {
+  if (!it)
+    rtol = rtol_0;
+  else {
     const PetscReal stol_ew = gamma * PetscPowReal(fc->rtol_last, alpha);
 
     rtol = gamma * PetscPowReal(norm / fc->norm_last, alpha);
     if (stol_ew > threshold) rtol = PetscMax(rtol, stol_ew);
   }
   if (fc->guard > 0.0 && norm > 0.0) {
-    PetscReal ref = fc->norm_first;
+    PetscReal ref;
 
     PetscCall(SNESGetTolerances(snes, &atol, &srtol, &stol, &maxit, &maxf));
-    if (user->prob.warm) ref = PetscMin(ref, user->prob.load_norm / user->prob.snes_scale); /* SolverConverged()'s target */
-    rtol = PetscMax(rtol, fc->guard * srtol * ref / norm);
+    PetscCall(SolverStopReference(user, &ref)); /* SolverConverged()'s, in the user's units; the SNES sees F/U */
+    rtol = PetscMax(rtol, fc->guard * srtol * (ref / user->prob.snes_scale) / norm);
   }
   rtol = PetscMin(rtol, rtol_max);
   PetscCall(KSPSetTolerances(ksp, rtol, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));

@@ -122,6 +122,13 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
    by -snes_rtol. A warm start whose first residual exceeds the load (an interpolated guess, whose error is of the order
    of h) must also bring |F| below -snes_rtol ||F(0)||: its final residual is as tight as a start from zero would give.
    Every norm here is relative, so the test is the same in any units. */
+PetscErrorCode SolverStopReference(const AppCtx *user, PetscReal *ref)
+{
+  PetscFunctionBeginUser;
+  *ref = user->prob.warm ? PetscMin(user->prob.fnorm0, user->prob.load_norm) : user->prob.fnorm0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm, SNESConvergedReason *reason,
                                       void *ctx)
 {
@@ -132,11 +139,12 @@ static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, P
   PetscCall(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, NULL));
   if (it == 0) user->prob.fnorm0 = f;
   if (*reason == SNES_CONVERGED_FNORM_RELATIVE && user->prob.warm) {
-    PetscReal atol, rtol, stol;
+    PetscReal atol, rtol, stol, ref;
     PetscInt  maxit, maxf;
 
     PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
-    if (f > rtol * user->prob.load_norm) *reason = SNES_CONVERGED_ITERATING;
+    PetscCall(SolverStopReference(user, &ref));
+    if (f > rtol * ref) *reason = SNES_CONVERGED_ITERATING;
   }
   if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->opt.contact.load_rtol * user->prob.load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -334,7 +342,7 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
 static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, PetscInt *ksp)
 {
   PetscInt  its, lits, maxit, maxf;
-  PetscReal fnorm, atol, rtol, stol;
+  PetscReal fnorm, atol, rtol, stol, ref;
 
   PetscFunctionBeginUser;
   PetscCall(SNESGetConvergedReason(snes, &user->rec.stats.reason));
@@ -347,8 +355,9 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   user->rec.stats.newton_its    = *newton;
   user->rec.stats.ksp_its       = *ksp;
   user->rec.stats.residual_norm = fnorm * user->prob.displacement_scale; /* the SNES saw F/U */
+  PetscCall(SolverStopReference(user, &ref));
   user->rec.stats.residual_reduced =
-      (PetscBool)(user->rec.stats.residual_norm <= rtol * (user->prob.warm ? PetscMin(user->prob.fnorm0, user->prob.load_norm) : user->prob.fnorm0) ||
+      (PetscBool)(user->rec.stats.residual_norm <= rtol * ref ||
                   user->rec.stats.residual_norm <= user->opt.contact.load_rtol * user->prob.load_norm || fnorm <= atol);
   user->rec.stats.converged = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
   PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
