@@ -329,10 +329,20 @@ typedef struct {
   ErrorNorms   ref_errors; /* against the -reference solution */
 } RunRecord;
 
-/* The state of a run, by concern: its options, its scene, the problem on the current mesh, and its record. */
+/* The interpolations between the nested meshes solved so far (src/solver/multigrid.c): the levels of a geometric
+   multigrid (-pc_type mg) on the mesh of the current problem, which has n + 1 of them. */
+#define MULTIGRID_MAX_LEVELS 16
+typedef struct {
+  PetscInt n;
+  Mat      interp[MULTIGRID_MAX_LEVELS]; /* [l]: from the global vector of mesh l to that of mesh l + 1 */
+} Multigrid;
+
+/* The state of a run, by concern: its options, its scene, the problem on the current mesh, the hierarchy of the meshes
+   solved before it, and its record. */
 typedef struct {
   RunOptions opt;
   Scene      scene;
   Problem    prob;
+  Multigrid  mg;
   RunRecord  rec;
 } AppCtx;

@@ -137,10 +137,10 @@ int main(int argc, char **argv)
   PetscCall(BandwidthGetOptions(comm, &user.opt.perf_bandwidth));
 
   {
-    PetscInt coarse_request;
+    PetscInt coarse_request, coarse_min_faces;
 
-    PetscCall(GridSequenceCoarseRequest(comm, &user.opt, &coarse_request));
-    PetscCall(MeshCreate(comm, user.opt.contact.grid_sequence, coarse_request, &user.opt.box, &dm));
+    PetscCall(GridSequenceCoarseRequest(comm, &user.opt, &coarse_request, &coarse_min_faces));
+    PetscCall(MeshCreate(comm, user.opt.contact.grid_sequence, coarse_request, coarse_min_faces, &user.opt.box, &dm));
   }
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition)); /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(user.opt.scene_name, dm, &user.opt.material, &user.scene)); /* its options, once for every level */
@@ -181,6 +181,7 @@ int main(int argc, char **argv)
 
   PetscCall(VecDestroy(&u));
   PetscCall(ProblemDestroy(&user, &snes));
+  PetscCall(MultigridDestroy(&user.mg));
   PetscCall(DMDestroy(&dm));
   PetscCall(ContactOptionsDestroy(&user.opt.contact));
   PetscCall(PetscFree(user.rec.records));

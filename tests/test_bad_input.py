@@ -39,6 +39,9 @@ BAD_INPUTS = {
     "coarse_levels_not_divisible": (["-dm_plex_box_faces", "12,20", "-contact_coarse_levels", 3], "-dm_plex_box_faces 12 is not divisible by 2^3"),
     "coarse_levels_quads": (["-dm_plex_simplex", 0, "-contact_coarse_levels", 1], "-contact_coarse_levels 1 needs the 2D simplex box"),
     "coarse_levels_p2": (["-displacement_petscspace_degree", 2, "-contact_coarse_levels", 1], "-contact_coarse_levels 1 needs P1 displacements"),
+    "mg_without_nested_meshes": (["-pc_type", "mg", "-contact_coarse_levels", 0], "-pc_type mg takes its levels from nested meshes, and this mesh has none"),
+    "mg_p2": (["-pc_type", "mg", "-displacement_petscspace_degree", 2], "-pc_type mg takes its levels from nested meshes, and this mesh has none"),
+    "vi_with_mg": (["-contact_method", "vi", "-pc_type", "mg"], "-pc_type mg cannot follow"),
     "bad_output_dir": (["-output", "/nonexistent_dir/x.h5"], "Output directory '/nonexistent_dir' (-output /nonexistent_dir/x.h5) does not exist"),
 }
 

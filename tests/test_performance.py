@@ -332,3 +332,42 @@ def test_a_failed_coarser_box_still_solves_the_mesh_of_the_options():
     assert a["converged"] == 0 and a["coarse_levels"] == 1 and a["n_cells"] == 2 * 256 * 128
     s = solves(h5)
     assert list(s["level"]) == [0, 1] and list(s["converged"]) == [0, 0]
+
+
+MG = ["-options_file", "options/solvers/mg.yaml"]
+
+
+@pytest.mark.parametrize("method", ["penalty", "none"])
+def test_geometric_multigrid_on_the_nested_boxes(method):
+    """-pc_type mg (options/solvers/mg.yaml): the default nests the 2D box down to 16 cells per side (128 x 128: three
+    coarser boxes), for the elastic solve too, and each level's PCMG has one level per box solved so far. The answer is
+    the direct solve's (MUMPS, no nesting) to solver tolerance, and the CG iterations of the final box do not grow with
+    h (a wrong interpolation would leave a preconditioner that still converges, slowly)."""
+    its = {}
+    for n in (128, 256):
+        base = SQUARE + ["-dm_plex_box_faces", f"{n},{n}", "-contact_method", method]
+        _, h5 = run(base + MG, f"mg_{method}_{n}")
+        a, _ = load(h5)
+        assert a["converged"] == 1 and a["coarse_levels"] == (3 if n == 128 else 4)
+        assert a["residual_norm"] <= 1e-8 * a["load_norm"]  # -snes_rtol
+        s = solves(h5)
+        assert len(s["level"]) == a["coarse_levels"] + 1 and s["n_dofs"][-1] == a["n_dofs"]
+        its[n] = a["ksp_its"] / a["newton_its"]
+        if n == 128:
+            _, direct = run(base + ["-contact_coarse_levels", 0], f"mg_{method}_direct")
+            assert max_diff(h5, direct) < 1e-8
+    assert its[128] <= 16 and its[256] <= its[128] + 2, its
+
+
+def test_geometric_multigrid_over_the_grid_sequence_in_parallel():
+    """-pc_type mg over the uniform refinements of -contact_grid_sequence, on two ranks: the answer of one rank with the
+    default direct solver, and the same CG iterations per Newton step as on one rank, within one."""
+    base = SQUARE + ["-dm_plex_box_faces", "22,22", "-contact_grid_sequence", 2]
+    _, two = run(base + MG, "mg_gs_np2", np_=2)
+    _, one = run(base + MG, "mg_gs_np1")
+    _, direct = run(base, "mg_gs_direct")
+    a, b = load(two)[0], load(one)[0]
+    assert a["converged"] == 1 and b["converged"] == 1 and a["n_dofs"] == b["n_dofs"]
+    assert max_diff(two, direct) < 1e-8 and max_diff(one, direct) < 1e-8
+    assert abs(a["ksp_its"] - b["ksp_its"]) <= a["newton_its"], (a["ksp_its"], b["ksp_its"])
+    assert a["ksp_its"] / a["newton_its"] <= 8

@@ -50,15 +50,12 @@ static PetscErrorCode MeshReadFile(MPI_Comm comm, const char filename[], DM *dm)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The coarsest box of nested iteration to the box of the options (-contact_coarse_levels -1) has at least this many cells per side. */
-#define MESH_COARSE_MIN_FACES 64
-
 /* Creates the mesh from PETSc's own options; simplex boxes, which PETSc 3.18 cannot generate
    without Triangle/CTetGen, come from MeshCreateSimplexBox(). later_refinements: uniform refinements the run will
    still make (grid sequencing), counted in the size check. coarse_request: nested iteration to the box of the options
-   (-1: as many levels as keep MESH_COARSE_MIN_FACES cells per side, where the box nests; 0: none; k: k levels, or an
+   (-1: as many levels as keep coarse_min_faces cells per side, where the box nests; 0: none; k: k levels, or an
    error): the box built is then the coarsest, and box->coarse_levels says how many doublings lead to the one asked for. */
-PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt coarse_request, MeshBox *box, DM *dm)
+PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt coarse_request, PetscInt coarse_min_faces, MeshBox *box, DM *dm)
 {
   PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
   PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
@@ -140,7 +137,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
     } else if (coarse_request < 0 && nests) {
       for (PetscBool halves = PETSC_TRUE; halves && coarse < 8;) {
         for (PetscInt d = 0; d < dim; ++d)
-          halves = (PetscBool)(halves && faces[d] % (2 << coarse) == 0 && faces[d] >> (coarse + 1) >= MESH_COARSE_MIN_FACES);
+          halves = (PetscBool)(halves && faces[d] % (2 << coarse) == 0 && faces[d] >> (coarse + 1) >= coarse_min_faces);
         if (halves) ++coarse;
       }
     }

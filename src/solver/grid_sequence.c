@@ -29,6 +29,7 @@ static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *
     PetscCall(MeshRefineRegular(*dm, 1, &fine, &parent, &vertex_source));
   user->prob.level++;
   PetscCall(ProblemSetUp(fine, user, snes));
+  if (user->opt.degree == 1) PetscCall(MultigridAddLevel(*dm, fine, vertex_source, &user->mg)); /* for -pc_type mg */
   if (user->opt.degree == 1)
     PetscCall(MeshInterpolateVertexSources(*dm, fine, vertex_source, loc, &fine_loc)); /* exact and fast */
   else
@@ -59,14 +60,24 @@ static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, const RunOptions *opt, PetscInt *request)
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, const RunOptions *opt, PetscInt *request, PetscInt *min_faces)
 {
   const PetscInt k = opt->contact.coarse_levels;
 
   PetscFunctionBeginUser;
   PetscCheck(k <= 0 || opt->degree == 1, comm, PETSC_ERR_USER_INPUT,
              "-contact_coarse_levels %" PetscInt_FMT " needs P1 displacements, got -displacement_petscspace_degree %" PetscInt_FMT, k, opt->degree);
-  *request = (k < 0 && (opt->contact.method != CONTACT_PENALTY || opt->degree != 1)) ? 0 : k;
+  *request   = k;
+  *min_faces = GRID_SEQUENCE_MIN_FACES;
+  if (k < 0) { /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels) */
+    char      pc_type[64] = "";
+    PetscBool is_mg;
+
+    PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc_type, sizeof(pc_type), NULL));
+    PetscCall(PetscStrcmp(pc_type, PCMG, &is_mg));
+    if (is_mg) *min_faces = GRID_SEQUENCE_MIN_FACES_MG;
+    if (!(opt->contact.method == CONTACT_PENALTY || (opt->contact.method == CONTACT_NONE && is_mg)) || opt->degree != 1) *request = 0;
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

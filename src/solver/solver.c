@@ -314,13 +314,16 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscCall(PetscObjectTypeCompareAny((PetscObject)*snes, &is_vi, SNESVINEWTONRSLS, SNESVINEWTONSSLS, ""));
   PetscCall(SNESGetType(*snes, &type));
   {
-    PetscBool is_gamg, is_rsls;
+    PetscBool is_multigrid, is_rsls;
+    PCType    pc_type;
 
-    PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &is_gamg));
+    PetscCall(PCGetType(pc, &pc_type));
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &is_multigrid, PCGAMG, PCMG, ""));
     PetscCall(PetscObjectTypeCompare((PetscObject)*snes, SNESVINEWTONRSLS, &is_rsls));
-    PetscCheck(!(is_gamg && is_rsls), comm, PETSC_ERR_USER_INPUT,
-               "-pc_type gamg cannot follow the reduced system of -snes_type vinewtonrsls (its size changes between steps): use hypre or mumps with "
-               "-contact_method vi");
+    PetscCheck(!(is_multigrid && is_rsls), comm, PETSC_ERR_USER_INPUT,
+               "-pc_type %s cannot follow the reduced system of -snes_type vinewtonrsls (its size changes between steps): use hypre or mumps with "
+               "-contact_method vi",
+               pc_type);
   }
   {
     PetscBool is_preonly;
@@ -439,6 +442,7 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm)
   PetscFunctionBeginUser;
   PetscCall(SNESGetDM(snes, &dm));
   if (!warm) PetscCall(VecZeroEntries(u));
+  PetscCall(MultigridSetUpPC(snes, user)); /* -pc_type mg: the levels of the meshes solved so far */
   user->prob.warm = warm;
   PetscCall(PetscTime(&t0));
   user->prob.pc_reuse.builds          = 0; /* counted per solve */

@@ -1,0 +1,164 @@
+/* Geometric multigrid (-pc_type mg) over the nested meshes of nested iteration: the box's coarser boxes
+   (-contact_coarse_levels) and the uniform refinements of -contact_grid_sequence. Each refinement adds the interpolation
+   from the global vector of the coarser mesh to that of the finer one (P1/Q1: a fine vertex gets the mean of the values
+   at the vertices of its source point, exact for nested spaces); the problem on the finest mesh so far then has a PCMG
+   of one level per mesh, with Galerkin coarse operators (P^T A P: the penalty rows included, whatever the coarser
+   meshes' own eps), and the coarsest mesh's operator is solved by the PCMG's coarse solver (LU by default). */
+#include "mesh.h"
+#include "solver.h"
+
+/* The coarse vertices whose mean is the fine vertex with source point src (a coarse vertex, edge, quad or hex). */
+static PetscErrorCode SourceVertices(DM coarse, PetscInt cvStart, PetscInt cvEnd, PetscInt src, PetscInt verts[], PetscInt *nv)
+{
+  PetscInt *closure = NULL, ncl, eStart, eEnd;
+
+  PetscFunctionBeginUser;
+  *nv = 0;
+  if (src >= cvStart && src < cvEnd) {
+    verts[(*nv)++] = src;
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(DMPlexGetDepthStratum(coarse, 1, &eStart, &eEnd));
+  if (src >= eStart && src < eEnd) { /* an edge: its cone */
+    const PetscInt *cone;
+
+    PetscCall(DMPlexGetCone(coarse, src, &cone));
+    verts[0] = cone[0];
+    verts[1] = cone[1];
+    *nv      = 2;
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(DMPlexGetTransitiveClosure(coarse, src, PETSC_TRUE, &ncl, &closure));
+  for (PetscInt j = 0; j < ncl; ++j)
+    if (closure[2 * j] >= cvStart && closure[2 * j] < cvEnd && *nv < 8) verts[(*nv)++] = closure[2 * j];
+  PetscCall(DMPlexRestoreTransitiveClosure(coarse, src, PETSC_TRUE, &ncl, &closure));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Adds the interpolation from coarse to fine, refined once (vertex_source[]: MeshCreateBoxLevel(), MeshRefineRegular()).
+   Both meshes' problems must be set up (their sections); fine's rows are its owned free components, coarse's columns its
+   free components, a fixed coarse component contributing nothing. */
+PetscErrorCode MultigridAddLevel(DM coarse, DM fine, const PetscInt vertex_source[], Multigrid *mg)
+{
+  MPI_Comm     comm = PetscObjectComm((PetscObject)fine);
+  PetscSection cl, cg, fl, fg;
+  PetscInt     dim, vStart, vEnd, cvStart, cvEnd, m, n, rstart, cstart, cend, *dnz, *onz;
+  Mat          P;
+
+  PetscFunctionBeginUser;
+  PetscCheck(mg->n < MULTIGRID_MAX_LEVELS, comm, PETSC_ERR_USER_INPUT, "-pc_type mg: at most %d nested meshes", MULTIGRID_MAX_LEVELS + 1);
+  PetscCall(DMGetDimension(fine, &dim));
+  PetscCall(DMGetLocalSection(coarse, &cl));
+  PetscCall(DMGetGlobalSection(coarse, &cg));
+  PetscCall(DMGetLocalSection(fine, &fl));
+  PetscCall(DMGetGlobalSection(fine, &fg));
+  PetscCall(DMPlexGetDepthStratum(fine, 0, &vStart, &vEnd));
+  PetscCall(DMPlexGetDepthStratum(coarse, 0, &cvStart, &cvEnd));
+  PetscCall(PetscSectionGetConstrainedStorageSize(fg, &m));
+  PetscCall(PetscSectionGetConstrainedStorageSize(cg, &n));
+  PetscCallMPI(MPI_Scan(&m, &rstart, 1, MPIU_INT, MPI_SUM, comm));
+  rstart -= m;
+  PetscCallMPI(MPI_Scan(&n, &cend, 1, MPIU_INT, MPI_SUM, comm));
+  cstart = cend - n;
+  PetscCall(PetscCalloc2(m, &dnz, m, &onz));
+  for (PetscInt pass = 0; pass < 2; ++pass) {
+    if (pass == 1) {
+      PetscCall(MatCreateAIJ(comm, m, n, PETSC_DETERMINE, PETSC_DETERMINE, 0, dnz, 0, onz, &P));
+      PetscCall(MatSetOption(P, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+    }
+    for (PetscInt v = vStart; v < vEnd; ++v) {
+      PetscInt fidx[3], verts[8], nv, goff, dof;
+
+      PetscCall(PetscSectionGetDof(fg, v, &dof));
+      PetscCall(PetscSectionGetOffset(fg, v, &goff));
+      if (dof <= 0 || goff < 0) continue; /* no unknowns, or another rank's */
+      PetscCall(MeshPointGlobalIndices(fl, fg, v, dim, fidx));
+      PetscCall(SourceVertices(coarse, cvStart, cvEnd, vertex_source[v - vStart], verts, &nv));
+      for (PetscInt i = 0; i < nv; ++i) {
+        PetscInt cidx[3];
+
+        PetscCall(MeshPointGlobalIndices(cl, cg, verts[i], dim, cidx));
+        for (PetscInt c = 0; c < dim; ++c) {
+          if (fidx[c] < 0 || cidx[c] < 0) continue;
+          if (pass == 0) {
+            if (cidx[c] >= cstart && cidx[c] < cend) dnz[fidx[c] - rstart]++;
+            else onz[fidx[c] - rstart]++;
+          } else PetscCall(MatSetValue(P, fidx[c], cidx[c], 1.0 / nv, INSERT_VALUES));
+        }
+      }
+    }
+  }
+  PetscCall(PetscFree2(dnz, onz));
+  PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
+  mg->interp[mg->n++] = P;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* With -pc_type mg, gives the SNES's PCMG one level per mesh solved so far (the current one the finest), the
+   interpolations between them, and Galerkin coarse operators unless -pc_mg_galerkin says otherwise. The problem of the
+   options must have coarser meshes: a PCMG of one level would be its coarse solver alone. */
+PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
+{
+  const Multigrid *mg = &user->mg;
+  KSP              ksp;
+  PC               pc;
+  PetscBool        is_mg, set;
+  PetscInt         nlevels;
+  const char      *prefix;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESGetKSP(snes, &ksp));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
+  if (!is_mg) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCheck(mg->n > 0 || user->prob.level < user->opt.box.coarse_levels + user->opt.contact.grid_sequence, PetscObjectComm((PetscObject)snes),
+             PETSC_ERR_USER_INPUT,
+             "-pc_type mg takes its levels from nested meshes, and this mesh has none: use the 2D simplex box (-dm_plex_box_faces, "
+             "-contact_coarse_levels) or -contact_grid_sequence N, or another -pc_type");
+  PetscCall(PCMGGetLevels(pc, &nlevels));
+  if (nlevels == mg->n + 1) { /* set up by an earlier solve on this mesh? */
+    if (mg->n) {
+      Mat P;
+
+      PetscCall(PCMGGetInterpolation(pc, mg->n, &P));
+      if (P == mg->interp[mg->n - 1]) PetscFunctionReturn(PETSC_SUCCESS);
+    } else {
+      KSP         coarse;
+      const char *kprefix;
+      PetscBool   done;
+
+      PetscCall(PCMGGetCoarseSolve(pc, &coarse));
+      PetscCall(KSPGetOptionsPrefix(coarse, &kprefix));
+      PetscCall(PetscStrendswith(kprefix, "mg_coarse_", &done));
+      if (done) PetscFunctionReturn(PETSC_SUCCESS);
+    }
+  }
+  PetscCall(PCMGSetLevels(pc, mg->n + 1, NULL));
+  for (PetscInt l = 1; l <= mg->n; ++l) PetscCall(PCMGSetInterpolation(pc, l, mg->interp[l - 1]));
+  PetscCall(PCGetOptionsPrefix(pc, &prefix));
+  if (!mg->n) { /* the coarsest mesh alone: PCMG's one level would be a smoother; it is the coarse solver (mg_coarse_) */
+    KSP         coarse;
+    PC          cpc;
+    PetscMPIInt size;
+
+    PetscCall(PCMGGetCoarseSolve(pc, &coarse));
+    PetscCall(KSPSetOptionsPrefix(coarse, prefix));
+    PetscCall(KSPAppendOptionsPrefix(coarse, "mg_coarse_"));
+    PetscCall(KSPSetType(coarse, KSPPREONLY));
+    PetscCall(KSPGetPC(coarse, &cpc));
+    PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)pc), &size));
+    PetscCall(PCSetType(cpc, size > 1 ? PCREDUNDANT : PCLU));
+  }
+  PetscCall(PetscOptionsHasName(NULL, prefix, "-pc_mg_galerkin", &set));
+  if (!set) PetscCall(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode MultigridDestroy(Multigrid *mg)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt l = 0; l < mg->n; ++l) PetscCall(MatDestroy(&mg->interp[l]));
+  mg->n = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
