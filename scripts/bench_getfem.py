@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """GetFEM side by side (make bench): the default scene on one N x N mesh written by this project, the nodal penalty at
-eps = h (the cell diameter), solved by bin/signorini (its default solver, and GAMG) and by GetFEM with MUMPS, each as a
-whole process, alternating, PAIRS times; the medians, their ratio, and the largest difference between the two
+eps = h (the cell diameter), solved by bin/signorini (its default solver, GAMG, and on the box it builds itself GAMG and the
+geometric multigrid) and by GetFEM with MUMPS, each as a whole process, alternating, PAIRS times; the medians, their ratio, and the largest difference between the two
 displacement fields. Writes bench/getfem.md and bench/getfem.csv."""
 import argparse
 import csv
@@ -32,20 +32,22 @@ def main():
     eps = math.sqrt(2.0) / args.faces  # h, the cell diameter, as -penalty_eps0 1 gives on this mesh
     # the last signorini row builds the same mesh itself (its box, the mesh the file holds) instead of reading the file:
     # what a user of the box gets, nested iteration included
-    codes = {"signorini (MUMPS)": None, "signorini (GAMG)": "options/solvers/gamg.yaml", "signorini (GAMG, its own box)": "box",
-             "GetFEM (MUMPS)": "getfem"}
-    h5_of = {None: "mumps.h5", "options/solvers/gamg.yaml": "gamg.h5", "box": "gamg_box.h5"}
+    codes = {"signorini (MUMPS)": ("file", None), "signorini (GAMG)": ("file", "options/solvers/gamg.yaml"),
+             "signorini (GAMG, its own box)": ("box", "options/solvers/gamg.yaml"),
+             "signorini (geometric MG, its own box)": ("box", "options/solvers/mg.yaml"), "GetFEM (MUMPS)": ("getfem", None)}
+    h5_of = {"signorini (MUMPS)": "mumps.h5", "signorini (GAMG)": "gamg.h5", "signorini (GAMG, its own box)": "gamg_box.h5",
+             "signorini (geometric MG, its own box)": "mg_box.h5"}
     times = {k: [] for k in codes}
     mems = {k: [] for k in codes}
     for p in range(args.pairs):
-        for name, solver in codes.items():
-            if solver == "getfem":
+        for name, (kind, solver) in codes.items():
+            if kind == "getfem":
                 result = os.path.join(runs, "getfem.npz")
                 wall, mem, _ = run_timed(gs.getfem_cmd(mesh, eps, result), env={"PYTHONPATH": os.path.dirname(os.path.abspath(__file__))})
             else:
-                h5 = os.path.join(runs, h5_of[solver])
-                if solver == "box":
-                    wall, mem, _ = run_timed(gs.signorini_cmd(None, eps, h5, "options/solvers/gamg.yaml", box_faces=args.faces))
+                h5 = os.path.join(runs, h5_of[name])
+                if kind == "box":
+                    wall, mem, _ = run_timed(gs.signorini_cmd(None, eps, h5, solver, box_faces=args.faces))
                 else:
                     wall, mem, _ = run_timed(gs.signorini_cmd(mesh, eps, h5, solver))
             times[name].append(wall)
@@ -54,13 +56,13 @@ def main():
     ref = np.load(os.path.join(runs, "getfem.npz"))
     u_ref = gs.sorted_by_position(ref["x"], ref["u"])
     rows = []
-    for name, solver in codes.items():
+    for name, (kind, solver) in codes.items():
         row = {"code": name, "dofs": 2 * (args.faces + 1) ** 2, "eps": eps, "wall_median_s": statistics.median(times[name]),
                "walls_s": " ".join(f"{t:.2f}" for t in times[name]), "peak_memory_mib": statistics.median(mems[name])}
-        if solver == "getfem":
+        if kind == "getfem":
             row.update(newton=int(ref["newton_its"]), max_rel_diff=0.0)
         else:
-            with h5py.File(os.path.join(runs, h5_of[solver]), "r") as f:
+            with h5py.File(os.path.join(runs, h5_of[name]), "r") as f:
                 assert int(f["run"].attrs["converged"]) == 1, f"{name} did not converge"
                 u = gs.sorted_by_position(f["geometry/vertices"][:], f["vertex_fields/displacement"][:])
                 row.update(newton=int(f["run"].attrs["newton_its"]), max_rel_diff=float(np.abs(u - u_ref).max() / np.abs(u_ref).max()))
