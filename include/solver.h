@@ -23,7 +23,7 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
 /* The coarsest box of nested iteration by default (-contact_coarse_levels -1) has at least this many cells per side:
    with an algebraic multigrid, each coarser box costs its own hierarchy's build; with the geometric one (-pc_type mg)
    a coarser box costs little and is one more level of the hierarchy (a smaller coarse factorization). */
-#define GRID_SEQUENCE_MIN_FACES    64
+#define GRID_SEQUENCE_MIN_FACES 64
 #define GRID_SEQUENCE_MIN_FACES_MG 16
 PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, const RunOptions *opt, PetscInt *request, PetscInt *min_faces);
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
@@ -55,6 +55,11 @@ PetscErrorCode AssemblyP1BlockPattern(DM dm, PetscInt bs, PetscInt nb, const Pet
 PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
                                       PetscBool *done);
 PetscErrorCode AssemblyP1CSRAllocated(Mat K, PetscLogDouble *nz);
+PetscErrorCode AssemblyP1CSRCompose(Mat K, PetscInt *i, PetscInt *j, PetscScalar *a, PetscInt *oi, PetscInt *oj, PetscScalar *oa);
+
+/* assembly_p1_mpiaij.c */
+PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
+                                      PetscBool *done);
 
 /* bandwidth.c */
 PetscErrorCode BandwidthGetOptions(MPI_Comm comm, PetscBool *measure);

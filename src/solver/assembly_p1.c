@@ -368,7 +368,8 @@ PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K)
   PetscCall(AssemblyP1VertexIndices(dm, &vidx));
   PetscCall(AssemblyP1CellVertices(dm, &cverts));
   PetscCall(DMGetLocalToGlobalMapping(dm, &ltog));
-  PetscCall(AssemblyP1CreateSeqAIJ(dm, user, nlocal, bs, vidx, cverts, K, &done)); /* one rank, AIJ: its own CSR arrays */
+  PetscCall(AssemblyP1CreateSeqAIJ(dm, user, nlocal, bs, vidx, cverts, K, &done));            /* one rank, AIJ: its own CSR arrays */
+  if (!done) PetscCall(AssemblyP1CreateMPIAIJ(dm, user, nlocal, bs, vidx, cverts, K, &done)); /* several ranks, AIJ: the same */
   if (done) {
     PetscCall(MatSetLocalToGlobalMapping(*K, ltog, ltog));
     PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));

@@ -9,8 +9,8 @@
 #include "solver.h"
 
 typedef struct {
-  PetscInt    *i, *j;
-  PetscScalar *a;
+  PetscInt    *i, *j, *oi, *oj; /* the off-diagonal part of an MPIAIJ K (assembly_p1_mpiaij.c), NULL on one rank */
+  PetscScalar *a, *oa;
 } AssemblyCSR;
 
 static PetscErrorCode AssemblyCSRDestroy(void *ctx)
@@ -21,7 +21,32 @@ static PetscErrorCode AssemblyCSRDestroy(void *ctx)
   PetscCall(PetscFree(csr->i));
   PetscCall(PetscFree(csr->j));
   PetscCall(PetscFree(csr->a));
+  PetscCall(PetscFree(csr->oi));
+  PetscCall(PetscFree(csr->oj));
+  PetscCall(PetscFree(csr->oa));
   PetscCall(PetscFree(csr));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Gives K's own CSR arrays to a container composed with K, which frees them with K. */
+PetscErrorCode AssemblyP1CSRCompose(Mat K, PetscInt *i, PetscInt *j, PetscScalar *a, PetscInt *oi, PetscInt *oj, PetscScalar *oa)
+{
+  AssemblyCSR   *csr;
+  PetscContainer container;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&csr));
+  csr->i  = i;
+  csr->j  = j;
+  csr->a  = a;
+  csr->oi = oi;
+  csr->oj = oj;
+  csr->oa = oa;
+  PetscCall(PetscContainerCreate(PETSC_COMM_SELF, &container));
+  PetscCall(PetscContainerSetPointer(container, csr));
+  PetscCall(PetscContainerSetUserDestroy(container, AssemblyCSRDestroy));
+  PetscCall(PetscObjectCompose((PetscObject)K, "AssemblyP1CSR", (PetscObject)container));
+  PetscCall(PetscContainerDestroy(&container));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -92,11 +117,11 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   PetscInt           dim, depth, cStart, cEnd, vStart, vEnd, nb, *bptr, *bcol;
   MatType            mtype;
   PetscBool          aij, type_set;
-  AssemblyCSR       *csr;
+  PetscInt          *ci_, *cj;
+  PetscScalar       *ca;
   PetscSection       csection;
   Vec                coords;
   const PetscScalar *xa;
-  PetscContainer     container;
 
   PetscFunctionBeginUser;
   *done = PETSC_FALSE;
@@ -115,22 +140,21 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   if (size > 1 || bs != dim || depth != dim || !aij || type_set) PetscFunctionReturn(PETSC_SUCCESS);
   nb = nlocal / bs;
   PetscCall(AssemblyP1BlockPattern(dm, bs, nb, vidx, &bptr, &bcol));
-  PetscCall(PetscNew(&csr));
-  PetscCall(PetscMalloc1(nlocal + 1, &csr->i));
-  PetscCall(PetscMalloc1(bs * bs * bptr[nb], &csr->j));
-  PetscCall(PetscCalloc1(bs * bs * bptr[nb], &csr->a));
+  PetscCall(PetscMalloc1(nlocal + 1, &ci_));
+  PetscCall(PetscMalloc1(bs * bs * bptr[nb], &cj));
+  PetscCall(PetscCalloc1(bs * bs * bptr[nb], &ca));
   for (PetscInt r = 0; r < nb; ++r) { /* row r bs + c: the blocks of block row r, each as bs consecutive columns */
     const PetscInt n = bptr[r + 1] - bptr[r];
 
     for (PetscInt c = 0; c < bs; ++c) {
       const PetscInt start = bs * bs * bptr[r] + c * bs * n;
 
-      csr->i[r * bs + c] = start;
+      ci_[r * bs + c] = start;
       for (PetscInt k = 0; k < n; ++k)
-        for (PetscInt d = 0; d < bs; ++d) csr->j[start + k * bs + d] = bcol[bptr[r] + k] * bs + d;
+        for (PetscInt d = 0; d < bs; ++d) cj[start + k * bs + d] = bcol[bptr[r] + k] * bs + d;
     }
   }
-  csr->i[nlocal] = bs * bs * bptr[nb];
+  ci_[nlocal] = bs * bs * bptr[nb];
 
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
@@ -162,7 +186,7 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
         if (blk[b] < 0) continue;
         while (bcol[bptr[r] + k] != blk[b]) ++k; /* present: an edge or the vertex itself */
         for (PetscInt ci = 0; ci < bs; ++ci)
-          for (PetscInt d = 0; d < bs; ++d) csr->a[bs * bs * bptr[r] + ci * bs * nr + k * bs + d] += Ke[(a * dim + ci) * n + b * dim + d];
+          for (PetscInt d = 0; d < bs; ++d) ca[bs * bs * bptr[r] + ci * bs * nr + k * bs + d] += Ke[(a * dim + ci) * n + b * dim + d];
       }
     }
   }
@@ -170,12 +194,8 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   PetscCall(PetscFree(bptr));
   PetscCall(PetscFree(bcol));
 
-  PetscCall(MatCreateSeqAIJWithArrays(comm, nlocal, nlocal, csr->i, csr->j, csr->a, K));
-  PetscCall(PetscContainerCreate(PETSC_COMM_SELF, &container));
-  PetscCall(PetscContainerSetPointer(container, csr));
-  PetscCall(PetscContainerSetUserDestroy(container, AssemblyCSRDestroy));
-  PetscCall(PetscObjectCompose((PetscObject)*K, "AssemblyP1CSR", (PetscObject)container));
-  PetscCall(PetscContainerDestroy(&container));
+  PetscCall(MatCreateSeqAIJWithArrays(comm, nlocal, nlocal, ci_, cj, ca, K));
+  PetscCall(AssemblyP1CSRCompose(*K, ci_, cj, ca, NULL, NULL, NULL));
   PetscCall(MatSetBlockSize(*K, bs));
   PetscCall(MatSetFromOptions(*K));
   *done = PETSC_TRUE;
@@ -195,6 +215,10 @@ PetscErrorCode AssemblyP1CSRAllocated(Mat K, PetscLogDouble *nz)
   if (!container) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscContainerGetPointer(container, (void **)&csr));
   PetscCall(MatGetLocalSize(K, &m, NULL));
-  *nz = (PetscLogDouble)csr->i[m];
+  {
+    PetscLogDouble local = (PetscLogDouble)csr->i[m] + (csr->oi ? (PetscLogDouble)csr->oi[m] : 0.0);
+
+    PetscCallMPI(MPIU_Allreduce(&local, nz, 1, MPI_DOUBLE, MPI_SUM, PetscObjectComm((PetscObject)K)));
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

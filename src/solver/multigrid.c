@@ -81,9 +81,12 @@ PetscErrorCode MultigridAddLevel(DM coarse, DM fine, const PetscInt vertex_sourc
         for (PetscInt c = 0; c < dim; ++c) {
           if (fidx[c] < 0 || cidx[c] < 0) continue;
           if (pass == 0) {
-            if (cidx[c] >= cstart && cidx[c] < cend) dnz[fidx[c] - rstart]++;
-            else onz[fidx[c] - rstart]++;
-          } else PetscCall(MatSetValue(P, fidx[c], cidx[c], 1.0 / nv, INSERT_VALUES));
+            if (cidx[c] >= cstart && cidx[c] < cend)
+              dnz[fidx[c] - rstart]++;
+            else
+              onz[fidx[c] - rstart]++;
+          } else
+            PetscCall(MatSetValue(P, fidx[c], cidx[c], 1.0 / nv, INSERT_VALUES));
         }
       }
     }
