@@ -69,8 +69,10 @@ static PetscErrorCode PenaltySetUpLocalEps(DM dm, AppCtx *user)
 PetscErrorCode PenaltySetUp(DM dm, AppCtx *user)
 {
   PetscFunctionBeginUser;
-  if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS && user->prob.eps_local)
-    PetscCall(PenaltySetUpLocalEps(dm, user)); /* a graded mesh: eps varies along Gamma_C */
+  /* a graded mesh: eps varies along Gamma_C; PETSc's boundary integration needs it as an auxiliary field (the closed form
+     of the P1 assembly has its own, penalty_faces.c), which -assembly_check compares with */
+  if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS && user->prob.eps_local && (user->prob.assembly != ASSEMBLY_P1 || user->opt.assembly_check))
+    PetscCall(PenaltySetUpLocalEps(dm, user));
   PetscCall(PetscWeakFormCreate(PetscObjectComm((PetscObject)dm), &user->prob.wf_penalty));
   PetscCall(PetscWeakFormSetNumFields(user->prob.wf_penalty, 1));
   for (PetscInt i = 0; i < user->scene.bcs.ncontact; ++i) {

@@ -234,6 +234,7 @@ PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
   ErrorTarget exact = {&user->scene, NULL, NULL};
 
   PetscFunctionBeginUser;
+  PetscCall(MeshIndexCellTypes(dm)); /* the closures below look each point's cell type up: sorted, not hashed */
   PetscCall(ErrorNormsReset(&user->rec.errors));
   PetscCall(DMGetLocalVector(dm, &loc_uh));
   PetscCall(VecCopy(user->prob.loc_bc, loc_uh)); /* the Dirichlet values, inserted once by ProblemSetUp() */
