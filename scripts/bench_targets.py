@@ -131,12 +131,24 @@ def measure_parallel(out, s, pairs):
     r2 = side_by_side({"2d_np1": (box4, 1), "2d_np2": (box4, 2), "2d_np1_direct": (box4 + ["-contact_coarse_levels", 0], 1)}, 1, out)
     s2, s3 = r2["2d_np1"][0] / r2["2d_np2"][0], r3["3d_np1"][0] / r3["3d_np2"][0]
     s2d = r2["2d_np1_direct"][0] / r2["2d_np2"][0]
-    return [row(f"3D penalty, eps = h, 1M unknowns on 2 ranks <= 30 s ({d3} unknowns)", f"{r3['3d_np2'][0]:.1f} s", r3["3d_np2"][0] <= 30.0,
-                f"mpiexec -n 2 bin/signorini ... -dm_plex_dim 3 -dm_plex_box_faces {n3},{n3},{n3}"),
+    # the geometric multigrid (mg.yaml) over the grid sequence, the same command on 1 and 2 ranks: 3D 9^3 refined 3 times
+    # (72^3, 1.15M unknowns), 2D 22^2 refined 5 times (704^2); the levels' meshes are PETSc's refinements on 2 ranks
+    m3, m2 = max(72 // s // 8, 2), max(704 // s // 32, 4)
+    g3 = ["-dm_plex_dim", 3, "-dm_plex_box_faces", f"{m3},{m3},{m3}", "-contact_grid_sequence", 3]
+    g2 = ["-dm_plex_box_faces", f"{m2},{m2}", "-contact_grid_sequence", 5]
+    rm = side_by_side({"3d_mg_np2": (g3, 2, BASE_MG), "3d_mg_np1": (g3, 1, BASE_MG), "2d_mg_np1": (g2, 1, BASE_MG), "2d_mg_np2": (g2, 2, BASE_MG)}, 1, out)
+    dm3 = int(rm["3d_mg_np2"][2]["n_dofs"])
+    sm2, sm3 = rm["2d_mg_np1"][0] / rm["2d_mg_np2"][0], rm["3d_mg_np1"][0] / rm["3d_mg_np2"][0]
+    t3 = min(r3["3d_np2"][0], rm["3d_mg_np2"][0])
+    return [row("3D penalty, eps = h, 1M unknowns on 2 ranks <= 30 s", f"GAMG {r3['3d_np2'][0]:.1f} s ({d3} unknowns, the box of {n3}^3); geometric MG "
+                f"{rm['3d_mg_np2'][0]:.1f} s ({dm3} unknowns, {m3}^3 refined 3 times, mg.yaml)", t3 <= 30.0,
+                f"mpiexec -n 2 bin/signorini ... -dm_plex_dim 3 -dm_plex_box_faces {n3},{n3},{n3}; ... mg.yaml -dm_plex_box_faces {m3},{m3},{m3} -contact_grid_sequence 3"),
             row("mpiexec -n 2 speed-up >= 1.8 at 1M unknowns, 2D and 3D (default penalty run)",
-                f"2D {s2:.2f} ({r2['2d_np1'][0]:.1f} s, nested, / {r2['2d_np2'][0]:.1f} s; the direct one-rank solve, -contact_coarse_levels 0: "
-                f"{s2d:.2f}, {r2['2d_np1_direct'][0]:.1f} s), 3D {s3:.2f} ({r3['3d_np1'][0]:.1f} s / {r3['3d_np2'][0]:.1f} s)", min(s2, s3) >= 1.8,
-                f"bin/signorini ... -dm_plex_box_faces {n4},{n4} on 1 and 2 ranks; 3D as above")]
+                f"GAMG: 2D {s2:.2f} ({r2['2d_np1'][0]:.1f} s, nested, / {r2['2d_np2'][0]:.1f} s; the direct one-rank solve, -contact_coarse_levels 0: "
+                f"{s2d:.2f}, {r2['2d_np1_direct'][0]:.1f} s), 3D {s3:.2f} ({r3['3d_np1'][0]:.1f} s / {r3['3d_np2'][0]:.1f} s); geometric MG: "
+                f"2D {sm2:.2f} ({rm['2d_mg_np1'][0]:.1f} s / {rm['2d_mg_np2'][0]:.1f} s), 3D {sm3:.2f} ({rm['3d_mg_np1'][0]:.1f} s / {rm['3d_mg_np2'][0]:.1f} s)",
+                max(min(s2, s3), min(sm2, sm3)) >= 1.8,
+                f"bin/signorini ... -dm_plex_box_faces {n4},{n4} on 1 and 2 ranks, 3D as above; mg.yaml: {m2},{m2} -contact_grid_sequence 5, 3D as above")]
 
 
 def measure_mg(out, s, pairs):
