@@ -91,8 +91,20 @@ def measure_iterations(out, s, pairs):
         _, _, a = solver(["-dm_plex_dim", dim, "-dm_plex_box_faces", ",".join([str(f)] * dim), "-contact_method", "none", "-ksp_rtol", "1e-8"],
                          f"gamg_its_{dim}d_{f}", out, ranks)
         its.append((f"{dim}D {int(a['n_dofs'])}", int(a["ksp_its"])))
+    # the geometric multigrid on the same sizes: the 2D boxes nest by default, 3D over the grid sequence (2^3 to 9^3 cells refined)
+    mg_its = []
+    for dim, faces, ranks in [(2, 72, 1), (2, 256, 1), (2, 1024, 2), (3, 16, 1), (3, 32, 2), (3, 72, 2)]:
+        f = max(faces // s, 32 if dim == 2 else 4)  # a 2D box nests (-contact_coarse_levels) from 32 cells per side
+        mesh = ["-dm_plex_box_faces", f"{f},{f}"] if dim == 2 else ["-dm_plex_dim", 3, "-dm_plex_box_faces", ",".join([str(max(f // 8, 1))] * 3),
+                                                                    "-contact_grid_sequence", 3]
+        if dim == 2 and ranks > 1:  # the boxes nest on one rank only: 2 ranks refine 32^2 five times
+            mesh = ["-dm_plex_box_faces", f"{max(f // 32, 1)},{max(f // 32, 1)}", "-contact_grid_sequence", 5]
+        _, _, a = solver(mesh + ["-contact_method", "none", "-ksp_rtol", "1e-8"], f"mg_its_{dim}d_{f}", out, ranks, base=BASE_MG)
+        mg_its.append((f"{dim}D {int(a['n_dofs'])}", int(a["ksp_its"])))
     return [row("elastic GAMG <= 20 CG iterations to rtol 1e-8, 10k to 2M unknowns in 2D, to 1M in 3D", "; ".join(f"{k}: {v}" for k, v in its),
-                max(v for _, v in its) <= 20, "bin/signorini ... -contact_method none -ksp_rtol 1e-8 -dm_plex_dim D -dm_plex_box_faces N,...")]
+                max(v for _, v in its) <= 20, "bin/signorini ... -contact_method none -ksp_rtol 1e-8 -dm_plex_dim D -dm_plex_box_faces N,..."),
+            row("geometric MG (mg.yaml): CG iterations of the elastic solve to rtol 1e-8 (a figure: the target is GAMG's)", "; ".join(f"{k}: {v}" for k, v in mg_its),
+                None, "bin/signorini ... mg.yaml -contact_method none -ksp_rtol 1e-8 (2D: the box, 2 ranks 32^2 refined 5 times; 3D: N/8 cells refined 3 times)")]
 
 
 def measure_eps(out, s, pairs):
@@ -117,6 +129,19 @@ def measure_eps(out, s, pairs):
     rows.append(row(f"GAMG Krylov iterations per Newton step within 2x over eps = 1e4 h to 1e-8 h ({n2} x {n2})",
                     ", ".join(f"{e} h: {v}" for e, v in per) + f" (spread {spread:.1f} over the converged)", spread <= 2.0 and not failed,
                     f"... -dm_plex_box_faces {n2},{n2} -penalty_eps0 E"))
+    # the same with the geometric multigrid (a figure: the targets are GAMG's)
+    box2 = ["-dm_plex_box_faces", f"{max(n2, 32)},{max(n2, 32)}"]
+    r = side_by_side({"mg_one": (box2, 1, BASE_MG), "mg_sweep": (box2 + ["-penalty_eps0_sweep", "1,0.1,0.01,1e-3,1e-4,1e-5,1e-6,1e-7"], 1, BASE_MG)}, 3, out)
+    mg_ratio = r["mg_sweep"][0] / r["mg_one"][0]
+    per = []
+    for eps0 in ["1e4", "1e2", "1", "1e-2", "1e-4", "1e-6", "1e-8"]:
+        _, _, a = solver(box2 + ["-penalty_eps0", eps0], f"mg_eps_{eps0}", out, base=BASE_MG)
+        per.append((eps0, int(a["ksp_its"]) / max(int(a["newton_its"]), 1)))
+    mg_spread = max(v for _, v in per) / min(v for _, v in per)
+    rows.append(row("geometric MG (mg.yaml): the eps sweep over one solve, and Krylov iterations per Newton step over eps = 1e4 h to 1e-8 h (figures)",
+                    f"sweep {mg_ratio:.2f} ({r['mg_sweep'][0]:.2f} s / {r['mg_one'][0]:.2f} s, medians of 3 pairs); per step "
+                    + ", ".join(f"{e} h: {v:.1f}" for e, v in per) + f" (spread {mg_spread:.2f})", None,
+                    f"... mg.yaml -dm_plex_box_faces {n2},{n2} [-penalty_eps0_sweep 1,...,1e-7 | -penalty_eps0 E]"))
     return rows
 
 

@@ -371,3 +371,18 @@ def test_geometric_multigrid_over_the_grid_sequence_in_parallel():
     assert max_diff(two, direct) < 1e-8 and max_diff(one, direct) < 1e-8
     assert abs(a["ksp_its"] - b["ksp_its"]) <= a["newton_its"], (a["ksp_its"], b["ksp_its"])
     assert a["ksp_its"] / a["newton_its"] <= 8
+
+
+@pytest.mark.parametrize("solver_file, n", [("gamg", 128), ("mg", 32)])
+def test_nested_iteration_at_small_eps_continues_from_eps_h(solver_file, n):
+    """At eps = 1e-6 h the guess interpolated from a coarser box is far from the finer box's solution on the 1/eps scale
+    (a new contact node between an active and a free one); each level then runs the continuation from eps = h down to
+    its eps, from that guess, as a start from zero does. Without it Newton stalled (DIVERGED_MAX_IT at 128 x 128 with
+    GAMG and 32 x 32 with mg, the defaults nesting). The answer is the direct solve's (MUMPS, no nesting)."""
+    box = SQUARE + ["-dm_plex_box_faces", f"{n},{n}", "-penalty_eps0", "1e-6"]
+    _, nested = run(box + ["-options_file", f"options/solvers/{solver_file}.yaml"], f"nested_small_eps_{solver_file}")
+    _, direct = run(box + ["-contact_coarse_levels", 0], f"nested_small_eps_{solver_file}_direct")
+    a, b = load(nested)[0], load(direct)[0]
+    assert a["converged"] == 1 and a["coarse_levels"] >= 1 and a["continuation_stages"] > 0
+    assert a["residual_norm"] <= 1e-8 * a["load_norm"]
+    assert max_diff(nested, direct) < 1e-7 and a["active_vertices"] == b["active_vertices"]

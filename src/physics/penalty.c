@@ -71,7 +71,8 @@ PetscErrorCode PenaltySetUp(DM dm, AppCtx *user)
   PetscFunctionBeginUser;
   /* a graded mesh: eps varies along Gamma_C; PETSc's boundary integration needs it as an auxiliary field (the closed form
      of the P1 assembly has its own, penalty_faces.c), which -assembly_check compares with */
-  if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS && user->prob.eps_local && (user->prob.assembly != ASSEMBLY_P1 || user->opt.assembly_check))
+  if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS && user->prob.eps_local &&
+      (user->prob.assembly != ASSEMBLY_P1 || user->opt.assembly_check))
     PetscCall(PenaltySetUpLocalEps(dm, user));
   PetscCall(PetscWeakFormCreate(PetscObjectComm((PetscObject)dm), &user->prob.wf_penalty));
   PetscCall(PetscWeakFormSetNumFields(user->prob.wf_penalty, 1));

@@ -102,7 +102,9 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     user->prob.setup_time = t1 - t0; /* refinement, set-up and interpolation */
     user->rec.stats.time_setup += t1 - t0;
     PetscCall(GridSequenceSetTolerance(*snes, user));
+    user->prob.from_coarser = (PetscBool)!failed;
     PetscCall(SolverSolve(*snes, user, *u, (PetscBool)!failed));
+    user->prob.from_coarser = PETSC_FALSE;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
