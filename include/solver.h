@@ -30,7 +30,7 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 
 /* multigrid.c */
-PetscErrorCode MultigridAddLevel(DM coarse, DM fine, const PetscInt vertex_source[], Multigrid *mg);
+PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt vertex_source[], AppCtx *user);
 PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user);
 PetscErrorCode MultigridDestroy(Multigrid *mg);
 
@@ -55,6 +55,8 @@ PetscErrorCode AssemblyP1BlockPattern(DM dm, PetscInt bs, PetscInt nb, const Pet
 PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
                                       PetscBool *done);
 PetscErrorCode AssemblyP1CSRAllocated(Mat K, PetscLogDouble *nz);
+PetscErrorCode AssemblyP1CSRApplies(DM dm, PetscInt bs, PetscBool *applies);
+PetscErrorCode AssemblyP1CellCoordinates(PetscSection csection, const PetscScalar xa[], PetscInt dim, const PetscInt verts[], PetscReal x[]);
 PetscErrorCode AssemblyP1CSRCompose(Mat K, PetscInt *i, PetscInt *j, PetscScalar *a, PetscInt *oi, PetscInt *oj, PetscScalar *oa);
 
 /* assembly_p1_mpiaij.c */

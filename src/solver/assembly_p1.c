@@ -328,16 +328,9 @@ static PetscErrorCode AssemblyP1CreateAnyMatrix(DM dm, AppCtx *user, PetscInt nl
     PetscReal   x[12];
     PetscScalar Ke[144];
 
-    for (PetscInt a = 0; a <= dim; ++a) {
-      const PetscInt v = cverts[(c - cStart) * (dim + 1) + a];
-      PetscInt       off;
-
-      PetscCall(PetscSectionGetOffset(csection, v, &off));
-      for (PetscInt e = 0; e < dim; ++e) {
-        idx[a * dim + e] = vidx[(v - vStart) * dim + e];
-        x[a * dim + e]   = PetscRealPart(xa[off + e]);
-      }
-    }
+    PetscCall(AssemblyP1CellCoordinates(csection, xa, dim, &cverts[(c - cStart) * (dim + 1)], x));
+    for (PetscInt a = 0; a <= dim; ++a)
+      for (PetscInt e = 0; e < dim; ++e) idx[a * dim + e] = vidx[(cverts[(c - cStart) * (dim + 1) + a] - vStart) * dim + e];
     PetscCall(ElasticityP1ElementStiffness(dim, user->opt.material.lambda, user->opt.material.mu, x, Ke));
     PetscCall(MatSetValues(*K, n, idx, n, idx, Ke, ADD_VALUES));
   }

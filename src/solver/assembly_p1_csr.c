@@ -28,6 +28,39 @@ static PetscErrorCode AssemblyCSRDestroy(void *ctx)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Whether K can be built in its own CSR arrays (here and in assembly_p1_mpiaij.c): AIJ (the DM's type, no -mat_type for
+   MatSetFromOptions() to convert it to), a block of bs = dim dofs per vertex, and the edges (an interpolated mesh). */
+PetscErrorCode AssemblyP1CSRApplies(DM dm, PetscInt bs, PetscBool *applies)
+{
+  PetscInt  dim, depth;
+  MatType   mtype;
+  PetscBool aij, seqaij, mpiaij, type_set;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetDepth(dm, &depth));
+  PetscCall(DMGetMatType(dm, &mtype));
+  PetscCall(PetscStrcmp(mtype, MATAIJ, &aij));
+  PetscCall(PetscStrcmp(mtype, MATSEQAIJ, &seqaij));
+  PetscCall(PetscStrcmp(mtype, MATMPIAIJ, &mpiaij));
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-mat_type", &type_set));
+  *applies = (PetscBool)((aij || seqaij || mpiaij) && !type_set && bs == dim && depth == dim);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The coordinates x[dim + 1][dim] of the vertices verts[] of a cell. */
+PetscErrorCode AssemblyP1CellCoordinates(PetscSection csection, const PetscScalar xa[], PetscInt dim, const PetscInt verts[], PetscReal x[])
+{
+  PetscFunctionBeginUser;
+  for (PetscInt a = 0; a <= dim; ++a) {
+    PetscInt off;
+
+    PetscCall(PetscSectionGetOffset(csection, verts[a], &off));
+    for (PetscInt e = 0; e < dim; ++e) x[a * dim + e] = PetscRealPart(xa[off + e]);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Gives K's own CSR arrays to a container composed with K, which frees them with K. */
 PetscErrorCode AssemblyP1CSRCompose(Mat K, PetscInt *i, PetscInt *j, PetscScalar *a, PetscInt *oi, PetscInt *oj, PetscScalar *oa)
 {
@@ -114,9 +147,8 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
   PetscMPIInt        size;
-  PetscInt           dim, depth, cStart, cEnd, vStart, vEnd, nb, *bptr, *bcol;
-  MatType            mtype;
-  PetscBool          aij, type_set;
+  PetscInt           dim, cStart, cEnd, vStart, vEnd, nb, *bptr, *bcol;
+  PetscBool          applies;
   PetscInt          *ci_, *cj;
   PetscScalar       *ca;
   PetscSection       csection;
@@ -127,17 +159,8 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   *done = PETSC_FALSE;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(DMPlexGetDepth(dm, &depth));
-  PetscCall(DMGetMatType(dm, &mtype));
-  {
-    PetscBool seqaij;
-
-    PetscCall(PetscStrcmp(mtype, MATAIJ, &aij));
-    PetscCall(PetscStrcmp(mtype, MATSEQAIJ, &seqaij));
-    aij = (PetscBool)(aij || seqaij);
-  }
-  PetscCall(PetscOptionsHasName(NULL, NULL, "-mat_type", &type_set)); /* MatSetFromOptions() would convert K */
-  if (size > 1 || bs != dim || depth != dim || !aij || type_set) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(AssemblyP1CSRApplies(dm, bs, &applies));
+  if (size > 1 || !applies) PetscFunctionReturn(PETSC_SUCCESS);
   nb = nlocal / bs;
   PetscCall(AssemblyP1BlockPattern(dm, bs, nb, vidx, &bptr, &bcol));
   PetscCall(PetscMalloc1(nlocal + 1, &ci_));
@@ -167,12 +190,10 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
     PetscReal      x[12];
     PetscScalar    Ke[144];
 
+    PetscCall(AssemblyP1CellCoordinates(csection, xa, dim, &cverts[(c - cStart) * (dim + 1)], x));
     for (PetscInt a = 0; a <= dim; ++a) {
-      const PetscInt v = cverts[(c - cStart) * (dim + 1) + a], g = vidx[(v - vStart) * dim];
-      PetscInt       off;
+      const PetscInt g = vidx[(cverts[(c - cStart) * (dim + 1) + a] - vStart) * dim];
 
-      PetscCall(PetscSectionGetOffset(csection, v, &off));
-      for (PetscInt e = 0; e < dim; ++e) x[a * dim + e] = PetscRealPart(xa[off + e]);
       blk[a] = g < 0 ? -1 : g / bs;
     }
     PetscCall(ElasticityP1ElementStiffness(dim, user->opt.material.lambda, user->opt.material.mu, x, Ke));

@@ -155,6 +155,18 @@ static inline void SplitRowsAdd(SplitRows *s, PetscInt r, PetscInt b, const Pets
   }
 }
 
+/* at[q]: where rank q's part starts in a buffer of counts[] per rank, in rank order; total: its length. */
+static PetscErrorCode RankOffsets(PetscMPIInt size, const PetscMPIInt counts[], PetscInt at[], PetscInt *total)
+{
+  PetscFunctionBeginUser;
+  *total = 0;
+  for (PetscMPIInt q = 0; q < size; ++q) {
+    at[q] = *total;
+    *total += counts[q];
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Sends the ghost rows to their owners in groups by rank (MPI_Alltoallv): sendcounts[] per rank, the data in rank order. */
 static PetscErrorCode Exchange(MPI_Comm comm, MPI_Datatype type, const PetscMPIInt sendcounts[], const void *sendbuf, PetscMPIInt **recvcounts,
                                PetscMPIInt **rdispls, void **recvbuf, size_t unit)
@@ -183,10 +195,9 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
   PetscMPIInt        size, *icounts, *scounts, *ircounts, *irdispls, *srcounts, *srdispls;
-  PetscInt           dim, depth, cStart, cEnd, vStart, vEnd, eStart, eEnd, rstart, ng = 0, *blk, *ghost, *owner, *ibuf, *irecv;
+  PetscInt           dim, cStart, cEnd, vStart, vEnd, eStart, eEnd, rstart, ng = 0, *blk, *ghost, *owner, *ibuf, *irecv, *at, total;
   PetscScalar       *sbuf, *srecv, *gval;
-  MatType            mtype;
-  PetscBool          aij, type_set;
+  PetscBool          applies;
   SplitRows          s;
   BlockRows          grows;
   PetscSection       csection;
@@ -197,17 +208,8 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   *done = PETSC_FALSE;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(DMPlexGetDepth(dm, &depth));
-  PetscCall(DMGetMatType(dm, &mtype));
-  {
-    PetscBool mpiaij;
-
-    PetscCall(PetscStrcmp(mtype, MATAIJ, &aij));
-    PetscCall(PetscStrcmp(mtype, MATMPIAIJ, &mpiaij));
-    aij = (PetscBool)(aij || mpiaij);
-  }
-  PetscCall(PetscOptionsHasName(NULL, NULL, "-mat_type", &type_set)); /* MatSetFromOptions() would convert K */
-  if (size == 1 || bs != dim || depth != dim || !aij || type_set) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(AssemblyP1CSRApplies(dm, bs, &applies));
+  if (size == 1 || !applies) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMemzero(&s, sizeof(s)));
   PetscCall(PetscMemzero(&grows, sizeof(grows)));
   PetscCallMPI(MPI_Scan(&nlocal, &rstart, 1, MPIU_INT, MPI_SUM, comm));
@@ -296,25 +298,17 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
       icounts[owner[v]] += 2 + grows.ptr[ghost[v] + 1] - grows.ptr[ghost[v]];
       scounts[owner[v]] += bs * bs * (grows.ptr[ghost[v] + 1] - grows.ptr[ghost[v]]);
     }
-  {
-    PetscInt *at, total = 0;
+  PetscCall(PetscMalloc1(size, &at));
+  PetscCall(RankOffsets(size, icounts, at, &total));
+  PetscCall(PetscMalloc1(total ? total : 1, &ibuf));
+  for (PetscInt v = 0; v < vEnd - vStart; ++v)
+    if (ghost[v] >= 0) {
+      const PetscInt g = ghost[v], n = grows.ptr[g + 1] - grows.ptr[g];
 
-    PetscCall(PetscMalloc1(size, &at));
-    for (PetscMPIInt q = 0; q < size; ++q) {
-      at[q] = total;
-      total += icounts[q];
+      ibuf[at[owner[v]]++] = blk[v];
+      ibuf[at[owner[v]]++] = n;
+      for (PetscInt k = 0; k < n; ++k) ibuf[at[owner[v]]++] = grows.col[grows.ptr[g] + k];
     }
-    PetscCall(PetscMalloc1(total ? total : 1, &ibuf));
-    for (PetscInt v = 0; v < vEnd - vStart; ++v)
-      if (ghost[v] >= 0) {
-        const PetscInt g = ghost[v], n = grows.ptr[g + 1] - grows.ptr[g];
-
-        ibuf[at[owner[v]]++] = blk[v];
-        ibuf[at[owner[v]]++] = n;
-        for (PetscInt k = 0; k < n; ++k) ibuf[at[owner[v]]++] = grows.col[grows.ptr[g] + k];
-      }
-    PetscCall(PetscFree(at));
-  }
   PetscCall(Exchange(comm, MPIU_INT, icounts, ibuf, &ircounts, &irdispls, (void **)&irecv, sizeof(PetscInt)));
 
   /* the owned rows: the local edges and the rows received */
@@ -359,14 +353,8 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
     PetscReal      x[12];
     PetscScalar    Ke[144];
 
-    for (PetscInt a = 0; a <= dim; ++a) {
-      const PetscInt v = cverts[(c - cStart) * (dim + 1) + a];
-      PetscInt       off;
-
-      PetscCall(PetscSectionGetOffset(csection, v, &off));
-      for (PetscInt e = 0; e < dim; ++e) x[a * dim + e] = PetscRealPart(xa[off + e]);
-      vl[a] = v - vStart;
-    }
+    PetscCall(AssemblyP1CellCoordinates(csection, xa, dim, &cverts[(c - cStart) * (dim + 1)], x));
+    for (PetscInt a = 0; a <= dim; ++a) vl[a] = cverts[(c - cStart) * (dim + 1) + a] - vStart;
     PetscCall(ElasticityP1ElementStiffness(dim, user->opt.material.lambda, user->opt.material.mu, x, Ke));
     for (PetscInt a = 0; a <= dim; ++a) {
       const PetscInt ra = vl[a];
@@ -390,24 +378,15 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   PetscCall(VecRestoreArrayRead(coords, &xa));
 
   /* the ghost rows' values to their owners, in the order of their patterns */
-  {
-    PetscInt *at, total = 0;
+  PetscCall(RankOffsets(size, scounts, at, &total));
+  PetscCall(PetscMalloc1(total ? total : 1, &sbuf));
+  for (PetscInt v = 0; v < vEnd - vStart; ++v)
+    if (ghost[v] >= 0) {
+      const PetscInt g = ghost[v], m = bs * bs * (grows.ptr[g + 1] - grows.ptr[g]);
 
-    PetscCall(PetscMalloc1(size, &at));
-    for (PetscMPIInt q = 0; q < size; ++q) {
-      at[q] = total;
-      total += scounts[q];
+      PetscCall(PetscArraycpy(&sbuf[at[owner[v]]], &gval[bs * bs * grows.ptr[g]], m));
+      at[owner[v]] += m;
     }
-    PetscCall(PetscMalloc1(total ? total : 1, &sbuf));
-    for (PetscInt v = 0; v < vEnd - vStart; ++v)
-      if (ghost[v] >= 0) {
-        const PetscInt g = ghost[v], m = bs * bs * (grows.ptr[g + 1] - grows.ptr[g]);
-
-        PetscCall(PetscArraycpy(&sbuf[at[owner[v]]], &gval[bs * bs * grows.ptr[g]], m));
-        at[owner[v]] += m;
-      }
-    PetscCall(PetscFree(at));
-  }
   PetscCall(Exchange(comm, MPIU_SCALAR, scounts, sbuf, &srcounts, &srdispls, (void **)&srecv, sizeof(PetscScalar)));
   for (PetscInt q = 0, sq = 0; q < irdispls[size];) {
     const PetscInt r = irecv[q] - s.b0, n = irecv[q + 1];
@@ -422,6 +401,7 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   PetscCall(MatSetFromOptions(*K));
   *done = PETSC_TRUE;
 
+  PetscCall(PetscFree(at));
   PetscCall(PetscFree3(blk, ghost, owner));
   PetscCall(PetscFree2(icounts, scounts));
   PetscCall(PetscFree(ibuf));

@@ -29,7 +29,7 @@ static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *
     PetscCall(MeshRefineRegular(*dm, 1, &fine, &parent, &vertex_source));
   user->prob.level++;
   PetscCall(ProblemSetUp(fine, user, snes));
-  if (user->opt.degree == 1) PetscCall(MultigridAddLevel(*dm, fine, vertex_source, &user->mg)); /* for -pc_type mg */
+  PetscCall(MultigridAddLevel(*snes, *dm, fine, vertex_source, user)); /* with -pc_type mg */
   if (user->opt.degree == 1)
     PetscCall(MeshInterpolateVertexSources(*dm, fine, vertex_source, loc, &fine_loc)); /* exact and fast */
   else

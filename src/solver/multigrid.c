@@ -35,17 +35,26 @@ static PetscErrorCode SourceVertices(DM coarse, PetscInt cvStart, PetscInt cvEnd
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Adds the interpolation from coarse to fine, refined once (vertex_source[]: MeshCreateBoxLevel(), MeshRefineRegular()).
-   Both meshes' problems must be set up (their sections); fine's rows are its owned free components, coarse's columns its
-   free components, a fixed coarse component contributing nothing. */
-PetscErrorCode MultigridAddLevel(DM coarse, DM fine, const PetscInt vertex_source[], Multigrid *mg)
+/* With -pc_type mg (the PC of snes, the fine mesh's problem) and P1/Q1, adds the interpolation from coarse to fine,
+   refined once (vertex_source[]: MeshCreateBoxLevel(), MeshRefineRegular()). Both meshes' problems must be set up (their
+   sections); fine's rows are its owned free components, coarse's columns its free components, a fixed coarse component
+   contributing nothing. */
+PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt vertex_source[], AppCtx *user)
 {
   MPI_Comm     comm = PetscObjectComm((PetscObject)fine);
+  Multigrid   *mg   = &user->mg;
   PetscSection cl, cg, fl, fg;
   PetscInt     dim, vStart, vEnd, cvStart, cvEnd, m, n, rstart, cstart, cend, *dnz, *onz;
   Mat          P;
+  KSP          ksp;
+  PC           pc;
+  PetscBool    is_mg;
 
   PetscFunctionBeginUser;
+  PetscCall(SNESGetKSP(snes, &ksp));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
+  if (!is_mg || user->opt.degree != 1) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCheck(mg->n < MULTIGRID_MAX_LEVELS, comm, PETSC_ERR_USER_INPUT, "-pc_type mg: at most %d nested meshes", MULTIGRID_MAX_LEVELS + 1);
   PetscCall(DMGetDimension(fine, &dim));
   PetscCall(DMGetLocalSection(coarse, &cl));
