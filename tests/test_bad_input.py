@@ -42,6 +42,7 @@ BAD_INPUTS = {
     "mg_without_nested_meshes": (["-pc_type", "mg", "-contact_coarse_levels", 0], "-pc_type mg takes its levels from nested meshes, and this mesh has none"),
     "mg_p2": (["-pc_type", "mg", "-displacement_petscspace_degree", 2], "-pc_type mg takes its levels from nested meshes, and this mesh has none"),
     "vi_with_mg": (["-contact_method", "vi", "-pc_type", "mg"], "-pc_type mg cannot follow"),
+    "mg_levels": (["-dm_plex_box_faces", "64,64", "-pc_type", "mg", "-pc_mg_levels", 3], "-pc_mg_levels: the levels of -pc_type mg are the nested meshes"),
     "bad_output_dir": (["-output", "/nonexistent_dir/x.h5"], "Output directory '/nonexistent_dir' (-output /nonexistent_dir/x.h5) does not exist"),
 }
 

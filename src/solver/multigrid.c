@@ -128,6 +128,10 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
              PETSC_ERR_USER_INPUT,
              "-pc_type mg takes its levels from nested meshes, and this mesh has none: use the 2D simplex box (-dm_plex_box_faces, "
              "-contact_coarse_levels) or -contact_grid_sequence N, or another -pc_type");
+  PetscCall(PCGetOptionsPrefix(pc, &prefix));
+  PetscCall(PetscOptionsHasName(NULL, prefix, "-pc_mg_levels", &set));
+  PetscCheck(!set, PetscObjectComm((PetscObject)snes), PETSC_ERR_USER_INPUT,
+             "-pc_mg_levels: the levels of -pc_type mg are the nested meshes (-contact_coarse_levels, -contact_grid_sequence)");
   PetscCall(PCMGGetLevels(pc, &nlevels));
   if (nlevels == mg->n + 1) { /* set up by an earlier solve on this mesh? */
     if (mg->n) {
@@ -148,7 +152,6 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
   }
   PetscCall(PCMGSetLevels(pc, mg->n + 1, NULL));
   for (PetscInt l = 1; l <= mg->n; ++l) PetscCall(PCMGSetInterpolation(pc, l, mg->interp[l - 1]));
-  PetscCall(PCGetOptionsPrefix(pc, &prefix));
   if (!mg->n) { /* the coarsest mesh alone: PCMG's one level would be a smoother; it is the coarse solver (mg_coarse_) */
     KSP         coarse;
     PC          cpc;
