@@ -155,6 +155,47 @@ static inline void SplitRowsAdd(SplitRows *s, PetscInt r, PetscInt b, const Pets
   }
 }
 
+/* The entry (r, c) of local vertices r and c: counted (fill false) or filled into r's block row. */
+static inline void LocalPatternAdd(const PetscInt blk[], const PetscInt ghost[], PetscInt b0, BlockRows *own, BlockRows *ghosts, PetscBool fill,
+                                   PetscInt r, PetscInt c)
+{
+  BlockRows     *br  = ghost[r] >= 0 ? ghosts : own;
+  const PetscInt row = ghost[r] >= 0 ? ghost[r] : blk[r] - b0;
+
+  if (!br) return;
+  if (fill)
+    br->col[br->ptr[row] + br->fill[row]++] = blk[c];
+  else
+    ++br->ptr[row + 1];
+}
+
+/* Counts (fill false) or fills the entries of the local block rows along this rank's edges, each free vertex with
+   itself and its free neighbours: an owned vertex's row into own (block row blk - b0), a ghost's into ghosts (its ghost
+   number); either may be NULL. blk[], ghost[]: per local vertex, its global block (-1: fixed) and ghost number (-1: owned). */
+static PetscErrorCode LocalPattern(DM dm, const PetscInt blk[], const PetscInt ghost[], PetscInt b0, BlockRows *own, BlockRows *ghosts,
+                                   PetscBool fill)
+{
+  PetscInt vStart, vEnd, eStart, eEnd;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetDepthStratum(dm, 1, &eStart, &eEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  for (PetscInt v = 0; v < vEnd - vStart; ++v)
+    if (blk[v] >= 0) LocalPatternAdd(blk, ghost, b0, own, ghosts, fill, v, v);
+  for (PetscInt e = eStart; e < eEnd; ++e) {
+    const PetscInt *cone;
+    PetscInt        va, vb;
+
+    PetscCall(DMPlexGetCone(dm, e, &cone));
+    va = cone[0] - vStart;
+    vb = cone[1] - vStart;
+    if (blk[va] < 0 || blk[vb] < 0) continue;
+    LocalPatternAdd(blk, ghost, b0, own, ghosts, fill, va, vb);
+    LocalPatternAdd(blk, ghost, b0, own, ghosts, fill, vb, va);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* at[q]: where rank q's part starts in a buffer of counts[] per rank, in rank order; total: its length. */
 static PetscErrorCode RankOffsets(PetscMPIInt size, const PetscMPIInt counts[], PetscInt at[], PetscInt *total)
 {
@@ -195,7 +236,7 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
   PetscMPIInt        size, *icounts, *scounts, *ircounts, *irdispls, *srcounts, *srdispls;
-  PetscInt           dim, cStart, cEnd, vStart, vEnd, eStart, eEnd, rstart, ng = 0, *blk, *ghost, *owner, *ibuf, *irecv, *at, total;
+  PetscInt           dim, cStart, cEnd, vStart, vEnd, rstart, ng = 0, *blk, *ghost, *owner, *ibuf, *irecv, *at, total;
   PetscScalar       *sbuf, *srecv, *gval;
   PetscBool          applies;
   SplitRows          s;
@@ -218,7 +259,6 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   s.b0 = rstart / bs;
   s.nb = nlocal / bs;
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  PetscCall(DMPlexGetDepthStratum(dm, 1, &eStart, &eEnd));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
 
   /* each free vertex's global block, and for a ghost its number among the ghosts and its owner's rank (the point SF) */
@@ -257,39 +297,9 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   /* the local block rows along the edges: owned rows into s.rows (with room for what the other ranks send), ghosts into grows */
   PetscCall(BlockRowsCount(&s.rows, s.nb));
   PetscCall(BlockRowsCount(&grows, ng));
-  for (PetscInt pass = 0; pass < 2; ++pass) {
-    if (pass) PetscCall(BlockRowsAllocate(&grows));
-    for (PetscInt v = 0; v < vEnd - vStart; ++v) {
-      if (blk[v] < 0) continue;
-      if (ghost[v] >= 0) {
-        if (pass)
-          grows.col[grows.ptr[ghost[v]] + grows.fill[ghost[v]]++] = blk[v];
-        else
-          ++grows.ptr[ghost[v] + 1];
-      } else if (!pass)
-        ++s.rows.ptr[blk[v] - s.b0 + 1];
-    }
-    for (PetscInt e = eStart; e < eEnd; ++e) {
-      const PetscInt *cone;
-      PetscInt        va, vb;
-
-      PetscCall(DMPlexGetCone(dm, e, &cone));
-      va = cone[0] - vStart;
-      vb = cone[1] - vStart;
-      if (blk[va] < 0 || blk[vb] < 0) continue;
-      for (PetscInt side = 0; side < 2; ++side) {
-        const PetscInt r = side ? vb : va, c = side ? va : vb;
-
-        if (ghost[r] >= 0) {
-          if (pass)
-            grows.col[grows.ptr[ghost[r]] + grows.fill[ghost[r]]++] = blk[c];
-          else
-            ++grows.ptr[ghost[r] + 1];
-        } else if (!pass)
-          ++s.rows.ptr[blk[r] - s.b0 + 1];
-      }
-    }
-  }
+  PetscCall(LocalPattern(dm, blk, ghost, s.b0, &s.rows, &grows, PETSC_FALSE));
+  PetscCall(BlockRowsAllocate(&grows));
+  PetscCall(LocalPattern(dm, blk, ghost, s.b0, NULL, &grows, PETSC_TRUE));
   PetscCall(BlockRowsFinish(&grows));
   /* the ghost rows' patterns to their owners, [block row, n, n block columns] each, and later their values */
   PetscCall(PetscCalloc2(size, &icounts, size, &scounts));
@@ -320,19 +330,7 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
     q += 2 + n;
   }
   PetscCall(BlockRowsAllocate(&s.rows));
-  for (PetscInt v = 0; v < vEnd - vStart; ++v)
-    if (blk[v] >= 0 && ghost[v] < 0) s.rows.col[s.rows.ptr[blk[v] - s.b0] + s.rows.fill[blk[v] - s.b0]++] = blk[v];
-  for (PetscInt e = eStart; e < eEnd; ++e) {
-    const PetscInt *cone;
-    PetscInt        va, vb;
-
-    PetscCall(DMPlexGetCone(dm, e, &cone));
-    va = cone[0] - vStart;
-    vb = cone[1] - vStart;
-    if (blk[va] < 0 || blk[vb] < 0) continue;
-    if (ghost[va] < 0) s.rows.col[s.rows.ptr[blk[va] - s.b0] + s.rows.fill[blk[va] - s.b0]++] = blk[vb];
-    if (ghost[vb] < 0) s.rows.col[s.rows.ptr[blk[vb] - s.b0] + s.rows.fill[blk[vb] - s.b0]++] = blk[va];
-  }
+  PetscCall(LocalPattern(dm, blk, ghost, s.b0, &s.rows, NULL, PETSC_TRUE));
   for (PetscInt q = 0; q < irdispls[size];) {
     const PetscInt r = irecv[q] - s.b0, n = irecv[q + 1];
 
