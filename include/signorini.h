@@ -316,7 +316,6 @@ typedef struct {
   Vec          bulk_x;
   PetscReal    fnorm0;                          /* |F| at the start of the last SNESSolve, in the user's units */
   PetscBool    warm;                            /* the last SolverSolve() started from a given guess, not from zero */
-  PetscBool    from_coarser;                    /* the guess is a coarser mesh's solution (nested iteration) */
   PetscInt64   active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
   PetscReal    fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */
 } Problem;

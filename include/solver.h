@@ -10,7 +10,10 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user);
 PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
 PetscErrorCode SolverComputeScales(DM dm, AppCtx *user);
 PetscErrorCode SolverIterateDisplacement(AppCtx *user, Vec X, Vec *u);
-PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm);
+/* Where a solve starts: from zero, from the solution for a nearby eps (the sweep), or from a coarser mesh's (nested
+   iteration); the last two are warm starts, and the first and last reach a small eps by continuation. */
+typedef enum { SOLVER_START_ZERO, SOLVER_START_NEARBY_EPS, SOLVER_START_COARSER_MESH } SolverStart;
+PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start);
 /* |F| (user's units) that -snes_rtol is relative to in the current solve: its first, or for a warm start the smaller of
    its first and the load ||F(0)||, so that a warm start ends as tight as a start from zero */
 PetscErrorCode SolverStopReference(const AppCtx *user, PetscReal *ref);

@@ -121,6 +121,32 @@ PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **pa
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The coarse vertices whose mean is the fine vertex with source point src (MeshRefineRegular(), MeshCreateBoxLevel()): the
+   vertex itself, an edge's cone, or the vertices of a quad's or hex's closure (at most 8). vb, eb: dm's vertex and edge
+   strata. */
+PetscErrorCode MeshSourceVertices(DM dm, const PetscInt vb[2], const PetscInt eb[2], PetscInt src, PetscInt verts[], PetscInt *nv)
+{
+  PetscInt *closure = NULL, ncl;
+
+  PetscFunctionBeginUser;
+  *nv = 0;
+  if (src >= vb[0] && src < vb[1]) {
+    verts[(*nv)++] = src;
+  } else if (src >= eb[0] && src < eb[1]) {
+    const PetscInt *cone;
+
+    PetscCall(DMPlexGetCone(dm, src, &cone));
+    verts[(*nv)++] = cone[0];
+    verts[(*nv)++] = cone[1];
+  } else {
+    PetscCall(DMPlexGetTransitiveClosure(dm, src, PETSC_TRUE, &ncl, &closure));
+    for (PetscInt j = 0; j < ncl; ++j)
+      if (closure[2 * j] >= vb[0] && closure[2 * j] < vb[1] && *nv < 8) verts[(*nv)++] = closure[2 * j];
+    PetscCall(DMPlexRestoreTransitiveClosure(dm, src, PETSC_TRUE, &ncl, &closure));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The interpolation of a local vector of dm with its unknowns at the vertices (P1, Q1) to fine, refined once by
    MeshRefineRegular(): every fine vertex is the centre of its source point (a vertex, an edge midpoint, the centre of
    a quad or a hex) and gets the mean of the values at the source point's vertices, which is exact for nested P1/Q1.
@@ -128,7 +154,7 @@ PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **pa
 PetscErrorCode MeshInterpolateVertexSources(DM dm, DM fine, const PetscInt vertex_source[], Vec loc, Vec *fine_loc)
 {
   PetscSection       csec, fsec;
-  PetscInt           vStart, vEnd, cvStart, cvEnd, nc;
+  PetscInt           vStart, vEnd, cvb[2], ceb[2], nc;
   const PetscScalar *cv;
   PetscScalar       *fv;
 
@@ -136,28 +162,19 @@ PetscErrorCode MeshInterpolateVertexSources(DM dm, DM fine, const PetscInt verte
   PetscCall(DMGetLocalSection(dm, &csec));
   PetscCall(DMGetLocalSection(fine, &fsec));
   PetscCall(DMPlexGetDepthStratum(fine, 0, &vStart, &vEnd));
-  PetscCall(DMPlexGetDepthStratum(dm, 0, &cvStart, &cvEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &cvb[0], &cvb[1]));
+  PetscCall(DMPlexGetDepthStratum(dm, 1, &ceb[0], &ceb[1]));
   PetscCall(DMCreateLocalVector(fine, fine_loc));
   PetscCall(VecZeroEntries(*fine_loc));
   PetscCall(VecGetArrayRead(loc, &cv));
   PetscCall(VecGetArray(*fine_loc, &fv));
   for (PetscInt v = vStart; v < vEnd; ++v) {
-    const PetscInt src = vertex_source[v - vStart];
-    PetscInt       verts[8], nv = 0, foff;
+    PetscInt verts[8], nv, foff;
 
     PetscCall(PetscSectionGetDof(fsec, v, &nc));
     if (!nc) continue;
     PetscCall(PetscSectionGetOffset(fsec, v, &foff));
-    if (src >= cvStart && src < cvEnd)
-      verts[nv++] = src;
-    else {
-      PetscInt *closure = NULL, ncl;
-
-      PetscCall(DMPlexGetTransitiveClosure(dm, src, PETSC_TRUE, &ncl, &closure));
-      for (PetscInt j = 0; j < ncl; ++j)
-        if (closure[2 * j] >= cvStart && closure[2 * j] < cvEnd && nv < 8) verts[nv++] = closure[2 * j];
-      PetscCall(DMPlexRestoreTransitiveClosure(dm, src, PETSC_TRUE, &ncl, &closure));
-    }
+    PetscCall(MeshSourceVertices(dm, cvb, ceb, vertex_source[v - vStart], verts, &nv));
     for (PetscInt i = 0; i < nv; ++i) {
       PetscInt coff;
 

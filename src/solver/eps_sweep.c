@@ -12,7 +12,7 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
     user->opt.contact.eps0 = user->opt.contact.eps0_sweep[k];
     PetscCall(ContactComputeEps(user));
     PetscCall(ElasticityUpdateConstants(dm, user));
-    PetscCall(SolverSolve(snes, user, u, PETSC_TRUE));
+    PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -87,7 +87,7 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
 
   PetscFunctionBeginUser;
   PetscCall(GridSequenceSetTolerance(*snes, user));
-  PetscCall(SolverSolve(*snes, user, *u, PETSC_FALSE));
+  PetscCall(SolverSolve(*snes, user, *u, SOLVER_START_ZERO));
   for (PetscInt l = 1; l <= nlevels; ++l) {
     const PetscBool failed = (PetscBool)!user->rec.stats.converged;
     PetscLogDouble  t0, t1;
@@ -102,9 +102,7 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     user->prob.setup_time = t1 - t0; /* refinement, set-up and interpolation */
     user->rec.stats.time_setup += t1 - t0;
     PetscCall(GridSequenceSetTolerance(*snes, user));
-    user->prob.from_coarser = (PetscBool)!failed;
-    PetscCall(SolverSolve(*snes, user, *u, (PetscBool)!failed));
-    user->prob.from_coarser = PETSC_FALSE;
+    PetscCall(SolverSolve(*snes, user, *u, failed ? SOLVER_START_ZERO : SOLVER_START_COARSER_MESH));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

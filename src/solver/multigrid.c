@@ -7,34 +7,6 @@
 #include "mesh.h"
 #include "solver.h"
 
-/* The coarse vertices whose mean is the fine vertex with source point src (a coarse vertex, edge, quad or hex). */
-static PetscErrorCode SourceVertices(DM coarse, PetscInt cvStart, PetscInt cvEnd, PetscInt src, PetscInt verts[], PetscInt *nv)
-{
-  PetscInt *closure = NULL, ncl, eStart, eEnd;
-
-  PetscFunctionBeginUser;
-  *nv = 0;
-  if (src >= cvStart && src < cvEnd) {
-    verts[(*nv)++] = src;
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-  PetscCall(DMPlexGetDepthStratum(coarse, 1, &eStart, &eEnd));
-  if (src >= eStart && src < eEnd) { /* an edge: its cone */
-    const PetscInt *cone;
-
-    PetscCall(DMPlexGetCone(coarse, src, &cone));
-    verts[0] = cone[0];
-    verts[1] = cone[1];
-    *nv      = 2;
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-  PetscCall(DMPlexGetTransitiveClosure(coarse, src, PETSC_TRUE, &ncl, &closure));
-  for (PetscInt j = 0; j < ncl; ++j)
-    if (closure[2 * j] >= cvStart && closure[2 * j] < cvEnd && *nv < 8) verts[(*nv)++] = closure[2 * j];
-  PetscCall(DMPlexRestoreTransitiveClosure(coarse, src, PETSC_TRUE, &ncl, &closure));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* With -pc_type mg (the PC of snes, the fine mesh's problem) and P1/Q1, adds the interpolation from coarse to fine,
    refined once (vertex_source[]: MeshCreateBoxLevel(), MeshRefineRegular()). Both meshes' problems must be set up (their
    sections); fine's rows are its owned free components, coarse's columns its free components, a fixed coarse component
@@ -44,7 +16,7 @@ PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt v
   MPI_Comm     comm = PetscObjectComm((PetscObject)fine);
   Multigrid   *mg   = &user->mg;
   PetscSection cl, cg, fl, fg;
-  PetscInt     dim, vStart, vEnd, cvStart, cvEnd, m, n, rstart, cstart, cend, *dnz, *onz;
+  PetscInt     dim, vStart, vEnd, cvb[2], ceb[2], m, n, rstart, cstart, cend, *dnz, *onz;
   Mat          P;
   KSP          ksp;
   PC           pc;
@@ -62,7 +34,8 @@ PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt v
   PetscCall(DMGetLocalSection(fine, &fl));
   PetscCall(DMGetGlobalSection(fine, &fg));
   PetscCall(DMPlexGetDepthStratum(fine, 0, &vStart, &vEnd));
-  PetscCall(DMPlexGetDepthStratum(coarse, 0, &cvStart, &cvEnd));
+  PetscCall(DMPlexGetDepthStratum(coarse, 0, &cvb[0], &cvb[1]));
+  PetscCall(DMPlexGetDepthStratum(coarse, 1, &ceb[0], &ceb[1]));
   PetscCall(PetscSectionGetConstrainedStorageSize(fg, &m));
   PetscCall(PetscSectionGetConstrainedStorageSize(cg, &n));
   PetscCallMPI(MPI_Scan(&m, &rstart, 1, MPIU_INT, MPI_SUM, comm));
@@ -82,7 +55,7 @@ PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt v
       PetscCall(PetscSectionGetOffset(fg, v, &goff));
       if (dof <= 0 || goff < 0) continue; /* no unknowns, or another rank's */
       PetscCall(MeshPointGlobalIndices(fl, fg, v, dim, fidx));
-      PetscCall(SourceVertices(coarse, cvStart, cvEnd, vertex_source[v - vStart], verts, &nv));
+      PetscCall(MeshSourceVertices(coarse, cvb, ceb, vertex_source[v - vStart], verts, &nv));
       for (PetscInt i = 0; i < nv; ++i) {
         PetscInt cidx[3];
 

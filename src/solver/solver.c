@@ -427,15 +427,16 @@ static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Solves from a zero initial guess (warm: from u) and records the outcome; a failed solve is recorded, not raised.
+/* Solves from a zero initial guess (or from u, start) and records the outcome; a failed solve is recorded, not raised.
    An eps below h/M is reached by continuation: the penalty problems for eps = h/M, h/M f, h/M f^2, ... are solved in turn,
    each from the solution of the previous one, so that Newton starts near the active set and the 1/eps scale of the
    residual never meets a far-off initial guess (the direct solve at eps = 1e-12 h diverges on the square scene).
    A warm start from the solution for a nearby eps (the sweep) needs no continuation; one from a coarser mesh's
-   (nested iteration, prob.from_coarser) runs it from that guess: below h/100 its new contact nodes, between an active
+   (nested iteration) runs it from that guess: below h/100 its new contact nodes, between an active
    and a free coarse one, start far off on the 1/eps scale, and Newton stalled (128 x 128, eps = 1e-6 h). */
-PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm)
+PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
 {
+  const PetscBool warm       = (PetscBool)(start != SOLVER_START_ZERO);
   const PetscReal eps_target = user->prob.eps, eps_start = user->prob.h / ContactPenaltyModulus(user);
   PetscLogDouble  t0, t1;
   PetscInt        newton = 0, ksp = 0;
@@ -450,7 +451,7 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, PetscBool warm)
   user->prob.pc_reuse.builds          = 0; /* counted per solve */
   user->prob.pc_reuse.updates         = 0;
   user->rec.stats.continuation_stages = 0;
-  if ((!warm || user->prob.from_coarser) && user->opt.contact.method == CONTACT_PENALTY && user->opt.contact.continuation && eps_target < eps_start) {
+  if (start != SOLVER_START_NEARBY_EPS && user->opt.contact.method == CONTACT_PENALTY && user->opt.contact.continuation && eps_target < eps_start) {
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= user->opt.contact.continuation_factor) {
       user->prob.eps = eps;
       PetscCall(ElasticityUpdateConstants(dm, user));
