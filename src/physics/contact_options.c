@@ -71,6 +71,11 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
                              "With the updates: the finest level's Chebyshev smoother estimates its eigenvalues again at each update, "
                              "instead of keeping the build's interval when the penalty term provably does not raise them",
                              NULL, opts->pc_update_esteig, &opts->pc_update_esteig, NULL));
+  opts->pc_update_truncate = 10.0;
+  PetscCall(PetscOptionsReal("-contact_pc_update_truncate",
+                             "With the updates: the coarse operators leave out the contact dofs whose penalty diagonal exceeds this times "
+                             "K's diagonal (Jacobi smooths them alone), so that a small eps does not stiffen the coarse spaces; 0: never",
+                             NULL, opts->pc_update_truncate, &opts->pc_update_truncate, NULL));
   opts->grid_sequence = 0;
   PetscCall(PetscOptionsInt("-contact_grid_sequence",
                             "Nested iteration: solve on the mesh, then on N uniform refinements of it, each from the interpolated last solution",
@@ -128,6 +133,8 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscCheck(!(sweep_set && eps_set), comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep cannot be given together with -penalty_eps");
   PetscCheck(!sweep_set || opts->method == CONTACT_PENALTY, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep needs -contact_method penalty");
   if (opts->n_sweep) opts->eps0 = opts->eps0_sweep[0]; /* the sweep starts with its first value, in place of -penalty_eps0 */
+  PetscCheck(opts->pc_update_truncate >= 0.0, comm, PETSC_ERR_USER_INPUT, "-contact_pc_update_truncate must be >= 0 (0: never), got %g",
+             (double)opts->pc_update_truncate);
   PetscCheck(opts->pc_reuse_changes >= 0, comm, PETSC_ERR_USER_INPUT, "-contact_pc_reuse_changes must be >= 0, got %" PetscInt_FMT,
              opts->pc_reuse_changes);
   PetscCheck(opts->continuation_factor > 0.0 && opts->continuation_factor < 1.0, comm, PETSC_ERR_USER_INPUT,

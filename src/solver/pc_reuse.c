@@ -80,7 +80,174 @@ static PetscErrorCode DestroyProducts(PcReuse *r)
   PetscCall(MatDestroy(&r->rlocal));
   PetscCall(MatDestroy(&r->dlocal));
   PetscCall(MatDestroy(&r->clocal));
+  PetscCall(PetscFree2(r->mirror_k, r->mirror_at));
+  PetscCall(PetscFree3(r->eff_vals, r->eff_dvals, r->zrows));
+  PetscCall(PetscFree3(r->rrow_ptr, r->rrow_cols, r->rrow_vals));
+  PetscCall(MatDestroy(&r->rfine));
+  PetscCall(VecDestroy(&r->zmark));
+  PetscCall(VecDestroy(&r->zcols));
+  r->nmirror = 0;
+  r->nz      = 0;
   r->nlevels = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The place of each contact row's diagonal among its entries (bulk_ptr numbering). */
+static PetscErrorCode DiagonalEntry(const Problem *pb, PetscInt row, PetscInt *k)
+{
+  PetscFunctionBeginUser;
+  for (*k = pb->bulk_ptr[row]; *k < pb->bulk_ptr[row + 1] && pb->bulk_cols[*k] != pb->bulk_rows[row]; ++*k) { }
+  PetscCheck(*k < pb->bulk_ptr[row + 1], PETSC_COMM_SELF, PETSC_ERR_PLIB, "a contact row without its diagonal");
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The marks of the contact rows (1, or 2 in Z) at their columns, from any rank. */
+static PetscErrorCode ScatterMarks(Problem *pb)
+{
+  PcReuse *r = &pb->pc_reuse;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecScatterBegin(pb->bulk_scatter, r->zmark, r->zcols, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(pb->bulk_scatter, r->zmark, r->zcols, INSERT_VALUES, SCATTER_FORWARD));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The mirrors: the entries (s, c) of J whose column c is a contact row of this rank and whose row s is no contact row
+   of any rank, J(s, c) = K(c, s) by symmetry. */
+static PetscErrorCode MirrorsSetUp(AppCtx *user)
+{
+  Problem           *pb = &user->prob;
+  PcReuse           *r  = &pb->pc_reuse;
+  PetscInt           rstart, n = 0;
+  const PetscScalar *mark;
+
+  PetscFunctionBeginUser;
+  PetscCall(MatCreateVecs(pb->K, &r->zmark, NULL));
+  PetscCall(VecDuplicate(pb->bulk_x, &r->zcols));
+  PetscCall(MatGetOwnershipRange(pb->K, &rstart, NULL));
+  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) PetscCall(VecSetValue(r->zmark, pb->bulk_rows[row], 1.0, INSERT_VALUES));
+  PetscCall(VecAssemblyBegin(r->zmark));
+  PetscCall(VecAssemblyEnd(r->zmark));
+  PetscCall(ScatterMarks(pb));
+  PetscCall(VecGetArrayRead(r->zcols, &mark));
+  for (PetscInt k = 0; k < pb->bulk_ptr[pb->nbulk_rows]; ++k) n += PetscRealPart(mark[pb->bulk_lcols[k]]) == 0.0;
+  PetscCall(PetscMalloc2(n, &r->mirror_k, n, &r->mirror_at));
+  r->nmirror = 0;
+  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
+    PetscInt kd;
+
+    PetscCall(DiagonalEntry(pb, row, &kd));
+    for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k)
+      if (PetscRealPart(mark[pb->bulk_lcols[k]]) == 0.0) {
+        r->mirror_k[r->nmirror]  = k;
+        r->mirror_at[r->nmirror] = pb->bulk_lcols[kd];
+        r->nmirror++;
+      }
+  }
+  PetscCall(VecRestoreArrayRead(r->zcols, &mark));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* J' at dlocal's entries, from J's values in the contact rows (jvals): J itself without the truncation; with it, zero
+   in the rows and columns of Z, the contact dofs whose penalty diagonal exceeds -contact_pc_update_truncate times K's
+   diagonal. Such a row is nearly diagonal, so the finest level's Jacobi smoother solves it alone, while in the coarse
+   operators its 1/eps would pin every coarse function touching it (GAMG's aggregates mix the contact dofs with the
+   bulk); a rebuild at that eps would leave the same dofs out of its aggregates. Also sets zrows. */
+static PetscErrorCode EffectiveValues(AppCtx *user, const PetscScalar jvals[], PetscScalar eff[])
+{
+  Problem           *pb    = &user->prob;
+  PcReuse           *r     = &pb->pc_reuse;
+  const PetscInt     nnz   = pb->bulk_ptr[pb->nbulk_rows];
+  const PetscReal    ratio = user->opt.contact.pc_update_truncate;
+  const PetscScalar *mark;
+
+  PetscFunctionBeginUser;
+  if (ratio <= 0.0) {
+    PetscCall(PetscArraycpy(eff, jvals, nnz));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  r->nz = 0;
+  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
+    PetscInt  kd;
+    PetscBool in_z;
+
+    PetscCall(DiagonalEntry(pb, row, &kd));
+    in_z = (PetscBool)(PetscRealPart(jvals[kd] - pb->bulk_vals[kd]) > ratio * PetscRealPart(pb->bulk_vals[kd]));
+    if (in_z) r->zrows[r->nz++] = pb->bulk_rows[row];
+    PetscCall(VecSetValue(r->zmark, pb->bulk_rows[row], in_z ? 2.0 : 1.0, INSERT_VALUES));
+  }
+  PetscCall(VecAssemblyBegin(r->zmark));
+  PetscCall(VecAssemblyEnd(r->zmark));
+  PetscCall(ScatterMarks(pb));
+  PetscCall(VecGetArrayRead(r->zcols, &mark));
+  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
+    PetscInt kd;
+
+    PetscCall(DiagonalEntry(pb, row, &kd));
+    for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k)
+      eff[k] = PetscRealPart(mark[pb->bulk_lcols[kd]]) == 2.0 || PetscRealPart(mark[pb->bulk_lcols[k]]) == 2.0 ? 0.0 : jvals[k];
+  }
+  for (PetscInt t = 0; t < r->nmirror; ++t) eff[nnz + t] = PetscRealPart(mark[r->mirror_at[t]]) == 2.0 ? 0.0 : pb->bulk_vals[r->mirror_k[t]];
+  PetscCall(VecRestoreArrayRead(r->zcols, &mark));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The finest prolongator's rows at the owned contact rows, as GAMG made them. */
+static PetscErrorCode ProlongatorRowsSave(PC pc, AppCtx *user)
+{
+  Problem *pb = &user->prob;
+  PcReuse *r  = &pb->pc_reuse;
+  PetscInt n  = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PCMGGetInterpolation(pc, r->nlevels - 1, &r->rfine));
+  PetscCall(PetscObjectReference((PetscObject)r->rfine));
+  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
+    PetscInt ncols;
+
+    PetscCall(MatGetRow(r->rfine, pb->bulk_rows[row], &ncols, NULL, NULL));
+    n += ncols;
+    PetscCall(MatRestoreRow(r->rfine, pb->bulk_rows[row], &ncols, NULL, NULL));
+  }
+  PetscCall(PetscMalloc3(pb->nbulk_rows + 1, &r->rrow_ptr, n, &r->rrow_cols, n, &r->rrow_vals));
+  r->rrow_ptr[0] = 0;
+  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
+    const PetscInt    *cols;
+    const PetscScalar *vals;
+    PetscInt           ncols;
+
+    PetscCall(MatGetRow(r->rfine, pb->bulk_rows[row], &ncols, &cols, &vals));
+    PetscCall(PetscArraycpy(&r->rrow_cols[r->rrow_ptr[row]], cols, ncols));
+    PetscCall(PetscArraycpy(&r->rrow_vals[r->rrow_ptr[row]], vals, ncols));
+    r->rrow_ptr[row + 1] = r->rrow_ptr[row] + ncols;
+    PetscCall(MatRestoreRow(r->rfine, pb->bulk_rows[row], &ncols, &cols, &vals));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The finest prolongator's contact rows: zero in Z (all = PETSC_FALSE), GAMG's values elsewhere (all rows with all). */
+static PetscErrorCode ProlongatorRowsSet(AppCtx *user, PetscBool all)
+{
+  Problem     *pb = &user->prob;
+  PcReuse     *r  = &pb->pc_reuse;
+  PetscScalar *zero;
+  PetscInt     iz = 0, nmax = 0;
+
+  PetscFunctionBeginUser;
+  if (!r->rfine) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) nmax = PetscMax(nmax, r->rrow_ptr[row + 1] - r->rrow_ptr[row]);
+  PetscCall(PetscCalloc1(nmax, &zero));
+  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
+    const PetscInt  n    = r->rrow_ptr[row + 1] - r->rrow_ptr[row];
+    const PetscBool in_z = (PetscBool)(!all && iz < r->nz && r->zrows[iz] == pb->bulk_rows[row]); /* zrows follow the rows' order */
+
+    iz += in_z;
+    PetscCall(MatSetValues(r->rfine, 1, &pb->bulk_rows[row], n, &r->rrow_cols[r->rrow_ptr[row]], in_z ? zero : &r->rrow_vals[r->rrow_ptr[row]],
+                           INSERT_VALUES));
+  }
+  PetscCall(PetscFree(zero));
+  PetscCall(MatAssemblyBegin(r->rfine, MAT_FINAL_ASSEMBLY));
+  PetscCall(MatAssemblyEnd(r->rfine, MAT_FINAL_ASSEMBLY));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -111,8 +278,13 @@ static PetscErrorCode FinestProductSetUp(PC pc, AppCtx *user)
   PetscCall(MatCreateSubMatrices(R, 1, &is_rows, &is_cols, MAT_INITIAL_MATRIX, &sub));
   r->rlocal = sub[0];
   PetscCall(PetscFree(sub));
-  /* D_S in COO form: the contact rows' places in S, their columns' places (bulk_lcols) */
-  PetscCall(PetscMalloc2(nnz, &coo_i, nnz, &coo_j));
+  /* with the truncation, the columns S that are no contact row (on any rank) get the mirrors of their entries */
+  if (user->opt.contact.pc_update_truncate > 0.0) {
+    PetscCall(MirrorsSetUp(user));
+    PetscCall(ProlongatorRowsSave(pc, user));
+  }
+  /* D_S in COO form: the contact rows' places in S, their columns' places (bulk_lcols); then the mirrors */
+  PetscCall(PetscMalloc2(nnz + r->nmirror, &coo_i, nnz + r->nmirror, &coo_j));
   for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
     PetscInt at;
 
@@ -123,13 +295,21 @@ static PetscErrorCode FinestProductSetUp(PC pc, AppCtx *user)
       coo_j[k] = pb->bulk_lcols[k];
     }
   }
+  for (PetscInt t = 0; t < r->nmirror; ++t) {
+    coo_i[nnz + t] = pb->bulk_lcols[r->mirror_k[t]];
+    coo_j[nnz + t] = r->mirror_at[t];
+  }
   PetscCall(MatCreate(PETSC_COMM_SELF, &r->dlocal));
   PetscCall(MatSetSizes(r->dlocal, nS, nS, nS, nS));
   PetscCall(MatSetType(r->dlocal, MATSEQAIJ));
-  PetscCall(MatSetPreallocationCOO(r->dlocal, nnz, coo_i, coo_j));
+  PetscCall(MatSetPreallocationCOO(r->dlocal, nnz + r->nmirror, coo_i, coo_j));
   PetscCall(PetscFree2(coo_i, coo_j));
-  PetscCall(PetscArrayzero(r->dvals, nnz));
-  PetscCall(MatSetValuesCOO(r->dlocal, r->dvals, INSERT_VALUES));
+  /* the coarse operators hold the build's Jacobian, nothing left out */
+  PetscCall(PetscMalloc3(nnz + r->nmirror, &r->eff_vals, nnz + r->nmirror, &r->eff_dvals, pb->nbulk_rows, &r->zrows));
+  PetscCall(PetscArraycpy(r->eff_vals, r->built_vals, nnz));
+  for (PetscInt t = 0; t < r->nmirror; ++t) r->eff_vals[nnz + t] = pb->bulk_vals[r->mirror_k[t]];
+  PetscCall(PetscArrayzero(r->eff_dvals, nnz + r->nmirror));
+  PetscCall(MatSetValuesCOO(r->dlocal, r->eff_dvals, INSERT_VALUES));
   PetscCall(MatPtAP(r->dlocal, r->rlocal, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &r->clocal));
   /* the sum over the ranks, on the first coarse level's layout */
   PetscCall(MatGetRowIJ(r->clocal, 0, PETSC_FALSE, PETSC_FALSE, &nrows, &ia, &ja, &done));
@@ -153,8 +333,8 @@ static PetscErrorCode FinestProductSetUp(PC pc, AppCtx *user)
 }
 
 /* -contact_pc_update_check: each updated coarse operator against the Galerkin product of the level above, computed
-   in full (R^T A_f R, as a rebuild would). */
-static PetscErrorCode CheckHierarchy(PC pc, PetscInt nlevels, PetscInt update)
+   in full (R^T A_f R, as a rebuild would; with the truncation, R's rows Z are zero). */
+static PetscErrorCode CheckHierarchy(PC pc, PetscInt nlevels, PcReuse *r)
 {
   PetscFunctionBeginUser;
   for (PetscInt l = nlevels - 1; l > 0; --l) {
@@ -175,7 +355,7 @@ static PetscErrorCode CheckHierarchy(PC pc, PetscInt nlevels, PetscInt update)
     PetscCall(PetscPrintf(PetscObjectComm((PetscObject)pc),
                           "pc update check: update %" PetscInt_FMT ", level %" PetscInt_FMT " of %" PetscInt_FMT
                           ": ||A_c - R^T A_f R||_F / ||R^T A_f R||_F = %.3e\n",
-                          update, l - 1, nlevels, (double)(diff / norm)));
+                          r->updates, l - 1, nlevels, (double)(diff / norm)));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -197,17 +377,20 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
   }
   PetscCheck(r->nlevels == nlevels, PetscObjectComm((PetscObject)pc), PETSC_ERR_PLIB, "the multigrid hierarchy changed its levels");
   PetscCall(ContactRowValues(user, r->dvals));
-  for (PetscInt k = 0; k < nnz; ++k) {
-    const PetscScalar now = r->dvals[k];
+  PetscCall(PetscArraycpy(r->built_vals, r->dvals, nnz)); /* J now, for the finest smoother's bound */
+  PetscCall(EffectiveValues(user, r->dvals, r->eff_dvals));
+  PetscCall(ProlongatorRowsSet(user, PETSC_FALSE));
+  for (PetscInt k = 0; k < nnz + r->nmirror; ++k) {
+    const PetscScalar now = r->eff_dvals[k];
 
-    r->dvals[k]      = now - r->built_vals[k];
-    r->built_vals[k] = now;
-    dmax             = PetscMax(dmax, PetscAbsScalar(r->dvals[k]));
+    r->eff_dvals[k] = now - r->eff_vals[k];
+    r->eff_vals[k]  = now;
+    dmax            = PetscMax(dmax, PetscAbsScalar(r->eff_dvals[k]));
   }
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &dmax, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)pc)));
   if (dmax == 0.0) PetscFunctionReturn(PETSC_SUCCESS); /* the same Jacobian in the contact rows: nothing to carry */
   /* the first coarse level: this rank's R_S^T D_S R_S, summed over the ranks */
-  PetscCall(MatSetValuesCOO(r->dlocal, r->dvals, INSERT_VALUES));
+  PetscCall(MatSetValuesCOO(r->dlocal, r->eff_dvals, INSERT_VALUES));
   PetscCall(MatPtAP(r->dlocal, r->rlocal, MAT_REUSE_MATRIX, PETSC_DEFAULT, &r->clocal));
   {
     const PetscScalar *v;
@@ -228,7 +411,7 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
     PetscCall(KSPGetOperators(smoother, &A, NULL));
     PetscCall(MatAXPY(A, 1.0, r->dcoarse[l - 1], SUBSET_NONZERO_PATTERN));
   }
-  if (user->opt.contact.pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r->updates));
+  if (user->opt.contact.pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r));
   /* every level's operator is new: its Chebyshev smoother estimates its eigenvalues again, its Jacobi or LU sets up
      again (KSPSetOperators() marks the new matrix, as a rebuild would) */
   for (PetscInt l = 0; l < nlevels; ++l) {
@@ -332,7 +515,8 @@ PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user)
       for (PetscInt k = 0; k < nnz && on_K; ++k) on_K = (PetscBool)(r->built_vals[k] == pb->bulk_vals[k]);
       PetscCall(MPIU_Allreduce(&on_K, &r->built_on_K, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)pc)));
     }
-    PetscCall(DestroyProducts(r)); /* a rebuild may make new prolongators: new patterns */
+    PetscCall(ProlongatorRowsSet(user, PETSC_TRUE)); /* GAMG may reuse its prolongators: give them back whole */
+    PetscCall(DestroyProducts(r));                   /* a rebuild may make new prolongators: new patterns */
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
