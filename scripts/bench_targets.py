@@ -215,18 +215,30 @@ def measure_getfem(out, s, pairs):
 SECTIONS = {"default": measure_default, "mg": measure_mg, "iterations": measure_iterations, "eps": measure_eps, "parallel": measure_parallel, "getfem": measure_getfem}
 
 
+def rows_of_table(path):
+    """The sections' rows of an earlier table (targets.csv), for a clone without the runs of its last invocation."""
+    kept = {}
+    if os.path.exists(path):
+        with open(path, newline="") as fh:
+            for r in csv.DictReader(fh):
+                sec = kept.setdefault(r["section"], {"date": r["date"], "rows": []})
+                sec["rows"].append({k: r[k] for k in ("target", "measured", "met", "command")})
+    return kept
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--pairs", type=int, default=3, help="runs of each command in the side-by-side ratios (default 3)")
     ap.add_argument("--out", default=os.path.join(ROOT, "bench"))
     ap.add_argument("--small", action="store_true", help="small meshes (a test of the script, not of the targets)")
     ap.add_argument("--sections", default=",".join(SECTIONS),
-                    help="the sections to measure (default all); the rows of the others are kept from the last invocation (bench/runs/targets/rows.json)")
+                    help="the sections to measure (default all); the rows of the others are kept from the last invocation (bench/runs/targets/rows.json, "
+                         "or the table's targets.csv where that is missing)")
     args = ap.parse_args()
     out = os.path.join(args.out, "runs", "targets")
     os.makedirs(out, exist_ok=True)
     saved = os.path.join(out, "rows.json")
-    kept = json.load(open(saved)) if os.path.exists(saved) else {}
+    kept = json.load(open(saved)) if os.path.exists(saved) else rows_of_table(os.path.join(args.out, "targets.csv"))
     for name in args.sections.split(","):
         if name not in SECTIONS:
             sys.exit(f"unknown section '{name}' (known: {', '.join(SECTIONS)})")
