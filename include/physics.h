@@ -49,6 +49,7 @@ static inline PetscReal ContactNodeEps(const ContactSet *cs, PetscReal eps, Pets
 PetscErrorCode PenaltySetUp(DM dm, AppCtx *user);
 PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F);
 PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J);
+PetscErrorCode PenaltySameActivity(DM dm, AppCtx *user, Vec X, Vec Y, PetscBool *same);
 PetscErrorCode PenaltySaveBulkRows(DM dm, AppCtx *user);
 PetscErrorCode PenaltyFreeBulkRows(AppCtx *user);
 PetscErrorCode PenaltyJacobianInK(DM dm, AppCtx *user, Vec X);
@@ -63,6 +64,7 @@ PetscErrorCode PenaltyFacesDestroy(PenaltyFaces *pf);
 PetscErrorCode PenaltyFacesResidual(DM dm, AppCtx *user, Vec locX, Vec locF);
 PetscErrorCode PenaltyFacesJacobian(DM dm, AppCtx *user, Vec locX, Mat J);
 PetscErrorCode PenaltyFacesEnergy(DM dm, AppCtx *user, Vec locX, PetscReal *energy);
+PetscErrorCode PenaltyFacesSameActivity(DM dm, AppCtx *user, Vec locA, Vec locB, PetscBool *same);
 
 /* vi_bounds.c */
 PetscErrorCode VICreateBounds(DM dm, AppCtx *user);

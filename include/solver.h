@@ -18,6 +18,7 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start);
    its first and the load ||F(0)||, so that a warm start ends as tight as a start from zero */
 PetscErrorCode SolverStopReference(const AppCtx *user, PetscReal *ref);
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
+PetscErrorCode SolverResidualNorm(SNES snes, AppCtx *user, Vec u, PetscReal *norm);
 PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
 
 /* problem.c, grid_sequence.c, eps_sweep.c */

@@ -200,6 +200,41 @@ PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Whether the penalty term is active at the same points at X and Y (on every rank): the contact nodes with the nodal
+   rule, the Gauss points of the contact faces with the Gauss rule; PETSC_FALSE where the points are PETSc's (the Gauss
+   rule without the P1 closed form), which are not looked at. */
+PetscErrorCode PenaltySameActivity(DM dm, AppCtx *user, Vec X, Vec Y, PetscBool *same)
+{
+  PetscInt dim;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  *same = PETSC_TRUE;
+  if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS) {
+    Vec locX, locY;
+
+    if (user->prob.assembly != ASSEMBLY_P1) *same = PETSC_FALSE;
+    else {
+      PetscCall(GetLocalSolution(dm, user, X, &locX));
+      PetscCall(GetLocalSolution(dm, user, Y, &locY));
+      PetscCall(PenaltyFacesSameActivity(dm, user, locX, locY, same));
+      PetscCall(DMRestoreLocalVector(dm, &locX));
+      PetscCall(DMRestoreLocalVector(dm, &locY));
+    }
+  } else {
+    const ContactSet  *cs = &user->prob.cset;
+    const PetscScalar *x, *y;
+
+    PetscCall(VecGetArrayRead(X, &x));
+    PetscCall(VecGetArrayRead(Y, &y));
+    for (PetscInt i = 0; i < cs->n && *same; ++i) *same = (PetscBool)((ContactNodePenetration(cs, dim, i, x) > 0.0) == (ContactNodePenetration(cs, dim, i, y) > 0.0));
+    PetscCall(VecRestoreArrayRead(X, &x));
+    PetscCall(VecRestoreArrayRead(Y, &y));
+  }
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, same, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)dm)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Adds the penalty Jacobian to J (ADD_VALUES); the caller assembles J. */
 PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J)
 {

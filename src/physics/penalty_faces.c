@@ -261,3 +261,43 @@ PetscErrorCode PenaltyFacesJacobian(DM dm, AppCtx *user, Vec locX, Mat J)
   PetscCall(VecRestoreArrayRead(locX, &x));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* Whether the Gauss points penetrating at locA are those penetrating at locB (this rank's faces): where the Jacobian's
+   kernel is nonzero at one and not at the other, Newton's model at one misses a kink that the other crosses. */
+PetscErrorCode PenaltyFacesSameActivity(DM dm, AppCtx *user, Vec locA, Vec locB, PetscBool *same)
+{
+  const PenaltyFaces *pf       = &user->prob.penalty_faces;
+  const PetscInt      zero[1]  = {0};
+  const PetscReal     nzero[3] = {0.0, 0.0, 0.0};
+  const PetscScalar  *xa, *xb, *cst;
+  PetscInt            dim, ncst;
+
+  PetscFunctionBeginUser;
+  PetscCall(FaceKernelData(dm, &dim, &ncst, &cst));
+  PetscCall(VecGetArrayRead(locA, &xa));
+  PetscCall(VecGetArrayRead(locB, &xb));
+  *same = PETSC_TRUE;
+  for (PetscInt e = 0; e < pf->n && *same; ++e) {
+    const PetscScalar a[1]  = {pf->inv_factor ? pf->inv_factor[e] : 1.0};
+    const PetscInt    nfaux = pf->inv_factor ? 1 : 0;
+
+    for (PetscInt q = 0; q < pf->nq && *same; ++q) {
+      const PetscReal *xq = &pf->x[(e * pf->nq + q) * dim];
+      PetscScalar      u[3], ga[9] = {0.0}, gb[9] = {0.0};
+      PetscBool        on_a = PETSC_FALSE, on_b = PETSC_FALSE;
+
+      FaceDisplacement(pf, dim, e, q, xa, u);
+      g0_bd_penalty(dim, 1, nfaux, zero, zero, u, NULL, NULL, zero, zero, a, NULL, NULL, 0.0, 0.0, xq, nzero, ncst, cst, ga);
+      FaceDisplacement(pf, dim, e, q, xb, u);
+      g0_bd_penalty(dim, 1, nfaux, zero, zero, u, NULL, NULL, zero, zero, a, NULL, NULL, 0.0, 0.0, xq, nzero, ncst, cst, gb);
+      for (PetscInt c = 0; c < dim * dim; ++c) {
+        on_a = (PetscBool)(on_a || ga[c] != 0.0);
+        on_b = (PetscBool)(on_b || gb[c] != 0.0);
+      }
+      *same = (PetscBool)(on_a == on_b);
+    }
+  }
+  PetscCall(VecRestoreArrayRead(locA, &xa));
+  PetscCall(VecRestoreArrayRead(locB, &xb));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

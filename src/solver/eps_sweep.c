@@ -5,14 +5,47 @@
 #include "physics.h"
 #include "solver.h"
 
+static PetscErrorCode ExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec prev, PetscReal factor)
+{
+  Vec       guess;
+  PetscReal f_last, f_guess;
+  PetscBool same;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecDuplicate(u, &guess));
+  PetscCall(VecWAXPY(guess, -1.0, prev, u));
+  PetscCall(VecAYPX(guess, factor, u));
+  PetscCall(PenaltySameActivity(dm, user, u, guess, &same));
+  if (same) {
+    PetscCall(SolverResidualNorm(snes, user, u, &f_last));
+    PetscCall(SolverResidualNorm(snes, user, guess, &f_guess));
+    if (f_guess < f_last) PetscCall(VecCopy(guess, u));
+  }
+  PetscCall(VecDestroy(&guess));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 {
+  Vec       prev = NULL, last = NULL;
+  PetscReal eps_prev = 0.0;
+
   PetscFunctionBeginUser;
   for (PetscInt k = 1; k < user->opt.contact.n_sweep && user->rec.stats.converged; ++k) {
+    const PetscReal eps_last = user->prob.eps;
+
     user->opt.contact.eps0 = user->opt.contact.eps0_sweep[k];
     PetscCall(ContactComputeEps(user));
     PetscCall(ElasticityUpdateConstants(dm, user));
+    if (!last) PetscCall(VecDuplicate(u, &last));
+    PetscCall(VecCopy(u, last));
+    if (k > 1 && eps_last != eps_prev) PetscCall(ExtrapolatedStart(snes, dm, user, u, prev, (user->prob.eps - eps_last) / (eps_last - eps_prev)));
+    if (!prev) PetscCall(VecDuplicate(u, &prev));
+    PetscCall(VecSwap(prev, last));
+    eps_prev = eps_last;
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
   }
+  PetscCall(VecDestroy(&prev));
+  PetscCall(VecDestroy(&last));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -75,6 +75,21 @@ static PetscErrorCode SolverResidual(DM dm, AppCtx *user, Vec u, Vec F)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* ||F(u)||_2 at the displacement u, in the user's units (outside SolverSolve()). */
+PetscErrorCode SolverResidualNorm(SNES snes, AppCtx *user, Vec u, PetscReal *norm)
+{
+  DM  dm;
+  Vec F;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESGetDM(snes, &dm));
+  PetscCall(VecDuplicate(u, &F));
+  PetscCall(SolverResidual(dm, user, u, F));
+  PetscCall(VecNorm(F, NORM_2, norm));
+  PetscCall(VecDestroy(&F));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode FormFunction(SNES snes, Vec X, Vec F, void *ctx)
 {
   AppCtx *user = (AppCtx *)ctx;
@@ -125,7 +140,7 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
 PetscErrorCode SolverStopReference(const AppCtx *user, PetscReal *ref)
 {
   PetscFunctionBeginUser;
-  *ref = user->prob.warm ? PetscMin(user->prob.fnorm0, user->prob.load_norm) : user->prob.fnorm0;
+  *ref = user->prob.warm ? user->prob.load_norm : user->prob.fnorm0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -138,13 +153,13 @@ static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, P
   PetscFunctionBeginUser;
   PetscCall(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, NULL));
   if (it == 0) user->prob.fnorm0 = f;
-  if (*reason == SNES_CONVERGED_FNORM_RELATIVE && user->prob.warm) {
+  if (user->prob.warm && (*reason == SNES_CONVERGED_FNORM_RELATIVE || *reason == SNES_CONVERGED_ITERATING)) {
     PetscReal atol, rtol, stol, ref;
     PetscInt  maxit, maxf;
 
     PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
     PetscCall(SolverStopReference(user, &ref));
-    if (f > rtol * ref) *reason = SNES_CONVERGED_ITERATING;
+    *reason = f <= rtol * ref ? SNES_CONVERGED_FNORM_RELATIVE : SNES_CONVERGED_ITERATING;
   }
   if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->opt.contact.load_rtol * user->prob.load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
   PetscFunctionReturn(PETSC_SUCCESS);
