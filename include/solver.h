@@ -14,11 +14,11 @@ PetscErrorCode SolverIterateDisplacement(AppCtx *user, Vec X, Vec *u);
    iteration); the last two are warm starts, and the first and last reach a small eps by continuation. */
 typedef enum { SOLVER_START_ZERO, SOLVER_START_NEARBY_EPS, SOLVER_START_COARSER_MESH } SolverStart;
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start);
-/* |F| (user's units) that -snes_rtol is relative to in the current solve: its first, or for a warm start the smaller of
-   its first and the load ||F(0)||, so that a warm start ends as tight as a start from zero */
+/* |F| (user's units) that -snes_rtol is relative to in the current solve: its first, or for a warm start the load
+   ||F(0)||, so that a warm start ends as tight as a start from zero */
+PetscErrorCode SolverResidualNorm(SNES snes, AppCtx *user, Vec u, PetscReal *norm);
 PetscErrorCode SolverStopReference(const AppCtx *user, PetscReal *ref);
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
-PetscErrorCode SolverResidualNorm(SNES snes, AppCtx *user, Vec u, PetscReal *norm);
 PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
 
 /* problem.c, grid_sequence.c, eps_sweep.c */

@@ -134,8 +134,10 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
 
 /* Newton stops, converged, when PETSc's tests say so (|F| fell by -snes_rtol, ...) or when |F| <= -contact_load_rtol
    ||F(0)||: at round-off for the load, which a warm start (eps sweep, grid sequence) may reach before any reduction
-   by -snes_rtol. A warm start whose first residual exceeds the load (an interpolated guess, whose error is of the order
-   of h) must also bring |F| below -snes_rtol ||F(0)||: its final residual is as tight as a start from zero would give.
+   by -snes_rtol. A warm start stops when |F| <= -snes_rtol ||F(0)||, whatever its first residual: its final residual
+   is as tight as a start from zero would give. One whose first residual exceeds the load (an interpolated guess, whose
+   error is of the order of h) is not stopped by a reduction of that residual alone; one far below it (an extrapolated
+   start of the eps sweep) is not held to a reduction that round-off cannot reach.
    Every norm here is relative, so the test is the same in any units. */
 PetscErrorCode SolverStopReference(const AppCtx *user, PetscReal *ref)
 {
