@@ -118,13 +118,12 @@ static PetscErrorCode MirrorsSetUp(AppCtx *user)
 {
   Problem           *pb = &user->prob;
   PcReuse           *r  = &pb->pc_reuse;
-  PetscInt           rstart, n = 0;
+  PetscInt           n = 0;
   const PetscScalar *mark;
 
   PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(pb->K, &r->zmark, NULL));
   PetscCall(VecDuplicate(pb->bulk_x, &r->zcols));
-  PetscCall(MatGetOwnershipRange(pb->K, &rstart, NULL));
   for (PetscInt row = 0; row < pb->nbulk_rows; ++row) PetscCall(VecSetValue(r->zmark, pb->bulk_rows[row], 1.0, INSERT_VALUES));
   PetscCall(VecAssemblyBegin(r->zmark));
   PetscCall(VecAssemblyEnd(r->zmark));
