@@ -39,7 +39,12 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user);
 PetscErrorCode MultigridDestroy(Multigrid *mg);
 
 /* ew_forcing.c */
-PetscErrorCode SolverForcingSetUp(SNES snes, AppCtx *user);
+PetscErrorCode SolverForcingSetUp(SNES snes, AppCtx *user, PetscBool *petsc_presolve);
+PetscErrorCode SolverForcingPreSolve(KSP ksp, AppCtx *user);
+
+/* fine_smoother.c: -mg_fine_ksp_*, -mg_fine_pc_* */
+PetscErrorCode FineSmootherGiven(KSP ksp, PetscBool *given);
+PetscErrorCode FineSmootherSetUp(KSP ksp);
 
 /* pc_reuse.c */
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X);

@@ -19,6 +19,7 @@ from signorini.paths import BIN, ROOT  # noqa: E402
 
 BASE = ["-options_file", "options/square.yaml", "-options_file", "options/solvers/gamg.yaml", "-contact_monitor", "0"]
 BASE_MG = ["-options_file", "options/square.yaml", "-options_file", "options/solvers/mg.yaml", "-contact_monitor", "0"]
+BASE_SSOR = BASE + ["-options_file", "options/solvers/ssor_fine.yaml"]  # GAMG with one SSOR sweep on the finest level (2D)
 
 
 def solver(args, name, out, ranks=1, may_fail=False, base=BASE):
@@ -91,6 +92,12 @@ def measure_iterations(out, s, pairs):
         _, _, a = solver(["-dm_plex_dim", dim, "-dm_plex_box_faces", ",".join([str(f)] * dim), "-contact_method", "none", "-ksp_rtol", "1e-8"],
                          f"gamg_its_{dim}d_{f}", out, ranks)
         its.append((f"{dim}D {int(a['n_dofs'])}", int(a["ksp_its"])))
+    # GAMG with SSOR on the finest level, 2D (a figure)
+    ssor_its = []
+    for faces, ranks in [(72, 1), (256, 1), (1024, 2)]:
+        f = max(faces // s, 4)
+        _, _, a = solver(["-dm_plex_box_faces", f"{f},{f}", "-contact_method", "none", "-ksp_rtol", "1e-8"], f"ssor_its_2d_{f}", out, ranks, base=BASE_SSOR)
+        ssor_its.append((f"2D {int(a['n_dofs'])}", int(a["ksp_its"])))
     # the geometric multigrid on the same sizes: the 2D boxes nest by default, 3D over the grid sequence (2^3 to 9^3 cells refined)
     mg_its = []
     for dim, faces, ranks in [(2, 72, 1), (2, 256, 1), (2, 1024, 2), (3, 16, 1), (3, 32, 2), (3, 72, 2)]:
@@ -103,6 +110,8 @@ def measure_iterations(out, s, pairs):
         mg_its.append((f"{dim}D {int(a['n_dofs'])}", f"{int(a['ksp_its'])} in {int(a['newton_its'])} Newton steps"))
     return [row("elastic GAMG <= 20 CG iterations to rtol 1e-8, 10k to 2M unknowns in 2D, to 1M in 3D", "; ".join(f"{k}: {v}" for k, v in its),
                 max(v for _, v in its) <= 20, "bin/signorini ... -contact_method none -ksp_rtol 1e-8 -dm_plex_dim D -dm_plex_box_faces N,..."),
+            row("GAMG + ssor_fine.yaml (2D): CG iterations of the elastic solve to rtol 1e-8 (a figure)", "; ".join(f"{k}: {v}" for k, v in ssor_its), None,
+                "bin/signorini ... gamg.yaml ssor_fine.yaml -contact_method none -ksp_rtol 1e-8 -dm_plex_box_faces N,N"),
             row("geometric MG (mg.yaml): CG iterations of the elastic solve to rtol 1e-8, from the coarser meshes' solution (a figure: the target is GAMG's)",
                 "; ".join(f"{k}: {v}" for k, v in mg_its),
                 None, "bin/signorini ... mg.yaml -contact_method none -ksp_rtol 1e-8 (2D: the box, 2 ranks 32^2 refined 5 times; 3D: N/8 cells refined 3 times)")]
@@ -132,6 +141,21 @@ def measure_eps(out, s, pairs):
     rows.append(row(f"GAMG Krylov iterations per Newton step within 2x over eps = 1e4 h to 1e-8 h ({n2} x {n2})",
                     ", ".join(f"{e} h: {v}" for e, v in per) + f" (spread {spread:.1f} over the converged)", spread <= 2.0 and not failed,
                     f"... -dm_plex_box_faces {n2},{n2} -penalty_eps0 E"))
+    # GAMG with SSOR on the finest level (options/solvers/ssor_fine.yaml, the 2D configuration)
+    r = side_by_side({"ssor_one": (box2, 1, BASE_SSOR), "ssor_sweep": (box2 + ["-penalty_eps0_sweep", "1,0.1,0.01,1e-3,1e-4,1e-5,1e-6,1e-7"], 1, BASE_SSOR)},
+                     pairs, out)
+    ssor_ratio = r["ssor_sweep"][0] / r["ssor_one"][0]
+    per = []
+    for eps0 in ["1e4", "1e2", "1", "1e-2", "1e-4", "1e-6", "1e-8"]:
+        _, _, a = solver(box2 + ["-penalty_eps0", eps0], f"ssor_eps_{eps0}", out, base=BASE_SSOR)
+        per.append((eps0, int(a["ksp_its"]) / max(int(a["newton_its"]), 1)))
+    ssor_spread = max(v for _, v in per) / min(v for _, v in per)
+    rows.append(row(f"GAMG + ssor_fine.yaml (2D): 8-value eps sweep <= 2 penalty solves, Krylov iterations per Newton step within 2x ({n2} x {n2})",
+                    f"sweep {ssor_ratio:.2f} ({r['ssor_sweep'][0]:.2f} s / {r['ssor_one'][0]:.2f} s, medians of {pairs} pairs; "
+                    f"{pair_range(r['ssor_sweep'], r['ssor_one'])}; {int(r['ssor_sweep'][2]['ksp_its_total'])} CG iterations in "
+                    f"{int(r['ssor_sweep'][2]['newton_its_total'])} Newton steps); per step " + ", ".join(f"{e} h: {v:.1f}" for e, v in per)
+                    + f" (spread {ssor_spread:.2f})", ssor_ratio <= 2.0 and ssor_spread <= 2.0,
+                    f"... gamg.yaml ssor_fine.yaml -dm_plex_box_faces {n2},{n2} [-penalty_eps0_sweep 1,...,1e-7 | -penalty_eps0 E]"))
     # the same with the geometric multigrid (a figure: the targets are GAMG's)
     box2 = ["-dm_plex_box_faces", f"{max(n2, 32)},{max(n2, 32)}"]
     r = side_by_side({"mg_one": (box2, 1, BASE_MG), "mg_sweep": (box2 + ["-penalty_eps0_sweep", "1,0.1,0.01,1e-3,1e-4,1e-5,1e-6,1e-7"], 1, BASE_MG)}, 3, out)

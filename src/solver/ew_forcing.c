@@ -4,13 +4,13 @@
    (-snes_rtol times |F| at the start, or times the load for a warm start). Near the solution version 2's terms fall
    superlinearly, and the last linear solve went several orders of magnitude below what Newton needed (512 x 512:
    13 CG iterations to 7e-6 where 1e-4 sufficed). The guard only loosens a term, never beyond -snes_ksp_ew_rtolmax.
-   This pre-solve replaces PETSc's (KSPPreSolve_SNESEW(), installed with the SNES's KSP); without the guard its terms
-   are PETSc's exactly. Other versions (-snes_ksp_ew_version) keep PETSc's. */
+   This pre-solve (part of SolverPreSolve() in solver.c) replaces PETSc's (KSPPreSolve_SNESEW(), installed with the
+   SNES's KSP); without the guard its terms are PETSc's exactly. Other versions (-snes_ksp_ew_version) keep PETSc's. */
 #include "solver.h"
 
-static PetscErrorCode ForcingPreSolve(KSP ksp, Vec b, Vec x, void *ctx)
+/* Before a linear solve (SolverPreSolve()): its tolerance, if the forcing is on. */
+PetscErrorCode SolverForcingPreSolve(KSP ksp, AppCtx *user)
 {
-  AppCtx        *user = (AppCtx *)ctx;
   SolverForcing *fc   = &user->prob.forcing;
   SNES           snes = fc->snes;
   PetscInt       it;
@@ -19,6 +19,7 @@ static PetscErrorCode ForcingPreSolve(KSP ksp, Vec b, Vec x, void *ctx)
   PetscBool      ew;
 
   PetscFunctionBeginUser;
+  if (!snes) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESKSPGetUseEW(snes, &ew));
   if (!ew) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESKSPGetParametersEW(snes, NULL, &rtol_0, &rtol_max, &gamma, &alpha, NULL, &threshold));
@@ -48,21 +49,22 @@ static PetscErrorCode ForcingPreSolve(KSP ksp, Vec b, Vec x, void *ctx)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SolverForcingSetUp(SNES snes, AppCtx *user)
+/* Records the forcing's parameters if Eisenstat-Walker's version 2 is on (SolverForcingPreSolve() then computes the
+   terms); *petsc_presolve: another version is on, whose pre-solve is PETSc's own and must stay. */
+PetscErrorCode SolverForcingSetUp(SNES snes, AppCtx *user, PetscBool *petsc_presolve)
 {
-  KSP       ksp;
   PetscBool ew;
   PetscInt  version;
 
   PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(&user->prob.forcing, sizeof(user->prob.forcing)));
+  *petsc_presolve = PETSC_FALSE;
   PetscCall(SNESKSPGetUseEW(snes, &ew));
   if (!ew) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESKSPGetParametersEW(snes, &version, NULL, NULL, NULL, NULL, NULL, NULL));
-  if (version != 2) PetscFunctionReturn(PETSC_SUCCESS); /* PETSc's own */
-  PetscCall(PetscMemzero(&user->prob.forcing, sizeof(user->prob.forcing)));
+  *petsc_presolve = (PetscBool)(version != 2);
+  if (version != 2) PetscFunctionReturn(PETSC_SUCCESS);
   user->prob.forcing.snes  = snes;
   user->prob.forcing.guard = user->opt.contact.ew_guard;
-  PetscCall(SNESGetKSP(snes, &ksp));
-  PetscCall(KSPSetPreSolve(ksp, ForcingPreSolve, user));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -256,14 +256,27 @@ static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Before each linear solve: the finest multigrid smoother's -mg_fine_ options (fine_smoother.c), then the linear
+   tolerance of the inexact Newton (ew_forcing.c). */
+static PetscErrorCode SolverPreSolve(KSP ksp, Vec b, Vec x, void *ctx)
+{
+  AppCtx *user = (AppCtx *)ctx;
+
+  PetscFunctionBeginUser;
+  PetscCall(FineSmootherSetUp(ksp));
+  PetscCall(SolverForcingPreSolve(ksp, user));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
 {
   MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
   Mat       J;
   KSP       ksp;
   PC        pc;
-  PetscBool is_vi;
+  PetscBool is_vi, is_multigrid;
   SNESType  type;
+  PCType    pc_type;
 
   PetscFunctionBeginUser;
   PetscCall(SNESCreate(comm, snes));
@@ -330,12 +343,11 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscCall(SNESSetFromOptions(*snes));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)*snes, &is_vi, SNESVINEWTONRSLS, SNESVINEWTONSSLS, ""));
   PetscCall(SNESGetType(*snes, &type));
+  PetscCall(PCGetType(pc, &pc_type));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &is_multigrid, PCGAMG, PCMG, ""));
   {
-    PetscBool is_multigrid, is_rsls;
-    PCType    pc_type;
+    PetscBool is_rsls;
 
-    PetscCall(PCGetType(pc, &pc_type));
-    PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &is_multigrid, PCGAMG, PCMG, ""));
     PetscCall(PetscObjectTypeCompare((PetscObject)*snes, SNESVINEWTONRSLS, &is_rsls));
     PetscCheck(!(is_multigrid && is_rsls), comm, PETSC_ERR_USER_INPUT,
                "-pc_type %s cannot follow the reduced system of -snes_type vinewtonrsls (its size changes between steps): use hypre or mumps with "
@@ -349,7 +361,17 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     user->prob.pc_reuse.enabled = (PetscBool)(user->opt.contact.method == CONTACT_PENALTY && user->opt.contact.pc_reuse && !is_preonly);
   }
   PetscCall(SolverSetIterativeDefaults(*snes, user));
-  PetscCall(SolverForcingSetUp(*snes, user)); /* Eisenstat-Walker's terms with the oversolving guard */
+  {
+    PetscBool petsc_presolve, fine;
+
+    PetscCall(SolverForcingSetUp(*snes, user, &petsc_presolve)); /* Eisenstat-Walker's terms with the oversolving guard */
+    if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, user));
+    PetscCall(FineSmootherGiven(ksp, &fine));
+    PetscCheck(!fine || is_multigrid, comm, PETSC_ERR_USER_INPUT, "-mg_fine_ksp_type and -mg_fine_pc_type need a multigrid preconditioner (-pc_type gamg or mg), not %s",
+               pc_type);
+    PetscCheck(!(petsc_presolve && fine), comm, PETSC_ERR_USER_INPUT,
+               "-mg_fine_ksp_type and -mg_fine_pc_type need -snes_ksp_ew_version 2 (or no Eisenstat-Walker): another version keeps PETSc's own pre-solve");
+  }
   PetscCheck(is_vi == (user->opt.contact.method == CONTACT_VI), comm, PETSC_ERR_USER_INPUT,
              "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type,
              ContactMethods[user->opt.contact.method]);
