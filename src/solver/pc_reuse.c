@@ -149,7 +149,7 @@ static PetscErrorCode MirrorsSetUp(AppCtx *user)
 
 /* J' at dlocal's entries, from J's values in the contact rows (jvals): J itself without the truncation; with it, zero
    in the rows and columns of Z, the contact dofs whose penalty diagonal exceeds -contact_pc_update_truncate times K's
-   diagonal. Such a row is nearly diagonal, so the finest level's Jacobi smoother solves it alone, while in the coarse
+   diagonal. Such a row is nearly diagonal, so the finest level's smoother (Jacobi, SOR) solves it alone, while in the coarse
    operators its 1/eps would pin every coarse function touching it (GAMG's aggregates mix the contact dofs with the
    bulk); a rebuild at that eps would leave the same dofs out of its aggregates. Also sets zrows. */
 static PetscErrorCode EffectiveValues(AppCtx *user, const PetscScalar jvals[], PetscScalar eff[])
