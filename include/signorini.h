@@ -326,6 +326,7 @@ typedef struct {
   PetscInt     nbulk_rows;                       /* owned rows of the contact dofs */
   PetscInt    *bulk_rows, *bulk_ptr, *bulk_cols; /* their global numbers, and their columns in CSR form */
   PetscScalar *bulk_vals;                        /* and K's values there */
+  PetscInt    *bulk_diag;                        /* each row's diagonal entry (bulk_ptr numbering) */
   PetscInt    *bulk_lcols;                       /* each column's place in bulk_x */
   VecScatter   bulk_scatter;                     /* the displacement at those columns (any rank's) into bulk_x */
   Vec          bulk_x;

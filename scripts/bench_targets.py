@@ -117,57 +117,66 @@ def measure_iterations(out, s, pairs):
                 None, "bin/signorini ... mg.yaml -contact_method none -ksp_rtol 1e-8 (2D: the box, 2 ranks 32^2 refined 5 times; 3D: N/8 cells refined 3 times)")]
 
 
+SWEEP = "1,0.1,0.01,1e-3,1e-4,1e-5,1e-6,1e-7"  # the 8 values of eps0 of the sweep
+SPREAD = ["1e4", "1e2", "1", "1e-2", "1e-4", "1e-6", "1e-8"]  # the eps0 of the Krylov spread
+
+
+def sweep_against_one(box, tag, pairs, out, base=BASE):
+    """The sweep and one penalty solve side by side (runs <tag>one and <tag>sweep): (ratio of medians, sweep, one)."""
+    r = side_by_side({f"{tag}one": (box, 1, base), f"{tag}sweep": (box + ["-penalty_eps0_sweep", SWEEP], 1, base)}, pairs, out)
+    return r[f"{tag}sweep"][0] / r[f"{tag}one"][0], r[f"{tag}sweep"], r[f"{tag}one"]
+
+
+def iterations_per_step(box, tag, out, base=BASE, may_fail=False):
+    """Krylov iterations per Newton step for each eps0 of SPREAD (runs <tag>eps_<eps0>): [(eps0, value, None)], or
+    [(eps0, None, reason)] for a failed solve (with may_fail)."""
+    per = []
+    for eps0 in SPREAD:
+        _, _, a = solver(box + ["-penalty_eps0", eps0], f"{tag}eps_{eps0}", out, base=base, may_fail=may_fail)
+        if int(a["converged"]) == 1:
+            per.append((eps0, int(a["ksp_its"]) / max(int(a["newton_its"]), 1), None))
+        else:
+            per.append((eps0, None, a["snes_reason"].decode() if isinstance(a["snes_reason"], bytes) else a["snes_reason"]))
+    return per
+
+
+def spread_of(per):
+    values = [v for _, v, _ in per if v is not None]
+    return max(values) / min(values)
+
+
 def measure_eps(out, s, pairs):
     """The 8-value sweep against one penalty solve, and the Krylov iterations per Newton step over eps."""
     n2 = 256 // s
     box2 = ["-dm_plex_box_faces", f"{n2},{n2}"]
-    r = side_by_side({"one": (box2, 1), "sweep": (box2 + ["-penalty_eps0_sweep", "1,0.1,0.01,1e-3,1e-4,1e-5,1e-6,1e-7"], 1)}, pairs, out)
-    ratio = r["sweep"][0] / r["one"][0]
+    ratio, sweep, one = sweep_against_one(box2, "", pairs, out)
     rows = [row(f"8-value eps sweep (h to 1e-7 h) <= 2 penalty solves ({n2} x {n2})",
-                f"{ratio:.2f} ({r['sweep'][0]:.2f} s / {r['one'][0]:.2f} s, medians of {pairs} pairs; {pair_range(r['sweep'], r['one'])}; "
-                f"{int(r['sweep'][2]['ksp_its_total'])} CG iterations in {int(r['sweep'][2]['newton_its_total'])} Newton steps)", ratio <= 2.0,
+                f"{ratio:.2f} ({sweep[0]:.2f} s / {one[0]:.2f} s, medians of {pairs} pairs; {pair_range(sweep, one)}; "
+                f"{int(sweep[2]['ksp_its_total'])} CG iterations in {int(sweep[2]['newton_its_total'])} Newton steps)", ratio <= 2.0,
                 f"... -dm_plex_box_faces {n2},{n2} [-penalty_eps0_sweep 1,0.1,...,1e-7]")]
-    per, failed = [], []
-    for eps0 in ["1e4", "1e2", "1", "1e-2", "1e-4", "1e-6", "1e-8"]:
-        _, _, a = solver(box2 + ["-penalty_eps0", eps0], f"eps_{eps0}", out, may_fail=True)
-        if int(a["converged"]) == 1:
-            per.append((eps0, f"{int(a['ksp_its']) / max(int(a['newton_its']), 1):.1f}"))
-        else:
-            failed.append(eps0)
-            reason = a["snes_reason"].decode() if isinstance(a["snes_reason"], bytes) else a["snes_reason"]
-            per.append((eps0, f"failed ({reason})"))
-    values = [float(v) for _, v in per if not v.startswith("failed")]
-    spread = max(values) / min(values)
+    per = iterations_per_step(box2, "", out, may_fail=True)
+    failed = [e for e, v, _ in per if v is None]
+    spread = spread_of(per)
     rows.append(row(f"GAMG Krylov iterations per Newton step within 2x over eps = 1e4 h to 1e-8 h ({n2} x {n2})",
-                    ", ".join(f"{e} h: {v}" for e, v in per) + f" (spread {spread:.1f} over the converged)", spread <= 2.0 and not failed,
+                    ", ".join(f"{e} h: {v:.1f}" if v is not None else f"{e} h: failed ({why})" for e, v, why in per)
+                    + f" (spread {spread:.1f} over the converged)", spread <= 2.0 and not failed,
                     f"... -dm_plex_box_faces {n2},{n2} -penalty_eps0 E"))
     # GAMG with SSOR on the finest level (options/solvers/ssor_fine.yaml, the 2D configuration)
-    r = side_by_side({"ssor_one": (box2, 1, BASE_SSOR), "ssor_sweep": (box2 + ["-penalty_eps0_sweep", "1,0.1,0.01,1e-3,1e-4,1e-5,1e-6,1e-7"], 1, BASE_SSOR)},
-                     pairs, out)
-    ssor_ratio = r["ssor_sweep"][0] / r["ssor_one"][0]
-    per = []
-    for eps0 in ["1e4", "1e2", "1", "1e-2", "1e-4", "1e-6", "1e-8"]:
-        _, _, a = solver(box2 + ["-penalty_eps0", eps0], f"ssor_eps_{eps0}", out, base=BASE_SSOR)
-        per.append((eps0, int(a["ksp_its"]) / max(int(a["newton_its"]), 1)))
-    ssor_spread = max(v for _, v in per) / min(v for _, v in per)
+    ssor_ratio, sweep, one = sweep_against_one(box2, "ssor_", pairs, out, base=BASE_SSOR)
+    per = iterations_per_step(box2, "ssor_", out, base=BASE_SSOR)
+    ssor_spread = spread_of(per)
     rows.append(row(f"GAMG + ssor_fine.yaml (2D): 8-value eps sweep <= 2 penalty solves, Krylov iterations per Newton step within 2x ({n2} x {n2})",
-                    f"sweep {ssor_ratio:.2f} ({r['ssor_sweep'][0]:.2f} s / {r['ssor_one'][0]:.2f} s, medians of {pairs} pairs; "
-                    f"{pair_range(r['ssor_sweep'], r['ssor_one'])}; {int(r['ssor_sweep'][2]['ksp_its_total'])} CG iterations in "
-                    f"{int(r['ssor_sweep'][2]['newton_its_total'])} Newton steps); per step " + ", ".join(f"{e} h: {v:.1f}" for e, v in per)
-                    + f" (spread {ssor_spread:.2f})", ssor_ratio <= 2.0 and ssor_spread <= 2.0,
+                    f"sweep {ssor_ratio:.2f} ({sweep[0]:.2f} s / {one[0]:.2f} s, medians of {pairs} pairs; {pair_range(sweep, one)}; "
+                    f"{int(sweep[2]['ksp_its_total'])} CG iterations in {int(sweep[2]['newton_its_total'])} Newton steps); per step "
+                    + ", ".join(f"{e} h: {v:.1f}" for e, v, _ in per) + f" (spread {ssor_spread:.2f})", ssor_ratio <= 2.0 and ssor_spread <= 2.0,
                     f"... gamg.yaml ssor_fine.yaml -dm_plex_box_faces {n2},{n2} [-penalty_eps0_sweep 1,...,1e-7 | -penalty_eps0 E]"))
     # the same with the geometric multigrid (a figure: the targets are GAMG's)
     box2 = ["-dm_plex_box_faces", f"{max(n2, 32)},{max(n2, 32)}"]
-    r = side_by_side({"mg_one": (box2, 1, BASE_MG), "mg_sweep": (box2 + ["-penalty_eps0_sweep", "1,0.1,0.01,1e-3,1e-4,1e-5,1e-6,1e-7"], 1, BASE_MG)}, 3, out)
-    mg_ratio = r["mg_sweep"][0] / r["mg_one"][0]
-    per = []
-    for eps0 in ["1e4", "1e2", "1", "1e-2", "1e-4", "1e-6", "1e-8"]:
-        _, _, a = solver(box2 + ["-penalty_eps0", eps0], f"mg_eps_{eps0}", out, base=BASE_MG)
-        per.append((eps0, int(a["ksp_its"]) / max(int(a["newton_its"]), 1)))
-    mg_spread = max(v for _, v in per) / min(v for _, v in per)
+    mg_ratio, sweep, one = sweep_against_one(box2, "mg_", 3, out, base=BASE_MG)
+    per = iterations_per_step(box2, "mg_", out, base=BASE_MG)
     rows.append(row("geometric MG (mg.yaml): the eps sweep over one solve, and Krylov iterations per Newton step over eps = 1e4 h to 1e-8 h (figures)",
-                    f"sweep {mg_ratio:.2f} ({r['mg_sweep'][0]:.2f} s / {r['mg_one'][0]:.2f} s, medians of 3 pairs); per step "
-                    + ", ".join(f"{e} h: {v:.1f}" for e, v in per) + f" (spread {mg_spread:.2f})", None,
+                    f"sweep {mg_ratio:.2f} ({sweep[0]:.2f} s / {one[0]:.2f} s, medians of 3 pairs); per step "
+                    + ", ".join(f"{e} h: {v:.1f}" for e, v, _ in per) + f" (spread {spread_of(per):.2f})", None,
                     f"... mg.yaml -dm_plex_box_faces {n2},{n2} [-penalty_eps0_sweep 1,...,1e-7 | -penalty_eps0 E]"))
     return rows
 

@@ -336,6 +336,7 @@ PetscErrorCode PenaltySaveBulkRows(DM dm, AppCtx *user)
     PetscCall(MatRestoreRow(pb->K, pb->bulk_rows[r], &ncols, NULL, NULL));
   }
   PetscCall(PetscMalloc2(nnz, &pb->bulk_cols, nnz, &pb->bulk_vals));
+  PetscCall(PetscMalloc1(n, &pb->bulk_diag));
   for (PetscInt r = 0; r < n; ++r) {
     const PetscInt    *cols;
     const PetscScalar *vals;
@@ -345,6 +346,9 @@ PetscErrorCode PenaltySaveBulkRows(DM dm, AppCtx *user)
     PetscCall(PetscArraycpy(&pb->bulk_cols[pb->bulk_ptr[r]], cols, ncols));
     PetscCall(PetscArraycpy(&pb->bulk_vals[pb->bulk_ptr[r]], vals, ncols));
     PetscCall(MatRestoreRow(pb->K, pb->bulk_rows[r], &ncols, &cols, &vals));
+    for (pb->bulk_diag[r] = pb->bulk_ptr[r]; pb->bulk_diag[r] < pb->bulk_ptr[r + 1] && pb->bulk_cols[pb->bulk_diag[r]] != pb->bulk_rows[r]; ++pb->bulk_diag[r]) { }
+    PetscCheck(pb->bulk_diag[r] < pb->bulk_ptr[r + 1], PETSC_COMM_SELF, PETSC_ERR_PLIB, "K's pattern has no diagonal in contact row %" PetscInt_FMT,
+               pb->bulk_rows[r]);
   }
   /* the columns, once each, and a scatter of the displacement there (on any rank) */
   {
@@ -377,6 +381,7 @@ PetscErrorCode PenaltyFreeBulkRows(AppCtx *user)
   PetscCall(PetscFree2(pb->bulk_rows, pb->bulk_ptr));
   PetscCall(PetscFree2(pb->bulk_cols, pb->bulk_vals));
   PetscCall(PetscFree(pb->bulk_lcols));
+  PetscCall(PetscFree(pb->bulk_diag));
   PetscCall(VecScatterDestroy(&pb->bulk_scatter));
   PetscCall(VecDestroy(&pb->bulk_x));
   pb->nbulk_rows    = 0;

@@ -218,13 +218,29 @@ PetscErrorCode PenaltyFacesEnergy(DM dm, AppCtx *user, Vec locX, PetscReal *ener
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The Jacobian's kernel g0 at point q of face e for the local solution x, and whether it is nonzero there (the point
+   penetrates: the penalty is active). */
+static inline PetscBool FacePointKernel(const PenaltyFaces *pf, PetscInt dim, PetscInt e, PetscInt q, const PetscScalar x[], PetscInt ncst,
+                                        const PetscScalar cst[], PetscScalar g0[])
+{
+  const PetscInt    zero[1]  = {0}, nfaux = pf->inv_factor ? 1 : 0;
+  const PetscReal   nzero[3] = {0.0, 0.0, 0.0};
+  const PetscScalar a[1]     = {pf->inv_factor ? pf->inv_factor[e] : 1.0};
+  PetscScalar       u[3];
+  PetscBool         active = PETSC_FALSE;
+
+  for (PetscInt c = 0; c < dim * dim; ++c) g0[c] = 0.0;
+  FaceDisplacement(pf, dim, e, q, x, u);
+  g0_bd_penalty(dim, 1, nfaux, zero, zero, u, NULL, NULL, zero, zero, a, NULL, NULL, 0.0, 0.0, &pf->x[(e * pf->nq + q) * dim], nzero, ncst, cst, g0);
+  for (PetscInt c = 0; c < dim * dim; ++c) active = (PetscBool)(active || g0[c] != 0.0);
+  return active;
+}
+
 /* J += the penalty Jacobian at locX (ADD_VALUES into the global rows, any rank's; the caller assembles J). A face
    without a penetrating point adds nothing and is skipped. */
 PetscErrorCode PenaltyFacesJacobian(DM dm, AppCtx *user, Vec locX, Mat J)
 {
-  const PenaltyFaces *pf       = &user->prob.penalty_faces;
-  const PetscInt      zero[1]  = {0};
-  const PetscReal     nzero[3] = {0.0, 0.0, 0.0};
+  const PenaltyFaces *pf = &user->prob.penalty_faces;
   const PetscScalar  *x, *cst;
   PetscInt            dim, ncst;
 
@@ -232,21 +248,15 @@ PetscErrorCode PenaltyFacesJacobian(DM dm, AppCtx *user, Vec locX, Mat J)
   PetscCall(FaceKernelData(dm, &dim, &ncst, &cst));
   PetscCall(VecGetArrayRead(locX, &x));
   for (PetscInt e = 0; e < pf->n; ++e) {
-    const PetscScalar a[1]  = {pf->inv_factor ? pf->inv_factor[e] : 1.0};
-    const PetscInt    nfaux = pf->inv_factor ? 1 : 0, nd = pf->nv * dim;
-    PetscScalar       em[81] = {0.0};
-    PetscBool         any    = PETSC_FALSE;
+    const PetscInt nd     = pf->nv * dim;
+    PetscScalar    em[81] = {0.0};
+    PetscBool      any    = PETSC_FALSE;
 
     for (PetscInt q = 0; q < pf->nq; ++q) {
-      const PetscReal  w  = pf->w[e * pf->nq + q];
-      const PetscReal *xq = &pf->x[(e * pf->nq + q) * dim];
-      PetscScalar      u[3], g0[9] = {0.0};
-      PetscBool        active = PETSC_FALSE;
+      const PetscReal w = pf->w[e * pf->nq + q];
+      PetscScalar     g0[9];
 
-      FaceDisplacement(pf, dim, e, q, x, u);
-      g0_bd_penalty(dim, 1, nfaux, zero, zero, u, NULL, NULL, zero, zero, a, NULL, NULL, 0.0, 0.0, xq, nzero, ncst, cst, g0);
-      for (PetscInt c = 0; c < dim * dim; ++c) active = (PetscBool)(active || g0[c] != 0.0);
-      if (!active) continue;
+      if (!FacePointKernel(pf, dim, e, q, x, ncst, cst, g0)) continue;
       any = PETSC_TRUE;
       for (PetscInt k = 0; k < pf->nv; ++k)
         for (PetscInt l = 0; l < pf->nv; ++l) {
@@ -266,9 +276,7 @@ PetscErrorCode PenaltyFacesJacobian(DM dm, AppCtx *user, Vec locX, Mat J)
    kernel is nonzero at one and not at the other, Newton's model at one misses a kink that the other crosses. */
 PetscErrorCode PenaltyFacesSameActivity(DM dm, AppCtx *user, Vec locA, Vec locB, PetscBool *same)
 {
-  const PenaltyFaces *pf       = &user->prob.penalty_faces;
-  const PetscInt      zero[1]  = {0};
-  const PetscReal     nzero[3] = {0.0, 0.0, 0.0};
+  const PenaltyFaces *pf = &user->prob.penalty_faces;
   const PetscScalar  *xa, *xb, *cst;
   PetscInt            dim, ncst;
 
@@ -277,26 +285,12 @@ PetscErrorCode PenaltyFacesSameActivity(DM dm, AppCtx *user, Vec locA, Vec locB,
   PetscCall(VecGetArrayRead(locA, &xa));
   PetscCall(VecGetArrayRead(locB, &xb));
   *same = PETSC_TRUE;
-  for (PetscInt e = 0; e < pf->n && *same; ++e) {
-    const PetscScalar a[1]  = {pf->inv_factor ? pf->inv_factor[e] : 1.0};
-    const PetscInt    nfaux = pf->inv_factor ? 1 : 0;
-
+  for (PetscInt e = 0; e < pf->n && *same; ++e)
     for (PetscInt q = 0; q < pf->nq && *same; ++q) {
-      const PetscReal *xq = &pf->x[(e * pf->nq + q) * dim];
-      PetscScalar      u[3], ga[9] = {0.0}, gb[9] = {0.0};
-      PetscBool        on_a = PETSC_FALSE, on_b = PETSC_FALSE;
+      PetscScalar g0[9];
 
-      FaceDisplacement(pf, dim, e, q, xa, u);
-      g0_bd_penalty(dim, 1, nfaux, zero, zero, u, NULL, NULL, zero, zero, a, NULL, NULL, 0.0, 0.0, xq, nzero, ncst, cst, ga);
-      FaceDisplacement(pf, dim, e, q, xb, u);
-      g0_bd_penalty(dim, 1, nfaux, zero, zero, u, NULL, NULL, zero, zero, a, NULL, NULL, 0.0, 0.0, xq, nzero, ncst, cst, gb);
-      for (PetscInt c = 0; c < dim * dim; ++c) {
-        on_a = (PetscBool)(on_a || ga[c] != 0.0);
-        on_b = (PetscBool)(on_b || gb[c] != 0.0);
-      }
-      *same = (PetscBool)(on_a == on_b);
+      *same = (PetscBool)(FacePointKernel(pf, dim, e, q, xa, ncst, cst, g0) == FacePointKernel(pf, dim, e, q, xb, ncst, cst, g0));
     }
-  }
   PetscCall(VecRestoreArrayRead(locA, &xa));
   PetscCall(VecRestoreArrayRead(locB, &xb));
   PetscFunctionReturn(PETSC_SUCCESS);

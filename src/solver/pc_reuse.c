@@ -92,15 +92,6 @@ static PetscErrorCode DestroyProducts(PcReuse *r)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The place of each contact row's diagonal among its entries (bulk_ptr numbering). */
-static PetscErrorCode DiagonalEntry(const Problem *pb, PetscInt row, PetscInt *k)
-{
-  PetscFunctionBeginUser;
-  for (*k = pb->bulk_ptr[row]; *k < pb->bulk_ptr[row + 1] && pb->bulk_cols[*k] != pb->bulk_rows[row]; ++*k) { }
-  PetscCheck(*k < pb->bulk_ptr[row + 1], PETSC_COMM_SELF, PETSC_ERR_PLIB, "a contact row without its diagonal");
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* The marks of the contact rows (1, or 2 in Z) at their columns, from any rank. */
 static PetscErrorCode ScatterMarks(Problem *pb)
 {
@@ -133,9 +124,8 @@ static PetscErrorCode MirrorsSetUp(AppCtx *user)
   PetscCall(PetscMalloc2(n, &r->mirror_k, n, &r->mirror_at));
   r->nmirror = 0;
   for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
-    PetscInt kd;
+    const PetscInt kd = pb->bulk_diag[row];
 
-    PetscCall(DiagonalEntry(pb, row, &kd));
     for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k)
       if (PetscRealPart(mark[pb->bulk_lcols[k]]) == 0.0) {
         r->mirror_k[r->nmirror]  = k;
@@ -167,11 +157,8 @@ static PetscErrorCode EffectiveValues(AppCtx *user, const PetscScalar jvals[], P
   }
   r->nz = 0;
   for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
-    PetscInt  kd;
-    PetscBool in_z;
-
-    PetscCall(DiagonalEntry(pb, row, &kd));
-    in_z = (PetscBool)(PetscRealPart(jvals[kd] - pb->bulk_vals[kd]) > ratio * PetscRealPart(pb->bulk_vals[kd]));
+    const PetscInt  kd   = pb->bulk_diag[row];
+    const PetscBool in_z = (PetscBool)(PetscRealPart(jvals[kd] - pb->bulk_vals[kd]) > ratio * PetscRealPart(pb->bulk_vals[kd]));
     if (in_z) r->zrows[r->nz++] = pb->bulk_rows[row];
     PetscCall(VecSetValue(r->zmark, pb->bulk_rows[row], in_z ? 2.0 : 1.0, INSERT_VALUES));
   }
@@ -180,9 +167,8 @@ static PetscErrorCode EffectiveValues(AppCtx *user, const PetscScalar jvals[], P
   PetscCall(ScatterMarks(pb));
   PetscCall(VecGetArrayRead(r->zcols, &mark));
   for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
-    PetscInt kd;
+    const PetscInt kd = pb->bulk_diag[row];
 
-    PetscCall(DiagonalEntry(pb, row, &kd));
     for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k)
       eff[k] = PetscRealPart(mark[pb->bulk_lcols[kd]]) == 2.0 || PetscRealPart(mark[pb->bulk_lcols[k]]) == 2.0 ? 0.0 : jvals[k];
   }
@@ -285,10 +271,8 @@ static PetscErrorCode FinestProductSetUp(PC pc, AppCtx *user)
   /* D_S in COO form: the contact rows' places in S, their columns' places (bulk_lcols); then the mirrors */
   PetscCall(PetscMalloc2(nnz + r->nmirror, &coo_i, nnz + r->nmirror, &coo_j));
   for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
-    PetscInt at;
+    const PetscInt at = pb->bulk_lcols[pb->bulk_diag[row]]; /* the row's own place in S */
 
-    PetscCall(PetscFindInt(pb->bulk_rows[row], nS, S, &at));
-    PetscCheck(at >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "a contact row without its diagonal");
     for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k) {
       coo_i[k] = at;
       coo_j[k] = pb->bulk_lcols[k];

@@ -105,18 +105,15 @@ static PetscErrorCode PenaltyBound(AppCtx *user, const PetscScalar jvals[], Pets
   PetscCall(MatGetOwnershipRange(pb->K, &rstart, NULL));
   PetscCall(VecSet(r->pdiag, 0.0));
   PetscCall(VecGetArray(r->pdiag, &d));
-  for (PetscInt row = 0; row < pb->nbulk_rows; ++row)
-    for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k)
-      if (pb->bulk_cols[k] == pb->bulk_rows[row]) d[pb->bulk_rows[row] - rstart] = jvals[k] - pb->bulk_vals[k];
+  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) d[pb->bulk_rows[row] - rstart] = jvals[pb->bulk_diag[row]] - pb->bulk_vals[pb->bulk_diag[row]];
   PetscCall(VecRestoreArray(r->pdiag, &d));
   PetscCall(VecScatterBegin(pb->bulk_scatter, r->pdiag, r->pcols, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecScatterEnd(pb->bulk_scatter, r->pdiag, r->pcols, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecGetArrayRead(r->pcols, &dcol));
   for (PetscInt row = 0; row < pb->nbulk_rows && local < PETSC_MAX_REAL; ++row) {
-    PetscReal pii = 0.0, sum = 0.0;
+    const PetscReal pii = PetscRealPart(jvals[pb->bulk_diag[row]] - pb->bulk_vals[pb->bulk_diag[row]]);
+    PetscReal       sum = 0.0;
 
-    for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k)
-      if (pb->bulk_cols[k] == pb->bulk_rows[row]) pii = PetscRealPart(jvals[k] - pb->bulk_vals[k]);
     for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k) {
       const PetscReal pij = PetscAbsScalar(jvals[k] - pb->bulk_vals[k]), pjj = PetscRealPart(dcol[pb->bulk_lcols[k]]);
 
