@@ -5,6 +5,7 @@
 
 /* section.c */
 PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user);
+PetscErrorCode SectionSetUpGlobalP1(DM dm, PetscBool check);
 
 /* elasticity.c */
 PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degree, PetscBool *section_check);

@@ -183,7 +183,8 @@ def test_cylinder_options_file(outdir, quarter_disk):
 def test_p1_section_is_petscs(outdir, quarter_disk, case, np_):
     """src/physics/section.c builds the P1/Q1 section itself (the Dirichlet components constrained face set by face set,
     several on one vertex at the corners); -section_check also has DMCreateLocalSection() build it and compares the two
-    with PetscSectionCompare() (dofs, offsets, constraint counts and indices, the field's too)."""
+    with PetscSectionCompare() (dofs, offsets, constraint counts and indices, the field's too); the global section and the
+    section SF built over the vertices (src/physics/section_global.c) are compared with PETSc's, the SF graph entry by entry."""
     args = {"slips_2d": patch_args(2, "traction", 0.05, 0.01), "slips_3d": patch_args(3, "pressure", 0.05, 0.01),
             "clamp_quads": ["-dm_plex_simplex", 0, "-dm_plex_box_faces", "5,4"],
             "clamp_hexes": ["-dm_plex_dim", 3, "-dm_plex_simplex", 0, "-dm_plex_box_faces", "2,3,2"],
@@ -191,4 +192,6 @@ def test_p1_section_is_petscs(outdir, quarter_disk, case, np_):
             "disk_names": HERTZ_2D + ["-dm_plex_filename", quarter_disk]}[case]
     log, h5 = run(args + ["-section_check"], f"section_{case}_np{np_}", np_=np_, output=os.path.join(outdir, f"section_{case}_np{np_}.h5"))
     assert log.count("section check: the P1 section is equal to DMCreateLocalSection()'s") == 1, log[-2000:]
+    assert log.count("section check: the global section is equal to PetscSectionCreateGlobalSection()'s, "
+                     "the section SF equal to PetscSFSetGraphSection()'s") == 1, log[-2000:]
     assert load(h5)[0]["converged"] == 1

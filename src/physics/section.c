@@ -226,5 +226,6 @@ PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user)
   }
   PetscCall(DMSetLocalSection(dm, section));
   PetscCall(PetscSectionDestroy(&section));
+  PetscCall(SectionSetUpGlobalP1(dm, user->opt.section_check)); /* src/physics/section_global.c */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
