@@ -11,7 +11,7 @@ PetscErrorCode SectionSetUpGlobalP1(DM dm, PetscBool check);
 PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degree, PetscBool *section_check);
 PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user);
 PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user);
-PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace);
+PetscErrorCode ElasticityRigidBodyModesP1(DM dm, Vec like, MatNullSpace *nullspace);
 PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, PetscReal mu, const PetscReal x[], PetscScalar Ke[]);
 PetscErrorCode ElasticityP1CellVertices(MeshClosure *mc, PetscSection csec, PetscSection lsec, const PetscScalar xc[], PetscInt c, PetscReal x[],
                                         PetscInt off[], PetscInt *nv);

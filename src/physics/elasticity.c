@@ -54,8 +54,9 @@ static PetscErrorCode CreateRigidBodyModes(DM dm, PetscInt origField, PetscInt f
 
 /* The rigid-body modes (the near-null space of GAMG) of a field whose unknowns all sit at the vertices (P1, Q1),
    directly from the vertex coordinates: DMPlexCreateRigidBody projects them through PetscFE, which took 2 of the
-   5.5 s of set-up at 250k unknowns. Constrained (Dirichlet) unknowns drop out in the local-to-global map, as there. */
-PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace)
+   5.5 s of set-up at 250k unknowns. Constrained (Dirichlet) unknowns drop out in the local-to-global map, as there.
+   like: a global vector of dm. */
+PetscErrorCode ElasticityRigidBodyModesP1(DM dm, Vec like, MatNullSpace *nullspace)
 {
   const PetscInt nmodes[4] = {0, 1, 3, 6};
   PetscInt       dim, vStart, vEnd, n, rstart;
@@ -73,7 +74,7 @@ PetscErrorCode ElasticityRigidBodyModesP1(DM dm, MatNullSpace *nullspace)
   PetscCall(DMGetLocalSection(cdm, &csec));
   PetscCall(DMGetCoordinatesLocal(dm, &coords));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  PetscCall(DMCreateGlobalVector(dm, &mode[0]));
+  PetscCall(VecDuplicate(like, &mode[0])); /* not DMCreateGlobalVector(), which scans every mesh point for a block size */
   PetscCall(VecGetOwnershipRange(mode[0], &rstart, NULL));
   for (PetscInt m = 0; m < n; ++m) { /* written straight into the global vectors: the free components of the owned vertices */
     if (m) PetscCall(VecDuplicate(mode[0], &mode[m]));

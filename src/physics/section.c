@@ -82,16 +82,17 @@ static PetscErrorCode SectionBuild(DM dm, PetscInt nc, PetscInt ndof, PetscInt n
   PetscCall(PetscSectionSetFromOptions(*section));
   PetscCall(PetscSectionSetUp(*section));
   if (!nbc) PetscFunctionReturn(PETSC_SUCCESS);
-  /* the field's constraint indices: DMPlexCreateSectionBCIndicesField() */
-  for (PetscInt p = pStart; p < pEnd; ++p) {
+  /* the field's constraint indices: DMPlexCreateSectionBCIndicesField(), over the vertices (the only points with
+     dofs, so with constraints; at the others it sets nothing) */
+  for (PetscInt v = vStart; v < vEnd; ++v) {
     PetscInt cdof;
 
-    PetscCall(PetscSectionGetConstraintDof(*section, p, &cdof));
+    PetscCall(PetscSectionGetConstraintDof(*section, v, &cdof));
     max_cdof = PetscMax(max_cdof, cdof);
   }
   PetscCall(PetscMalloc1(PetscMax(max_cdof, ndof) + nc, &indices));
   for (PetscInt d = 0; d < max_cdof; ++d) indices[d] = -1;
-  for (PetscInt p = pStart; p < pEnd; ++p) PetscCall(PetscSectionSetFieldConstraintIndices(*section, p, 0, indices));
+  for (PetscInt v = vStart; v < vEnd; ++v) PetscCall(PetscSectionSetFieldConstraintIndices(*section, v, 0, indices));
   for (PetscInt bc = 0; bc < nbc; ++bc) {
     const PetscInt *idx, *comp = NULL;
     PetscInt        n, cnc     = -1;
@@ -131,8 +132,8 @@ static PetscErrorCode SectionBuild(DM dm, PetscInt nc, PetscInt ndof, PetscInt n
     PetscCall(ISRestoreIndices(points[bc], &idx));
     if (comp) PetscCall(ISRestoreIndices(comps[bc], &comp));
   }
-  /* the points' constraint indices: DMPlexCreateSectionBCIndices(), with one field */
-  for (PetscInt p = pStart; p < pEnd; ++p) {
+  /* the points' constraint indices: DMPlexCreateSectionBCIndices(), with one field (vertices only, as above) */
+  for (PetscInt p = vStart; p < vEnd; ++p) {
     const PetscInt *find;
     PetscInt        cdof, fcdof;
 

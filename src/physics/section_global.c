@@ -14,7 +14,7 @@ static PetscErrorCode SectionCreateGlobalP1(DM dm, PetscSection lsec, PetscSecti
   MPI_Comm     comm = PetscObjectComm((PetscObject)dm);
   PetscSection gs, gfs;
   PetscSF      sf;
-  PetscInt     pStart, pEnd, vStart, vEnd, nc, nroots, off = 0, goff = 0, *neg = NULL, *recv = NULL;
+  PetscInt     pStart, pEnd, vStart, vEnd, nc, nroots, off = 0, goff = 0, *neg = NULL, *recv = NULL, *count;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetPointSF(dm, &sf));
@@ -80,43 +80,45 @@ static PetscErrorCode SectionCreateGlobalP1(DM dm, PetscSection lsec, PetscSecti
       PetscCall(PetscSectionSetDof(gs, p, recv[p]));
     }
   }
-  /* the offsets: first this rank's, then shifted by the ranks before it */
-  for (PetscInt p = pStart; p < pEnd; ++p) {
-    PetscInt dof = 0, cdof = 0;
+  /* the offsets: a point's is the count of unconstrained owned dofs before it, on this rank and the ranks before it;
+     only vertices have dofs, and a depth stratum is a range of points, so a point before the vertices has the rank's
+     first offset and a point after them its end */
+  PetscCall(PetscMalloc1(vEnd - vStart, &count));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    PetscInt dof, cdof;
 
-    PetscCall(PetscSectionSetOffset(gs, p, off));
-    if (p < vStart || p >= vEnd) continue;
-    PetscCall(PetscSectionGetDof(gs, p, &dof));
-    PetscCall(PetscSectionGetConstraintDof(lsec, p, &cdof));
-    off += dof > 0 ? dof - cdof : 0;
+    PetscCall(PetscSectionGetDof(gs, v, &dof));
+    PetscCall(PetscSectionGetConstraintDof(lsec, v, &cdof));
+    count[v - vStart] = dof > 0 ? dof - cdof : 0;
+    off += count[v - vStart];
   }
   PetscCallMPI(MPI_Scan(&off, &goff, 1, MPIU_INT, MPI_SUM, comm));
   goff -= off;
-  for (PetscInt p = pStart; p < pEnd; ++p) {
-    PetscInt o;
+  off = goff;
+  for (PetscInt p = pStart; p < pEnd; ++p) { /* the field's offsets are the point's: one field */
+    const PetscInt o = p < vStart ? goff : off;
 
-    PetscCall(PetscSectionGetOffset(gs, p, &o));
-    PetscCall(PetscSectionSetOffset(gs, p, o + goff));
-    if (neg) neg[p] = -(o + goff + 1);
+    PetscCall(PetscSectionSetOffset(gs, p, o));
+    PetscCall(PetscSectionSetFieldOffset(gs, p, 0, o));
+    if (neg) neg[p] = -(o + 1);
+    if (p >= vStart && p < vEnd) off += count[p - vStart];
   }
-  if (neg) { /* the ghost points' offsets: their owners', negative */
+  PetscCall(PetscFree(count));
+  if (neg) { /* the ghost points' offsets, their owners' negative, and their field dofs negative */
     PetscCall(PetscArrayzero(recv, nroots));
     PetscCall(PetscSFBcastBegin(sf, MPIU_INT, neg, recv, MPI_REPLACE));
     PetscCall(PetscSFBcastEnd(sf, MPIU_INT, neg, recv, MPI_REPLACE));
-    for (PetscInt p = pStart; p < pEnd; ++p)
-      if (recv[p] < 0) PetscCall(PetscSectionSetOffset(gs, p, recv[p]));
+    for (PetscInt p = pStart; p < pEnd; ++p) {
+      PetscInt fdof = 0;
+
+      if (recv[p] >= 0) continue;
+      PetscCall(PetscSectionSetOffset(gs, p, recv[p]));
+      PetscCall(PetscSectionSetFieldOffset(gs, p, 0, recv[p]));
+      if (p >= vStart && p < vEnd) PetscCall(PetscSectionGetFieldDof(lsec, p, 0, &fdof));
+      PetscCall(PetscSectionSetFieldDof(gs, p, 0, -(fdof + 1)));
+    }
   }
   PetscCall(PetscFree2(neg, recv));
-  /* the field: the point's offset, and a ghost point's dofs negative */
-  for (PetscInt p = pStart; p < pEnd; ++p) {
-    PetscInt o, fdof = 0;
-
-    PetscCall(PetscSectionGetOffset(gs, p, &o));
-    PetscCall(PetscSectionSetFieldOffset(gs, p, 0, o));
-    if (o >= 0) continue;
-    if (p >= vStart && p < vEnd) PetscCall(PetscSectionGetFieldDof(lsec, p, 0, &fdof));
-    PetscCall(PetscSectionSetFieldDof(gs, p, 0, -(fdof + 1)));
-  }
   *gsec = gs;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -34,7 +34,7 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscCall(DMRestoreLocalVector(dm, &locF));
   if (user->opt.degree == 1)
-    PetscCall(ElasticityRigidBodyModesP1(dm, &rigid)); /* unknowns at the vertices only */
+    PetscCall(ElasticityRigidBodyModesP1(dm, user->prob.r0, &rigid)); /* unknowns at the vertices only */
   else
     PetscCall(DMPlexCreateRigidBody(dm, 0, &rigid));
   PetscCall(MatSetNearNullSpace(user->prob.K, rigid));
@@ -179,7 +179,7 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
   Mat         K;
 
   PetscFunctionBeginUser;
-  PetscCall(DMCreateGlobalVector(dm, &user->prob.work));
+  PetscCall(VecDuplicate(user->prob.r0, &user->prob.work)); /* DMCreateGlobalVector() would scan every mesh point again */
   PetscCall(DMGetGlobalVector(dm, &zero));
   PetscCall(DMGetGlobalVector(dm, &F));
   PetscCall(DMGetGlobalVector(dm, &KF));
