@@ -84,7 +84,7 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
     PetscInt          *faces, nf, pStart, pEnd;
 
     PetscCall(DMGetLocalVector(dm, &locI));
-    PetscCall(DMGetGlobalVector(dm, &mark));
+    PetscCall(VecDuplicate(user->prob.r0, &mark));
     PetscCall(VecZeroEntries(locI));
     PetscCall(DMGetLocalVector(dm, &locH));
     PetscCall(VecZeroEntries(locH));
@@ -116,7 +116,7 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
       }
       PetscCall(PetscFree(faces));
     }
-    PetscCall(DMGetGlobalVector(dm, &H)); /* the largest cell at each node's contact faces, over all ranks */
+    PetscCall(VecDuplicate(user->prob.r0, &H)); /* the largest cell at each node's contact faces, over all ranks */
     PetscCall(VecZeroEntries(H));
     {
       PetscSF      sf;
@@ -135,7 +135,8 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
     PetscCall(VecZeroEntries(mark));
     PetscCall(DMLocalToGlobal(dm, locI, ADD_VALUES, mark));
     PetscCall(VecGetOwnershipRange(mark, &rstart, NULL));
-    PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+    if (user->opt.degree == 1) PetscCall(DMPlexGetDepthStratum(dm, 0, &pStart, &pEnd)); /* P1/Q1: the nodes are the vertices */
+    else PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
     PetscCall(PetscMalloc1(PetscMax(pEnd - pStart, 1), &pts));
     PetscCall(VecGetArrayRead(mark, &ind));
     for (PetscInt p = pStart; p < pEnd; ++p) {
@@ -148,11 +149,11 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
       if (PetscRealPart(ind[goff - rstart]) > 0.0) pts[npts++] = p;
     }
     PetscCall(VecRestoreArrayRead(mark, &ind));
-    PetscCall(DMRestoreGlobalVector(dm, &mark));
+    PetscCall(VecDestroy(&mark));
     PetscCall(DMRestoreLocalVector(dm, &locI));
   }
 
-  PetscCall(DMGetGlobalVector(dm, &M));
+  PetscCall(VecDuplicate(user->prob.r0, &M));
   PetscCall(ContactLumpedMass(dm, user, M));
   PetscCall(VecGetOwnershipRange(M, &rstart, NULL));
   PetscCall(VecGetArrayRead(M, &m));
@@ -204,7 +205,7 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
   }
   PetscCall(VecRestoreArrayRead(user->prob.loc_bc, &bcv));
   PetscCall(VecRestoreArrayRead(H, &hn));
-  PetscCall(DMRestoreGlobalVector(dm, &H));
+  PetscCall(VecDestroy(&H));
   {
     PetscReal range[2] = {PETSC_MAX_REAL, PETSC_MAX_REAL}, grange[2];
 
@@ -223,7 +224,7 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
     user->prob.eps_local = (PetscBool)(user->prob.eps_factor_max - user->prob.eps_factor_min > 1e-12 * user->prob.eps_factor_max);
   }
   PetscCall(VecRestoreArrayRead(M, &m));
-  PetscCall(DMRestoreGlobalVector(dm, &M));
+  PetscCall(VecDestroy(&M));
   PetscCall(PetscFree(pts));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -163,7 +163,7 @@ static PetscErrorCode AssemblyP1BlockSize(DM dm, PetscInt *bs)
 
   PetscFunctionBeginUser;
   PetscCall(DMGetGlobalSection(dm, &gsection));
-  PetscCall(PetscSectionGetChart(gsection, &pStart, &pEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &pStart, &pEnd)); /* the vertices: the other points of a P1 field have no dofs */
   for (PetscInt p = pStart; p < pEnd; ++p) {
     PetscInt dof, cdof, bdof;
 

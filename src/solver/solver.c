@@ -14,7 +14,6 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
     PetscCall(AssemblyP1CreateMatrix(dm, user, &user->prob.K));
   else
     PetscCall(DMCreateMatrix(dm, &user->prob.K));
-  PetscCall(DMCreateGlobalVector(dm, &user->prob.r0));
   PetscCall(DMGetLocalVector(dm, &locX));
   PetscCall(DMGetLocalVector(dm, &locF));
   PetscCall(VecCopy(user->prob.loc_bc, locX)); /* u = 0 with the Dirichlet values, inserted once by ProblemSetUp() */
@@ -180,9 +179,9 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
 
   PetscFunctionBeginUser;
   PetscCall(VecDuplicate(user->prob.r0, &user->prob.work)); /* DMCreateGlobalVector() would scan every mesh point again */
-  PetscCall(DMGetGlobalVector(dm, &zero));
-  PetscCall(DMGetGlobalVector(dm, &F));
-  PetscCall(DMGetGlobalVector(dm, &KF));
+  PetscCall(VecDuplicate(user->prob.r0, &zero));
+  PetscCall(VecDuplicate(user->prob.r0, &F));
+  PetscCall(VecDuplicate(user->prob.r0, &KF));
   PetscCall(VecZeroEntries(zero));
   PetscCall(SolverResidual(dm, user, zero, F));
   PetscCall(VecNorm(F, NORM_2, &user->prob.load_norm));
@@ -199,9 +198,9 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
   }
   user->prob.displacement_scale = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
   user->prob.snes_scale         = 1.0;
-  PetscCall(DMRestoreGlobalVector(dm, &zero));
-  PetscCall(DMRestoreGlobalVector(dm, &F));
-  PetscCall(DMRestoreGlobalVector(dm, &KF));
+  PetscCall(VecDestroy(&zero));
+  PetscCall(VecDestroy(&F));
+  PetscCall(VecDestroy(&KF));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
