@@ -21,6 +21,24 @@ static void SortKey(PetscInt n, PetscInt k[])
     }
 }
 
+/* DMPolytopeGetVertexOrientation() inlined (PETSc's search over the arrangements, in the same order): the orientation
+   o of the cone target of type ct relative to source, target[c] = source[arrangement(o)[c]]; -1 - nO if none. */
+static inline PetscInt VertexOrientation(DMPolytopeType ct, const PetscInt source[], const PetscInt target[])
+{
+  const PetscInt cS = DMPolytopeTypeGetNumVertices(ct), nO = DMPolytopeTypeGetNumArrangments(ct) / 2;
+
+  if (!nO) return 0;
+  for (PetscInt o = -nO; o < nO; ++o) {
+    const PetscInt *arr = DMPolytopeTypeGetVertexArrangment(ct, o);
+    PetscInt        c;
+
+    for (c = 0; c < cS; ++c)
+      if (source[arr[c]] != target[c]) break;
+    if (c == cS) return o;
+  }
+  return -1 - nO;
+}
+
 /* One interpolation step: the nsrc sources (cells, or the faces of a tetrahedral mesh), each with the vertex list
    src[s * (fs + 1) .. ] of a simplex of fs + 1 vertices, get their fs + 1 faces of fs vertices (the vertices are points
    vbase .. vbase + nv - 1). Out: the number of new faces, their vertex cones (first met), and per source its faces
@@ -97,7 +115,9 @@ static PetscErrorCode InterpolateStep(PetscInt nsrc, PetscInt fs, const PetscInt
       PetscInt raw[3];
 
       for (PetscInt i = 0; i < fs; ++i) raw[i] = src[s * nf + (fs == 2 ? tri_faces[lf][i] : tet_faces[lf][i])];
-      PetscCall(DMPolytopeGetVertexOrientation(ft, &cones[(face[s * nf + lf] - first) * fs], raw, &ornt[s * nf + lf]));
+      ornt[s * nf + lf] = VertexOrientation(ft, &cones[(face[s * nf + lf] - first) * fs], raw);
+      PetscCheck(ornt[s * nf + lf] >= -DMPolytopeTypeGetNumArrangments(ft) / 2, PETSC_COMM_SELF, PETSC_ERR_PLIB,
+                 "No orientation of face %" PetscInt_FMT " in simplex %" PetscInt_FMT, face[s * nf + lf], s);
     }
   PetscCall(PetscFree2(start, fill));
   PetscCall(PetscMalloc1(n * fs, new_cones));
