@@ -45,6 +45,8 @@ typedef struct {
   PetscBool      by_depth;   /* else DMPlexGetTransitiveClosure() */
   PetscInt       max_points; /* of a closure or star */
   PetscInt      *points, *fifo;
+  PetscSection   cone_section; /* the DM's cones, read directly */
+  PetscInt      *cones, *cone_ornts;
 } MeshClosure;
 PetscErrorCode MeshClosureCreate(DM dm, MeshClosure *mc);
 PetscErrorCode MeshClosureDestroy(MeshClosure *mc);

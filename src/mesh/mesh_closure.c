@@ -64,6 +64,9 @@ PetscErrorCode MeshClosureCreate(DM dm, MeshClosure *mc)
   }
   mc->max_points = (PetscInt)PetscMin(PetscMax(series[0], series[1]), (PetscInt64)PetscMax(pEnd - pStart, 1)); /* at most every point */
   PetscCall(PetscMalloc2(2 * mc->max_points, &mc->points, 3 * mc->max_points, &mc->fifo));
+  PetscCall(DMPlexGetConeSection(dm, &mc->cone_section));
+  PetscCall(DMPlexGetCones(dm, &mc->cones));
+  PetscCall(DMPlexGetConeOrientations(dm, &mc->cone_ornts));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -109,14 +112,18 @@ PetscErrorCode MeshClosureGet(MeshClosure *mc, PetscInt p, PetscBool use_cone, P
   fifo[tail++]    = depth;
   while (tail > head) {
     const PetscInt  q = fifo[head++], o = fifo[head++], qd = fifo[head++], cd = use_cone ? qd - 1 : qd + 1;
-    const PetscInt *qarr = DMPolytopeTypeGetArrangment(mc->type[qd], o), *tmp, *tmp_o = NULL;
+    const PetscInt *qarr, *tmp, *tmp_o = NULL;
     PetscInt        ntmp;
 
     if (cd < 0 || cd > mc->depth) continue;
-    if (use_cone) {
-      PetscCall(DMPlexGetConeSize(dm, q, &ntmp));
-      PetscCall(DMPlexGetCone(dm, q, &tmp));
-      PetscCall(DMPlexGetConeOrientation(dm, q, &tmp_o));
+    qarr = DMPolytopeTypeGetArrangment(mc->type[qd], o);
+    if (use_cone) { /* DMPlexGetCone() and DMPlexGetConeOrientation() without their checks */
+      PetscInt off;
+
+      PetscCall(PetscSectionGetDof(mc->cone_section, q, &ntmp));
+      PetscCall(PetscSectionGetOffset(mc->cone_section, q, &off));
+      tmp   = &mc->cones[off];
+      tmp_o = &mc->cone_ornts[off];
     } else {
       PetscCall(DMPlexGetSupportSize(dm, q, &ntmp));
       PetscCall(DMPlexGetSupport(dm, q, &tmp));
