@@ -12,7 +12,7 @@
 static PetscErrorCode SectionCreateGlobalP1(DM dm, PetscSection lsec, PetscSection *gsec)
 {
   MPI_Comm     comm = PetscObjectComm((PetscObject)dm);
-  PetscSection gs, gfs;
+  PetscSection gs, gfs, lfs;
   PetscSF      sf;
   PetscInt     pStart, pEnd, vStart, vEnd, nc, nroots, off = 0, goff = 0, *neg = NULL, *recv = NULL, *count;
 
@@ -25,19 +25,20 @@ static PetscErrorCode SectionCreateGlobalP1(DM dm, PetscSection lsec, PetscSecti
   PetscCall(PetscSectionSetNumFields(gs, 1));
   PetscCall(PetscSectionSetChart(gs, pStart, pEnd));
   PetscCall(PetscSectionSetFieldComponents(gs, 0, nc));
+  PetscCall(PetscSectionGetField(lsec, 0, &lfs)); /* the field's own sections: PetscSection*Field*() call them */
+  PetscCall(PetscSectionGetField(gs, 0, &gfs));
   for (PetscInt v = vStart; v < vEnd; ++v) {
     PetscInt dof, cdof, fdof, fcdof;
 
     PetscCall(PetscSectionGetDof(lsec, v, &dof));
     PetscCall(PetscSectionGetConstraintDof(lsec, v, &cdof));
-    PetscCall(PetscSectionGetFieldDof(lsec, v, 0, &fdof));
-    PetscCall(PetscSectionGetFieldConstraintDof(lsec, v, 0, &fcdof));
+    PetscCall(PetscSectionGetDof(lfs, v, &fdof));
+    PetscCall(PetscSectionGetConstraintDof(lfs, v, &fcdof));
     PetscCall(PetscSectionSetDof(gs, v, dof));
-    PetscCall(PetscSectionSetFieldDof(gs, v, 0, fdof));
+    PetscCall(PetscSectionSetDof(gfs, v, fdof));
     if (cdof > 0) PetscCall(PetscSectionSetConstraintDof(gs, v, cdof));
-    if (fcdof > 0) PetscCall(PetscSectionSetFieldConstraintDof(gs, v, 0, fcdof));
+    if (fcdof > 0) PetscCall(PetscSectionSetConstraintDof(gfs, v, fcdof));
   }
-  PetscCall(PetscSectionGetField(gs, 0, &gfs));
   PetscCall(PetscSectionSetIncludesConstraints(gs, PETSC_FALSE));
   PetscCall(PetscSectionSetIncludesConstraints(gfs, PETSC_FALSE));
   PetscCall(PetscSectionSetUpBC(gs)); /* the constraints' layout, as PETSc's: no PetscSectionSetUp(), the offsets are set below */
@@ -51,10 +52,10 @@ static PetscErrorCode SectionCreateGlobalP1(DM dm, PetscSection lsec, PetscSecti
       PetscCall(PetscSectionGetConstraintIndices(lsec, v, &idx));
       PetscCall(PetscSectionSetConstraintIndices(gs, v, idx));
     }
-    PetscCall(PetscSectionGetFieldConstraintDof(lsec, v, 0, &fcdof));
+    PetscCall(PetscSectionGetConstraintDof(lfs, v, &fcdof));
     if (fcdof > 0) {
-      PetscCall(PetscSectionGetFieldConstraintIndices(lsec, v, 0, &idx));
-      PetscCall(PetscSectionSetFieldConstraintIndices(gs, v, 0, idx));
+      PetscCall(PetscSectionGetConstraintIndices(lfs, v, &idx));
+      PetscCall(PetscSectionSetConstraintIndices(gfs, v, idx));
     }
   }
   PetscCall(PetscSFGetGraph(sf, &nroots, NULL, NULL, NULL));
@@ -99,7 +100,7 @@ static PetscErrorCode SectionCreateGlobalP1(DM dm, PetscSection lsec, PetscSecti
     const PetscInt o = p < vStart ? goff : off;
 
     PetscCall(PetscSectionSetOffset(gs, p, o));
-    PetscCall(PetscSectionSetFieldOffset(gs, p, 0, o));
+    PetscCall(PetscSectionSetOffset(gfs, p, o));
     if (neg) neg[p] = -(o + 1);
     if (p >= vStart && p < vEnd) off += count[p - vStart];
   }
@@ -113,9 +114,9 @@ static PetscErrorCode SectionCreateGlobalP1(DM dm, PetscSection lsec, PetscSecti
 
       if (recv[p] >= 0) continue;
       PetscCall(PetscSectionSetOffset(gs, p, recv[p]));
-      PetscCall(PetscSectionSetFieldOffset(gs, p, 0, recv[p]));
-      if (p >= vStart && p < vEnd) PetscCall(PetscSectionGetFieldDof(lsec, p, 0, &fdof));
-      PetscCall(PetscSectionSetFieldDof(gs, p, 0, -(fdof + 1)));
+      PetscCall(PetscSectionSetOffset(gfs, p, recv[p]));
+      if (p >= vStart && p < vEnd) PetscCall(PetscSectionGetDof(lfs, p, &fdof));
+      PetscCall(PetscSectionSetDof(gfs, p, -(fdof + 1)));
     }
   }
   PetscCall(PetscFree2(neg, recv));

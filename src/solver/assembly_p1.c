@@ -118,12 +118,15 @@ static PetscErrorCode AssemblyP1VertexIndices(DM dm, PetscInt **vidx)
    DMPlexGetTransitiveClosure(), which dominated the preallocation). */
 static PetscErrorCode AssemblyP1CellVertices(DM dm, PetscInt **cverts)
 {
-  PetscInt dim, cStart, cEnd, vStart, vEnd;
+  PetscInt     dim, cStart, cEnd, vStart, vEnd, *cones;
+  PetscSection cone_section;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(DMPlexGetConeSection(dm, &cone_section)); /* the cones read directly, as DMPlexGetCone() gives them */
+  PetscCall(DMPlexGetCones(dm, &cones));
   PetscCall(PetscMalloc1((cEnd - cStart) * (dim + 1), cverts));
   for (PetscInt c = cStart; c < cEnd; ++c) {
     PetscInt *verts = &(*cverts)[(c - cStart) * (dim + 1)], stack[64], top = 0, nv = 0;
@@ -142,10 +145,11 @@ static PetscErrorCode AssemblyP1CellVertices(DM dm, PetscInt **cverts)
         }
       } else {
         const PetscInt *cone;
-        PetscInt        ncone;
+        PetscInt        ncone, off;
 
-        PetscCall(DMPlexGetConeSize(dm, p, &ncone));
-        PetscCall(DMPlexGetCone(dm, p, &cone));
+        PetscCall(PetscSectionGetDof(cone_section, p, &ncone));
+        PetscCall(PetscSectionGetOffset(cone_section, p, &off));
+        cone = &cones[off];
         PetscCheck(top + ncone <= 64, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Cone walk of cell %" PetscInt_FMT " too deep", c);
         for (PetscInt i = 0; i < ncone; ++i) stack[top++] = cone[i];
       }
@@ -360,15 +364,15 @@ PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K)
   PetscCall(AssemblyP1BlockSize(dm, &bs));
   PetscCall(AssemblyP1VertexIndices(dm, &vidx));
   PetscCall(AssemblyP1CellVertices(dm, &cverts));
-  PetscCall(DMGetLocalToGlobalMapping(dm, &ltog));
   PetscCall(AssemblyP1CreateSeqAIJ(dm, user, nlocal, bs, vidx, cverts, K, &done));            /* one rank, AIJ: its own CSR arrays */
   if (!done) PetscCall(AssemblyP1CreateMPIAIJ(dm, user, nlocal, bs, vidx, cverts, K, &done)); /* several ranks, AIJ: the same */
-  if (done) {
-    PetscCall(MatSetLocalToGlobalMapping(*K, ltog, ltog));
+  if (done) { /* assembled, with global indices: no local-to-global map (DMGetLocalToGlobalMapping() scans every mesh point) */
     PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
     PetscCall(PetscLogEventEnd(ASSEMBLY_P1_Preallocate, dm, 0, 0, 0));
-  } else
+  } else {
+    PetscCall(DMGetLocalToGlobalMapping(dm, &ltog)); /* as DMCreateMatrix() gives it, for any other type (MATIS needs it) */
     PetscCall(AssemblyP1CreateAnyMatrix(dm, user, nlocal, bs, vidx, cverts, ltog, K));
+  }
   PetscCall(MatSetDM(*K, dm));
   PetscCall(PetscFree(vidx));
   PetscCall(PetscFree(cverts));
