@@ -116,14 +116,14 @@ typedef struct {
   PetscBool         pc_update;           /* multigrid (GAMG): the coarse operators follow the Jacobian instead of rebuilds */
   PetscBool         pc_update_check;     /*   and each update is compared with the full Galerkin products */
   PetscBool         pc_update_esteig;    /*   and the finest smoother estimates its eigenvalues again at each update */
-  PetscReal         pc_update_truncate;  /*   and the coarse spaces leave out the contact dofs whose penalty exceeds this times K's diagonal (0: none) */
-  PetscInt          grid_sequence;       /* solve on the mesh and on this many uniform refinements of it, each from the last */
-  PetscInt          coarse_levels;       /* nested iteration to the mesh: this many coarser boxes solved first (-1: automatic) */
-  PetscReal         coarse_rtol;         /*   Newton's relative tolerance there */
-  PetscReal         ew_guard;            /* Eisenstat-Walker's terms no smaller than this times Newton's target / |F| */
-  PetscReal        *eps0_sweep;          /* eps0 values solved in turn on the final mesh, each from the last solution (any number) */
-  PetscInt          n_sweep;
-  PetscReal         load_rtol; /* Newton also stops when |F| <= load_rtol ||F(0)||: the residual is at round-off for the load */
+  PetscReal  pc_update_truncate; /*   and the coarse spaces leave out the contact dofs whose penalty exceeds this times K's diagonal (0: none) */
+  PetscInt   grid_sequence;      /* solve on the mesh and on this many uniform refinements of it, each from the last */
+  PetscInt   coarse_levels;      /* nested iteration to the mesh: this many coarser boxes solved first (-1: automatic) */
+  PetscReal  coarse_rtol;        /*   Newton's relative tolerance there */
+  PetscReal  ew_guard;           /* Eisenstat-Walker's terms no smaller than this times Newton's target / |F| */
+  PetscReal *eps0_sweep;         /* eps0 values solved in turn on the final mesh, each from the last solution (any number) */
+  PetscInt   n_sweep;
+  PetscReal  load_rtol; /* Newton also stops when |F| <= load_rtol ||F(0)||: the residual is at round-off for the load */
 } ContactOptions;
 
 /* State of the preconditioner reuse (pc_reuse.c). */
@@ -149,17 +149,17 @@ typedef struct {
   /* -contact_pc_update_truncate: the finest prolongator R has zero rows at the penalty-dominated contact dofs Z, so the
      coarse operators are R^T J' R, J' the Jacobian with the rows and columns Z set to zero (R the build's), and dlocal also holds the
      columns Z of the rows that are not contact rows: the mirrors of the contact rows' entries there */
-  PetscInt     nmirror;    /* those entries */
-  PetscInt    *mirror_k;   /* [nmirror]: the contact-row entry (bulk_ptr numbering) each one mirrors, */
-  PetscInt    *mirror_at;  /*   and that row's place among the columns (bulk_x) */
-  PetscScalar *eff_vals;   /* [nnz + nmirror]: J' at dlocal's entries, as the coarse operators hold it */
-  PetscScalar *eff_dvals;  /* [nnz + nmirror]: its change, the values of dlocal */
-  PetscInt     nz;         /* owned rows in Z */
-  PetscInt    *zrows;      /* [nbulk_rows]: their global numbers */
-  Mat          rfine;      /* the finest prolongator, whose rows Z are set to zero, */
+  PetscInt     nmirror;              /* those entries */
+  PetscInt    *mirror_k;             /* [nmirror]: the contact-row entry (bulk_ptr numbering) each one mirrors, */
+  PetscInt    *mirror_at;            /*   and that row's place among the columns (bulk_x) */
+  PetscScalar *eff_vals;             /* [nnz + nmirror]: J' at dlocal's entries, as the coarse operators hold it */
+  PetscScalar *eff_dvals;            /* [nnz + nmirror]: its change, the values of dlocal */
+  PetscInt     nz;                   /* owned rows in Z */
+  PetscInt    *zrows;                /* [nbulk_rows]: their global numbers */
+  Mat          rfine;                /* the finest prolongator, whose rows Z are set to zero, */
   PetscInt    *rrow_ptr, *rrow_cols; /*   its rows at the owned contact rows (CSR, global columns), */
-  PetscScalar *rrow_vals;  /*   with their values as GAMG made them */
-  Vec          zmark, zcols; /* 0 outside the contact rows, 1 in them, 2 in Z; and those marks at the contact rows' columns */
+  PetscScalar *rrow_vals;            /*   with their values as GAMG made them */
+  Vec          zmark, zcols;         /* 0 outside the contact rows, 1 in them, 2 in Z; and those marks at the contact rows' columns */
   /* the finest level's Chebyshev interval, bounded instead of estimated again at each update (SmootherBoundFinest(), smoother_bound.c) */
   PetscBool built_on_K;       /* the build's Jacobian was K itself in the contact rows (no penalty term yet) */
   PetscBool bound_set;        /* the build's estimate has been read, and the bound applies */

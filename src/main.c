@@ -145,7 +145,7 @@ int main(int argc, char **argv)
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition)); /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(user.opt.scene_name, dm, &user.opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(ProblemSetUp(dm, &user, &snes));
-  PetscCall(ReferenceCheckFile(dm, &user)); /* before the solve, not after it */
+  PetscCall(ReferenceCheckFile(dm, &user));  /* before the solve, not after it */
   PetscCall(VecDuplicate(user.prob.r0, &u)); /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
   PetscCall(DMSNESCheckFromOptions(snes, u)); /* -dmsnes_check: PETSc's checks against the exact solution */

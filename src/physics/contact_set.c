@@ -135,8 +135,10 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
     PetscCall(VecZeroEntries(mark));
     PetscCall(DMLocalToGlobal(dm, locI, ADD_VALUES, mark));
     PetscCall(VecGetOwnershipRange(mark, &rstart, NULL));
-    if (user->opt.degree == 1) PetscCall(DMPlexGetDepthStratum(dm, 0, &pStart, &pEnd)); /* P1/Q1: the nodes are the vertices */
-    else PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+    if (user->opt.degree == 1)
+      PetscCall(DMPlexGetDepthStratum(dm, 0, &pStart, &pEnd)); /* P1/Q1: the nodes are the vertices */
+    else
+      PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
     PetscCall(PetscMalloc1(PetscMax(pEnd - pStart, 1), &pts));
     PetscCall(VecGetArrayRead(mark, &ind));
     for (PetscInt p = pStart; p < pEnd; ++p) {

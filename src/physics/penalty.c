@@ -213,7 +213,8 @@ PetscErrorCode PenaltySameActivity(DM dm, AppCtx *user, Vec X, Vec Y, PetscBool 
   if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS) {
     Vec locX, locY;
 
-    if (user->prob.assembly != ASSEMBLY_P1) *same = PETSC_FALSE;
+    if (user->prob.assembly != ASSEMBLY_P1)
+      *same = PETSC_FALSE;
     else {
       PetscCall(GetLocalSolution(dm, user, X, &locX));
       PetscCall(GetLocalSolution(dm, user, Y, &locY));
@@ -227,7 +228,8 @@ PetscErrorCode PenaltySameActivity(DM dm, AppCtx *user, Vec X, Vec Y, PetscBool 
 
     PetscCall(VecGetArrayRead(X, &x));
     PetscCall(VecGetArrayRead(Y, &y));
-    for (PetscInt i = 0; i < cs->n && *same; ++i) *same = (PetscBool)((ContactNodePenetration(cs, dim, i, x) > 0.0) == (ContactNodePenetration(cs, dim, i, y) > 0.0));
+    for (PetscInt i = 0; i < cs->n && *same; ++i)
+      *same = (PetscBool)((ContactNodePenetration(cs, dim, i, x) > 0.0) == (ContactNodePenetration(cs, dim, i, y) > 0.0));
     PetscCall(VecRestoreArrayRead(X, &x));
     PetscCall(VecRestoreArrayRead(Y, &y));
   }
@@ -346,7 +348,9 @@ PetscErrorCode PenaltySaveBulkRows(DM dm, AppCtx *user)
     PetscCall(PetscArraycpy(&pb->bulk_cols[pb->bulk_ptr[r]], cols, ncols));
     PetscCall(PetscArraycpy(&pb->bulk_vals[pb->bulk_ptr[r]], vals, ncols));
     PetscCall(MatRestoreRow(pb->K, pb->bulk_rows[r], &ncols, &cols, &vals));
-    for (pb->bulk_diag[r] = pb->bulk_ptr[r]; pb->bulk_diag[r] < pb->bulk_ptr[r + 1] && pb->bulk_cols[pb->bulk_diag[r]] != pb->bulk_rows[r]; ++pb->bulk_diag[r]) { }
+    for (pb->bulk_diag[r] = pb->bulk_ptr[r]; pb->bulk_diag[r] < pb->bulk_ptr[r + 1] && pb->bulk_cols[pb->bulk_diag[r]] != pb->bulk_rows[r];
+         ++pb->bulk_diag[r]) {
+    }
     PetscCheck(pb->bulk_diag[r] < pb->bulk_ptr[r + 1], PETSC_COMM_SELF, PETSC_ERR_PLIB, "K's pattern has no diagonal in contact row %" PetscInt_FMT,
                pb->bulk_rows[r]);
   }

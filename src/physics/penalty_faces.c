@@ -223,7 +223,7 @@ PetscErrorCode PenaltyFacesEnergy(DM dm, AppCtx *user, Vec locX, PetscReal *ener
 static inline PetscBool FacePointKernel(const PenaltyFaces *pf, PetscInt dim, PetscInt e, PetscInt q, const PetscScalar x[], PetscInt ncst,
                                         const PetscScalar cst[], PetscScalar g0[])
 {
-  const PetscInt    zero[1]  = {0}, nfaux = pf->inv_factor ? 1 : 0;
+  const PetscInt    zero[1] = {0}, nfaux = pf->inv_factor ? 1 : 0;
   const PetscReal   nzero[3] = {0.0, 0.0, 0.0};
   const PetscScalar a[1]     = {pf->inv_factor ? pf->inv_factor[e] : 1.0};
   PetscScalar       u[3];

@@ -76,8 +76,8 @@ static PetscErrorCode SectionCreateGlobalP1(DM dm, PetscSection lsec, PetscSecti
 
       if (recv[p] >= 0) continue;
       PetscCall(PetscSectionGetDof(lsec, p, &dof));
-      PetscCheck(-(recv[p] + 1) == dof, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Point %" PetscInt_FMT " has %" PetscInt_FMT " dofs on its owner, %" PetscInt_FMT " here", p,
-                 -(recv[p] + 1), dof);
+      PetscCheck(-(recv[p] + 1) == dof, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG,
+                 "Point %" PetscInt_FMT " has %" PetscInt_FMT " dofs on its owner, %" PetscInt_FMT " here", p, -(recv[p] + 1), dof);
       PetscCall(PetscSectionSetDof(gs, p, recv[p]));
     }
   }
@@ -178,7 +178,8 @@ static PetscErrorCode SectionCreateSFP1(DM dm, PetscSection lsec, PetscSection g
       if (gdof < 0) {
         PetscCall(PetscFindInt(g, size + 1, ranges, &r));
         if (r < 0) r = -(r + 2);
-        PetscCheck(r >= 0 && r < size, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Vertex %" PetscInt_FMT " mapped to invalid rank %" PetscInt_FMT, v, r);
+        PetscCheck(r >= 0 && r < size, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Vertex %" PetscInt_FMT " mapped to invalid rank %" PetscInt_FMT, v,
+                   r);
       }
       remote[l].rank  = r;
       remote[l].index = g - ranges[r];
@@ -236,8 +237,10 @@ PetscErrorCode SectionSetUpGlobalP1(DM dm, PetscBool check)
     PetscCall(PetscSFCreate(PetscObjectComm((PetscObject)dm), &ref_sf));
     PetscCall(PetscSFSetGraphSection(ref_sf, lsec, ref));
     PetscCall(SectionSFCompare(sf, ref_sf, &same_sf));
-    PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm), "  section check: the global section is %s PetscSectionCreateGlobalSection()'s, the section SF %s PetscSFSetGraphSection()'s\n",
-                          same_section ? "equal to" : "DIFFERENT from", same_sf ? "equal to" : "DIFFERENT from"));
+    PetscCall(
+        PetscPrintf(PetscObjectComm((PetscObject)dm),
+                    "  section check: the global section is %s PetscSectionCreateGlobalSection()'s, the section SF %s PetscSFSetGraphSection()'s\n",
+                    same_section ? "equal to" : "DIFFERENT from", same_sf ? "equal to" : "DIFFERENT from"));
     PetscCall(PetscSFDestroy(&ref_sf));
     PetscCall(PetscSectionDestroy(&ref));
   }

@@ -109,7 +109,7 @@ static PetscErrorCode MirrorsSetUp(AppCtx *user)
 {
   Problem           *pb = &user->prob;
   PcReuse           *r  = &pb->pc_reuse;
-  PetscInt           n = 0;
+  PetscInt           n  = 0;
   const PetscScalar *mark;
 
   PetscFunctionBeginUser;

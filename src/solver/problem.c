@@ -20,7 +20,7 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(SectionSetUpP1(dm, user)); /* P1/Q1: the local section without PETSc's cell-type lookups */
   PetscCall(BoundaryCheckRigidMotions(dm, &user->scene));
   PetscCall(DMCreateLocalVector(dm, &user->prob.loc_bc)); /* the Dirichlet values, zero elsewhere */
-  PetscCall(DMCreateGlobalVector(dm, &user->prob.r0));     /* F(0), assembled below; the set-up's global vectors duplicate it */
+  PetscCall(DMCreateGlobalVector(dm, &user->prob.r0));    /* F(0), assembled below; the set-up's global vectors duplicate it */
   PetscCall(VecZeroEntries(user->prob.loc_bc));
   PetscCall(BoundaryInsertDirichlet(dm, user, user->prob.loc_bc));
   PetscCall(AssemblyResolve(dm, user));                                      /* -assembly auto: fe or p1 for this mesh */

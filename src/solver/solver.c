@@ -366,10 +366,11 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscCall(SolverForcingSetUp(*snes, user, &petsc_presolve)); /* Eisenstat-Walker's terms with the oversolving guard */
     if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, user));
     PetscCall(FineSmootherGiven(ksp, &fine));
-    PetscCheck(!fine || is_multigrid, comm, PETSC_ERR_USER_INPUT, "-mg_fine_ksp_type and -mg_fine_pc_type need a multigrid preconditioner (-pc_type gamg or mg), not %s",
-               pc_type);
-    PetscCheck(!(petsc_presolve && fine), comm, PETSC_ERR_USER_INPUT,
-               "-mg_fine_ksp_type and -mg_fine_pc_type need -snes_ksp_ew_version 2 (or no Eisenstat-Walker): another version keeps PETSc's own pre-solve");
+    PetscCheck(!fine || is_multigrid, comm, PETSC_ERR_USER_INPUT,
+               "-mg_fine_ksp_type and -mg_fine_pc_type need a multigrid preconditioner (-pc_type gamg or mg), not %s", pc_type);
+    PetscCheck(
+        !(petsc_presolve && fine), comm, PETSC_ERR_USER_INPUT,
+        "-mg_fine_ksp_type and -mg_fine_pc_type need -snes_ksp_ew_version 2 (or no Eisenstat-Walker): another version keeps PETSc's own pre-solve");
   }
   PetscCheck(is_vi == (user->opt.contact.method == CONTACT_VI), comm, PETSC_ERR_USER_INPUT,
              "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type,
