@@ -51,6 +51,7 @@ typedef struct {
 PetscErrorCode MeshClosureCreate(DM dm, MeshClosure *mc);
 PetscErrorCode MeshClosureDestroy(MeshClosure *mc);
 PetscErrorCode MeshClosureGet(MeshClosure *mc, PetscInt p, PetscBool use_cone, PetscInt *n, const PetscInt **points);
+PetscErrorCode MeshClosureVertices(MeshClosure *mc, PetscInt p, PetscInt max, PetscInt *nv, PetscInt verts[]);
 PetscErrorCode MeshClosureCheck(DM dm, PetscInt *differences, PetscBool *by_depth);
 
 /* mesh_gmsh_names.c */

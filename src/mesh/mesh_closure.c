@@ -63,7 +63,7 @@ PetscErrorCode MeshClosureCreate(DM dm, MeshClosure *mc)
     series[1] += term[1];
   }
   mc->max_points = (PetscInt)PetscMin(PetscMax(series[0], series[1]), (PetscInt64)PetscMax(pEnd - pStart, 1)); /* at most every point */
-  PetscCall(PetscMalloc2(2 * mc->max_points, &mc->points, 3 * mc->max_points, &mc->fifo));
+  PetscCall(PetscMalloc2(2 * mc->max_points, &mc->points, 4 * mc->max_points, &mc->fifo)); /* MeshClosureVertices(): two lists of pairs */
   PetscCall(DMPlexGetConeSection(dm, &mc->cone_section));
   PetscCall(DMPlexGetCones(dm, &mc->cones));
   PetscCall(DMPlexGetConeOrientations(dm, &mc->cone_ornts));
@@ -150,6 +150,70 @@ PetscErrorCode MeshClosureGet(MeshClosure *mc, PetscInt p, PetscBool use_cone, P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The vertices of the closure of p, in the closure's order (MeshClosureGet() with the other points dropped), level by
+   level: the closure is a breadth-first walk down the depths, so its points of one depth follow those of the depth
+   above, each level in the order its points are met; no point of one level is in another. verts holds max. */
+PetscErrorCode MeshClosureVertices(MeshClosure *mc, PetscInt p, PetscInt max, PetscInt *nv, PetscInt verts[])
+{
+  PetscInt *cur = mc->fifo, *next, ncur = 1, depth;
+
+  PetscFunctionBeginUser;
+  if (!mc->by_depth) {
+    const PetscInt *cl;
+    PetscInt        ncl;
+
+    PetscCall(MeshClosureGet(mc, p, PETSC_TRUE, &ncl, &cl));
+    *nv = 0;
+    for (PetscInt k = 0; k < ncl; ++k)
+      if (cl[2 * k] >= mc->vstart && cl[2 * k] < mc->vend) {
+        PetscCheck(*nv < max, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Point %" PetscInt_FMT " has more than %" PetscInt_FMT " vertices", p, max);
+        verts[(*nv)++] = cl[2 * k];
+      }
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  depth = MeshClosureDepthOf(mc, p);
+  PetscCheck(depth >= 0, PETSC_COMM_SELF, PETSC_ERR_ARG_OUTOFRANGE, "Point %" PetscInt_FMT " is in no depth stratum", p);
+  next   = mc->fifo + 2 * mc->max_points; /* two lists of (point, orientation) in the walk's scratch space */
+  cur[0] = p;
+  cur[1] = 0;
+  for (PetscInt qd = depth; qd > 0; --qd) {
+    PetscInt nnext = 0, *swap;
+
+    for (PetscInt i = 0; i < ncur; ++i) {
+      const PetscInt  q = cur[2 * i], *qarr = DMPolytopeTypeGetArrangment(mc->type[qd], cur[2 * i + 1]);
+      const PetscInt *tmp, *tmp_o;
+      PetscInt        ntmp, off;
+
+      PetscCall(PetscSectionGetDof(mc->cone_section, q, &ntmp));
+      PetscCall(PetscSectionGetOffset(mc->cone_section, q, &off));
+      tmp   = &mc->cones[off];
+      tmp_o = &mc->cone_ornts[off];
+      for (PetscInt t = 0; t < ntmp; ++t) {
+        const PetscInt ip = qarr ? qarr[t * 2] : t, io = qarr ? qarr[t * 2 + 1] : 0, cp = tmp[ip];
+        PetscInt       c;
+
+        for (c = 0; c < nnext; ++c)
+          if (next[2 * c] == cp) break;
+        if (c < nnext) continue;
+        PetscCheck(nnext < mc->max_points, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Closure of %" PetscInt_FMT " exceeds %" PetscInt_FMT " points", p,
+                   mc->max_points);
+        next[2 * nnext]     = cp;
+        next[2 * nnext + 1] = DMPolytopeTypeComposeOrientation(mc->type[qd - 1], io, tmp_o[ip]);
+        ++nnext;
+      }
+    }
+    swap = cur;
+    cur  = next;
+    next = swap;
+    ncur = nnext;
+  }
+  PetscCheck(ncur <= max, PETSC_COMM_SELF, PETSC_ERR_ARG_SIZ, "Point %" PetscInt_FMT " has %" PetscInt_FMT " > %" PetscInt_FMT " vertices", p, ncur,
+             max);
+  for (PetscInt i = 0; i < ncur; ++i) verts[i] = cur[2 * i];
+  *nv = ncur;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Compares MeshClosureGet() with DMPlexGetTransitiveClosure() on every point, closure and star: the number of points
    that differ (0 on any mesh), and whether the walk by depth served (else both are PETSc's). */
 PetscErrorCode MeshClosureCheck(DM dm, PetscInt *differences, PetscBool *by_depth)
@@ -178,6 +242,23 @@ PetscErrorCode MeshClosureCheck(DM dm, PetscInt *differences, PetscBool *by_dept
             ++*differences;
             break;
           }
+      if (use_cone) { /* and the closure's vertices */
+        PetscInt nv, nref_v = 0, *verts, *ref_v;
+
+        PetscCall(PetscMalloc2(mc.max_points, &verts, n_ref, &ref_v));
+        PetscCall(MeshClosureVertices(&mc, p, mc.max_points, &nv, verts));
+        for (PetscInt i = 0; i < n_ref; ++i)
+          if (ref[2 * i] >= mc.vstart && ref[2 * i] < mc.vend) ref_v[nref_v++] = ref[2 * i];
+        if (nv != nref_v)
+          ++*differences;
+        else
+          for (PetscInt i = 0; i < nv; ++i)
+            if (verts[i] != ref_v[i]) {
+              ++*differences;
+              break;
+            }
+        PetscCall(PetscFree2(verts, ref_v));
+      }
       PetscCall(DMPlexRestoreTransitiveClosure(dm, p, use_cone, &n_ref, &ref));
     }
   PetscCall(MeshClosureDestroy(&mc));

@@ -282,21 +282,17 @@ PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, Pets
 PetscErrorCode ElasticityP1CellVertices(MeshClosure *mc, PetscSection csec, PetscSection lsec, const PetscScalar xc[], PetscInt c, PetscReal x[],
                                         PetscInt off[], PetscInt *nv)
 {
-  const PetscInt *cl, dim = mc->dim, vStart = mc->vstart, vEnd = mc->vend;
-  PetscInt        ncl;
+  const PetscInt dim = mc->dim;
+  PetscInt       verts[4];
 
   PetscFunctionBeginUser;
-  *nv = 0;
-  PetscCall(MeshClosureGet(mc, c, PETSC_TRUE, &ncl, &cl));
-  for (PetscInt k = 0; k < ncl; ++k) {
-    const PetscInt p = cl[2 * k];
-    PetscInt       coff;
+  PetscCall(MeshClosureVertices(mc, c, 4, nv, verts)); /* a simplex */
+  for (PetscInt k = 0; k < *nv; ++k) {
+    PetscInt coff;
 
-    if (p < vStart || p >= vEnd) continue;
-    PetscCall(PetscSectionGetOffset(csec, p, &coff));
-    PetscCall(PetscSectionGetOffset(lsec, p, &off[*nv]));
-    for (PetscInt d = 0; d < dim; ++d) x[*nv * dim + d] = PetscRealPart(xc[coff + d]);
-    ++*nv;
+    PetscCall(PetscSectionGetOffset(csec, verts[k], &coff));
+    PetscCall(PetscSectionGetOffset(lsec, verts[k], &off[k]));
+    for (PetscInt d = 0; d < dim; ++d) x[k * dim + d] = PetscRealPart(xc[coff + d]);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
