@@ -79,7 +79,7 @@ def test_distributed_direct_build_gives_petscs_answer(np_, extra, name):
 def test_closure_walk_is_petscs(np_, extra, name):
     """-mesh_closure_check walks every point's closure and star by depth (src/mesh/mesh_closure.c: the cell type of each
     depth instead of a label lookup per point) and compares it with DMPlexGetTransitiveClosure(), point, orientation
-    and order. The walk by depth must serve on every rank of these meshes (one cell type per depth), so the comparison
+    and order, and each closure's vertices as MeshClosureVertices() lists them (the P1 residual's). The walk by depth must serve on every rank of these meshes (one cell type per depth), so the comparison
     is between the two codes, not of PETSc with itself."""
     log, h5 = run(SQUARE + extra + ["-mesh_closure_check"], f"mesh_closure_{name}", np_=np_)
     m = re.findall(r"closure check: (\d+) differences from DMPlexGetTransitiveClosure\(\) in (\d+) closures and stars; walk by depth on (\d+) rank",
