@@ -36,15 +36,22 @@ def solver(args, name, out, ranks=1, may_fail=False, base=BASE):
 
 
 def side_by_side(runs, pairs, out):
-    """runs: {name: (args, ranks[, base options])}; each run `pairs` times, alternating; {name: (median wall, median MiB, attrs of the last, walls)}."""
-    walls, mems, attrs = {k: [] for k in runs}, {k: [] for k in runs}, {}
+    """runs: {name: (args, ranks[, base options])}; each run `pairs` times, alternating;
+    {name: (median wall, median MiB, attrs of the last, walls, attrs of each run)}."""
+    walls, mems, attrs, every = {k: [] for k in runs}, {k: [] for k in runs}, {}, {k: [] for k in runs}
     for _ in range(pairs):
         for name, spec in runs.items():
             w, m, a = solver(spec[0], name, out, spec[1], base=spec[2] if len(spec) > 2 else BASE)
             walls[name].append(w)
             mems[name].append(m)
             attrs[name] = a
-    return {k: (statistics.median(walls[k]), statistics.median(mems[k]), attrs[k], walls[k]) for k in runs}
+            every[name].append(a)
+    return {k: (statistics.median(walls[k]), statistics.median(mems[k]), attrs[k], walls[k], every[k]) for k in runs}
+
+
+def median_attr(result, key):
+    """The median of a /run attribute over the runs of one side_by_side entry."""
+    return statistics.median(float(a[key]) for a in result[4])
 
 
 def pair_range(a, b):
@@ -68,12 +75,13 @@ def measure_default(out, s, pairs):
     e, p, g = r["elastic"], r["penalty"], r["penalty_direct"]
     cmd = f"bin/signorini {' '.join(BASE)} -dm_plex_box_faces {n},{n} [-contact_method none]"
     dofs = int(e[2]["n_dofs"])
+    setup = median_attr(e, "time_setup")
     rows = [row(f"default penalty run / elastic solve <= 1.3 ({n} x {n}, 1 rank, whole process)", f"{p[0] / e[0]:.3f} ({p[0]:.3f} s / {e[0]:.3f} s; {pair_range(p, e)})",
                 p[0] / e[0] <= 1.3, cmd),
             row("with nested iteration <= 1.1", f"{p[0] / e[0]:.3f} (the default run, {int(p[2]['coarse_levels'])} coarser boxes first; "
                 f"without them, -contact_coarse_levels 0: {g[0] / e[0]:.3f}, {g[0]:.3f} s, {pair_range(g, e)})", p[0] / e[0] <= 1.1, cmd),
-            row("set-up <= 1.5 s per million unknowns (2D)", f"{e[2]['time_setup'] / dofs * 1e6:.1f} s (set-up {e[2]['time_setup']:.2f} s, {dofs} unknowns)",
-                e[2]["time_setup"] / dofs * 1e6 <= 1.5, cmd + " (time_setup in /run)")]
+            row("set-up <= 1.5 s per million unknowns (2D)", f"{setup / dofs * 1e6:.2f} s (set-up {setup:.3f} s, the median of the elastic runs; {dofs} unknowns)",
+                setup / dofs * 1e6 <= 1.5, cmd + " (time_setup in /run)")]
     for name, v in (("elastic", e), ("penalty", p)):
         kb = v[1] * 2**20 / dofs / 1e3  # MiB from /usr/bin/time, KB of 1000 bytes
         rows.append(row(f"peak memory <= 1.2 KB per unknown in 2D, {name}", f"{kb:.2f} KB ({v[1]:.0f} MiB whole process)", kb <= 1.2, cmd))
@@ -201,6 +209,12 @@ def measure_parallel(out, s, pairs):
     dm3 = int(rm["3d_mg_np2"][2]["n_dofs"])
     sm2, sm3 = rm["2d_mg_np1"][0] / rm["2d_mg_np2"][0], rm["3d_mg_np1"][0] / rm["3d_mg_np2"][0]
     t3 = min(r3["3d_np2"][0], rm["3d_mg_np2"][0])
+    # the memory system: the STREAM-like triad of -perf_bandwidth (three 64 MB vectors per rank, whatever the mesh) on 1
+    # and 2 ranks, alternated 3 times; a solve bound by the memory bandwidth speeds up by about its ratio
+    tb = ["-dm_plex_box_faces", "32,32", "-contact_method", "none", "-perf_bandwidth"]
+    rt = side_by_side({"triad_np1": (tb, 1), "triad_np2": (tb, 2)}, 3, out)
+    tri1, tri2 = median_attr(rt["triad_np1"], "bandwidth_triad_gbs"), median_attr(rt["triad_np2"], "bandwidth_triad_gbs")
+    tri_each = [a2["bandwidth_triad_gbs"] / a1["bandwidth_triad_gbs"] for a1, a2 in zip(rt["triad_np1"][4], rt["triad_np2"][4])]
     return [row("3D penalty, eps = h, 1M unknowns on 2 ranks <= 30 s", f"GAMG {r3['3d_np2'][0]:.1f} s ({d3} unknowns, the box of {n3}^3); geometric MG "
                 f"{rm['3d_mg_np2'][0]:.1f} s ({dm3} unknowns, {m3}^3 refined 3 times, mg.yaml)", t3 <= 30.0,
                 f"mpiexec -n 2 bin/signorini ... -dm_plex_dim 3 -dm_plex_box_faces {n3},{n3},{n3}; ... mg.yaml -dm_plex_box_faces {m3},{m3},{m3} -contact_grid_sequence 3"),
@@ -209,7 +223,10 @@ def measure_parallel(out, s, pairs):
                 f"{s2d:.2f}, {r2['2d_np1_direct'][0]:.1f} s), 3D {s3:.2f} ({r3['3d_np1'][0]:.1f} s / {r3['3d_np2'][0]:.1f} s); geometric MG: "
                 f"2D {sm2:.2f} ({rm['2d_mg_np1'][0]:.1f} s / {rm['2d_mg_np2'][0]:.1f} s), 3D {sm3:.2f} ({rm['3d_mg_np1'][0]:.1f} s / {rm['3d_mg_np2'][0]:.1f} s)",
                 max(min(s2, s3), min(sm2, sm3)) >= 1.8,
-                f"bin/signorini ... -dm_plex_box_faces {n4},{n4} on 1 and 2 ranks, 3D as above; mg.yaml: {m2},{m2} -contact_grid_sequence 5, 3D as above")]
+                f"bin/signorini ... -dm_plex_box_faces {n4},{n4} on 1 and 2 ranks, 3D as above; mg.yaml: {m2},{m2} -contact_grid_sequence 5, 3D as above"),
+            row("the memory bandwidth on 2 ranks over 1 rank (a figure: the speed-up a solve bound by the bandwidth can reach)",
+                f"STREAM-like triad {tri2 / tri1:.2f} ({tri2:.1f} GB/s / {tri1:.1f} GB/s, medians of 3 runs each; pairs {min(tri_each):.2f} to {max(tri_each):.2f})", None,
+                "mpiexec -n 1|2 bin/signorini ... -dm_plex_box_faces 32,32 -contact_method none -perf_bandwidth")]
 
 
 def measure_mg(out, s, pairs):
