@@ -372,6 +372,31 @@ def test_nested_iteration_levels(extra, levels):
         assert max_diff(h5, direct) < 1e-8
 
 
+@pytest.mark.parametrize("solver_file", ["gamg.yaml", "mg.yaml"])
+def test_nested_iteration_on_two_ranks_builds_row_slabs_that_nest(solver_file):
+    """On several ranks each box is built in slabs of rows (-partitioner box); where every slab boundary is a row of the
+    coarsest box (its rows divisible by the ranks), a rank's fine slab refines its coarse slab and the default nests as
+    on one rank (MeshCreateBoxLevel, the geometric multigrid's interpolations too): the same levels, the answer of the
+    one-rank nested run and of the two-rank direct run to the solver's tolerance, few Newton steps on the final box.
+    Where the rows do not divide (128 on 3 ranks), the default solves directly and an explicit count is refused."""
+    base = SQUARE + ["-dm_plex_box_faces", "128,128", "-options_file", f"options/solvers/{solver_file}", "-snes_rtol", "1e-9"]
+    _, np2 = run(base, f"nested_np2_{solver_file}", np_=2)
+    _, np1 = run(base, f"nested_np1_{solver_file}")
+    a2, a1 = load(np2)[0], load(np1)[0]
+    assert a2["coarse_levels"] == a1["coarse_levels"] >= 1 and a2["converged"] == 1 and a2["n_dofs"] == a1["n_dofs"]
+    assert len(solves(np2)["level"]) == a2["coarse_levels"] + 1
+    assert max_diff(np2, np1) < 1e-8
+    assert a2["active_vertices"] == a1["active_vertices"] and abs(a2["contact_force"] - a1["contact_force"]) <= 1e-8 * abs(a1["contact_force"])
+    if solver_file == "gamg.yaml":
+        _, direct = run(base + ["-contact_coarse_levels", 0], "nested_np2_direct", np_=2)
+        assert max_diff(np2, direct) < 1e-8
+        assert a2["newton_its"] <= 4 and a2["newton_its"] < load(direct)[0]["newton_its"]
+        _, np3 = run(base, "nested_np3", np_=3)
+        assert load(np3)[0]["coarse_levels"] == 0 and max_diff(np3, np1) < 1e-8
+        log, _ = run(base + ["-contact_coarse_levels", 1], "nested_np3_refused", np_=3, expect_rc=None)
+        assert "-contact_coarse_levels 1 on 3 ranks: the coarsest box's 64 rows are not divisible by the number of ranks" in log, log[-2000:]
+
+
 def test_ew_guard_loosens_only_the_last_solves_and_keeps_the_answer():
     """-contact_ew_guard (default 0.5) only loosens Eisenstat-Walker's terms near the solution: the answer is the one
     of PETSc's terms (-contact_ew_guard 0) to solver tolerance, with no more CG iterations, and the final residual is

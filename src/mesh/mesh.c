@@ -122,20 +122,29 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
     PetscCall(PetscSNPrintf(what, sizeof(what), "-dm_plex_box_faces with %" PetscInt_FMT " refinement(s)", refine + later_refinements));
     PetscCall(MeshCheckSize(comm, dim, ncells, what));
   }
-  { /* nested iteration to the box of the options: the box built first has 2^coarse times fewer cells per side */
-    const PetscBool nests = (PetscBool)(!has_file && simplex && refine == 0 && size == 1 && dim == 2); /* 3D: Kuhn boxes do not nest */
+  { /* nested iteration to the box of the options: the box built first has 2^coarse times fewer cells per side. On several
+       ranks each box is built in slabs of its rows (-partitioner box), and the boxes nest rank by rank where every slab
+       boundary is a row of the coarsest box: its rows divisible by the number of ranks */
+    const PetscBool nests = (PetscBool)(!has_file && simplex && refine == 0 && dim == 2 &&
+                                        (size == 1 || partitioner == MESH_PARTITIONER_BOX)); /* 3D: Kuhn boxes do not nest */
 
     if (coarse_request > 0) {
       PetscCheck(nests, comm, PETSC_ERR_USER_INPUT,
-                 "-contact_coarse_levels %" PetscInt_FMT " needs the 2D simplex box (-dm_plex_box_faces) on one rank without -dm_refine",
+                 "-contact_coarse_levels %" PetscInt_FMT
+                 " needs the 2D simplex box (-dm_plex_box_faces) without -dm_refine, and on several ranks -partitioner box",
                  coarse_request);
       for (PetscInt d = 0; d < dim; ++d)
         PetscCheck(faces[d] % (1 << coarse_request) == 0, comm, PETSC_ERR_USER_INPUT,
                    "-contact_coarse_levels %" PetscInt_FMT ": -dm_plex_box_faces %" PetscInt_FMT " is not divisible by 2^%" PetscInt_FMT,
                    coarse_request, faces[d], coarse_request);
+      PetscCheck((faces[1] >> coarse_request) % size == 0, comm, PETSC_ERR_USER_INPUT,
+                 "-contact_coarse_levels %" PetscInt_FMT " on %d ranks: the coarsest box's %" PetscInt_FMT
+                 " rows are not divisible by the number of ranks",
+                 coarse_request, (int)size, faces[1] >> coarse_request);
       coarse = coarse_request;
     } else if (coarse_request < 0 && nests) {
       for (PetscBool halves = PETSC_TRUE; halves && coarse < 8;) {
+        halves = (PetscBool)((faces[1] >> (coarse + 1)) % size == 0);
         for (PetscInt d = 0; d < dim; ++d)
           halves = (PetscBool)(halves && faces[d] % (2 << coarse) == 0 && faces[d] >> (coarse + 1) >= coarse_min_faces);
         if (halves) ++coarse;
@@ -191,7 +200,10 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
     PetscCall(CompatCreateBoxMesh(comm, dim, PETSC_FALSE, faces, lower, upper, NULL, PETSC_TRUE, dm));
   {
     PetscCall(PetscMemzero(box, sizeof(*box)));
-    box->is_box        = (PetscBool)(!has_file && simplex && refine == 0 && size == 1 && dim == 2); /* 3D: Kuhn boxes do not nest as refinements */
+    /* 3D: Kuhn boxes do not nest as refinements; several ranks: slabs of rows of this box, which nest in the finer boxes' */
+    box->is_box =
+        (PetscBool)(!has_file && simplex && refine == 0 && dim == 2 && (size == 1 || (partitioner == MESH_PARTITIONER_BOX && faces[1] % size == 0)));
+    box->distributed   = (PetscBool)(size > 1);
     box->coarse_levels = coarse;
     box->dim           = dim;
     for (PetscInt d = 0; d < dim; ++d) {
