@@ -159,20 +159,21 @@ static PetscErrorCode AssemblyP1CellVertices(DM dm, PetscInt **cverts)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The block size DMCreateMatrix() gives: the dofs per point, 1 if a point is partially constrained or the points differ. */
+/* The block size DMCreateMatrix() gives: the dofs per point, 1 if a point is partially constrained or the points differ
+   (scanned over the vertices, the only points with P1 dofs). */
 static PetscErrorCode AssemblyP1BlockSize(DM dm, PetscInt *bs)
 {
   PetscSection gsection;
-  PetscInt     pStart, pEnd, b = -1, local[2], minmax[2];
+  PetscInt     vStart, vEnd, b = -1, local[2], minmax[2];
 
   PetscFunctionBeginUser;
   PetscCall(DMGetGlobalSection(dm, &gsection));
-  PetscCall(DMPlexGetDepthStratum(dm, 0, &pStart, &pEnd)); /* the vertices: the other points of a P1 field have no dofs */
-  for (PetscInt p = pStart; p < pEnd; ++p) {
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd)); /* the vertices: the other points of a P1 field have no dofs */
+  for (PetscInt v = vStart; v < vEnd; ++v) {
     PetscInt dof, cdof, bdof;
 
-    PetscCall(PetscSectionGetDof(gsection, p, &dof));
-    PetscCall(PetscSectionGetConstraintDof(gsection, p, &cdof));
+    PetscCall(PetscSectionGetDof(gsection, v, &dof));
+    PetscCall(PetscSectionGetConstraintDof(gsection, v, &cdof));
     dof  = dof < 0 ? -(dof + 1) : dof;
     bdof = cdof && (dof - cdof) ? 1 : dof;
     if (dof) {
