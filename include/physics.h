@@ -51,6 +51,7 @@ PetscErrorCode PenaltySetUp(DM dm, AppCtx *user);
 PetscErrorCode PenaltyAddResidual(DM dm, AppCtx *user, Vec X, Vec F);
 PetscErrorCode PenaltyAddJacobian(DM dm, AppCtx *user, Vec X, Mat J);
 PetscErrorCode PenaltySameActivity(DM dm, AppCtx *user, Vec X, Vec Y, PetscBool *same);
+PetscErrorCode PenaltyCopyRows(Mat A, PetscInt n, const PetscInt rows[], PetscInt **ptr, PetscInt **cols, PetscScalar **vals);
 PetscErrorCode PenaltySaveBulkRows(DM dm, AppCtx *user);
 PetscErrorCode PenaltyFreeBulkRows(AppCtx *user);
 PetscErrorCode PenaltyJacobianInK(DM dm, AppCtx *user, Vec X);

@@ -59,7 +59,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
 {
   PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
   PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
-  PetscBool           simplex, has_file, dim_set, parallel_read = PETSC_FALSE, petsc_interpolate, check_interpolation, check_closures;
+  PetscBool           simplex, has_file, dim_set, nests, parallel_read = PETSC_FALSE, petsc_interpolate, check_interpolation, check_closures;
   char                filename[PETSC_MAX_PATH_LEN] = "";
   MeshPartitionerType partitioner;
   PetscMPIInt         size;
@@ -122,12 +122,11 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
     PetscCall(PetscSNPrintf(what, sizeof(what), "-dm_plex_box_faces with %" PetscInt_FMT " refinement(s)", refine + later_refinements));
     PetscCall(MeshCheckSize(comm, dim, ncells, what));
   }
+  /* the boxes of nested iteration (3D: Kuhn boxes do not nest); on several ranks built in slabs of rows */
+  nests = (PetscBool)(!has_file && simplex && refine == 0 && dim == 2 && (size == 1 || partitioner == MESH_PARTITIONER_BOX));
   { /* nested iteration to the box of the options: the box built first has 2^coarse times fewer cells per side. On several
        ranks each box is built in slabs of its rows (-partitioner box), and the boxes nest rank by rank where every slab
        boundary is a row of the coarsest box: its rows divisible by the number of ranks */
-    const PetscBool nests = (PetscBool)(!has_file && simplex && refine == 0 && dim == 2 &&
-                                        (size == 1 || partitioner == MESH_PARTITIONER_BOX)); /* 3D: Kuhn boxes do not nest */
-
     if (coarse_request > 0) {
       PetscCheck(nests, comm, PETSC_ERR_USER_INPUT,
                  "-contact_coarse_levels %" PetscInt_FMT
@@ -200,10 +199,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
     PetscCall(CompatCreateBoxMesh(comm, dim, PETSC_FALSE, faces, lower, upper, NULL, PETSC_TRUE, dm));
   {
     PetscCall(PetscMemzero(box, sizeof(*box)));
-    /* 3D: Kuhn boxes do not nest as refinements; several ranks: slabs of rows of this box, which nest in the finer boxes' */
-    box->is_box =
-        (PetscBool)(!has_file && simplex && refine == 0 && dim == 2 && (size == 1 || (partitioner == MESH_PARTITIONER_BOX && faces[1] % size == 0)));
-    box->distributed   = (PetscBool)(size > 1);
+    box->is_box        = (PetscBool)(nests && faces[1] % size == 0); /* several ranks: slabs of rows of this box nest in the finer boxes' */
     box->coarse_levels = coarse;
     box->dim           = dim;
     for (PetscInt d = 0; d < dim; ++d) {

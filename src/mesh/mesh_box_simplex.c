@@ -211,7 +211,7 @@ PetscErrorCode MeshCreateBoxLevel(DM coarse, const MeshBox *box, PetscInt level,
     ff[d] = 2 * cf[d];
     nlat *= cf[d] + 1;
   }
-  PetscCall(MeshCreateSimplexBox(comm, dim, ff, box->lower, box->upper, box->distributed, PETSC_FALSE, PETSC_FALSE, fine)); /* slabs nest */
+  PetscCall(MeshCreateSimplexBox(comm, dim, ff, box->lower, box->upper, PETSC_TRUE, PETSC_FALSE, PETSC_FALSE, fine)); /* in slabs on several ranks */
   PetscCall(DMGetMatType(coarse, &mtype));
   PetscCall(DMSetMatType(*fine, mtype));
   PetscCall(PetscObjectSetName((PetscObject)*fine, "mesh"));

@@ -308,6 +308,37 @@ PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* A's values in the rows rows[0 .. n-1] (global numbers, owned), in CSR arrays allocated together (PetscFree3(*ptr,
+   *cols, *vals)): row i's columns and values at ptr[i] .. ptr[i + 1] - 1. The contact rows of K here, and those of the
+   finest GAMG prolongator (src/solver/pc_reuse.c). */
+PetscErrorCode PenaltyCopyRows(Mat A, PetscInt n, const PetscInt rows[], PetscInt **ptr, PetscInt **cols, PetscScalar **vals)
+{
+  PetscInt nnz = 0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt r = 0; r < n; ++r) {
+    PetscInt ncols;
+
+    PetscCall(MatGetRow(A, rows[r], &ncols, NULL, NULL));
+    nnz += ncols;
+    PetscCall(MatRestoreRow(A, rows[r], &ncols, NULL, NULL));
+  }
+  PetscCall(PetscMalloc3(n + 1, ptr, nnz, cols, nnz, vals));
+  (*ptr)[0] = 0;
+  for (PetscInt r = 0; r < n; ++r) {
+    const PetscInt    *c;
+    const PetscScalar *v;
+    PetscInt           ncols;
+
+    PetscCall(MatGetRow(A, rows[r], &ncols, &c, &v));
+    PetscCall(PetscArraycpy(&(*cols)[(*ptr)[r]], c, ncols));
+    PetscCall(PetscArraycpy(&(*vals)[(*ptr)[r]], v, ncols));
+    (*ptr)[r + 1] = (*ptr)[r] + ncols;
+    PetscCall(MatRestoreRow(A, rows[r], &ncols, &c, &v));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* One matrix for the bulk operator and the penalty Jacobian: J = K + P differs from K only in the rows of the contact
    dofs (P couples contact dofs only), so K's values in those rows are kept (a few hundred rows) and J is made in K
    itself: those rows put back, P added. The residual computes K u with K's own rows there (PenaltyBulkMult()), and
@@ -317,37 +348,21 @@ PetscErrorCode PenaltySaveBulkRows(DM dm, AppCtx *user)
 {
   const ContactSet *cs = &user->prob.cset;
   Problem          *pb = &user->prob;
-  PetscInt          dim, rstart, n = 0, nnz = 0;
+  PetscInt          dim, rstart, n = 0, nnz;
 
   PetscFunctionBeginUser;
   PetscCall(PenaltyFreeBulkRows(user));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(MatGetOwnershipRange(pb->K, &rstart, NULL));
   for (PetscInt i = 0; i < cs->n * dim; ++i) n += cs->dof[i] >= 0;
-  PetscCall(PetscMalloc2(n, &pb->bulk_rows, n + 1, &pb->bulk_ptr));
+  PetscCall(PetscMalloc1(n, &pb->bulk_rows));
   n = 0;
   for (PetscInt i = 0; i < cs->n * dim; ++i)
     if (cs->dof[i] >= 0) pb->bulk_rows[n++] = rstart + cs->dof[i];
-  pb->bulk_ptr[0] = 0;
-  for (PetscInt r = 0; r < n; ++r) {
-    PetscInt ncols;
-
-    PetscCall(MatGetRow(pb->K, pb->bulk_rows[r], &ncols, NULL, NULL));
-    nnz += ncols;
-    pb->bulk_ptr[r + 1] = nnz;
-    PetscCall(MatRestoreRow(pb->K, pb->bulk_rows[r], &ncols, NULL, NULL));
-  }
-  PetscCall(PetscMalloc2(nnz, &pb->bulk_cols, nnz, &pb->bulk_vals));
+  PetscCall(PenaltyCopyRows(pb->K, n, pb->bulk_rows, &pb->bulk_ptr, &pb->bulk_cols, &pb->bulk_vals));
+  nnz = pb->bulk_ptr[n];
   PetscCall(PetscMalloc1(n, &pb->bulk_diag));
-  for (PetscInt r = 0; r < n; ++r) {
-    const PetscInt    *cols;
-    const PetscScalar *vals;
-    PetscInt           ncols;
-
-    PetscCall(MatGetRow(pb->K, pb->bulk_rows[r], &ncols, &cols, &vals));
-    PetscCall(PetscArraycpy(&pb->bulk_cols[pb->bulk_ptr[r]], cols, ncols));
-    PetscCall(PetscArraycpy(&pb->bulk_vals[pb->bulk_ptr[r]], vals, ncols));
-    PetscCall(MatRestoreRow(pb->K, pb->bulk_rows[r], &ncols, &cols, &vals));
+  for (PetscInt r = 0; r < n; ++r) { /* the diagonal entry of each row */
     for (pb->bulk_diag[r] = pb->bulk_ptr[r]; pb->bulk_diag[r] < pb->bulk_ptr[r + 1] && pb->bulk_cols[pb->bulk_diag[r]] != pb->bulk_rows[r];
          ++pb->bulk_diag[r]) {
     }
@@ -382,8 +397,8 @@ PetscErrorCode PenaltyFreeBulkRows(AppCtx *user)
   Problem *pb = &user->prob;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscFree2(pb->bulk_rows, pb->bulk_ptr));
-  PetscCall(PetscFree2(pb->bulk_cols, pb->bulk_vals));
+  PetscCall(PetscFree(pb->bulk_rows));
+  PetscCall(PetscFree3(pb->bulk_ptr, pb->bulk_cols, pb->bulk_vals));
   PetscCall(PetscFree(pb->bulk_lcols));
   PetscCall(PetscFree(pb->bulk_diag));
   PetscCall(VecScatterDestroy(&pb->bulk_scatter));

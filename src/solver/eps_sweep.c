@@ -26,9 +26,11 @@ static PetscErrorCode ExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, V
   PetscCall(VecDuplicate(u, &guess));
   PetscCall(VecWAXPY(guess, factor, dir, u));
   PetscCall(PenaltySameActivity(dm, user, u, guess, &same));
-  PetscCall(SolverResidualNorm(snes, user, u, &f_last));
-  PetscCall(SolverResidualNorm(snes, user, guess, &f_guess));
-  if ((same && f_guess < f_last) || f_guess < relaxed * f_last) PetscCall(VecCopy(guess, u));
+  if (same || relaxed > 0.0) {
+    PetscCall(SolverResidualNorm(snes, user, u, &f_last));
+    PetscCall(SolverResidualNorm(snes, user, guess, &f_guess));
+    if ((same && f_guess < f_last) || f_guess < relaxed * f_last) PetscCall(VecCopy(guess, u));
+  }
   PetscCall(VecDestroy(&guess));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

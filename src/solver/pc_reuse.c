@@ -182,31 +182,11 @@ static PetscErrorCode ProlongatorRowsSave(PC pc, AppCtx *user)
 {
   Problem *pb = &user->prob;
   PcReuse *r  = &pb->pc_reuse;
-  PetscInt n  = 0;
 
   PetscFunctionBeginUser;
   PetscCall(PCMGGetInterpolation(pc, r->nlevels - 1, &r->rfine));
   PetscCall(PetscObjectReference((PetscObject)r->rfine));
-  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
-    PetscInt ncols;
-
-    PetscCall(MatGetRow(r->rfine, pb->bulk_rows[row], &ncols, NULL, NULL));
-    n += ncols;
-    PetscCall(MatRestoreRow(r->rfine, pb->bulk_rows[row], &ncols, NULL, NULL));
-  }
-  PetscCall(PetscMalloc3(pb->nbulk_rows + 1, &r->rrow_ptr, n, &r->rrow_cols, n, &r->rrow_vals));
-  r->rrow_ptr[0] = 0;
-  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
-    const PetscInt    *cols;
-    const PetscScalar *vals;
-    PetscInt           ncols;
-
-    PetscCall(MatGetRow(r->rfine, pb->bulk_rows[row], &ncols, &cols, &vals));
-    PetscCall(PetscArraycpy(&r->rrow_cols[r->rrow_ptr[row]], cols, ncols));
-    PetscCall(PetscArraycpy(&r->rrow_vals[r->rrow_ptr[row]], vals, ncols));
-    r->rrow_ptr[row + 1] = r->rrow_ptr[row] + ncols;
-    PetscCall(MatRestoreRow(r->rfine, pb->bulk_rows[row], &ncols, &cols, &vals));
-  }
+  PetscCall(PenaltyCopyRows(r->rfine, pb->nbulk_rows, pb->bulk_rows, &r->rrow_ptr, &r->rrow_cols, &r->rrow_vals));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
