@@ -101,7 +101,7 @@ def test_sweep_starts_its_first_new_value_on_the_tangent():
     """The first new value of a sweep has no two solutions to extrapolate from: its start follows the solution path's
     tangent at the last eps, du/deps = J^-1 P(u) / eps, one loose CG solve with the last Newton step's Jacobian and
     preconditioner, whose iterations count in ksp_its_total beside those of /solves. On the 256 x 256 square (Gauss rule,
-    GAMG) the guess lowers the residual 140 times though a few Gauss points flip, so it is taken: the value takes at
+    GAMG) the guess lowered the residual 140 times though a few Gauss points flip (a temporary print, not asserted here), so it is taken: the value takes at
     most 4 Newton steps (5 and 40 CG iterations from the last solution, 4 and 26 from the tangent), and the sweep still
     ends at the direct solution."""
     args = SQUARE + ["-dm_plex_box_faces", "256,256", "-options_file", "options/solvers/gamg.yaml"]

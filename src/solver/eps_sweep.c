@@ -40,7 +40,7 @@ static PetscErrorCode ExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, V
    du/deps = J^-1 P(u; eps) / eps, J the Jacobian, which K and the SNES's preconditioner still hold from the last Newton
    step. dir = J^-1 P(u; eps_new), solved loosely (CG to 1e-2, the preconditioner shared); the step to eps_new is
    (eps_new - eps) du/deps = dir (eps_new - eps) eps_new / eps^2. Its CG iterations count in ksp_its_total. *ok is false
-   if CG did not converge. At 256 x 256 (h to h/10) the guess's residual is 140 times lower than the last solution's,
+   if CG did not converge. At 256 x 256 (h to h/10) the guess's residual was 140 times lower than the last solution's (a temporary print),
    though a few Gauss points at the edge of the contact zone flip: it is taken where its residual is 100 times lower
    (4 Newton steps and 26 CG iterations instead of 5 and 40, and 3 for the tangent); the secant's rule (the same
    active points) would refuse it. */
