@@ -120,6 +120,7 @@ typedef struct {
   PetscInt   grid_sequence;      /* solve on the mesh and on this many uniform refinements of it, each from the last */
   PetscInt   coarse_levels;      /* nested iteration to the mesh: this many coarser boxes solved first (-1: automatic) */
   PetscReal  coarse_rtol;        /*   Newton's relative tolerance there */
+  PetscBool  coarse_mg;          /*   solved with the geometric multigrid of the boxes below (resolved by GridSequenceCoarseRequest()) */
   PetscReal  ew_guard;           /* Eisenstat-Walker's terms no smaller than this times Newton's target / |F| */
   PetscReal *eps0_sweep;         /* eps0 values solved in turn on the final mesh, each from the last solution (any number) */
   PetscInt   n_sweep;

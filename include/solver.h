@@ -25,17 +25,19 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
 PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes);
 PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
 /* The coarsest box of nested iteration by default (-contact_coarse_levels -1) has at least this many cells per side:
-   with an algebraic multigrid, each coarser box costs its own hierarchy's build; with the geometric one (-pc_type mg)
-   a coarser box costs little and is one more level of the hierarchy (a smaller coarse factorization). */
+   where each box builds its own preconditioner (a factorization, or an algebraic multigrid with -contact_coarse_mg 0),
+   each coarser box costs that build; with the geometric multigrid (-pc_type mg, or the coarser boxes' solver of
+   -contact_coarse_mg) a coarser box costs little and is one more level of the hierarchy (a smaller coarse factorization). */
 #define GRID_SEQUENCE_MIN_FACES 64
 #define GRID_SEQUENCE_MIN_FACES_MG 16
-PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, const RunOptions *opt, PetscInt *request, PetscInt *min_faces);
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, RunOptions *opt, PetscInt *request, PetscInt *min_faces);
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 
 /* multigrid.c */
 PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt vertex_source[], AppCtx *user);
 PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user);
+PetscErrorCode MultigridSetCoarseBoxSolver(KSP ksp, const AppCtx *user);
 PetscErrorCode MultigridDestroy(Multigrid *mg);
 
 /* ew_forcing.c */

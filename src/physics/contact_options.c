@@ -84,7 +84,7 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscCall(
       PetscOptionsInt("-contact_coarse_levels",
                       "Nested iteration to the mesh of the options: solve first on this many coarser boxes, each with half the cells per "
-                      "side of the next, each from the last; -1: as many as keep 64 cells per side (16 with -pc_type mg), where the mesh is the "
+                      "side of the next, each from the last; -1: as many as keep 64 cells per side (16 with -pc_type mg or -contact_coarse_mg), where the mesh is the "
                       "2D P1 simplex box on one rank and the method penalty (or the elastic solve with -pc_type mg), else 0",
                       NULL, opts->coarse_levels, &opts->coarse_levels, NULL));
   opts->coarse_rtol = 1e-4;
@@ -92,6 +92,12 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
                              "Newton's relative tolerance on the coarser boxes of -contact_coarse_levels (their solutions are only initial guesses; "
                              "the final mesh keeps -snes_rtol)",
                              NULL, opts->coarse_rtol, &opts->coarse_rtol, NULL));
+  opts->coarse_mg = PETSC_TRUE;
+  PetscCall(PetscOptionsBool("-contact_coarse_mg",
+                             "With an iterative -pc_type other than mg (gamg, hypre, ...): the coarser boxes of -contact_coarse_levels are solved by "
+                             "CG with the geometric multigrid of the boxes below them (options prefix -contact_coarse_), the final mesh by the "
+                             "options' solver; 0: every box by the options' solver",
+                             NULL, opts->coarse_mg, &opts->coarse_mg, NULL));
   opts->ew_guard = 0.5;
   PetscCall(PetscOptionsReal("-contact_ew_guard",
                              "Inexact Newton (Eisenstat-Walker, version 2): no linear solve tighter than this times Newton's stopping residual / |F| "

@@ -60,24 +60,25 @@ static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, const RunOptions *opt, PetscInt *request, PetscInt *min_faces)
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, RunOptions *opt, PetscInt *request, PetscInt *min_faces)
 {
-  const PetscInt k = opt->contact.coarse_levels;
+  const PetscInt k           = opt->contact.coarse_levels;
+  char           pc_type[64] = "";
+  PetscBool      given, is_mg, is_factor;
 
   PetscFunctionBeginUser;
   PetscCheck(k <= 0 || opt->degree == 1, comm, PETSC_ERR_USER_INPUT,
              "-contact_coarse_levels %" PetscInt_FMT " needs P1 displacements, got -displacement_petscspace_degree %" PetscInt_FMT, k, opt->degree);
-  *request   = k;
-  *min_faces = GRID_SEQUENCE_MIN_FACES;
-  if (k < 0) { /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels) */
-    char      pc_type[64] = "";
-    PetscBool is_mg;
-
-    PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc_type, sizeof(pc_type), NULL));
-    PetscCall(PetscStrcmp(pc_type, PCMG, &is_mg));
-    if (is_mg) *min_faces = GRID_SEQUENCE_MIN_FACES_MG;
-    if (!(opt->contact.method == CONTACT_PENALTY || (opt->contact.method == CONTACT_NONE && is_mg)) || opt->degree != 1) *request = 0;
-  }
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc_type, sizeof(pc_type), &given));
+  PetscCall(PetscStrcmp(pc_type, PCMG, &is_mg));
+  PetscCall(PetscStrInList(pc_type, PCLU "," PCCHOLESKY, ',', &is_factor));
+  /* -contact_coarse_mg: with an iterative preconditioner that is not already the boxes' multigrid (without -pc_type, the
+     default is MUMPS's factorization, which a coarser box's small matrix does not make expensive) */
+  opt->contact.coarse_mg = (PetscBool)(opt->contact.coarse_mg && given && !is_mg && !is_factor);
+  *request               = k;
+  *min_faces             = (is_mg || opt->contact.coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
+  /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels) */
+  if (k < 0 && (!(opt->contact.method == CONTACT_PENALTY || (opt->contact.method == CONTACT_NONE && is_mg)) || opt->degree != 1)) *request = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -3,7 +3,9 @@
    from the global vector of the coarser mesh to that of the finer one (P1/Q1: a fine vertex gets the mean of the values
    at the vertices of its source point, exact for nested spaces); the problem on the finest mesh so far then has a PCMG
    of one level per mesh, with Galerkin coarse operators (P^T A P: the penalty rows included, whatever the coarser
-   meshes' own eps), and the coarsest mesh's operator is solved by the PCMG's coarse solver (LU by default). */
+   meshes' own eps), and the coarsest mesh's operator is solved by the PCMG's coarse solver (LU by default).
+   -contact_coarse_mg: with another iterative preconditioner, the coarser boxes of nested iteration are solved by this
+   geometric multigrid under the options prefix contact_coarse_, and the final mesh by the options' preconditioner. */
 #include "mesh.h"
 #include "solver.h"
 
@@ -26,7 +28,10 @@ PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt v
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
-  if (!is_mg || user->opt.degree != 1) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!is_mg || user->opt.degree != 1) { /* the coarser meshes' interpolations, if any (-contact_coarse_mg), serve no longer */
+    PetscCall(MultigridDestroy(mg));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   PetscCheck(mg->n < MULTIGRID_MAX_LEVELS, comm, PETSC_ERR_USER_INPUT, "-pc_type mg: at most %d nested meshes", MULTIGRID_MAX_LEVELS + 1);
   PetscCall(DMGetDimension(fine, &dim));
   PetscCall(DMGetLocalSection(coarse, &cl));
@@ -138,8 +143,34 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
     PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)pc), &size));
     PetscCall(PCSetType(cpc, size > 1 ? PCREDUNDANT : PCLU));
   }
+  if (user->opt.contact.coarse_mg && user->prob.level < user->opt.box.coarse_levels) /* the smoothers of mg.yaml; options may change them */
+    for (PetscInt l = 1; l <= mg->n; ++l) {
+      KSP smoother;
+      PC  spc;
+
+      PetscCall(PCMGGetSmoother(pc, l, &smoother));
+      PetscCall(KSPGetPC(smoother, &spc));
+      PetscCall(PCSetType(spc, PCJACOBI));
+    }
   PetscCall(PetscOptionsHasName(NULL, prefix, "-pc_mg_galerkin", &set));
   if (!set) PetscCall(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -contact_coarse_mg, on a coarser box of nested iteration: the linear solver is CG with the geometric multigrid of the
+   boxes solved so far (MultigridSetUpPC() gives it its levels before each solve; Chebyshev smoothers with point Jacobi,
+   LU on the coarsest box), read from the options under the prefix contact_coarse_ (-contact_coarse_ksp_rtol,
+   -contact_coarse_mg_levels_ksp_max_it, ...): the options without it are the final mesh's. */
+PetscErrorCode MultigridSetCoarseBoxSolver(KSP ksp, const AppCtx *user)
+{
+  PC pc;
+
+  PetscFunctionBeginUser;
+  if (!user->opt.contact.coarse_mg || user->prob.level >= user->opt.box.coarse_levels) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(KSPSetOptionsPrefix(ksp, "contact_coarse_"));
+  PetscCall(KSPSetType(ksp, KSPCG));
+  PetscCall(KSPGetPC(ksp, &pc));
+  PetscCall(PCSetType(pc, PCMG));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

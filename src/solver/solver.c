@@ -337,6 +337,7 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscCall(SNESSetConvergenceTest(*snes, SolverConverged, user, NULL));
   PetscCall(SNESGetKSP(*snes, &ksp));
   PetscCall(SolverSetDefaultLinearSolver(ksp, user));
+  PetscCall(MultigridSetCoarseBoxSolver(ksp, user)); /* -contact_coarse_mg on a coarser box */
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(SNESMonitorSet(*snes, ContactMonitor, user, NULL));
   PetscCall(SNESSetFromOptions(*snes));
