@@ -132,8 +132,9 @@ def test_gamg_hierarchy_update_is_the_rebuild(np_, eps0):
     """-contact_pc_update (the default with GAMG): the hierarchy is built once, and each Newton step adds to every coarse
     operator the Galerkin product of the Jacobian's change (in the contact rows only). -contact_pc_update_check compares
     each updated coarse operator with R^T A_f R computed in full, as a rebuild does; and the answer is the one of a
-    rebuild at every changed step. eps = 1e-6 h goes through the continuation's changes of eps, on 2 ranks."""
-    args = SQUARE + ["-dm_plex_box_faces", "64,64", "-penalty_eps0", eps0, "-options_file", "options/solvers/gamg.yaml"]
+    rebuild at every changed step. eps = 1e-6 h goes through the continuation's changes of eps, on 2 ranks. Without
+    nesting (-contact_coarse_levels 0): from a zero guess Newton takes enough steps to update several times."""
+    args = SQUARE + ["-dm_plex_box_faces", "64,64", "-penalty_eps0", eps0, "-options_file", "options/solvers/gamg.yaml", "-contact_coarse_levels", 0]
     out, upd = run(args + ["-contact_pc_update_check"], f"pc_update_{np_}_{eps0}", np_=np_)
     _, rebuilt = run(args + ["-contact_pc_update", "0", "-contact_pc_reuse_changes", "0"], f"pc_rebuilt_{np_}_{eps0}", np_=np_)
     a, _ = load(upd)
@@ -151,8 +152,9 @@ def test_truncated_prolongator_keeps_gamg_iterations_flat_in_eps(np_):
     """-contact_pc_update_truncate (10 by default): the updated hierarchy's finest prolongator has zero rows at the
     contact dofs whose penalty exceeds 10 times K's diagonal, so their 1/eps does not stiffen the coarse operators.
     At eps = 1e-8 h the CG iterations per Newton step stay within 1.5 times those at eps = h, where without the
-    truncation they double; the answer is the untruncated one. On 2 ranks the mirrored columns cross the ranks."""
-    args = SQUARE + ["-dm_plex_box_faces", "96,96", "-options_file", "options/solvers/gamg.yaml"]
+    truncation they double; the answer is the untruncated one. On 2 ranks the mirrored columns cross the ranks.
+    Without nesting, so that every run is one GAMG hierarchy on the 96 x 96 box."""
+    args = SQUARE + ["-dm_plex_box_faces", "96,96", "-options_file", "options/solvers/gamg.yaml", "-contact_coarse_levels", 0]
     _, at_h = run(args + ["-penalty_eps0", 1], f"truncate_{np_}_h", np_=np_)
     _, small = run(args + ["-penalty_eps0", "1e-8"], f"truncate_{np_}_small", np_=np_)
     _, whole = run(args + ["-penalty_eps0", "1e-8", "-contact_pc_update_truncate", 0], f"truncate_{np_}_off", np_=np_)
@@ -199,8 +201,9 @@ def test_finest_smoother_interval_is_bounded_not_estimated(np_, extra):
     """With the updates, the finest level's Chebyshev interval comes from the build's estimate on K and a Gershgorin
     bound of the penalty term (src/solver/smoother_bound.c), not from a new estimate. -contact_pc_update_check
     estimates afresh on every updated Jacobian: the interval's top stays above 1.1 times that estimate (what PETSc's
-    own re-estimate would give, to 1%), and the answer is the one of the re-estimates (-contact_pc_update_esteig)."""
-    args = SQUARE + extra + ["-options_file", "options/solvers/gamg.yaml"]
+    own re-estimate would give, to 1%), and the answer is the one of the re-estimates (-contact_pc_update_esteig).
+    Without nesting: from a zero guess Newton takes enough steps to update several times."""
+    args = SQUARE + extra + ["-options_file", "options/solvers/gamg.yaml", "-contact_coarse_levels", 0]
     tag = f"smoother_bound_{np_}_{len(extra)}"
     out, bounded = run(args + ["-contact_pc_update_check"], tag, np_=np_)
     _, estimated = run(args + ["-contact_pc_update_esteig"], tag + "_esteig", np_=np_)
@@ -350,8 +353,9 @@ def test_grid_sequence_builds_2d_box_levels_as_refinements():
 
 
 def test_nested_iteration_is_the_default_on_the_2d_box_and_keeps_the_answer():
-    """The default penalty run on a 2D box of at least 128 cells per side solves first on coarser boxes (here one, of
-    128 x 64 cells, to -contact_coarse_rtol), then on the box of the options from the interpolated guess. The final mesh
+    """The default penalty run on a 2D box of at least 32 cells per side solves first on coarser boxes (here three, down
+    to 32 x 16 cells, to -contact_coarse_rtol; with GAMG they are solved by the boxes' geometric multigrid,
+    -contact_coarse_mg), then on the box of the options from the interpolated guess. The final mesh
     is the direct build's, vertex for vertex, and the answer is the old default's (-contact_coarse_levels 0) to the
     solver's tolerance, with a final residual as tight."""
     base = SQUARE + ["-dm_plex_box_faces", "256,128", "-options_file", "options/solvers/gamg.yaml", "-snes_rtol", "1e-9"]
@@ -359,25 +363,27 @@ def test_nested_iteration_is_the_default_on_the_2d_box_and_keeps_the_answer():
     _, direct = run(base + ["-contact_coarse_levels", 0], "nested_direct")
     a, fa = load(nested)
     b, fb = load(direct)
-    assert a["coarse_levels"] == 1 and b["coarse_levels"] == 0
+    assert a["coarse_levels"] == 3 and b["coarse_levels"] == 0 and a["coarse_mg"] == 1
     assert np.array_equal(fa["x"], fb["x"])
     with h5py.File(nested, "r") as f, h5py.File(direct, "r") as g:
         assert np.array_equal(f["viz/topology/cells"][:], g["viz/topology/cells"][:])
     assert np.abs(fa["displacement"] - fb["displacement"]).max() / np.abs(fb["displacement"]).max() < 1e-8
     assert a["converged"] == 1 and a["residual_norm"] <= 1e-9 * a["load_norm"] and a["load_norm"] == b["load_norm"]
     s = solves(nested)
-    assert list(s["level"]) == [0, 1] and s["n_dofs"][-1] == a["n_dofs"] and 3.9 < s["n_dofs"][1] / s["n_dofs"][0] < 4.1
+    assert list(s["level"]) == [0, 1, 2, 3] and s["n_dofs"][-1] == a["n_dofs"] and 3.9 < s["n_dofs"][-1] / s["n_dofs"][-2] < 4.1
     assert np.all(s["converged"] == 1)
     assert a["newton_its"] <= 4 and a["newton_its"] < b["newton_its"], (a["newton_its"], b["newton_its"])
     assert a["active_vertices"] == b["active_vertices"] and abs(a["contact_force"] - b["contact_force"]) <= 1e-8 * abs(b["contact_force"])
 
 
-@pytest.mark.parametrize("extra, levels", [([], 2), (["-contact_coarse_levels", 2], 2), (["-contact_method", "none"], 0),
+@pytest.mark.parametrize("extra, levels", [([], 4), (["-contact_coarse_mg", 0], 2), (["-contact_coarse_levels", 2], 2), (["-contact_method", "none"], 0),
                                            (["-contact_method", "vi", "-options_file", "options/solvers/mumps.yaml"], 0),
-                                           (["-dm_plex_box_faces", "256,100"], 0), (["-dm_plex_box_faces", "12,20", "-contact_coarse_levels", 2], 2)])
+                                           (["-dm_plex_box_faces", "256,100"], 2), (["-dm_plex_box_faces", "256,30"], 0),
+                                           (["-dm_plex_box_faces", "12,20", "-contact_coarse_levels", 2], 2)])
 def test_nested_iteration_levels(extra, levels):
-    """Where the default nests (the penalty method on the 2D P1 box, halved while 64 cells per side remain) and where it
-    does not; an explicit count nests any box it divides, and the answer is the direct solve's."""
+    """Where the default nests (the penalty method on the 2D P1 box, halved while 16 cells per side remain with GAMG's
+    coarser boxes solved by the geometric multigrid, 64 without: -contact_coarse_mg 0) and where it does not; an
+    explicit count nests any box it divides, and the answer is the direct solve's."""
     solver = [] if "vi" in extra else ["-options_file", "options/solvers/gamg.yaml"]
     base = SQUARE + ["-dm_plex_box_faces", "256,256"] + solver + extra
     _, h5 = run(base, "nested_levels")
@@ -414,6 +420,40 @@ def test_nested_iteration_on_two_ranks_builds_row_slabs_that_nest(solver_file):
         assert "-contact_coarse_levels 1 on 3 ranks: the coarsest box's 64 rows are not divisible by the number of ranks" in log, log[-2000:]
 
 
+@pytest.mark.parametrize("np_", [1, 2])
+def test_coarser_boxes_under_gamg_are_solved_by_the_geometric_multigrid(np_):
+    """-contact_coarse_mg (the default with an iterative -pc_type other than mg): GAMG's nested run solves its coarser
+    boxes, down to 16 cells per side, by CG with the geometric multigrid of the boxes below them, and the final box by
+    GAMG. The answer is the one of -contact_coarse_mg 0 (every box by GAMG, down to 64 cells per side) and of the direct
+    solve, to the solver's tolerance, with no more Newton steps on the final box. Options under the prefix
+    contact_coarse_ reach the coarser boxes' solver: one smoothing step there (-contact_coarse_mg_levels_ksp_max_it 1
+    instead of 2) takes more CG iterations on the coarser boxes; an option no solver reads would stop the run."""
+    base = SQUARE + ["-dm_plex_box_faces", "128,128", "-options_file", "options/solvers/gamg.yaml", "-snes_rtol", "1e-9"]
+    _, mg = run(base, f"coarse_mg_{np_}", np_=np_)
+    _, own = run(base + ["-contact_coarse_mg", 0], f"coarse_mg_off_{np_}", np_=np_)
+    _, one = run(base + ["-contact_coarse_mg_levels_ksp_max_it", 1], f"coarse_mg_one_{np_}", np_=np_)
+    _, direct = run(base + ["-contact_coarse_levels", 0], f"coarse_mg_direct_{np_}", np_=np_)
+    a, b, c = load(mg)[0], load(own)[0], load(one)[0]
+    assert a["coarse_mg"] == 1 and a["coarse_levels"] == 3 and b["coarse_mg"] == 0 and b["coarse_levels"] == 1
+    assert a["converged"] == b["converged"] == c["converged"] == 1
+    assert max_diff(mg, own) < 1e-8 and max_diff(mg, direct) < 1e-8 and max_diff(one, direct) < 1e-8
+    assert a["newton_its"] <= b["newton_its"], (a["newton_its"], b["newton_its"])
+    sa, sc = solves(mg), solves(one)
+    assert len(sa["level"]) == 4 and np.all(sa["converged"] == 1)
+    assert sc["ksp_its"][:-1].sum() > sa["ksp_its"][:-1].sum(), (sc["ksp_its"], sa["ksp_its"])
+
+
+@pytest.mark.parametrize("solver, coarse_mg", [("gamg", 1), ("hypre", 1), ("mg", 0), ("mumps", 0), (None, 0)])
+def test_coarse_mg_applies_to_iterative_preconditioners_only(solver, coarse_mg):
+    """-contact_coarse_mg applies where the final mesh's preconditioner is iterative and not already the boxes' multigrid:
+    GAMG and hypre; mg.yaml is that multigrid, and a factorization (mumps.yaml, or no solver file: MUMPS) is kept on
+    every box. Each run converges on the 64 x 64 box, nested."""
+    args = SQUARE + ["-dm_plex_box_faces", "64,64"] + (["-options_file", f"options/solvers/{solver}.yaml"] if solver else [])
+    _, h5 = run(args, f"coarse_mg_applies_{solver}")
+    a = load(h5)[0]
+    assert a["converged"] == 1 and a["coarse_mg"] == coarse_mg and a["coarse_levels"] == (2 if coarse_mg or solver == "mg" else 0)
+
+
 def test_ew_guard_loosens_only_the_last_solves_and_keeps_the_answer():
     """-contact_ew_guard (default 0.5) only loosens Eisenstat-Walker's terms near the solution: the answer is the one
     of PETSc's terms (-contact_ew_guard 0) to solver tolerance, with no more CG iterations, and the final residual is
@@ -436,9 +476,9 @@ def test_a_failed_coarser_box_still_solves_the_mesh_of_the_options():
                   expect_rc=3)
     a, _ = load(h5)
     assert "nested iteration: level 0 failed (DIVERGED_MAX_IT), the next starts from zero" in out
-    assert a["converged"] == 0 and a["coarse_levels"] == 1 and a["n_cells"] == 2 * 256 * 128
+    assert a["converged"] == 0 and a["coarse_levels"] == 3 and a["n_cells"] == 2 * 256 * 128
     s = solves(h5)
-    assert list(s["level"]) == [0, 1] and list(s["converged"]) == [0, 0]
+    assert list(s["level"]) == [0, 1, 2, 3] and list(s["converged"]) == [0, 0, 0, 0]
 
 
 MG = ["-options_file", "options/solvers/mg.yaml"]

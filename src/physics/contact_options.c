@@ -81,12 +81,12 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
                             "Nested iteration: solve on the mesh, then on N uniform refinements of it, each from the interpolated last solution",
                             NULL, opts->grid_sequence, &opts->grid_sequence, NULL));
   opts->coarse_levels = -1;
-  PetscCall(
-      PetscOptionsInt("-contact_coarse_levels",
-                      "Nested iteration to the mesh of the options: solve first on this many coarser boxes, each with half the cells per "
-                      "side of the next, each from the last; -1: as many as keep 64 cells per side (16 with -pc_type mg or -contact_coarse_mg), where the mesh is the "
-                      "2D P1 simplex box on one rank and the method penalty (or the elastic solve with -pc_type mg), else 0",
-                      NULL, opts->coarse_levels, &opts->coarse_levels, NULL));
+  PetscCall(PetscOptionsInt("-contact_coarse_levels",
+                            "Nested iteration to the mesh of the options: solve first on this many coarser boxes, each with half the cells per "
+                            "side of the next, each from the last; -1: as many as keep 64 cells per side (16 with -pc_type mg or "
+                            "-contact_coarse_mg), where the mesh is the "
+                            "2D P1 simplex box on one rank and the method penalty (or the elastic solve with -pc_type mg), else 0",
+                            NULL, opts->coarse_levels, &opts->coarse_levels, NULL));
   opts->coarse_rtol = 1e-4;
   PetscCall(PetscOptionsReal("-contact_coarse_rtol",
                              "Newton's relative tolerance on the coarser boxes of -contact_coarse_levels (their solutions are only initial guesses; "
