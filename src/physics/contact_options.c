@@ -84,8 +84,8 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscCall(PetscOptionsInt("-contact_coarse_levels",
                             "Nested iteration to the mesh of the options: solve first on this many coarser boxes, each with half the cells per "
                             "side of the next, each from the last; -1: as many as keep 64 cells per side (16 with -pc_type mg or "
-                            "-contact_coarse_mg), where the mesh is the "
-                            "2D P1 simplex box on one rank and the method penalty (or the elastic solve with -pc_type mg), else 0",
+                            "-contact_coarse_mg), where the mesh is the 2D P1 simplex box and the method penalty (or the elastic solve with "
+                            "-pc_type mg), else 0",
                             NULL, opts->coarse_levels, &opts->coarse_levels, NULL));
   opts->coarse_rtol = 1e-4;
   PetscCall(PetscOptionsReal("-contact_coarse_rtol",
