@@ -443,15 +443,17 @@ def test_coarser_boxes_under_gamg_are_solved_by_the_geometric_multigrid(np_):
     assert sc["ksp_its"][:-1].sum() > sa["ksp_its"][:-1].sum(), (sc["ksp_its"], sa["ksp_its"])
 
 
-@pytest.mark.parametrize("solver, coarse_mg", [("gamg", 1), ("hypre", 1), ("mg", 0), ("mumps", 0), (None, 0)])
-def test_coarse_mg_applies_to_iterative_preconditioners_only(solver, coarse_mg):
+@pytest.mark.parametrize("solver, extra, coarse_mg, levels", [("gamg", [], 1, 2), ("hypre", [], 1, 2), ("mg", [], 0, 2), ("mumps", [], 0, 0), (None, [], 0, 0),
+                                                              ("hypre", ["-contact_method", "vi", "-contact_coarse_levels", 2], 0, 2)])
+def test_coarse_mg_applies_to_iterative_preconditioners_only(solver, extra, coarse_mg, levels):
     """-contact_coarse_mg applies where the final mesh's preconditioner is iterative and not already the boxes' multigrid:
     GAMG and hypre; mg.yaml is that multigrid, and a factorization (mumps.yaml, or no solver file: MUMPS) is kept on
-    every box. Each run converges on the 64 x 64 box, nested."""
-    args = SQUARE + ["-dm_plex_box_faces", "64,64"] + (["-options_file", f"options/solvers/{solver}.yaml"] if solver else [])
-    _, h5 = run(args, f"coarse_mg_applies_{solver}")
+    every box; SNESVI keeps its own solver on every box (no PCMG follows vinewtonrsls's reduced system). Each run
+    converges on the 64 x 64 box, nested where the default or the options say so."""
+    args = SQUARE + ["-dm_plex_box_faces", "64,64"] + (["-options_file", f"options/solvers/{solver}.yaml"] if solver else []) + extra
+    _, h5 = run(args, f"coarse_mg_applies_{solver}_{len(extra)}")
     a = load(h5)[0]
-    assert a["converged"] == 1 and a["coarse_mg"] == coarse_mg and a["coarse_levels"] == (2 if coarse_mg or solver == "mg" else 0)
+    assert a["converged"] == 1 and a["coarse_mg"] == coarse_mg and a["coarse_levels"] == levels
 
 
 def test_ew_guard_loosens_only_the_last_solves_and_keeps_the_answer():

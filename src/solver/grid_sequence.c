@@ -73,8 +73,9 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, RunOptions *opt, PetscIn
   PetscCall(PetscStrcmp(pc_type, PCMG, &is_mg));
   PetscCall(PetscStrInList(pc_type, PCLU "," PCCHOLESKY, ',', &is_factor));
   /* -contact_coarse_mg: with an iterative preconditioner that is not already the boxes' multigrid (without -pc_type, the
-     default is MUMPS's factorization, which a coarser box's small matrix does not make expensive) */
-  opt->contact.coarse_mg = (PetscBool)(opt->contact.coarse_mg && given && !is_mg && !is_factor);
+     default is MUMPS's factorization, which a coarser box's small matrix does not make expensive); not with SNESVI, whose
+     reduced system (vinewtonrsls) no PCMG can follow and whose vinewtonssls Jacobian CG cannot take */
+  opt->contact.coarse_mg = (PetscBool)(opt->contact.coarse_mg && given && !is_mg && !is_factor && opt->contact.method != CONTACT_VI);
   *request               = k;
   *min_faces             = (is_mg || opt->contact.coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
   /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels) */
