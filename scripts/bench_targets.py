@@ -121,7 +121,7 @@ def measure_iterations(out, s, pairs):
         f = max(faces // s, 32 if dim == 2 else 4)  # a 2D box nests (-contact_coarse_levels) from 32 cells per side
         mesh = ["-dm_plex_box_faces", f"{f},{f}"] if dim == 2 else ["-dm_plex_dim", 3, "-dm_plex_box_faces", ",".join([str(max(f // 8, 1))] * 3),
                                                                     "-contact_grid_sequence", 3]
-        if dim == 2 and ranks > 1:  # the boxes nest on one rank only: 2 ranks refine 32^2 five times
+        if dim == 2 and ranks > 1:  # 2 ranks: the grid sequence from 32^2, five times (the row's command since before the boxes nested on several ranks)
             mesh = ["-dm_plex_box_faces", f"{max(f // 32, 1)},{max(f // 32, 1)}", "-contact_grid_sequence", 5]
         _, _, a = solver(mesh + ["-contact_method", "none", "-ksp_rtol", "1e-8"], f"mg_its_{dim}d_{f}", out, ranks, base=BASE_MG)
         mg_its.append((f"{dim}D {int(a['n_dofs'])}", f"{int(a['ksp_its'])} in {int(a['newton_its'])} Newton steps"))

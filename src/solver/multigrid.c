@@ -9,6 +9,12 @@
 #include "mesh.h"
 #include "solver.h"
 
+/* Whether the problem's mesh is a coarser box of nested iteration solved under -contact_coarse_mg. */
+static inline PetscBool MultigridOnCoarseBox(const AppCtx *user)
+{
+  return (PetscBool)(user->opt.contact.coarse_mg && user->prob.level < user->opt.box.coarse_levels);
+}
+
 /* With -pc_type mg (the PC of snes, the fine mesh's problem) and P1/Q1, adds the interpolation from coarse to fine,
    refined once (vertex_source[]: MeshCreateBoxLevel(), MeshRefineRegular()). Both meshes' problems must be set up (their
    sections); fine's rows are its owned free components, coarse's columns its free components, a fixed coarse component
@@ -143,7 +149,7 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
     PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)pc), &size));
     PetscCall(PCSetType(cpc, size > 1 ? PCREDUNDANT : PCLU));
   }
-  if (user->opt.contact.coarse_mg && user->prob.level < user->opt.box.coarse_levels) /* the smoothers of mg.yaml; options may change them */
+  if (MultigridOnCoarseBox(user)) /* the smoothers of mg.yaml; options may change them */
     for (PetscInt l = 1; l <= mg->n; ++l) {
       KSP smoother;
       PC  spc;
@@ -166,7 +172,7 @@ PetscErrorCode MultigridSetCoarseBoxSolver(KSP ksp, const AppCtx *user)
   PC pc;
 
   PetscFunctionBeginUser;
-  if (!user->opt.contact.coarse_mg || user->prob.level >= user->opt.box.coarse_levels) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!MultigridOnCoarseBox(user)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(KSPSetOptionsPrefix(ksp, "contact_coarse_"));
   PetscCall(KSPSetType(ksp, KSPCG));
   PetscCall(KSPGetPC(ksp, &pc));
