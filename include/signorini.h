@@ -298,29 +298,37 @@ typedef struct {
   PetscReal norm_last, rtol_last; /* |F| and the linear tolerance of the last step */
 } SolverForcing;
 
+/* A predicted Newton step for the first linear solve of the next solve (step_guess.c). */
+typedef struct {
+  Vec       du;          /* the predicted change of the solution, in the user's units; NULL if none */
+  PetscBool nonzero;     /* the options' -ksp_initial_guess_nonzero, kept by every other linear solve */
+  PetscBool user_rnorm0; /* -ksp_converged_use_initial_residual_norm given: the options' test stays */
+} SolverStepGuess;
+
 /* The discrete problem on one mesh: created by ProblemSetUp(), destroyed by ProblemDestroy(), one per grid level. */
 typedef struct {
-  PetscInt      level;                          /* grid sequence level of the mesh (0: the mesh built first) */
-  PetscReal     setup_time;                     /* set-up time of this problem, counted with its first solve */
-  PetscReal     h, eps;                         /* the largest cell diameter, and eps = eps0 h^power / M for it (the node's: eps * eps_factor) */
-  PetscReal     eps_factor_min, eps_factor_max; /* over the contact nodes (local eps on graded meshes), all ranks */
-  PetscBool     eps_local;                      /* the factors differ by more than rounding (1e-12 relative): eps per face */
-  DMLabel       face_sets;
-  ContactSet    cset;
-  PetscWeakForm wf_penalty;         /* the penalty term on Gamma_C, kept out of the bulk weak form */
-  PenaltyFaces  penalty_faces;      /* the same term in closed form (P1 simplices, -assembly p1) */
-  Vec           loc_bc;             /* local vector holding the Dirichlet values, zero elsewhere */
-  AssemblyType  assembly;           /* how K is assembled: fe or p1 (-assembly auto resolved) */
-  Mat           K;                  /* bulk elastic operator, assembled once */
-  Vec           r0;                 /* bulk residual at u = 0 (loads and Dirichlet lifting) */
-  Vec           loc_r0;             /* the same, local, with the rows of the fixed components (for the supports' reactions) */
-  Vec           xl, xu;             /* SNESVI bounds */
-  PetscReal     load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
-  PetscReal     displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */
-  PetscReal     snes_scale;         /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
-  Vec           work;               /* U x~: the displacement of the SNES iterate x~ */
-  PcReuse       pc_reuse;
-  SolverForcing forcing;
+  PetscInt        level;                          /* grid sequence level of the mesh (0: the mesh built first) */
+  PetscReal       setup_time;                     /* set-up time of this problem, counted with its first solve */
+  PetscReal       h, eps;                         /* the largest cell diameter, and eps = eps0 h^power / M for it (the node's: eps * eps_factor) */
+  PetscReal       eps_factor_min, eps_factor_max; /* over the contact nodes (local eps on graded meshes), all ranks */
+  PetscBool       eps_local;                      /* the factors differ by more than rounding (1e-12 relative): eps per face */
+  DMLabel         face_sets;
+  ContactSet      cset;
+  PetscWeakForm   wf_penalty;         /* the penalty term on Gamma_C, kept out of the bulk weak form */
+  PenaltyFaces    penalty_faces;      /* the same term in closed form (P1 simplices, -assembly p1) */
+  Vec             loc_bc;             /* local vector holding the Dirichlet values, zero elsewhere */
+  AssemblyType    assembly;           /* how K is assembled: fe or p1 (-assembly auto resolved) */
+  Mat             K;                  /* bulk elastic operator, assembled once */
+  Vec             r0;                 /* bulk residual at u = 0 (loads and Dirichlet lifting) */
+  Vec             loc_r0;             /* the same, local, with the rows of the fixed components (for the supports' reactions) */
+  Vec             xl, xu;             /* SNESVI bounds */
+  PetscReal       load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
+  PetscReal       displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */
+  PetscReal       snes_scale;         /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
+  Vec             work;               /* U x~: the displacement of the SNES iterate x~ */
+  PcReuse         pc_reuse;
+  SolverForcing   forcing;
+  SolverStepGuess step_guess;
   /* The penalty Jacobian lives in K itself (one matrix; only the rows of the contact dofs differ): K's own values of
      those rows are kept here, and put back before K is used as the bulk operator (PenaltyBulkOperator()). */
   PetscBool    jacobian_in_K;                    /* K holds K + the penalty Jacobian in those rows */

@@ -44,6 +44,12 @@ PetscErrorCode MultigridDestroy(Multigrid *mg);
 PetscErrorCode SolverForcingSetUp(SNES snes, AppCtx *user, PetscBool *petsc_presolve);
 PetscErrorCode SolverForcingPreSolve(KSP ksp, AppCtx *user);
 
+/* step_guess.c */
+PetscErrorCode SolverStepGuessSetUp(KSP ksp, AppCtx *user);
+PetscErrorCode SolverSetStepGuess(AppCtx *user, Vec du);
+PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, AppCtx *user);
+PetscErrorCode SolverStepGuessDrop(AppCtx *user);
+
 /* fine_smoother.c: -mg_fine_ksp_*, -mg_fine_pc_* */
 PetscErrorCode FineSmootherGiven(KSP ksp, PetscBool *given);
 PetscErrorCode FineSmootherSetUp(KSP ksp);

@@ -15,8 +15,10 @@
    tangent's guess, below; 0 for the secant's). A secant guess active elsewhere is not taken: a Gauss point it lifts off that the new eps keeps
    in contact (near the edge of the contact zone) made the line search cut every Newton step at that kink, and Newton
    stalled (16 x 16 and 32 x 32, GAMG, 1e-5 h to 1e-7 h: 40 and 50 steps). Halving the step when the full one changes
-   the active points was tried: 116 CG iterations instead of 119 at 256 x 256, not kept. */
-static PetscErrorCode ExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscReal factor, PetscReal relaxed)
+   the active points was tried: 116 CG iterations instead of 119 at 256 x 256, not kept. Such a guess that still lowers
+   the residual gives, with step_guess, the first linear solve's initial guess instead (step_guess.c): Newton starts
+   from u, with its active points, and CG from the step factor dir; dir is then scaled. */
+static PetscErrorCode ExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscReal factor, PetscReal relaxed, PetscBool step_guess)
 {
   Vec       guess;
   PetscReal f_last, f_guess;
@@ -26,10 +28,15 @@ static PetscErrorCode ExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, V
   PetscCall(VecDuplicate(u, &guess));
   PetscCall(VecWAXPY(guess, factor, dir, u));
   PetscCall(PenaltySameActivity(dm, user, u, guess, &same));
-  if (same || relaxed > 0.0) {
+  if (same || relaxed > 0.0 || step_guess) {
     PetscCall(SolverResidualNorm(snes, user, u, &f_last));
     PetscCall(SolverResidualNorm(snes, user, guess, &f_guess));
-    if ((same && f_guess < f_last) || f_guess < relaxed * f_last) PetscCall(VecCopy(guess, u));
+    if ((same && f_guess < f_last) || f_guess < relaxed * f_last)
+      PetscCall(VecCopy(guess, u));
+    else if (step_guess && f_guess < f_last) {
+      PetscCall(VecScale(dir, factor));
+      PetscCall(SolverSetStepGuess(user, dir));
+    }
   }
   PetscCall(VecDestroy(&guess));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -92,12 +99,13 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
     PetscCall(VecCopy(u, last));
     if (k > 1 && eps_last != eps_prev) { /* the secant of the last two solutions */
       PetscCall(VecWAXPY(dir, -1.0, prev, u));
-      PetscCall(ExtrapolatedStart(snes, dm, user, u, dir, (user->prob.eps - eps_last) / (eps_last - eps_prev), 0.0));
+      PetscCall(ExtrapolatedStart(snes, dm, user, u, dir, (user->prob.eps - eps_last) / (eps_last - eps_prev), 0.0, PETSC_TRUE));
     } else if (k == 1 && user->opt.contact.method == CONTACT_PENALTY && user->prob.eps != eps_last) { /* the tangent */
       PetscBool ok = PETSC_FALSE;
 
       PetscCall(TangentDirection(snes, dm, user, u, dir, &ok));
-      if (ok) PetscCall(ExtrapolatedStart(snes, dm, user, u, dir, (user->prob.eps - eps_last) * user->prob.eps / (eps_last * eps_last), 1e-2));
+      if (ok)
+        PetscCall(ExtrapolatedStart(snes, dm, user, u, dir, (user->prob.eps - eps_last) * user->prob.eps / (eps_last * eps_last), 1e-2, PETSC_FALSE));
     }
     if (!prev) PetscCall(VecDuplicate(u, &prev));
     PetscCall(VecSwap(prev, last));

@@ -55,5 +55,6 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes)
   PetscCall(ContactSetDestroy(&user->prob.cset));
   PetscCall(PenaltyFreeBulkRows(user));
   PetscCall(PcReuseDestroy(user));
+  PetscCall(SolverStepGuessDrop(user));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

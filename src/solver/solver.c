@@ -255,14 +255,15 @@ static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Before each linear solve: the finest multigrid smoother's -mg_fine_ options (fine_smoother.c), then the linear
-   tolerance of the inexact Newton (ew_forcing.c). */
+/* Before each linear solve: the finest multigrid smoother's -mg_fine_ options (fine_smoother.c), the initial guess
+   (step_guess.c), then the linear tolerance of the inexact Newton (ew_forcing.c). */
 static PetscErrorCode SolverPreSolve(KSP ksp, Vec b, Vec x, void *ctx)
 {
   AppCtx *user = (AppCtx *)ctx;
 
   PetscFunctionBeginUser;
   PetscCall(FineSmootherSetUp(ksp));
+  PetscCall(SolverStepGuessPreSolve(ksp, x, user));
   PetscCall(SolverForcingPreSolve(ksp, user));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -365,6 +366,7 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscBool petsc_presolve, fine;
 
     PetscCall(SolverForcingSetUp(*snes, user, &petsc_presolve)); /* Eisenstat-Walker's terms with the oversolving guard */
+    PetscCall(SolverStepGuessSetUp(ksp, user));
     if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, user));
     PetscCall(FineSmootherGiven(ksp, &fine));
     PetscCheck(!fine || is_multigrid, comm, PETSC_ERR_USER_INPUT,
@@ -460,6 +462,7 @@ static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
   if (user->prob.xl) PetscCall(VecScale(user->prob.xl, 1.0 / U));
   if (user->prob.xu) PetscCall(VecScale(user->prob.xu, 1.0 / U));
   PetscCall(SNESSolve(snes, NULL, u));
+  PetscCall(SolverStepGuessDrop(user)); /* unused if no linear solve came */
   PetscCall(VecScale(u, U));
   if (user->prob.xl) PetscCall(VecScale(user->prob.xl, U));
   if (user->prob.xu) PetscCall(VecScale(user->prob.xu, U));
