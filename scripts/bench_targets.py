@@ -203,11 +203,13 @@ def measure_eps(out, s, pairs):
 
 
 def measure_parallel(out, s, pairs):
-    """3D 1M unknowns on 2 ranks, and the speed-up of 2 ranks at 1M unknowns in 2D and 3D."""
+    """3D 1M unknowns on 2 ranks, the speed-up of 2 ranks at 1M unknowns in 2D and 3D, and the peak memory per unknown
+    in 3D on one rank (the elastic solve and the penalty run of the same box)."""
     n3, n4 = 68 // s, 704 // s
     box3 = ["-dm_plex_dim", 3, "-dm_plex_box_faces", f"{n3},{n3},{n3}"]
-    r3 = side_by_side({"3d_np2": (box3, 2), "3d_np1": (box3, 1)}, 1, out)
+    r3 = side_by_side({"3d_np2": (box3, 2), "3d_np1": (box3, 1), "3d_elastic_np1": (box3 + ["-contact_method", "none"], 1)}, 1, out)
     d3 = int(r3["3d_np2"][2]["n_dofs"])
+    mem3 = [(name, r3[run][1], r3[run][1] * 2**20 / int(r3[run][2]["n_dofs"]) / 1e3) for name, run in (("elastic", "3d_elastic_np1"), ("penalty", "3d_np1"))]
     box4 = ["-dm_plex_box_faces", f"{n4},{n4}"]
     # both nest by default (-contact_coarse_levels -1: 704 = 2^5 x 22, and 22 rows split in two slabs of rows)
     r2 = side_by_side({"2d_np1": (box4, 1), "2d_np2": (box4, 2)}, 1, out)
@@ -227,7 +229,9 @@ def measure_parallel(out, s, pairs):
     rt = side_by_side({"triad_np1": (tb, 1), "triad_np2": (tb, 2)}, 3, out)
     tri1, tri2 = median_attr(rt["triad_np1"], "bandwidth_triad_gbs"), median_attr(rt["triad_np2"], "bandwidth_triad_gbs")
     tri_each = [a2["bandwidth_triad_gbs"] / a1["bandwidth_triad_gbs"] for a1, a2 in zip(rt["triad_np1"][4], rt["triad_np2"][4])]
-    return [row("3D penalty, eps = h, 1M unknowns on 2 ranks <= 30 s", f"GAMG {r3['3d_np2'][0]:.1f} s ({d3} unknowns, the box of {n3}^3); geometric MG "
+    return [row(f"peak memory <= 3 KB per unknown in 3D, {name} (1 rank, the box of {n3}^3)", f"{kb:.2f} KB ({mib:.0f} MiB whole process, {d3} unknowns)", kb <= 3.0,
+                f"bin/signorini ... -dm_plex_dim 3 -dm_plex_box_faces {n3},{n3},{n3} [-contact_method none]") for name, mib, kb in mem3] + [
+            row("3D penalty, eps = h, 1M unknowns on 2 ranks <= 30 s", f"GAMG {r3['3d_np2'][0]:.1f} s ({d3} unknowns, the box of {n3}^3); geometric MG "
                 f"{rm['3d_mg_np2'][0]:.1f} s ({dm3} unknowns, {m3}^3 refined 3 times, mg.yaml)", t3 <= 30.0,
                 f"mpiexec -n 2 bin/signorini ... -dm_plex_dim 3 -dm_plex_box_faces {n3},{n3},{n3}; ... mg.yaml -dm_plex_box_faces {m3},{m3},{m3} -contact_grid_sequence 3"),
             row("mpiexec -n 2 speed-up >= 1.8 at 1M unknowns, 2D and 3D (default penalty run)",
