@@ -87,10 +87,14 @@ def measure_default(out, s, pairs):
     for name, v in (("elastic", e), ("penalty", p)):
         kb = v[1] * 2**20 / dofs / 1e3  # MiB from /usr/bin/time, KB of 1000 bytes
         rows.append(row(f"peak memory <= 1.2 KB per unknown in 2D, {name}", f"{kb:.2f} KB ({v[1]:.0f} MiB whole process)", kb <= 1.2, cmd))
-    rows.append(row("Newton: inexact linear solves (Eisenstat-Walker), final residual as tight", f"ksp_ew = {int(p[2]['ksp_ew'])}, {int(p[2]['ksp_its'])} CG iterations "
-                    f"in {int(p[2]['newton_its'])} Newton steps on the final box, |F| = {p[2]['residual_norm']:.1e} (without nesting: "
-                    f"{int(g[2]['ksp_its'])} in {int(g[2]['newton_its'])}, |F| = {g[2]['residual_norm']:.1e})",
-                    int(p[2]["ksp_ew"]) == 1 and p[2]["residual_norm"] <= max(g[2]["residual_norm"], 1e-8 * p[2]["load_norm"]), cmd))
+    # the hierarchy's reuse: one GAMG build on the final box, updated at the Newton steps whose contact rows change
+    rows.append(row("Newton: inexact linear solves (Eisenstat-Walker), final residual as tight; the GAMG hierarchy reused while only the contact rows change",
+                    f"ksp_ew = {int(p[2]['ksp_ew'])}, {int(p[2]['ksp_its'])} CG iterations "
+                    f"in {int(p[2]['newton_its'])} Newton steps on the final box, |F| = {p[2]['residual_norm']:.1e}, GAMG built {int(p[2]['pc_builds'])} time(s) and "
+                    f"updated {int(p[2]['pc_updates'])} time(s) (without nesting: {int(g[2]['ksp_its'])} in {int(g[2]['newton_its'])}, |F| = {g[2]['residual_norm']:.1e}, "
+                    f"built {int(g[2]['pc_builds'])} time(s) and updated {int(g[2]['pc_updates'])} time(s))",
+                    int(p[2]["ksp_ew"]) == 1 and p[2]["residual_norm"] <= max(g[2]["residual_norm"], 1e-8 * p[2]["load_norm"])
+                    and int(p[2]["pc_builds"]) == 1 and int(g[2]["pc_builds"]) == 1, cmd))
     return rows
 
 
