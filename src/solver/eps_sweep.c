@@ -28,15 +28,13 @@ static PetscErrorCode ExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, V
   PetscCall(VecDuplicate(u, &guess));
   PetscCall(VecWAXPY(guess, factor, dir, u));
   PetscCall(PenaltySameActivity(dm, user, u, guess, &same));
-  if (same || relaxed > 0.0 || step_guess) {
-    PetscCall(SolverResidualNorm(snes, user, u, &f_last));
-    PetscCall(SolverResidualNorm(snes, user, guess, &f_guess));
-    if ((same && f_guess < f_last) || f_guess < relaxed * f_last)
-      PetscCall(VecCopy(guess, u));
-    else if (step_guess && f_guess < f_last) {
-      PetscCall(VecScale(dir, factor));
-      PetscCall(SolverSetStepGuess(user, dir));
-    }
+  PetscCall(SolverResidualNorm(snes, user, u, &f_last)); /* every start needs both: the tangent's and the secant's rules */
+  PetscCall(SolverResidualNorm(snes, user, guess, &f_guess));
+  if ((same && f_guess < f_last) || f_guess < relaxed * f_last)
+    PetscCall(VecCopy(guess, u));
+  else if (step_guess && f_guess < f_last) {
+    PetscCall(VecScale(dir, factor));
+    PetscCall(SolverSetStepGuess(user, dir));
   }
   PetscCall(VecDestroy(&guess));
   PetscFunctionReturn(PETSC_SUCCESS);
