@@ -54,6 +54,10 @@ PetscErrorCode MeshClosureGet(MeshClosure *mc, PetscInt p, PetscBool use_cone, P
 PetscErrorCode MeshClosureVertices(MeshClosure *mc, PetscInt p, PetscInt max, PetscInt *nv, PetscInt verts[]);
 PetscErrorCode MeshClosureCheck(DM dm, PetscInt *differences, PetscBool *by_depth);
 
+/* mesh_check.c: what the discretization cannot handle, refused before anything is assembled */
+PetscErrorCode MeshCheckFile(DM dm, const char filename[]);
+PetscErrorCode MeshCountInteriorFaces(DM dm, PetscInt n, const PetscInt faces[], PetscInt *ninterior);
+
 /* mesh_gmsh_names.c */
 PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[]);
 

@@ -168,6 +168,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
                "names of more than 240; use a shorter (for example relative) path",
                filename, (int)strlen(filename));
     PetscCall(MeshReadFile(comm, filename, dm));
+    PetscCall(MeshCheckFile(*dm, filename)); /* one cell type, first order, no cell twice: before anything is assembled */
     {
       PetscBool gmsh;
 

@@ -310,6 +310,12 @@ PetscErrorCode BoundaryCheckFaceSets(DM dm, const Scene *scene)
     PetscCall(MPIU_Allreduce(&nf[i], &total, 1, MPIU_INT, MPI_SUM, comm));
     PetscCheck(total > 0, comm, PETSC_ERR_USER_INPUT, "%s %s: no face of the mesh carries \"Face Sets\" value %" PetscInt_FMT " (scene %s)",
                FamilyOption(bcs, i), token, id, scene->name);
+    PetscCall(MeshCountInteriorFaces(dm, nf[i], faces[i], &total));
+    PetscCheck(total == 0, comm, PETSC_ERR_USER_INPUT,
+               "%s %s: %" PetscInt_FMT " face(s) of face set %" PetscInt_FMT
+               " are interior faces, with a cell on each side: a boundary condition or a contact acts on the boundary of the body. Put only "
+               "boundary faces in the physical group (Gmsh: a line or surface embedded in the body is interior)",
+               FamilyOption(bcs, i), token, total, id);
   }
   for (PetscInt i = 0; i < nall; ++i)
     for (PetscInt j = i + 1; j < nall; ++j) {
