@@ -16,7 +16,7 @@ else
   CC           = mpicc
 endif
 CFLAGS  ?= -O2 -g
-CFLAGS  += -std=c99 -Wall -Wextra -Wno-unused-parameter -Iinclude
+CFLAGS  += -std=c99 -Wall -Wextra -Wno-unused-parameter -Iinclude -Ibuild
 LDLIBS  += $(PETSC_LIBS) -lyaml -lmetis -lm
 
 SRC = $(wildcard src/*.c src/*/*.c)
@@ -35,6 +35,12 @@ deps:
 build/%.o: src/%.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS) -MMD -MP $(PETSC_CFLAGS) -c $< -o $@
+
+# The option names the project reads, for the suggestions of src/app/options_check.c ("did you mean -snes_rtol?")
+build/known_options.inc: $(SRC)
+	@mkdir -p build
+	@grep -ohE '"-[a-z][a-z0-9_]*"' $(SRC) | sort -u | sed 's/$$/,/' > $@
+build/app/options_check.o build-asan/app/options_check.o: build/known_options.inc
 
 $(BIN): $(OBJ)
 	@mkdir -p bin

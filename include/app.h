@@ -11,5 +11,10 @@ PetscErrorCode OptionsCheckFinite(MPI_Comm comm, const char name[], PetscReal va
 PetscErrorCode OptionsCheckFiniteArray(MPI_Comm comm, const char name[], PetscInt n, const PetscReal values[]);
 PetscErrorCode OptionsCountListValues(const char name[], PetscInt *n);
 PetscErrorCode OptionsCheckPrefixesUsed(MPI_Comm comm, const char prefixes[]);
+PetscErrorCode OptionsCheckAllUsed(MPI_Comm comm, PetscBool before_solve);
 PetscErrorCode OptionsReadVector(CompatOptionItems PetscOptionsObject, MPI_Comm comm, const char name[], const char help[], PetscInt dim,
                                  PetscReal v[], PetscBool *set);
+
+/* errors.c: a refusal of the user's input as one paragraph, PETSc's error block for internal errors */
+PetscErrorCode AppErrorPushHandler(void);
+int            AppErrorExit(PetscErrorCode ierr);

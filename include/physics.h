@@ -59,6 +59,7 @@ PetscErrorCode PenaltyBulkOperator(AppCtx *user, Mat *K);
 PetscErrorCode PenaltyBulkMult(AppCtx *user, Vec X, Vec R);
 PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy);
 PetscErrorCode PenaltyCheckClosedForm(DM dm, AppCtx *user, Vec X);
+PetscErrorCode PenaltyCountActive(DM dm, AppCtx *user, Vec X, PetscInt *active, PetscReal *dmax);
 
 /* penalty_faces.c: the Gauss rule on P1 simplices in closed form */
 PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user);
@@ -67,12 +68,14 @@ PetscErrorCode PenaltyFacesResidual(DM dm, AppCtx *user, Vec locX, Vec locF);
 PetscErrorCode PenaltyFacesJacobian(DM dm, AppCtx *user, Vec locX, Mat J);
 PetscErrorCode PenaltyFacesEnergy(DM dm, AppCtx *user, Vec locX, PetscReal *energy);
 PetscErrorCode PenaltyFacesSameActivity(DM dm, AppCtx *user, Vec locA, Vec locB, PetscBool *same);
+PetscErrorCode PenaltyFacesMaxPenetration(DM dm, AppCtx *user, Vec locX, PetscReal *dmax);
 
 /* vi_bounds.c */
 PetscErrorCode VICreateBounds(DM dm, AppCtx *user);
 
 /* postprocess.c */
 PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u);
+PetscErrorCode PostprocessPenetration(AppCtx *user);
 
 /* elasticity.c: sigma(grad u) = lambda tr(eps) I + 2 mu eps, grad[i*dim+j] = du_i/dx_j */
 void ElasticStress(PetscInt dim, const Material *mat, const PetscReal grad[], PetscReal sigma[]);

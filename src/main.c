@@ -89,30 +89,9 @@ static PetscErrorCode RecordPeakMemory(MPI_Comm comm, RunStats *s)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* A misspelled option must not pass unnoticed: every option given must have been read by now. */
-static PetscErrorCode CheckAllOptionsUsed(MPI_Comm comm)
-{
-  const char *read_at_finalize[] = {"-options_left", "-malloc_dump", "-memory_view", "-objects_dump"};
-  PetscInt    N, nleft;
-  char      **names, **values, list[1024] = "";
-
-  PetscFunctionBeginUser;
-  for (size_t i = 0; i < sizeof(read_at_finalize) / sizeof(read_at_finalize[0]); ++i) {
-    PetscBool set;
-    PetscCall(PetscOptionsHasName(NULL, NULL, read_at_finalize[i], &set)); /* marks them used */
-  }
-  PetscCall(PetscOptionsLeftGet(NULL, &N, &names, &values));
-  nleft = N; /* PetscOptionsLeftRestore() zeroes N */
-  for (PetscInt i = 0; i < N; ++i) {
-    PetscCall(PetscStrlcat(list, " -", sizeof(list)));
-    PetscCall(PetscStrlcat(list, names[i], sizeof(list)));
-  }
-  PetscCall(PetscOptionsLeftRestore(NULL, &N, &names, &values));
-  PetscCheck(nleft == 0, comm, PETSC_ERR_USER_INPUT, "%" PetscInt_FMT " option(s) given but never used (misspelled? see -help):%s", nleft, list);
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-int main(int argc, char **argv)
+/* The run, from the options to the output; *converged says whether the nonlinear solve converged. An error returns here
+   and then to main(), which ends the run as the error asks (AppErrorExit()). */
+static PetscErrorCode Run(PetscBool *converged)
 {
   AppCtx         user;
   DM             dm;
@@ -121,8 +100,7 @@ int main(int argc, char **argv)
   MPI_Comm       comm;
   PetscLogDouble t0, t1;
 
-  if (OptionsFilesCheckYAML(argc, argv)) return 1; /* PETSc's own message would not name the file */
-  PetscCall(PetscInitialize(&argc, &argv, NULL, help));
+  PetscFunctionBeginUser;
   comm = PETSC_COMM_WORLD;
   PetscCall(PetscTime(&t0));
   PetscCall(PetscMemzero(&user, sizeof(user)));
@@ -148,7 +126,8 @@ int main(int argc, char **argv)
   PetscCall(ReferenceCheckFile(dm, &user));  /* before the solve, not after it */
   PetscCall(VecDuplicate(user.prob.r0, &u)); /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
-  PetscCall(DMSNESCheckFromOptions(snes, u)); /* -dmsnes_check: PETSc's checks against the exact solution */
+  PetscCall(DMSNESCheckFromOptions(snes, u));       /* -dmsnes_check: PETSc's checks against the exact solution */
+  PetscCall(OptionsCheckAllUsed(comm, PETSC_TRUE)); /* a misspelled option before the solve, not after it */
   PetscCall(PetscTime(&t1));
   user.rec.stats.time_setup = t1 - t0;
 
@@ -157,13 +136,14 @@ int main(int argc, char **argv)
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
   PetscCall(ErrorNormsCompute(dm, &user, u));
+  PetscCall(PostprocessPenetration(&user));                        /* with the error norms' finer quadrature */
   PetscCall(ReferenceCompute(dm, &user, u));                       /* -reference, if given */
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition)); /* of the final mesh */
   PetscCall(PetscTime(&t1));
   user.rec.stats.time_total = t1 - t0;
   PetscCall(RecordPeakMemory(comm, &user.rec.stats));
-  PetscCall(BandwidthMeasure(snes, &user)); /* -perf_bandwidth: after the peak memory, which its vectors would raise */
-  PetscCall(CheckAllOptionsUsed(comm));
+  PetscCall(BandwidthMeasure(snes, &user));          /* -perf_bandwidth: after the peak memory, which its vectors would raise */
+  PetscCall(OptionsCheckAllUsed(comm, PETSC_FALSE)); /* the options read during the solve too */
   PetscCall(PrintSummary(dm, &user, u));
   PetscCall(OutputWriteHDF5(dm, &user, u));
   PetscCall(PetscPrintf(comm, "  output: %s\n", user.opt.output));
@@ -186,9 +166,20 @@ int main(int argc, char **argv)
   PetscCall(ContactOptionsDestroy(&user.opt.contact));
   PetscCall(PetscFree(user.rec.records));
   PetscCall(SceneFinalize());
-  {
-    const PetscBool converged = user.rec.stats.converged;
-    PetscCall(PetscFinalize());
-    return converged ? 0 : 3;
-  }
+  *converged = user.rec.stats.converged;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+int main(int argc, char **argv)
+{
+  PetscErrorCode ierr;
+  PetscBool      converged = PETSC_FALSE;
+
+  if (OptionsFilesCheckYAML(argc, argv)) return 1; /* PETSc's own message would not name the file */
+  PetscCall(PetscInitialize(&argc, &argv, NULL, help));
+  PetscCall(AppErrorPushHandler());
+  ierr = Run(&converged);
+  if (ierr) return AppErrorExit(ierr);
+  PetscCall(PetscFinalize());
+  return converged ? 0 : 3;
 }

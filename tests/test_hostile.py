@@ -344,3 +344,52 @@ def test_hostile_mesh(case_dir, name, writer, args, message, np_):
     out = refuse(d, GENERAL + ["-dm_plex_filename", mesh] + args, message, np_=np_)
     if "mesh file" in message or "cell" in message:
         assert mesh in out, "the message does not name the file"
+
+
+# ---------------------------------------------------------------- errors a user can read (issue 29)
+READABLE_CASES = [
+    ("young_inf", SMALL + ["-young_modulus", "inf"], "signorini: error: -young_modulus must be a finite number, got inf"),
+    ("value_not_a_number", ["-scene", "general", "-contact_faces", 1, "-bc_clamp", 4, "-bc_pressure", 3, "-bc_pressure_3", "1,2"],
+     "signorini: error: -bc_pressure_3 1,2: Input string 1,2 has no numeric value"),
+    ("value_in_a_list", ["-obstacle", "sphere", "-dm_plex_dim", 3, "-obstacle_center", "1e4.5,0,0", "-obstacle_radius", 1],
+     "signorini: error: -obstacle_center 1e4.5: Input string 1e4.5 has no numeric value"),
+    ("not_a_bool", SMALL + ["-contact_pc_reuse", "maybe"], "signorini: error: -contact_pc_reuse maybe: Unknown logical value: maybe"),
+    ("unknown_choice", SMALL + ["-contact_method", "bogus"], "signorini: error: Unknown option bogus for -contact_method"),
+    ("typo_suggestion", ["-dm_plex_box_faces", "64,64", "-snes_rtoll", 1e-9], "never used (misspelled? see -help): -snes_rtoll (did you mean -snes_rtol?)"),
+    ("typo_project_option", SMALL + ["-penalty_esp0", 1], "-penalty_esp0 (did you mean -penalty_eps0?)"),
+]
+@pytest.mark.parametrize("np_", (1, 2))
+@pytest.mark.parametrize("name,args,message", READABLE_CASES, ids=[c[0] for c in READABLE_CASES])
+def test_refusal_is_one_paragraph(case_dir, name, args, message, np_):
+    """A refusal of the input is one paragraph naming the option (and the nearest known option for a misspelling),
+    exit status 2, before the solve, without PETSc's error block or its list of "options not used" (which listed the
+    valid options of the run as if they were typos); once, on 2 ranks too."""
+    d = case_dir(f"readable_{name}_{np_}")
+    before = snapshot(d)
+    cmd = ["mpiexec", "-n", str(np_), BIN] + [str(a) for a in args] + ["-output", os.path.join(d, "result.h5")]
+    p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=300)
+    assert p.returncode == 2, f"exit {p.returncode}:\n{p.stdout[-2000:]}"
+    assert message in p.stdout, p.stdout[-2000:]
+    assert p.stdout.count("signorini: error:") == 1, p.stdout
+    for noise in ("PETSC ERROR", "Option left", "were not used", "Configure options", "MPI_ABORT"):
+        assert noise not in p.stdout, f"'{noise}' in:\n{p.stdout[-2000:]}"
+    assert "  SNES " not in p.stdout, "refused only after the solve"
+    assert snapshot(d) == before
+
+
+def test_error_verbose_gives_petsc_report(case_dir):
+    """-error_verbose: PETSc's whole error block, with the stack, for a refusal too."""
+    d = case_dir("error_verbose")
+    p = subprocess.run(["mpiexec", "-n", "1", BIN] + SMALL + ["-young_modulus", "inf", "-error_verbose", "-output", os.path.join(d, "result.h5")],
+                       cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=300)
+    assert p.returncode != 0 and "PETSC ERROR: -young_modulus must be a finite number" in p.stdout and "ElasticityGetOptions() at" in p.stdout, p.stdout
+
+
+def test_options_read_during_the_solve_are_not_refused_early(hostile_dir):
+    """The early check leaves the options PETSc reads during the solve (viewers, the levels of a multigrid) to the check
+    at the end: a run with them converges, and a misspelled one of them is still refused at the end."""
+    args = ["-dm_plex_box_faces", "16,16", "-options_file", "options/solvers/gamg.yaml", "-ksp_view", "ascii:/dev/null", "-mg_levels_ksp_max_it", 2]
+    out, _ = run(args, "hostile/read_late")
+    assert "  SNES CONVERGED" in out
+    out, _ = run(args + ["-mg_levels_ksp_typo", 1], "hostile/read_late_typo", expect_rc=2)
+    assert "-mg_levels_ksp_typo (did you mean -mg_levels_ksp_type?)" in out

@@ -73,8 +73,11 @@ def tail(text, n=LOG_TAIL_LINES):
 
 
 def error_line(text):
-    """The most telling line of a failed run's output (PETSc's error message if any)."""
+    """The most telling line of a failed run's output: the solver's refusal of its input, else PETSc's error message if any."""
     lines = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    for ln in lines:
+        if ln.startswith("signorini: error"):
+            return ln.split(": ", 2)[-1]
     for ln in lines:
         if "PETSC ERROR" in ln and not re.search(r"-{5}|Error Message|See https", ln):
             msg = ln.split("PETSC ERROR:", 1)[-1].strip()

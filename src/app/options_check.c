@@ -2,6 +2,118 @@
    (PETSc parses "inf" and "nan" as reals, which would run a whole solve into NaN without naming the option). */
 #include "app.h"
 
+/* The options the project reads (every "-name" string of src/, listed at build time into build/known_options.inc by the
+   Makefile) and PETSc's options a run of this solver commonly gives: the names a misspelling is compared with. */
+static const char *const known_options[] = {
+#include "known_options.inc"
+    "-snes_rtol",
+    "-snes_atol",
+    "-snes_stol",
+    "-snes_max_it",
+    "-snes_type",
+    "-snes_monitor",
+    "-snes_converged_reason",
+    "-snes_view",
+    "-snes_linesearch_type",
+    "-snes_linesearch_monitor",
+    "-snes_ksp_ew",
+    "-snes_ksp_ew_version",
+    "-snes_vi_zero_tolerance",
+    "-snes_test_jacobian",
+    "-ksp_type",
+    "-ksp_rtol",
+    "-ksp_atol",
+    "-ksp_max_it",
+    "-ksp_monitor",
+    "-ksp_converged_reason",
+    "-ksp_view",
+    "-ksp_norm_type",
+    "-ksp_initial_guess_nonzero",
+    "-ksp_gmres_restart",
+    "-pc_type",
+    "-pc_factor_mat_solver_type",
+    "-pc_gamg_threshold",
+    "-pc_gamg_agg_nsmooths",
+    "-pc_gamg_square_graph",
+    "-pc_gamg_reuse_interpolation",
+    "-pc_hypre_type",
+    "-pc_mg_levels",
+    "-pc_mg_galerkin",
+    "-mg_levels_ksp_type",
+    "-mg_levels_pc_type",
+    "-mg_levels_ksp_max_it",
+    "-mg_coarse_pc_type",
+    "-mg_coarse_ksp_type",
+    "-mat_mumps_icntl_14",
+    "-dm_plex_filename",
+    "-dm_plex_dim",
+    "-dm_plex_simplex",
+    "-dm_plex_box_faces",
+    "-dm_plex_box_lower",
+    "-dm_plex_box_upper",
+    "-dm_refine",
+    "-dm_view",
+    "-dm_mat_type",
+    "-displacement_petscspace_degree",
+    "-petscpartitioner_type",
+    "-log_view",
+    "-options_file",
+    "-options_left",
+    "-help",
+    "-malloc_debug",
+    "-malloc_dump",
+    "-error_verbose",
+};
+
+/* The edit distance of a and b (insertions, deletions, substitutions and transpositions of neighbours, each 1). */
+static PetscInt EditDistance(const char a[], const char b[])
+{
+  PetscInt la = (PetscInt)strlen(a), lb = (PetscInt)strlen(b), d[3][80];
+
+  if (la >= 79 || lb >= 79) return PETSC_MAX_INT;
+  for (PetscInt j = 0; j <= lb; ++j) d[0][j] = j;
+  for (PetscInt i = 1; i <= la; ++i) {
+    PetscInt *cur = d[i % 3], *prev = d[(i + 2) % 3], *prev2 = d[(i + 1) % 3];
+
+    cur[0] = i;
+    for (PetscInt j = 1; j <= lb; ++j) {
+      const PetscInt cost = a[i - 1] != b[j - 1];
+
+      cur[j] = PetscMin(PetscMin(prev[j] + 1, cur[j - 1] + 1), prev[j - 1] + cost);
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1]) cur[j] = PetscMin(cur[j], prev2[j - 2] + 1);
+    }
+  }
+  return d[la % 3][lb];
+}
+
+/* Appends to list " -name" and, when a known option is close to it, " (did you mean -known?)". name without its dash. */
+static PetscErrorCode AppendWithSuggestion(const char name[], char list[], size_t len)
+{
+  char        dashed[256];
+  const char *best   = NULL;
+  PetscInt    best_d = PETSC_MAX_INT, limit;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscSNPrintf(dashed, sizeof(dashed), "-%s", name));
+  limit = PetscMax(2, (PetscInt)strlen(dashed) / 5);
+  for (size_t k = 0; k < sizeof(known_options) / sizeof(known_options[0]); ++k) {
+    const PetscInt d = EditDistance(dashed, known_options[k]);
+
+    if (d < best_d) {
+      best_d = d;
+      best   = known_options[k];
+    }
+  }
+  PetscCall(PetscStrlcat(list, " ", len));
+  PetscCall(PetscStrlcat(list, dashed, len));
+  if (best && best_d > 0 && best_d <= limit) {
+    PetscCall(PetscStrlcat(list, " (did you mean ", len));
+    PetscCall(PetscStrlcat(list, best, len));
+    PetscCall(PetscStrlcat(list, "?)", len));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode OptionsCheckFinite(MPI_Comm comm, const char name[], PetscReal value)
 {
   PetscFunctionBeginUser;
@@ -39,7 +151,7 @@ PetscErrorCode OptionsCountListValues(const char name[], PetscInt *n)
 PetscErrorCode OptionsCheckPrefixesUsed(MPI_Comm comm, const char prefixes[])
 {
   PetscInt N, nbad = 0;
-  char   **names, **values, list[1024] = "";
+  char   **names, **values, list[2048] = "";
 
   PetscFunctionBeginUser;
   PetscCall(PetscOptionsLeftGet(NULL, &N, &names, &values));
@@ -54,8 +166,7 @@ PetscErrorCode OptionsCheckPrefixesUsed(MPI_Comm comm, const char prefixes[])
       PetscCall(PetscStrncpy(buf, rest + 1, PetscMin(len, sizeof(buf)))); /* without the dash: the names below have none */
       PetscCall(PetscStrbeginswith(names[i], buf, &match));
       if (match) {
-        PetscCall(PetscStrlcat(list, " -", sizeof(list)));
-        PetscCall(PetscStrlcat(list, names[i], sizeof(list)));
+        PetscCall(AppendWithSuggestion(names[i], list, sizeof(list)));
         ++nbad;
         break;
       }
@@ -66,6 +177,46 @@ PetscErrorCode OptionsCheckPrefixesUsed(MPI_Comm comm, const char prefixes[])
   PetscCall(PetscOptionsLeftRestore(NULL, &N, &names, &values));
   PetscCheck(nbad == 0, comm, PETSC_ERR_USER_INPUT,
              "%" PetscInt_FMT " option(s) given but never used (misspelled, or for a face set or obstacle not in use? see -help):%s", nbad, list);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Whether an option not read by the end of the set-up may still be read by the solve: PETSc reads its viewers and
+   monitors when an object is viewed or solved, the options of a multigrid's levels, of the sub-solvers and of a
+   factorization package when the preconditioner is built, and the project reads those of the coarser boxes
+   (-contact_coarse_) and of the finest smoother (-mg_fine_) when they exist. */
+static PetscBool ReadDuringTheSolve(const char name[])
+{
+  const char *const later[] = {"mg_levels_", "mg_coarse_",       "mg_fine_",   "sub_",           "contact_coarse_", "mat_", "pc_gamg_",   "pc_mg_",
+                               "pc_hypre_",  "snes_linesearch_", "snes_test_", "ksp_chebyshev_", "fieldsplit_",     "vec_", "pc_factor_", "ksp_"};
+
+  if (strstr(name, "view") || strstr(name, "monitor") || strstr(name, "converged_reason") || strstr(name, "log")) return PETSC_TRUE;
+  for (size_t k = 0; k < sizeof(later) / sizeof(later[0]); ++k)
+    if (!strncmp(name, later[k], strlen(later[k]))) return PETSC_TRUE;
+  return PETSC_FALSE;
+}
+
+/* Refuses the options given and never read, each with the nearest known option when one is close. before_solve: at the
+   end of the set-up (every module and the SNES have read their options), leaving those the solve may still read; then
+   again at the end of the run, for all of them. */
+PetscErrorCode OptionsCheckAllUsed(MPI_Comm comm, PetscBool before_solve)
+{
+  const char *read_at_finalize[] = {"-options_left", "-malloc_dump", "-memory_view", "-objects_dump"};
+  PetscInt    N, nleft = 0;
+  char      **names, **values, list[2048] = "";
+
+  PetscFunctionBeginUser;
+  for (size_t i = 0; i < sizeof(read_at_finalize) / sizeof(read_at_finalize[0]); ++i) {
+    PetscBool set;
+    PetscCall(PetscOptionsHasName(NULL, NULL, read_at_finalize[i], &set)); /* marks them used */
+  }
+  PetscCall(PetscOptionsLeftGet(NULL, &N, &names, &values));
+  for (PetscInt i = 0; i < N; ++i) {
+    if (before_solve && ReadDuringTheSolve(names[i])) continue;
+    PetscCall(AppendWithSuggestion(names[i], list, sizeof(list)));
+    ++nleft;
+  }
+  PetscCall(PetscOptionsLeftRestore(NULL, &N, &names, &values));
+  PetscCheck(nleft == 0, comm, PETSC_ERR_USER_INPUT, "%" PetscInt_FMT " option(s) given but never used (misspelled? see -help):%s", nleft, list);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

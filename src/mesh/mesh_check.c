@@ -67,8 +67,7 @@ static PetscErrorCode MeshCheckFirstOrder(DM dm, const char filename[])
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &nodes, 1, MPIU_INT, MPI_SUM, comm));
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &nv, 1, MPIU_INT, MPI_SUM, comm));
   PetscCheck(nodes == 0, comm, PETSC_ERR_USER_INPUT,
-             "The mesh file '%s' holds high-order (curved) elements: %" PetscInt_FMT
-             " edges, faces or cells carry nodes besides the %" PetscInt_FMT
+             "The mesh file '%s' holds high-order (curved) elements: %" PetscInt_FMT " edges, faces or cells carry nodes besides the %" PetscInt_FMT
              " vertices. The solver takes its geometry from the vertices (first-order cells); export a first-order mesh (Gmsh: "
              "Mesh.ElementOrder = 1, or gmsh -order 1), and ask for P2 unknowns with -displacement_petscspace_degree 2 if you want them",
              filename, nodes, nv);
@@ -127,8 +126,8 @@ static PetscErrorCode MeshCheckDuplicateCells(DM dm, const char filename[])
   PetscCall(PetscFree(keys));
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ndup, 1, MPIU_INT, MPI_SUM, comm));
   PetscCheck(ndup == 0, comm, PETSC_ERR_USER_INPUT,
-             "The mesh file '%s' has %" PetscInt_FMT
-             " duplicate cell(s): cells on the same vertices as another (the first pair: cells %" PetscInt_FMT " and %" PetscInt_FMT
+             "The mesh file '%s' has %" PetscInt_FMT " duplicate cell(s): cells on the same vertices as another (the first pair: cells %" PetscInt_FMT
+             " and %" PetscInt_FMT
              ", counted from 0 in the order read). Each would add its stiffness twice; remove the duplicates (Gmsh: Coherence Mesh, or check the "
              "physical groups for a surface or volume listed twice)",
              filename, ndup, first[0], first[1]);

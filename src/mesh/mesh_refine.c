@@ -19,13 +19,28 @@ PetscErrorCode MeshCellReferenceCoordinates(DM dm, PetscInt c, PetscInt n, const
   wt[0] = 1.0;
   PetscCall(PetscQuadratureSetData(q, dim, 1, 1, pt, wt));
   for (PetscInt i = 0; i < n; ++i) {
-    PetscReal v[3], J[9], invJ[9], detJ, res = PETSC_MAX_REAL;
+    PetscReal v[3], J[9], invJ[9], detJ, res = PETSC_MAX_REAL, scale = 1.0;
     PetscInt  it;
 
     for (PetscInt d = 0; d < dim; ++d) xi[i * dim + d] = 0.0;
-    for (it = 0; it < 20 && res > 1e-13; ++it) {
+    /* The steps are in reference coordinates, but x - v loses the digits of the coordinates' size: a point known to
+       round-off in physical units is known to |x| / (cell size) times round-off in the cell's. The tolerances scale with
+       that ratio (|x| ||J^-1||), so that a mesh far from the origin (a CAD part in millimetres) is located as one near it. */
+    for (it = 0; it < 20 && res > 1e-13 * scale; ++it) {
       for (PetscInt d = 0; d < dim; ++d) pt[d] = xi[i * dim + d];
       PetscCall(DMPlexComputeCellGeometryFEM(dm, c, q, v, J, invJ, &detJ));
+      if (it == 0) {
+        PetscReal xmax = 0.0, jnorm = 0.0;
+
+        for (PetscInt d = 0; d < dim; ++d) {
+          PetscReal row = 0.0;
+
+          xmax = PetscMax(xmax, PetscAbsReal(x[i * dim + d]));
+          for (PetscInt e = 0; e < dim; ++e) row += PetscAbsReal(invJ[d * dim + e]);
+          jnorm = PetscMax(jnorm, row);
+        }
+        scale = PetscMax(1.0, 1e3 * PETSC_MACHINE_EPSILON / 1e-13 * xmax * jnorm);
+      }
       res = 0.0;
       for (PetscInt d = 0; d < dim; ++d) {
         PetscReal step = 0.0;
@@ -35,8 +50,9 @@ PetscErrorCode MeshCellReferenceCoordinates(DM dm, PetscInt c, PetscInt n, const
         res = PetscMax(res, PetscAbsReal(step));
       }
     }
-    PetscCheck(res <= 1e-10, PETSC_COMM_SELF, PETSC_ERR_CONV_FAILED,
-               "No reference coordinates for a point of cell %" PetscInt_FMT " (Newton residual %g)", c, (double)res);
+    PetscCheck(res <= 1e-10 * scale, PETSC_COMM_SELF, PETSC_ERR_CONV_FAILED,
+               "No reference coordinates for a point of cell %" PetscInt_FMT " (Newton residual %g, in the cell's reference coordinates)", c,
+               (double)res);
   }
   PetscCall(PetscQuadratureDestroy(&q));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -218,6 +218,29 @@ PetscErrorCode PenaltyFacesEnergy(DM dm, AppCtx *user, Vec locX, PetscReal *ener
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The largest u_n - g at the Gauss points of this rank's contact faces (-PETSC_MAX_REAL if it has none). */
+PetscErrorCode PenaltyFacesMaxPenetration(DM dm, AppCtx *user, Vec locX, PetscReal *dmax)
+{
+  const PenaltyFaces *pf = &user->prob.penalty_faces;
+  const PetscScalar  *x, *cst;
+  PetscInt            dim, ncst;
+
+  PetscFunctionBeginUser;
+  PetscCall(FaceKernelData(dm, &dim, &ncst, &cst));
+  *dmax = -PETSC_MAX_REAL;
+  PetscCall(VecGetArrayRead(locX, &x));
+  for (PetscInt e = 0; e < pf->n; ++e)
+    for (PetscInt q = 0; q < pf->nq; ++q) {
+      PetscScalar u[3];
+      PetscReal   nu[3];
+
+      FaceDisplacement(pf, dim, e, q, x, u);
+      *dmax = PetscMax(*dmax, ObstaclePenetration(dim, &cst[CONST_OBSTACLE], &pf->x[(e * pf->nq + q) * dim], u, nu));
+    }
+  PetscCall(VecRestoreArrayRead(locX, &x));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The Jacobian's kernel g0 at point q of face e for the local solution x, and whether it is nonzero there (the point
    penetrates: the penalty is active). */
 static inline PetscBool FacePointKernel(const PenaltyFaces *pf, PetscInt dim, PetscInt e, PetscInt q, const PetscScalar x[], PetscInt ncst,

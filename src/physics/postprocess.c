@@ -1,8 +1,17 @@
 /* Contact quantities after the solve: nodal pressure, penetration, total force, energy. */
 #include "physics.h"
 
-/* The reaction of the foundation at node i is -R_i . n with R = K u + r0 the bulk residual;
-   the pressure is the penalty law (penalty) or the reaction over the lumped boundary mass (vi). */
+/* The contact outputs, every one from the force the rule exerts, for every method, rule and obstacle:
+   - the reaction of the obstacle at node i is -R_i . n with R = K u + r0 the bulk residual: the nodal contact force
+     (the penalty term's at a converged penalty solve, the multiplier of SNESVI's bound);
+   - the pressure is that reaction over the lumped boundary mass (the area the node stands for), so that the sum of
+     pressure times contact_area is the contact force to round-off. With the Gauss rule it is the face integral of
+     (1/eps)[u_n - g]_+ against the node's basis function over that of the basis function: a curved obstacle touching
+     the faces between their vertices has a pressure where it pushes, not the nodal penalty law's zero;
+   - the active vertices are those where the rule acts (the penalty term's nodal force is positive: a Gauss point of
+     one of its faces penetrates, or the node itself with the nodal rule; on the bound with SNESVI);
+   - the penetration is the largest of the nodes' and the rule's points' (PostprocessPenetration() adds those of the
+     finer quadrature of the error norms). */
 PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
@@ -31,18 +40,8 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
         local[2 + c] += PetscRealPart(r[cs->dof[i * dim + c]]); /* the obstacle's force on the body: R = K u + r0 */
       }
     cs->reaction[i] = reaction;
-    switch (user->opt.contact.method) {
-      case CONTACT_PENALTY:
-        cs->pressure[i] = d > 0.0 ? d / ContactNodeEps(cs, user->prob.eps, i) : 0.0;
-        break;
-      case CONTACT_VI:
-        cs->pressure[i] = cs->weight[i] > 0.0 ? reaction / cs->weight[i] : 0.0;
-        break;
-      case CONTACT_NONE:
-        cs->pressure[i] = 0.0;
-        break;
-    }
-    local[0] = PetscMax(local[0], d);
+    cs->pressure[i] = user->opt.contact.method != CONTACT_NONE && cs->weight[i] > 0.0 ? reaction / cs->weight[i] : 0.0;
+    local[0]        = PetscMax(local[0], d);
     local[1] += reaction;
   }
   PetscCall(VecRestoreArrayRead(R, &r));
@@ -54,10 +53,24 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   PetscCall(BoundaryComputeReactions(dm, user, u, user->rec.stats.reaction));
   user->rec.stats.max_penetration = global[0];
   user->rec.stats.contact_force   = global[1];
-  PetscCall(ContactCountActive(user, u, PETSC_FALSE, &user->rec.stats.active_vertices, NULL, NULL));
+  if (user->opt.contact.method == CONTACT_PENALTY)
+    PetscCall(PenaltyCountActive(dm, user, u, &user->rec.stats.active_vertices, &global[0]));
+  else
+    PetscCall(ContactCountActive(user, u, PETSC_FALSE, &user->rec.stats.active_vertices, NULL, NULL));
+  user->rec.stats.max_penetration = PetscMax(user->rec.stats.max_penetration, global[0]);
   PetscCall(PenaltyEnergy(dm, user, u, &penalty_energy));
   if (user->opt.assembly_check) PetscCall(PenaltyCheckClosedForm(dm, user, u));
   /* 1/2 a(u,u) - L(u) on the free unknowns (exact for homogeneous Dirichlet data) + penalty energy */
   user->rec.stats.energy = 0.5 * uKu + r0u + penalty_energy;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The largest penetration of the run: that of the nodes and the rule's points (PostprocessContact()) and that of the
+   finer quadrature of the error norms (ErrorNormsCompute()), which a curved obstacle may reach between them. */
+PetscErrorCode PostprocessPenetration(AppCtx *user)
+{
+  PetscFunctionBeginUser;
+  if (!PetscIsNanReal(user->rec.errors.penetration_max))
+    user->rec.stats.max_penetration = PetscMax(user->rec.stats.max_penetration, user->rec.errors.penetration_max);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
