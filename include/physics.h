@@ -59,7 +59,7 @@ PetscErrorCode PenaltyBulkOperator(AppCtx *user, Mat *K);
 PetscErrorCode PenaltyBulkMult(AppCtx *user, Vec X, Vec R);
 PetscErrorCode PenaltyEnergy(DM dm, AppCtx *user, Vec X, PetscReal *energy);
 PetscErrorCode PenaltyCheckClosedForm(DM dm, AppCtx *user, Vec X);
-PetscErrorCode PenaltyCountActive(DM dm, AppCtx *user, Vec X, PetscInt *active, PetscReal *dmax);
+PetscErrorCode PenaltyRuleActs(DM dm, AppCtx *user, Vec X, PetscBool acts[], PetscReal *dmax);
 
 /* penalty_faces.c: the Gauss rule on P1 simplices in closed form */
 PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user);

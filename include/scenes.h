@@ -19,3 +19,7 @@ PetscErrorCode SceneSetObstaclePlane(Scene *scene, const PetscReal point[], cons
 PetscErrorCode SceneSetFoundation(Scene *scene, PetscInt dim);
 PetscErrorCode SceneBoundaryGetOptions(DM dm, Scene *scene);
 PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene);
+
+/* scenes/fingerprint.c: the problem as one string, for -reference */
+#define SCENE_FINGERPRINT_LEN 4096
+PetscErrorCode SceneFingerprint(const Scene *scene, const Material *mat, PetscInt dim, char buf[], size_t len);

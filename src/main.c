@@ -180,6 +180,7 @@ int main(int argc, char **argv)
   PetscCall(AppErrorPushHandler());
   ierr = Run(&converged);
   if (ierr) return AppErrorExit(ierr);
+  PetscCall(PetscPopErrorHandler());
   PetscCall(PetscFinalize());
   return converged ? 0 : 3;
 }

@@ -393,3 +393,21 @@ def test_options_read_during_the_solve_are_not_refused_early(hostile_dir):
     assert "  SNES CONVERGED" in out
     out, _ = run(args + ["-mg_levels_ksp_typo", 1], "hostile/read_late_typo", expect_rc=2)
     assert "-mg_levels_ksp_typo (did you mean -mg_levels_ksp_type?)" in out
+
+
+def test_reference_of_another_problem_is_refused(case_dir):
+    """-reference compares a fingerprint of the problem (scene, material, boundary families and values, loads, obstacle),
+    not only the mesh (issue 29: a general problem with another load on the same mesh was accepted and compared); the
+    method and eps may differ (that is what a reference is for)."""
+    d = case_dir("reference_problem")
+    general = ["-scene", "general", "-dm_plex_box_faces", "8,8", "-contact_faces", 1, "-bc_clamp", 3]
+    ref = os.path.join(d, "ref.h5")
+    run(general + ["-bc_clamp_3_translate", "0,-0.01", "-contact_method", "vi"], None, output=ref)
+    refuse(d, general + ["-bc_clamp_3_translate", "0,-0.02", "-reference", ref],
+           "solved another problem: it has 'clamp 3 value=0,-0.01' where this run has 'clamp 3 value=0,-0.02'")
+    refuse(d, general + ["-bc_clamp_3_translate", "0,-0.01", "-young_modulus", 2, "-reference", ref],
+           "solved another problem: it has 'E 1' where this run has 'E 2'")
+    refuse(d, general + ["-bc_clamp_3_translate", "0,-0.01", "-obstacle_point", "0,-0.001", "-reference", ref], "solved another problem")
+    from harness import load
+    a, _ = load(run(general + ["-bc_clamp_3_translate", "0,-0.01", "-reference", ref], "hostile/reference_same_problem")[1])
+    assert a["converged"] == 1 and 0.0 < a["reference_error_h1"] < 1e-2

@@ -9,6 +9,7 @@
 #include "mesh.h"
 #include "physics.h"
 #include "io.h"
+#include "scenes.h"
 
 PetscErrorCode OutputGetOptions(MPI_Comm comm, RunOptions *opt)
 {
@@ -274,6 +275,12 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     }
   }
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "obstacle", PETSC_STRING, ObstacleTypes[user->scene.obstacle.type]));
+  {
+    char problem[SCENE_FINGERPRINT_LEN];
+
+    PetscCall(SceneFingerprint(&user->scene, &user->opt.material, dim, problem, sizeof(problem)));
+    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "problem", PETSC_STRING, problem)); /* what -reference compares */
+  }
   {
     PetscInt n = user->prob.cset.n, ntotal;
 

@@ -526,16 +526,16 @@ PetscErrorCode PenaltyCheckClosedForm(DM dm, AppCtx *user, Vec X)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The vertices of Gamma_C where the penalty term acts: its nodal force (the rule's, at X) has a positive normal
-   component. With the Gauss rule that is a vertex of a face with a penetrating Gauss point, with the nodal rule a
-   penetrating vertex. *dmax: the largest penetration at the rule's points (the nodes; the Gauss points of the P1
-   closed form; -PETSC_MAX_REAL where PETSc integrates, whose points are not at hand), over all ranks. */
-PetscErrorCode PenaltyCountActive(DM dm, AppCtx *user, Vec X, PetscInt *active, PetscReal *dmax)
+/* Where the penalty term acts: acts[i] for each contact node of this rank, its nodal force (the rule's, at X) has a
+   positive normal component. With the Gauss rule that is a node of a face with a penetrating Gauss point, with the
+   nodal rule a penetrating node. *dmax: the largest penetration at the Gauss points of the P1 closed form over all
+   ranks (-PETSC_MAX_REAL with the nodal rule, and where PETSc integrates, whose points are not at hand). */
+PetscErrorCode PenaltyRuleActs(DM dm, AppCtx *user, Vec X, PetscBool acts[], PetscReal *dmax)
 {
   const ContactSet  *cs = &user->prob.cset;
   Vec                P;
   const PetscScalar *p;
-  PetscInt           dim, n = 0;
+  PetscInt           dim;
   PetscReal          d = -PETSC_MAX_REAL;
 
   PetscFunctionBeginUser;
@@ -547,14 +547,12 @@ PetscErrorCode PenaltyCountActive(DM dm, AppCtx *user, Vec X, PetscInt *active, 
   for (PetscInt i = 0; i < cs->n; ++i) {
     PetscReal pn = 0.0;
 
-    if (!cs->is_vertex[i]) continue;
     for (PetscInt c = 0; c < dim; ++c)
       if (cs->dof[i * dim + c] >= 0) pn += PetscRealPart(p[cs->dof[i * dim + c]]) * cs->normal[i * dim + c];
-    n += pn > 0.0;
+    acts[i] = (PetscBool)(pn > 0.0);
   }
   PetscCall(VecRestoreArrayRead(P, &p));
   PetscCall(VecDestroy(&P));
-  PetscCall(MPIU_Allreduce(&n, active, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
   if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS && user->prob.assembly == ASSEMBLY_P1) {
     Vec locX;
 

@@ -9,6 +9,7 @@
 #include "physics.h"
 #include "verify.h"
 #include "io.h"
+#include "scenes.h"
 
 typedef struct {
   PetscInt   dim, nv, ncells, ncorners;
@@ -191,6 +192,46 @@ static PetscBool ReferenceHasCell(const Reference *ref, const PetscInt v[])
 
 /* Every rank reads the whole reference: mesh, displacement and contact pressure at the vertices. */
 /* The checks of the reference's /run against this run: same scene and dimension, converged, degree 1. */
+/* The reference solved this run's problem: its /run attribute "problem" (scenes/fingerprint.c) equals this run's; the
+   message names the first item that differs. */
+static PetscErrorCode ReferenceCheckProblem(MPI_Comm comm, const AppCtx *user, PetscInt dim, PetscViewer v)
+{
+  const char *file = user->opt.verify.reference;
+  char        mine[SCENE_FINGERPRINT_LEN], *theirs = NULL;
+  PetscBool   has, same;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscViewerHDF5HasAttribute(v, "/run", "problem", &has));
+  PetscCheck(has, comm, PETSC_ERR_USER_INPUT,
+             "Reference file %s has no /run attribute problem (written by an older version of the solver): the problem it solved cannot be "
+             "compared with this run's; run the reference again",
+             file);
+  PetscCall(SceneFingerprint(&user->scene, &user->opt.material, dim, mine, sizeof(mine)));
+  PetscCall(PetscViewerHDF5ReadAttribute(v, "/run", "problem", PETSC_STRING, NULL, &theirs));
+  PetscCall(PetscStrcmp(mine, theirs, &same));
+  if (!same) {
+    char        a[512] = "", b[512] = "";
+    const char *p = mine, *q = theirs;
+
+    while (*p || *q) { /* the first differing item, "; "-separated */
+      const size_t lp = strcspn(p, ";"), lq = strcspn(q, ";");
+
+      if (lp != lq || strncmp(p, q, lp)) {
+        PetscCall(PetscStrncpy(a, p, PetscMin(lp + 1, sizeof(a))));
+        PetscCall(PetscStrncpy(b, q, PetscMin(lq + 1, sizeof(b))));
+        break;
+      }
+      p += lp + (p[lp] ? 2 : 0);
+      q += lq + (q[lq] ? 2 : 0);
+    }
+    PetscCall(PetscFree(theirs));
+    SETERRQ(comm, PETSC_ERR_USER_INPUT, "Reference %s solved another problem: it has '%s' where this run has '%s'", file, b[0] ? b : "(nothing)",
+            a[0] ? a : "(nothing)");
+  }
+  PetscCall(PetscFree(theirs));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, PetscInt dim, PetscViewer v, PetscInt *ref_dim, PetscInt *ncells)
 {
   const char *file       = user->opt.verify.reference;
@@ -212,6 +253,7 @@ static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, Pe
   PetscCall(PetscStrcmp(scene, user->scene.name, &same));
   PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "Reference %s is a run of scene %s, this is scene %s", file, scene, user->scene.name);
   PetscCall(PetscFree(scene));
+  PetscCall(ReferenceCheckProblem(comm, user, dim, v));
   PetscCheck(*ref_dim == dim, comm, PETSC_ERR_USER_INPUT, "Reference %s is %" PetscInt_FMT "D, this run is %" PetscInt_FMT "D", file, *ref_dim, dim);
   PetscCheck(converged == 1, comm, PETSC_ERR_USER_INPUT, "Reference %s did not converge (/run converged = 0)", file);
   PetscCheck(degree == 1 && user->opt.degree == 1, comm, PETSC_ERR_USER_INPUT,
