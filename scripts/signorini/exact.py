@@ -199,3 +199,111 @@ def p1_error_norms(x, cells, uh, exact, n_smooth=10, n_kink=12):
         s1 += wts @ np.sum(ge * ge, axis=(1, 2))
         assert d == V.shape[1]
     return {"l2": float(np.sqrt(s0)), "h1_semi": float(np.sqrt(s1))}
+
+
+def boundary_faces(cells, mask):
+    """The boundary faces (d vertex indices each) of the simplex mesh `cells` with every vertex in the boolean mask:
+    the faces that belong to one cell only."""
+    count = {}
+    k = cells.shape[1]
+    for c in cells:
+        for drop in range(k):
+            f = tuple(sorted(int(v) for j, v in enumerate(c) if j != drop))
+            count[f] = count.get(f, 0) + 1
+    return np.array(sorted(f for f, n in count.items() if n == 1 and all(mask[list(f)])), dtype=int)
+
+
+def _simplex_measure(P):
+    """Length of a segment or area of a triangle with vertices P (2 x d or 3 x d)."""
+    E = P[1:] - P[0]
+    return float(np.sqrt(abs(np.linalg.det(E @ E.T)))) / (1.0 if len(P) == 2 else 2.0)
+
+
+def positive_part_integral(P, d):
+    """int_F [d]_+ ds, exactly, for d affine on the segment or triangle F with vertices P (2 x dim or 3 x dim) and vertex
+    values d: F is clipped to d >= 0 at the zero crossings and d, affine, integrates to measure times its mean at the
+    vertices on each piece."""
+    P, d = np.asarray(P, float), np.asarray(d, float)
+    if np.all(d <= 0.0):
+        return 0.0
+    if np.all(d >= 0.0):
+        return _simplex_measure(P) * d.mean()
+    pos = [i for i in range(len(d)) if d[i] > 0.0]
+    neg = [i for i in range(len(d)) if d[i] <= 0.0]
+    cut = lambda i, j: P[i] + d[i] / (d[i] - d[j]) * (P[j] - P[i])  # noqa: E731, the zero of d on edge ij
+    if len(P) == 2:
+        i, j = pos[0], neg[0]
+        return _simplex_measure(np.array([P[i], cut(i, j)])) * d[i] / 2.0
+    if len(pos) == 1:  # a triangle: the corner at pos[0]
+        i, (j, k) = pos[0], neg
+        return _simplex_measure(np.array([P[i], cut(i, j), cut(i, k)])) * d[i] / 3.0
+    (i, j), k = pos, neg[0]  # the quadrilateral P_i, P_j, cut(j, k), cut(i, k), as two triangles
+    a, b = cut(i, k), cut(j, k)
+    return _simplex_measure(np.array([P[i], P[j], b])) * (d[i] + d[j]) / 3.0 + _simplex_measure(np.array([P[i], b, a])) * d[i] / 3.0
+
+
+def plane_penetration(x, u, point, normal):
+    """d = u . n - g = (x + u - point) . n at the points x with displacements u, for the plane through `point` with the
+    normal `normal` (from the body into the obstacle, normalized here)."""
+    n = np.asarray(normal, float) / np.linalg.norm(normal)
+    return (np.asarray(x) + np.asarray(u) - np.asarray(point, float)) @ n, n
+
+
+def gauss_segment_integral(P, f, npoints=2):
+    """int over the segment P (2 x dim) of f(points) by npoints-point Gauss-Legendre."""
+    t, w = gauss_legendre01(npoints)
+    X = P[0][None, :] + t[:, None] * (P[1] - P[0])[None, :]
+    return _simplex_measure(P) * float(w @ f(X, t))
+
+
+def positive_part_loads(x, faces, d, rule="exact"):
+    """b_i = int_{faces} [d]_+ phi_i ds for every vertex i (phi_i the P1 hat, d affine on each face with the vertex values
+    d): rule "exact" clips each face to d >= 0 at the zero crossings and integrates the quadratic d phi_i exactly on
+    the pieces (Gauss-Legendre 2 points on segments, the degree-2 triangle rule on a fan of triangles); rule "gauss2"
+    (segments only) evaluates [d]_+ phi_i at the 2 Gauss-Legendre points of the whole face, the textbook rule."""
+    b = np.zeros(len(x))
+    for f in faces:
+        P, dv = x[f], d[f]
+        k = len(f)
+        if rule == "gauss2":
+            assert k == 2, "gauss2 is for segments"
+            t, w = gauss_legendre01(2)
+            dq = np.maximum((1 - t) * dv[0] + t * dv[1], 0.0)
+            L = _simplex_measure(P)
+            b[f[0]] += L * w @ (dq * (1 - t))
+            b[f[1]] += L * w @ (dq * t)
+            continue
+        if np.all(dv <= 0.0):
+            continue
+        # the clipped polygon in barycentric coordinates of the face
+        lam = np.eye(k)
+        poly = []
+        for i in range(k):
+            j = (i + 1) % k
+            if dv[i] >= 0.0:
+                poly.append(lam[i])
+            if (dv[i] > 0.0 > dv[j]) or (dv[i] < 0.0 < dv[j]):
+                s = dv[i] / (dv[i] - dv[j])
+                poly.append(lam[i] + s * (lam[j] - lam[i]))
+            if k == 2:
+                break
+        if k == 2 and dv[1] >= 0.0:
+            poly.append(lam[1])
+        poly = np.array(poly)
+        meas = _simplex_measure(P)
+        if k == 2:
+            pieces = [(poly[0], poly[-1])]
+            t, w = gauss_legendre01(2)
+            for l0, l1 in pieces:
+                Lq = l0[None, :] + t[:, None] * (l1 - l0)[None, :]  # barycentric points
+                wq = w * meas * abs(l1 - l0)[0]
+                b[f] += (wq * (Lq @ dv)) @ Lq
+        else:
+            rp, rw = _TRI2
+            for m in range(1, len(poly) - 1):
+                l0, l1, l2 = poly[0], poly[m], poly[m + 1]
+                Lq = l0[None, :] + rp[:, :1] * (l1 - l0)[None, :] + rp[:, 1:] * (l2 - l0)[None, :]
+                area = abs(np.linalg.det(np.array([l1 - l0, l2 - l0])[:, :2]))  # fraction of the face's (2 x its area)
+                wq = 2.0 * rw * area * meas
+                b[f] += (wq * (Lq @ dv)) @ Lq
+    return b
