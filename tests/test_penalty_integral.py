@@ -35,10 +35,10 @@ CASES = {
 
 def solve(outdir, case):
     args, normal = CASES[case]
-    _, h5 = run(["-scene", "general", "-contact_faces", 1, "-obstacle_normal", ",".join(map(str, normal))] + args, case,
+    _, h5 = run(["-scene", "general", "-contact_faces", 1, "-obstacle_normal", ",".join(map(str, normal)), "-snes_rtol", "1e-14"] + args, case,
                 output=os.path.join(outdir, "p.h5"))
     a, _ = load(h5)
-    assert a["converged"] == 1 and a["residual_norm"] <= 1e-14, (a["converged"], a["residual_norm"])
+    assert a["converged"] == 1 and a["residual_norm"] <= 1e-12 * a["load_norm"], (a["converged"], a["residual_norm"], a["load_norm"])
     assert a["penalty_quadrature"] == "gauss" and a["eps"] > 0  # uniform: the 3D box's cell sizes differ by rounding only
     assert abs(a["eps_min"] / a["eps"] - 1) <= 1e-12 and abs(a["eps_max"] / a["eps"] - 1) <= 1e-12
     x, cells, u = read_p1_mesh(h5)
