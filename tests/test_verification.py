@@ -69,14 +69,40 @@ def test_mms_quadrature_does_not_pollute_the_error():
 
 
 def test_mms_3d_error_decreases():
-    """3D tetrahedra: halving h must cut the H1 error by at least 2^0.65 (predicted exponent 3/4, minus 0.1)."""
-    errs = []
-    for n in (4, 8):
+    """3D tetrahedra, eps = h, 4^3, 8^3 and 12^3 cells: the level rates of the H1 error must be at least 0.85. README's
+    study 2 (rates3d.yaml) reports 0.93 and 0.92 for these levels (measured here: the same); the bar is that minus
+    0.07, and above the predicted 3/4 of Corollary 3.3, so a loss of the observed rate (not only of the bound) fails."""
+    errs, hs = [], []
+    for n in (4, 8, 12):
         _, h5 = run(["-options_file", "options/mms.yaml", "-dm_plex_dim", 3, "-dm_plex_box_faces", f"{n},{n},{n}"], f"mms_3d_{n}")
         a, _ = load(h5)
         assert a["converged"] == 1
         errs.append(a["error_h1"])
-    assert errs[1] <= errs[0] / 2 ** 0.65, errs
+        hs.append(a["h"])
+    rates = [np.log(errs[k] / errs[k + 1]) / np.log(hs[k] / hs[k + 1]) for k in range(2)]
+    assert min(rates) >= 0.85, (rates, errs)
+
+
+def test_penalty_eps_modulus_and_power():
+    """eps as /run records it against the formulas of README ("Options the project adds"), from /run's own h, E and nu:
+    -penalty_eps_modulus pwave gives eps0 h / (lambda + 2 mu), -penalty_eps_power p gives eps0 h^p / E (p = 0.5, 2, 0),
+    to 1e-12 relative (the same formula in double precision)."""
+    base = ["-options_file", "options/square.yaml", "-contact_monitor", "false", "-dm_plex_box_faces", "8,8", "-young_modulus", 3.0,
+            "-poisson_ratio", 0.45, "-penalty_eps0", 0.7]
+    cases = {"pwave": (["-penalty_eps_modulus", "pwave"], 1.0, "pwave"), "power_half": (["-penalty_eps_power", 0.5], 0.5, "young"),
+             "power_2": (["-penalty_eps_power", 2], 2.0, "young"), "power_0": (["-penalty_eps_power", 0], 0.0, "young"),
+             "pwave_power_2": (["-penalty_eps_modulus", "pwave", "-penalty_eps_power", 2], 2.0, "pwave")}
+    for name, (extra, power, modulus) in cases.items():
+        _, h5 = run(base + extra, f"eps_rule_{name}")
+        a, _ = load(h5)
+        assert a["converged"] == 1 and a["penalty_eps_modulus"] == modulus
+        E, nu = a["young_modulus"], a["poisson_ratio"]
+        lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+        M = lam + 2 * mu if modulus == "pwave" else E
+        expected = 0.7 * a["h"] ** power / M
+        assert abs(a["eps"] / expected - 1) <= 1e-12, (name, a["eps"], expected)
+        assert abs(a["eps_min"] / expected - 1) <= 1e-12 and abs(a["eps_max"] / expected - 1) <= 1e-12, (name, a["eps_min"], a["eps_max"])
+    assert abs(a["h"] - np.sqrt(2) / 8) <= 1e-15  # the diameter of the 8x8 box's cells
 
 
 def test_mms_norms_parallel_match_serial():
