@@ -13,6 +13,7 @@ TRACTION = (0.01, -0.05)             # on "traction" (top, x in [1, 2])
 CLAMP = (0.001, -0.01)               # "clamp" (top, x in [0, 1]) moved by this translation
 SLIP_LEFT = 0.0                      # "left" (x = 0): u_x = this, u_y free
 CENTER, RADIUS = (1.0, -5.0), 5.0    # the rigid disk below: the body stays outside it
+PLANE_POINT, PLANE_NORMAL = (1.0, -0.05), (0.1, -1.0)  # obstacle="plane": a tilted foundation (the normal normalized below)
 EPS = 1e-2                           # -penalty_eps
 GROUPS = {"contact_a": 1, "contact_b": 2, "right": 3, "traction": 4, "clamp": 5, "left": 6}
 
@@ -40,17 +41,36 @@ def write_mesh(path, size=0.1):
         gmsh.finalize()
 
 
-def solver_options():
+def obstacle_options(obstacle="cylinder"):
+    """The obstacle as bin/signorini options: the disk below (cylinder) or the tilted plane."""
+    if obstacle == "plane":
+        return ["-obstacle", "plane", "-obstacle_point", f"{PLANE_POINT[0]},{PLANE_POINT[1]}",
+                "-obstacle_normal", f"{PLANE_NORMAL[0]},{PLANE_NORMAL[1]}"]
+    return ["-obstacle", "cylinder", "-obstacle_center", f"{CENTER[0]},{CENTER[1]}", "-obstacle_radius", RADIUS]
+
+
+def obstacle_normal_gap(x, obstacle="cylinder"):
+    """The obstacle's unit normal (from the body into it) and the gap at the points x, from the formulas: for the disk,
+    n = -(x - c)/|x - c| and g = |x - c| - R; for the plane through p with unit normal n, g = (p - x) . n."""
+    if obstacle == "plane":
+        n = np.array(PLANE_NORMAL) / np.linalg.norm(PLANE_NORMAL)
+        return np.tile(n, (len(x), 1)), (np.array(PLANE_POINT) - x) @ n
+    r = x - np.array(CENTER)
+    dist = np.linalg.norm(r, axis=1)
+    return -r / dist[:, None], dist - RADIUS
+
+
+def solver_options(obstacle="cylinder"):
     """The same problem as bin/signorini options (scene general, nodal penalty quadrature, a fixed eps)."""
     return ["-scene", "general", "-young_modulus", E, "-poisson_ratio", NU, "-contact_faces", "contact_a,contact_b",
             "-bc_clamp", "clamp", "-bc_clamp_clamp_translate", f"{CLAMP[0]},{CLAMP[1]}", "-bc_slip", "left",
             "-bc_slip_left_components", "0", "-bc_slip_left_translate", f"{SLIP_LEFT},0", "-bc_traction", "traction",
             "-bc_traction_traction", f"{TRACTION[0]},{TRACTION[1]}", "-bc_pressure", "right", "-bc_pressure_right", PRESSURE,
-            "-body_force", f"{BODY_FORCE[0]},{BODY_FORCE[1]}", "-obstacle", "cylinder", "-obstacle_center", f"{CENTER[0]},{CENTER[1]}",
-            "-obstacle_radius", RADIUS, "-penalty_quadrature", "nodal", "-penalty_eps", EPS, "-snes_rtol", "1e-14"]
+            "-body_force", f"{BODY_FORCE[0]},{BODY_FORCE[1]}"] + obstacle_options(obstacle) + [
+            "-penalty_quadrature", "nodal", "-penalty_eps", EPS, "-snes_rtol", "1e-14"]
 
 
-def solve(path, tol=1e-13, max_it=50):
+def solve(path, tol=1e-13, max_it=50, obstacle="cylinder"):
     """(vertex coordinates [n, 2], displacement [n, 2], contact force) of the nodal penalty problem on the mesh at path."""
     import getfem as gf
 
@@ -76,9 +96,8 @@ def solve(path, tol=1e-13, max_it=50):
     fixed[left] = True
     value[left] = SLIP_LEFT
     nodes = np.unique(np.concatenate([mfu.basic_dof_on_region(GROUPS[r]) for r in ("contact_a", "contact_b")]) // 2)
-    r = x[2 * nodes] - np.array(CENTER)
-    dist = np.linalg.norm(r, axis=1)
-    normal, gap, weight = -r / dist[:, None], dist - RADIUS, W[2 * nodes]
+    normal, gap = obstacle_normal_gap(x[2 * nodes], obstacle)
+    weight = W[2 * nodes]
     free = ~fixed
     u = value.copy()
     for _ in range(max_it):

@@ -32,6 +32,52 @@ def test_patch_test(mesh, method):
     assert attrs["active_vertices"] == 0 and attrs["max_penetration"] <= 0.0
 
 
+ACTIVE_PATCH = {
+    2: ["-dm_plex_box_faces", "4,4", "-bc_slip", "2,4,3", "-bc_slip_2_components", 0, "-bc_slip_4_components", 0,
+        "-bc_slip_3_components", 1],
+    3: ["-dm_plex_dim", 3, "-dm_plex_box_faces", "2,2,2", "-bc_slip", "3,4,5,6,2", "-bc_slip_3_components", 1,
+        "-bc_slip_4_components", 1, "-bc_slip_5_components", 0, "-bc_slip_6_components", 0, "-bc_slip_2_components", 2],
+}
+
+
+@pytest.mark.parametrize("quad", ("gauss", "nodal"))
+@pytest.mark.parametrize("dim", (2, 3), ids=("2d", "3d"))
+def test_patch_test_with_active_penalty(dim, quad):
+    """The patch test with the penalty term active on the whole of Gamma_C. The unit box rests on the foundation
+    x_d = 0 (scene general, Gamma_C the bottom face set 1), its sides are symmetry planes (slips fixing the normal
+    component) and its top is pushed down by delta (a slip fixing u_d = -delta), eps set directly (-penalty_eps, so it is
+    uniform). By hand (uniaxial strain, M = lambda + 2 mu, 2D plane strain as 3D): u_i = 0 for i < d and
+    u_d = c0 + c1 x_d with sigma_dd = M c1 uniform, the penalty pressure p = -c0/eps balancing it (M c1 = c0/eps) and
+    c0 + c1 = -delta, so c0 = -delta eps M / (1 + eps M), p = delta M / (1 + eps M) and the penetration is eps p.
+    The field is affine and the penalty pressure uniform, so P1 with either rule (Gauss, exact for the constant pressure;
+    nodal, lumped) reproduces it: the field to 1e-12 delta (a direct solve, round-off), the penetration, pressure and
+    contact force (p times the unit area) to 1e-10 relative, and every Gamma_C vertex active."""
+    delta, eps = 0.01, 0.05
+    last = "3" if dim == 2 else "2"
+    translate = ",".join(["0"] * (dim - 1) + [str(-delta)])
+    args = ["-scene", "general", "-contact_faces", 1, "-penalty_eps", eps, "-penalty_quadrature", quad,
+            f"-bc_slip_{last}_translate", translate] + ACTIVE_PATCH[dim]
+    _, h5 = run(args, f"patch_active_{dim}d_{quad}")
+    a, f = load(h5)
+    assert a["converged"] == 1
+    assert a["eps"] == eps and a["eps_min"] == eps and a["eps_max"] == eps
+    E, nu = a["young_modulus"], a["poisson_ratio"]
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    M = lam + 2 * mu
+    c0 = -delta * eps * M / (1 + eps * M)
+    c1 = -delta - c0
+    p = delta * M / (1 + eps * M)
+    exact = np.zeros_like(f["displacement"])
+    exact[:, dim - 1] = c0 + c1 * f["x"][:, dim - 1]
+    err = np.abs(f["displacement"] - exact).max()
+    assert err <= 1e-12 * delta, f"field error {err:.3e}"
+    on = f["contact_boundary"] > 0.5
+    assert on.sum() == a["contact_nodes"] and a["active_vertices"] == a["contact_nodes"] == (5 if dim == 2 else 9)
+    assert abs(a["max_penetration"] / (eps * p) - 1) <= 1e-10, (a["max_penetration"], eps * p)
+    assert np.abs(f["contact_pressure"][on] / p - 1).max() <= 1e-10, (f["contact_pressure"][on], p)
+    assert abs(a["contact_force"] / p - 1) <= 1e-10, (a["contact_force"], p)
+
+
 def jacobian_ratios(log):
     return [float(m) for m in re.findall(r"\|\|J - Jfd\|\|_F/\|\|J\|\|_F = ([0-9.eE+-]+)", log)]
 

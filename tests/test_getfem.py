@@ -1,6 +1,7 @@
 """Every boundary-condition family at once (a clamp with a translation, a slip with its value, a traction, a pressure,
 a body force, two contact face sets under a curved obstacle) on a Gmsh mesh, against GetFEM on the very same mesh
-(tests/getfem_reference.py): the nodal displacements agree to solver tolerance, serially and on 2 ranks."""
+(tests/getfem_reference.py): the nodal displacements agree to solver tolerance, serially and on 2 ranks; and the same
+problem on a tilted plane foundation (-obstacle_point, -obstacle_normal), serially."""
 import os
 
 import numpy as np
@@ -18,6 +19,13 @@ def problem(tmp_path_factory):
     return path, x, u, force
 
 
+@pytest.fixture(scope="module")
+def problem_plane(problem):
+    path = problem[0]
+    x, u, force = ref.solve(path, obstacle="plane")
+    return path, x, u, force
+
+
 @pytest.mark.parametrize("ranks", [1, 2])
 def test_every_family_against_getfem(outdir, problem, ranks):
     path, x_ref, u_ref, force_ref = problem
@@ -31,3 +39,27 @@ def test_every_family_against_getfem(outdir, problem, ranks):
     scale = np.max(np.abs(u_ref))
     assert diff < 1e-10 * scale, f"max difference {diff:.3e} against GetFEM (displacement scale {scale:.3e})"
     assert abs(attrs["contact_force"] / force_ref - 1) < 1e-9
+
+
+def test_tilted_plane_against_getfem(outdir, problem_plane):
+    """The tilted plane (normal (0.1, -1) normalized, through (1, -0.05)): the gap and normal of each contact node
+    from GetFEM's side's formula g = (p - x) . n, the rest as above. Contact on part of Gamma_C only (the plane falls
+    away on one side); the displacements agree to 1e-10 of their size and the contact force to 1e-9, as for the disk
+    (both solve the same discrete problem to 1e-13 and 1e-14 relative residuals)."""
+    path, x_ref, u_ref, force_ref = problem_plane
+    _, h5 = run(["-dm_plex_filename", path] + ref.solver_options("plane"), "tilted", output=os.path.join(outdir, "tp.h5"))
+    attrs, fields = load(h5)
+    assert attrs["converged"] == 1 and attrs["obstacle"] == "plane"
+    assert 3 < attrs["active_vertices"] < attrs["contact_nodes"], (attrs["active_vertices"], attrs["contact_nodes"])
+    order_ref = np.lexsort(np.round(x_ref, 9).T)
+    order = np.lexsort(np.round(fields["x"], 9).T)
+    assert np.allclose(x_ref[order_ref], fields["x"][order], atol=1e-12)
+    diff = np.max(np.abs(u_ref[order_ref] - fields["displacement"][order]))
+    scale = np.max(np.abs(u_ref))
+    assert diff < 1e-10 * scale, f"max difference {diff:.3e} against GetFEM (displacement scale {scale:.3e})"
+    assert abs(attrs["contact_force"] / force_ref - 1) < 1e-9
+    # the gap written by the solver is the plane's: normal_gap = g - u_n at every contact node
+    on = fields["contact_boundary"] > 0.5
+    n, g = ref.obstacle_normal_gap(fields["x"][on], "plane")
+    un = np.sum(fields["displacement"][on] * n, axis=1)
+    assert np.max(np.abs(fields["normal_gap"][on] - (g - un))) < 1e-12

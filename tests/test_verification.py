@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from harness import ENV, OUT, ROOT, load, run
+from signorini.exact import gauss_legendre01, mms_from_run, p1_error_norms, read_p1_mesh
 
 STUDY = os.path.join(ROOT, "scripts", "study.py")
 NORMS = ["error_l2", "error_h1_semi", "error_h1", "error_energy", "error_pressure_l2", "error_pressure_weighted", "error_pressure_dual"]
@@ -68,14 +69,40 @@ def test_mms_quadrature_does_not_pollute_the_error():
 
 
 def test_mms_3d_error_decreases():
-    """3D tetrahedra: halving h must cut the H1 error by at least 2^0.65 (predicted exponent 3/4, minus 0.1)."""
-    errs = []
-    for n in (4, 8):
+    """3D tetrahedra, eps = h, 4^3, 8^3 and 12^3 cells: the level rates of the H1 error must be at least 0.85. README's
+    study 2 (rates3d.yaml) reports 0.93 and 0.92 for these levels (measured here: the same); the bar is that minus
+    0.07, and above the predicted 3/4 of Corollary 3.3, so a loss of the observed rate (not only of the bound) fails."""
+    errs, hs = [], []
+    for n in (4, 8, 12):
         _, h5 = run(["-options_file", "options/mms.yaml", "-dm_plex_dim", 3, "-dm_plex_box_faces", f"{n},{n},{n}"], f"mms_3d_{n}")
         a, _ = load(h5)
         assert a["converged"] == 1
         errs.append(a["error_h1"])
-    assert errs[1] <= errs[0] / 2 ** 0.65, errs
+        hs.append(a["h"])
+    rates = [np.log(errs[k] / errs[k + 1]) / np.log(hs[k] / hs[k + 1]) for k in range(2)]
+    assert min(rates) >= 0.85, (rates, errs)
+
+
+def test_penalty_eps_modulus_and_power():
+    """eps as /run records it against the formulas of README ("Options the project adds"), from /run's own h, E and nu:
+    -penalty_eps_modulus pwave gives eps0 h / (lambda + 2 mu), -penalty_eps_power p gives eps0 h^p / E (p = 0.5, 2, 0),
+    to 1e-12 relative (the same formula in double precision)."""
+    base = ["-options_file", "options/square.yaml", "-contact_monitor", "false", "-dm_plex_box_faces", "8,8", "-young_modulus", 3.0,
+            "-poisson_ratio", 0.45, "-penalty_eps0", 0.7]
+    cases = {"pwave": (["-penalty_eps_modulus", "pwave"], 1.0, "pwave"), "power_half": (["-penalty_eps_power", 0.5], 0.5, "young"),
+             "power_2": (["-penalty_eps_power", 2], 2.0, "young"), "power_0": (["-penalty_eps_power", 0], 0.0, "young"),
+             "pwave_power_2": (["-penalty_eps_modulus", "pwave", "-penalty_eps_power", 2], 2.0, "pwave")}
+    for name, (extra, power, modulus) in cases.items():
+        _, h5 = run(base + extra, f"eps_rule_{name}")
+        a, _ = load(h5)
+        assert a["converged"] == 1 and a["penalty_eps_modulus"] == modulus
+        E, nu = a["young_modulus"], a["poisson_ratio"]
+        lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+        M = lam + 2 * mu if modulus == "pwave" else E
+        expected = 0.7 * a["h"] ** power / M
+        assert abs(a["eps"] / expected - 1) <= 1e-12, (name, a["eps"], expected)
+        assert abs(a["eps_min"] / expected - 1) <= 1e-12 and abs(a["eps_max"] / expected - 1) <= 1e-12, (name, a["eps_min"], a["eps_max"])
+    assert abs(a["h"] - np.sqrt(2) / 8) <= 1e-15  # the diameter of the 8x8 box's cells
 
 
 def test_mms_norms_parallel_match_serial():
@@ -87,10 +114,52 @@ def test_mms_norms_parallel_match_serial():
         assert abs(a1[k] - a2[k]) <= 1e-9 * max(abs(a1[k]), 1e-14), f"{k}: {a1[k]:.12e} vs {a2[k]:.12e}"
 
 
+def _gamma_c_load_norm(h5):
+    """||b||_2, b_i = int_{Gamma_C} sigma_n(u_exact) phi_i ds over the vertices i of y = 0 (P1 hats of the uniform box),
+    integrated in Python from the closed form (Gauss on each edge, the kink x = a a breakpoint)."""
+    a, f = load(h5)
+    m = mms_from_run(a)
+    xs = np.sort(f["x"][np.abs(f["x"][:, 1]) < 1e-14, 0])
+    t, w = gauss_legendre01(40)
+    b = np.zeros(len(xs))
+    for k in range(len(xs) - 1):
+        x0, x1 = xs[k], xs[k + 1]
+        br = sorted([x0, x1] + ([m.a] if x0 < m.a < x1 else []))
+        for y0, y1 in zip(br[:-1], br[1:]):
+            X, W = y0 + (y1 - y0) * t, (y1 - y0) * w
+            s = m.normal_stress(X, a["young_modulus"], a["poisson_ratio"])
+            b[k] += W @ (s * (x1 - X) / (x1 - x0))
+            b[k + 1] += W @ (s * (X - x0) / (x1 - x0))
+    return np.linalg.norm(b)
+
+
 def test_dmsnes_check_runs_against_the_exact_solution():
-    out, _ = run(["-options_file", "options/mms.yaml", "-dm_plex_box_faces", "8,8", "-dmsnes_check"], "mms_dmsnes_check")
-    err = float(out.split("L_2 Error:")[1].split()[0])
-    assert 0.0 < err < 0.05, f"L_2 error of the interpolated exact solution {err}"
+    """PETSc's -dmsnes_check on the interpolant u_I of the exact solution, 8x8 and 16x16:
+    - "L_2 Error" (||u - u_I||_0 with PETSc's quadrature) falls by 3.5 to 4.3 from 8x8 to 16x16: O(h^2), since u is
+      C^1 with bounded second derivatives (s^(1/2) at the kink), so nothing limits the interpolation rate (measured 3.73,
+      3.86 from 16 to 32, the pre-asymptotic approach to 4); and it is within 6% of the same norm computed in Python
+      exactly (exact.p1_error_norms of u_I: PETSc's rule for P1 underestimates it by a steady 4.0 to 4.3%);
+    - "Function appears to be linear": u_I never penetrates (u_I,n = -I_h phi <= 0), so the penalty term vanishes at u_I
+      and at 0 and F(u_I) = J u_I + F(0);
+    - "L_2 Residual" = ||F(u_I)||_2 is then, up to the bulk consistency error, the Gamma_C load int sigma_n(u) phi_i that
+      no penalty pressure balances: within 5% of its norm computed in Python at 16x16 (measured 2.2%; 13% at 8x8, where
+      the bulk term is larger), falling like h^(1/2) (about a/h nodes of size h each: ratio 1.3 to 1.6, measured 1.45)."""
+    err, res = {}, {}
+    for n in (8, 16):
+        out, h5 = run(["-options_file", "options/mms.yaml", "-dm_plex_box_faces", f"{n},{n}", "-dmsnes_check"], f"mms_dmsnes_check_{n}")
+        err[n] = float(out.split("L_2 Error:")[1].split()[0])
+        res[n] = float(out.split("L_2 Residual:")[1].split()[0])
+        assert "Function appears to be linear" in out, out[:2000]
+        a, _ = load(h5)
+        x, cells, _ = read_p1_mesh(h5)
+        m = mms_from_run(a)
+        ref = p1_error_norms(x, cells, m.u(x), m)["l2"]
+        assert abs(err[n] / ref - 1) <= 0.06, (n, err[n], ref)
+        if n == 16:
+            load16 = _gamma_c_load_norm(h5)
+            assert abs(res[n] / load16 - 1) <= 0.05, (res[n], load16)
+    assert 3.5 <= err[8] / err[16] <= 4.3, err
+    assert 1.3 <= res[8] / res[16] <= 1.6, res
 
 
 def test_reference_on_nested_meshes_is_exact_for_the_patch_test():

@@ -9,6 +9,7 @@
     formatting  numbers as text in tables and sentences
     report      CSV, Markdown and text-file writers
     figures     PNG figures: pyplot on the Agg backend, saving, the note of an empty log plot
+    exact       closed forms (the mms solution) and an accurate P1 error quadrature, independent of the C code
 
 Front ends put the scripts directory on sys.path and import the modules they need, e.g.
 `from signorini.studyfile import StudyError`.
