@@ -77,6 +77,11 @@ PetscErrorCode VICreateBounds(DM dm, AppCtx *user);
 PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u);
 PetscErrorCode PostprocessPenetration(AppCtx *user);
 
+/* contact_checks.c */
+PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user);
+PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user);
+PetscErrorCode ContactChecksWarnings(MPI_Comm comm, const ContactChecks *ck, PetscBool print, PetscInt *nwarnings);
+
 /* elasticity.c: sigma(grad u) = lambda tr(eps) I + 2 mu eps, grad[i*dim+j] = du_i/dx_j */
 void ElasticStress(PetscInt dim, const Material *mat, const PetscReal grad[], PetscReal sigma[]);
 

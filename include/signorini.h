@@ -231,6 +231,18 @@ typedef struct {
   PetscReal vcycle_gbs, vcycle_s;   /* one application of its preconditioner (a PCMG; NaN otherwise) */
 } Bandwidth;
 
+/* Checks of the contact set-up and of the contact zone's resolution (src/physics/contact_checks.c): warnings only. */
+#define CONTACT_CHECK_OVERLAP_CELLS 1.0 /* an initial overlap deeper than this many cells is warned of */
+#define CONTACT_CHECK_ZONE_CELLS    4.0 /* a contact zone spanning fewer cells is warned of (bench/zone_resolution.md) */
+typedef struct {
+  PetscBool geometry_checked, resolution_checked;
+  PetscReal overlap_cells;    /* largest initial overlap -g/h at Gamma_C's vertices, h the diameter of the face's cell */
+  PetscReal overlap_fraction; /* part of Gamma_C's area whose faces start inside the obstacle (g < 0 at the centroid) */
+  PetscReal away_fraction;    /* part of Gamma_C's area where the obstacle's normal points into the body */
+  PetscInt  zone_faces;       /* faces of Gamma_C whose every node carries contact force */
+  PetscReal zone_cells;       /* cells across the contact zone: zone_faces in 2D, its square root in 3D */
+} ContactChecks;
+
 typedef struct {
   PetscInt            newton_its, ksp_its;             /* of the last solve (the finest mesh, the last eps) */
   PetscInt            newton_its_total, ksp_its_total; /* of all solves: grid sequence levels, continuation, eps sweep */
@@ -252,6 +264,7 @@ typedef struct {
   PetscReal           contact_force_vector[3];   /* the obstacle's force on the body: the sum of R = K u + r0 over the contact nodes */
   PetscReal           reaction[BOUNDARY_MAX][3]; /* force the support of each clamp or slip face set exerts on the body */
   MeshPartitionStats  partition;                 /* from MeshPartitionGetStats() */
+  ContactChecks       checks;                    /* the set-up's and the contact zone's warnings */
 } RunStats;
 
 /* One solve of a run: a level of the grid sequence or an eps of the sweep (/solves in the output). */

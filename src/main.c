@@ -59,6 +59,7 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
                             (double)r->time_solve, r->converged ? "" : "  FAILED"));
     }
   }
+  PetscCall(ContactChecksWarnings(comm, &s->checks, PETSC_TRUE, NULL));
   if (s->continuation_stages)
     PetscCall(PetscPrintf(comm, "  eps continuation: %" PetscInt_FMT " solve(s) from eps = h/M before the target eps (counted in the Newton steps)\n",
                           s->continuation_stages));
@@ -124,6 +125,7 @@ static PetscErrorCode Run(PetscBool *converged)
   PetscCall(SceneCreate(user.opt.scene_name, dm, &user.opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(ReferenceCheckFile(dm, &user));  /* before the solve, not after it */
+  PetscCall(ContactChecksGeometry(dm, &user)); /* initial overlap, an obstacle facing away: warnings */
   PetscCall(VecDuplicate(user.prob.r0, &u)); /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
   PetscCall(DMSNESCheckFromOptions(snes, u));       /* -dmsnes_check: PETSc's checks against the exact solution */
@@ -135,6 +137,7 @@ static PetscErrorCode Run(PetscBool *converged)
   PetscCall(EpsSweepSolve(dm, &user, snes, u));
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
+  PetscCall(ContactChecksResolution(dm, &user)); /* cells across the contact zone: a warning */
   PetscCall(ErrorNormsCompute(dm, &user, u));
   PetscCall(PostprocessPenetration(&user));                        /* with the error norms' finer quadrature */
   PetscCall(ReferenceCompute(dm, &user, u));                       /* -reference, if given */

@@ -287,6 +287,21 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
     PetscCall(WriteIntAttr(v, "contact_nodes", ntotal)); /* the free nodes of Gamma_C the contact acts on, each counted once */
   }
+  { /* the checks of contact_checks.c: the number of warnings, and the values checked (not written without contact) */
+    PetscInt nwarn;
+
+    PetscCall(ContactChecksWarnings(PetscObjectComm((PetscObject)dm), &s->checks, PETSC_FALSE, &nwarn));
+    PetscCall(WriteIntAttr(v, "warnings", nwarn));
+    if (s->checks.geometry_checked) {
+      PetscCall(WriteRealAttr(v, "initial_overlap_cells", s->checks.overlap_cells));
+      PetscCall(WriteRealAttr(v, "initial_overlap_fraction", s->checks.overlap_fraction));
+      PetscCall(WriteRealAttr(v, "obstacle_away_fraction", s->checks.away_fraction));
+    }
+    if (s->checks.resolution_checked) {
+      PetscCall(WriteIntAttr(v, "contact_zone_faces", s->checks.zone_faces));
+      PetscCall(WriteRealAttr(v, "contact_zone_cells", s->checks.zone_cells));
+    }
+  }
   PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));
   PetscCall(WriteIntAttr(v, "active_set_cycles", s->active_set_cycles));
   PetscCall(WriteIntAttr(v, "pc_builds", s->pc_builds));

@@ -1,0 +1,176 @@
+/* Checks of the contact set-up and of the resolution of the contact zone: warnings in the summary and in /run, for
+   answers that are what was asked but probably not what was meant. A warning never changes the answer.
+   - Before the solve, the geometry: the largest initial overlap of Gamma_C's vertices with the obstacle, in cells of
+     their faces (an overlap of many cells is a misplaced obstacle more often than a press fit), the part of Gamma_C
+     that starts inside the obstacle, and the part where the obstacle's normal (from the body into the obstacle)
+     points into the body, against the outward normal of the face: an obstacle facing away from the body, or a plane
+     behind it, which the penalty pushes the body through.
+   - After the solve, the resolution: how many cells span the contact zone along Gamma_C (the faces where the contact
+     acts at every node: their number in 2D, its square root in 3D). A zone of a few cells is a discretization artefact: the force
+     and the penetration no longer follow eps (README, "Warnings"; the threshold is measured by scripts/zone_resolution.py, bench/zone_resolution.md). */
+#include "mesh.h"
+#include "obstacle.h"
+#include "physics.h"
+
+/* The outward unit normal, centroid and area of boundary face f (its one cell on the inside). */
+static PetscErrorCode FaceOutwardGeometry(DM dm, PetscInt f, PetscInt dim, PetscReal n[], PetscReal xc[], PetscReal *area)
+{
+  const PetscInt *support;
+  PetscReal       cc[3], vol, dot = 0.0, norm = 0.0;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexComputeCellGeometryFVM(dm, f, area, xc, n));
+  PetscCall(DMPlexGetSupport(dm, f, &support));
+  PetscCall(DMPlexComputeCellGeometryFVM(dm, support[0], &vol, cc, NULL));
+  for (PetscInt d = 0; d < dim; ++d) {
+    dot += n[d] * (xc[d] - cc[d]);
+    norm += n[d] * n[d];
+  }
+  norm = PetscSqrtReal(norm);
+  for (PetscInt d = 0; d < dim; ++d) n[d] = (dot < 0.0 ? -n[d] : n[d]) / (norm > 0.0 ? norm : 1.0);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
+{
+  MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
+  ContactChecks *ck   = &user->rec.stats.checks;
+  PetscInt       dim, vStart, vEnd;
+  PetscReal      sums[3] = {0.0, 0.0, 0.0}, overlap = 0.0; /* area, area facing away, area overlapping */
+
+  PetscFunctionBeginUser;
+  if (user->opt.contact.method == CONTACT_NONE) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
+    PetscInt *faces, nf;
+
+    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces));
+    for (PetscInt i = 0; i < nf; ++i) {
+      const PetscInt *support;
+      PetscInt       *closure = NULL, ncl;
+      PetscReal       n[3] = {0, 0, 0}, xc[3] = {0, 0, 0}, area, nob[3], g, dot = 0.0, diam;
+
+      PetscCall(FaceOutwardGeometry(dm, faces[i], dim, n, xc, &area));
+      ObstacleGapNormalAt(&user->scene.obstacle, dim, xc, nob, &g);
+      for (PetscInt d = 0; d < dim; ++d) dot += n[d] * nob[d];
+      sums[0] += area;
+      sums[1] += dot <= 0.0 ? area : 0.0;
+      sums[2] += g < 0.0 ? area : 0.0;
+      PetscCall(DMPlexGetSupport(dm, faces[i], &support));
+      PetscCall(MeshCellDiameter(dm, support[0], &diam));
+      PetscCall(DMPlexGetTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
+      for (PetscInt j = 0; j < ncl; ++j) {
+        PetscReal x[3] = {0, 0, 0}, nv[3];
+
+        if (closure[2 * j] < vStart || closure[2 * j] >= vEnd) continue;
+        PetscCall(MeshPointPosition(dm, closure[2 * j], x));
+        ObstacleGapNormalAt(&user->scene.obstacle, dim, x, nv, &g);
+        overlap = PetscMax(overlap, -g / diam);
+      }
+      PetscCall(DMPlexRestoreTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
+    }
+    PetscCall(PetscFree(faces));
+  }
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, sums, 3, MPIU_REAL, MPIU_SUM, comm));
+  PetscCall(MPIU_Allreduce(&overlap, &ck->overlap_cells, 1, MPIU_REAL, MPIU_MAX, comm));
+  ck->away_fraction    = sums[0] > 0.0 ? sums[1] / sums[0] : 0.0;
+  ck->overlap_fraction = sums[0] > 0.0 ? sums[2] / sums[0] : 0.0;
+  ck->geometry_checked = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static int ComparePoints(const void *a, const void *b)
+{
+  const PetscInt x = *(const PetscInt *)a, y = *(const PetscInt *)b;
+  return x < y ? -1 : x > y;
+}
+
+/* After PostprocessContact(): the faces of Gamma_C whose every node carries contact force (a positive pressure). A face
+   with only some nodes pressed is the zone's edge, which the rule smears over a cell or two whatever the zone's true
+   width: counting it, a zone narrower than a cell counted 4 faces at every h (bench/zone_resolution.md). */
+PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user)
+{
+  MPI_Comm          comm = PetscObjectComm((PetscObject)dm);
+  ContactChecks    *ck   = &user->rec.stats.checks;
+  const ContactSet *cs   = &user->prob.cset;
+  PetscInt          dim, nzone = 0, (*pairs)[2];
+
+  PetscFunctionBeginUser;
+  if (user->opt.contact.method == CONTACT_NONE) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(PetscMalloc1(cs->n + 1, &pairs)); /* (point, node) sorted by point: a face's nodes found by bisection */
+  for (PetscInt i = 0; i < cs->n; ++i) {
+    pairs[i][0] = cs->point[i];
+    pairs[i][1] = i;
+  }
+  qsort(pairs, (size_t)cs->n, sizeof(pairs[0]), ComparePoints);
+  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
+    PetscInt *faces, nf;
+
+    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces));
+    for (PetscInt i = 0; i < nf; ++i) {
+      PetscInt *closure = NULL, ncl, nodes = 0, acting = 0;
+
+      PetscCall(DMPlexGetTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
+      for (PetscInt j = 0; j < ncl; ++j) {
+        PetscInt lo = 0, hi = cs->n - 1;
+
+        while (lo <= hi) {
+          const PetscInt mid = (lo + hi) / 2;
+
+          if (pairs[mid][0] == closure[2 * j]) {
+            ++nodes;
+            acting += cs->pressure[pairs[mid][1]] > 0.0;
+            break;
+          }
+          if (pairs[mid][0] < closure[2 * j]) lo = mid + 1;
+          else hi = mid - 1;
+        }
+      }
+      PetscCall(DMPlexRestoreTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
+      nzone += nodes > 0 && acting == nodes;
+    }
+    PetscCall(PetscFree(faces));
+  }
+  PetscCall(PetscFree(pairs));
+  PetscCall(MPIU_Allreduce(&nzone, &ck->zone_faces, 1, MPIU_INT, MPI_SUM, comm));
+  ck->zone_cells = dim == 2 ? (PetscReal)ck->zone_faces : PetscSqrtReal((PetscReal)ck->zone_faces);
+  ck->resolution_checked = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The warnings of the checks, one sentence each, through print (the summary) or counted. */
+PetscErrorCode ContactChecksWarnings(MPI_Comm comm, const ContactChecks *ck, PetscBool print, PetscInt *nwarnings)
+{
+  PetscInt n = 0;
+
+  PetscFunctionBeginUser;
+  if (ck->geometry_checked && ck->overlap_cells > CONTACT_CHECK_OVERLAP_CELLS) {
+    ++n;
+    if (print)
+      PetscCall(PetscPrintf(comm,
+                            "  WARNING: Gamma_C starts %.3g cells deep inside the obstacle (on %.0f%% of its area): a misplaced obstacle? (check "
+                            "-obstacle_point, -obstacle_center, -obstacle_translate)\n",
+                            (double)ck->overlap_cells, (double)(100.0 * ck->overlap_fraction)));
+  }
+  if (ck->geometry_checked && ck->away_fraction > 0.5) {
+    ++n;
+    if (print)
+      PetscCall(PetscPrintf(comm,
+                            "  WARNING: on %.0f%% of Gamma_C the obstacle's normal points into the body: the obstacle faces away from it or lies "
+                            "behind it (-obstacle_normal is the normal from the body into the obstacle)\n",
+                            (double)(100.0 * ck->away_fraction)));
+  }
+  if (ck->resolution_checked && ck->zone_faces > 0 && ck->zone_cells < CONTACT_CHECK_ZONE_CELLS) {
+    ++n;
+    if (print)
+      PetscCall(PetscPrintf(comm,
+                            "  WARNING: the contact zone spans %.3g cell(s) along Gamma_C (%" PetscInt_FMT
+                            " faces), fewer than %g: the force and the penetration are a discretization artefact there; refine near the "
+                            "contact\n",
+                            (double)ck->zone_cells, ck->zone_faces, (double)CONTACT_CHECK_ZONE_CELLS));
+  }
+  if (nwarnings) *nwarnings = n;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
