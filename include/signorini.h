@@ -233,7 +233,7 @@ typedef struct {
 
 /* Checks of the contact set-up and of the contact zone's resolution (src/physics/contact_checks.c): warnings only. */
 #define CONTACT_CHECK_OVERLAP_CELLS 1.0 /* an initial overlap deeper than this many cells is warned of */
-#define CONTACT_CHECK_ZONE_CELLS    4.0 /* a contact zone spanning fewer cells is warned of (bench/zone_resolution.md) */
+#define CONTACT_CHECK_ZONE_CELLS 4.0    /* a contact zone spanning fewer cells is warned of (bench/zone_resolution.md) */
 typedef struct {
   PetscBool geometry_checked, resolution_checked;
   PetscReal overlap_cells;    /* largest initial overlap -g/h at Gamma_C's vertices, h the diameter of the face's cell */
@@ -363,8 +363,9 @@ typedef struct {
   RunStats     stats;
   SolveRecord *records; /* one per solve, any number */
   PetscInt     nrecords, maxrecords;
-  ErrorNorms   errors;     /* against the scene's exact solution */
-  ErrorNorms   ref_errors; /* against the -reference solution */
+  ErrorNorms   errors;                   /* against the scene's exact solution */
+  ErrorNorms   ref_errors;               /* against the -reference solution */
+  char         diagnostics_failed[1024]; /* the diagnostics that failed after the solve, with their messages ("" if none) */
 } RunRecord;
 
 /* The interpolations between the nested meshes solved so far (src/solver/multigrid.c): the levels of a geometric

@@ -195,7 +195,6 @@ def test_reference_mismatch_is_refused():
     cases = {
         "scene": (["-scene", "square", "-dm_plex_box_faces", "4,4"], "is a run of scene patch, this is scene square"),
         "cells": (["-scene", "patch", "-dm_plex_box_faces", "3,3"], "which is not this mesh (18 cells) uniformly refined"),
-        "vertices": (["-scene", "patch", "-dm_plex_box_faces", "4,4", "-dm_plex_box_upper", "1,2"], "a vertex of this mesh refined is not one"),
         "degree": (["-scene", "patch", "-dm_plex_box_faces", "4,4", "-displacement_petscspace_degree", 2], "-reference needs degree 1"),
         "missing": (["-scene", "patch", "-reference", "tests/out/none.h5"], "Reference file 'tests/out/none.h5' (-reference) does not exist"),
     }
@@ -204,7 +203,14 @@ def test_reference_mismatch_is_refused():
             args = args + ["-reference", ref]
         out, h5 = run(args, f"ref_bad_{name}", expect_rc=None)
         assert message in out, f"{name}: '{message}' not in\n{out[-1500:]}"
+        assert "  SNES " not in out, f"{name}: refused only after the solve"
         assert not glob.glob(h5 + "*"), f"{name}: output left behind"
+    # a mismatch found only on the refined mesh, after the solve: the solve is not lost (issue 29): written without the
+    # comparison, /run says which diagnostic failed and why, exit status 4
+    out, h5 = run(["-scene", "patch", "-dm_plex_box_faces", "4,4", "-dm_plex_box_upper", "1,2", "-reference", ref], "ref_bad_vertices", expect_rc=4)
+    a, _ = load(h5)
+    assert a["converged"] == 1 and "-reference comparison: " in a["diagnostics_failed"] and "a vertex of this mesh refined is not one" in a["diagnostics_failed"]
+    assert "reference_error_h1" not in a and "WARNING: written without a diagnostic that failed" in out
 
 
 def test_mms_bad_parameters_are_refused():

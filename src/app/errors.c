@@ -146,3 +146,38 @@ int AppErrorExit(PetscErrorCode ierr)
   (void)MPI_Finalize(); /* not PetscFinalize(): the run's objects were not destroyed, and -malloc_dump would list them */
   return 2;
 }
+
+/* A diagnostic after the solve (the error norms, the -reference comparison) must not lose the solve: an error in it is
+   caught (PETSc's return handler, not the run's), its message kept in failed[] ("" if none), and the run goes on to
+   write its output without it. Every rank learns whether any rank failed; a rank that fails while the others wait for
+   it inside the diagnostic would leave them there, so the agreement waits a minute at most and then aborts. */
+PetscErrorCode AppDiagnosticRun(const char name[], PetscErrorCode (*fn)(DM, AppCtx *, Vec), DM dm, AppCtx *user, Vec u, char failed[], size_t len)
+{
+  PetscErrorCode ierr;
+  int            mine, any = 0, done = 0;
+  MPI_Request    req;
+
+  PetscFunctionBeginUser;
+  failed[0] = 0;
+  PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
+  ierr = fn(dm, user, u);
+  PetscCall(PetscPopErrorHandler());
+  mine = ierr ? 1 : 0;
+  PetscCallMPI(MPI_Iallreduce(&mine, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD, &req));
+  for (int waited = 0; !done && waited < 60000; waited += 10) {
+    PetscCallMPI(MPI_Test(&req, &done, MPI_STATUS_IGNORE));
+    if (!done) (void)usleep(10000);
+  }
+  if (!done) {
+    fprintf(stderr, "signorini: error: the diagnostic %s failed on some ranks and not on others; aborting\n", name);
+    (void)MPI_Abort(MPI_COMM_WORLD, 4);
+  }
+  if (any) {
+    const char *text     = NULL;
+    char       *specific = NULL;
+
+    if (ierr) PetscCall(PetscErrorMessage(ierr, &text, &specific));
+    PetscCall(PetscSNPrintf(failed, len, "%s: %s", name, ierr ? (specific && specific[0] ? specific : text) : "failed on another rank"));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -292,6 +292,8 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
 
     PetscCall(ContactChecksWarnings(PetscObjectComm((PetscObject)dm), &s->checks, PETSC_FALSE, &nwarn));
     PetscCall(WriteIntAttr(v, "warnings", nwarn));
+    if (user->rec.diagnostics_failed[0])
+      PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "diagnostics_failed", PETSC_STRING, user->rec.diagnostics_failed));
     if (s->checks.geometry_checked) {
       PetscCall(WriteRealAttr(v, "initial_overlap_cells", s->checks.overlap_cells));
       PetscCall(WriteRealAttr(v, "initial_overlap_fraction", s->checks.overlap_fraction));

@@ -7,7 +7,8 @@
      behind it, which the penalty pushes the body through.
    - After the solve, the resolution: how many cells span the contact zone along Gamma_C (the faces where the contact
      acts at every node: their number in 2D, its square root in 3D). A zone of a few cells is a discretization artefact: the force
-     and the penetration no longer follow eps (README, "Warnings"; the threshold is measured by scripts/zone_resolution.py, bench/zone_resolution.md). */
+     and the penetration no longer follow eps (README, "Warnings"; the threshold is measured by scripts/zone_resolution.py, bench/zone_resolution.md).
+ */
 #include "mesh.h"
 #include "obstacle.h"
 #include "physics.h"
@@ -124,8 +125,10 @@ PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user)
             acting += cs->pressure[pairs[mid][1]] > 0.0;
             break;
           }
-          if (pairs[mid][0] < closure[2 * j]) lo = mid + 1;
-          else hi = mid - 1;
+          if (pairs[mid][0] < closure[2 * j])
+            lo = mid + 1;
+          else
+            hi = mid - 1;
         }
       }
       PetscCall(DMPlexRestoreTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
@@ -135,7 +138,7 @@ PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user)
   }
   PetscCall(PetscFree(pairs));
   PetscCall(MPIU_Allreduce(&nzone, &ck->zone_faces, 1, MPIU_INT, MPI_SUM, comm));
-  ck->zone_cells = dim == 2 ? (PetscReal)ck->zone_faces : PetscSqrtReal((PetscReal)ck->zone_faces);
+  ck->zone_cells         = dim == 2 ? (PetscReal)ck->zone_faces : PetscSqrtReal((PetscReal)ck->zone_faces);
   ck->resolution_checked = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -289,6 +289,15 @@ PetscErrorCode ReferenceCheckFile(DM dm, const AppCtx *user)
   PetscCall(ReferenceCheckHeader(PetscObjectComm((PetscObject)dm), user, dim, v, &ref_dim, &ncells));
   PetscCall(PetscViewerDestroy(&v));
   PetscCall(OutputFileLeaveDirectory(cwd));
+  { /* the reference's mesh is this one refined uniformly (the final mesh of nested iteration too: this one refined) */
+    PetscInt cStart, cEnd, mine, levels = 0;
+
+    PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+    PetscCall(MeshCountOwned(dm, cStart, cEnd, &mine));
+    while ((PetscInt64)mine << (dim * levels) < (PetscInt64)ncells && levels < 12) ++levels;
+    PetscCheck((PetscInt64)mine << (dim * levels) == (PetscInt64)ncells, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT,
+               "Reference %s has %" PetscInt_FMT " cells, which is not this mesh (%" PetscInt_FMT " cells) uniformly refined", file, ncells, mine);
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
