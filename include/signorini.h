@@ -248,6 +248,7 @@ typedef struct {
   PetscInt            newton_its_total, ksp_its_total; /* of all solves: grid sequence levels, continuation, eps sweep */
   PetscBool           converged;                       /* PETSc's reason is a convergence and the residual fell as asked (residual_reduced) */
   PetscBool           residual_reduced;                /* |F| <= rtol |F0|, or at round-off for the load, or below -snes_atol */
+  PetscBool           roundoff_stop;                   /* or Newton stalled at the round-off of the terms the residual sums */
   SNESConvergedReason reason;
   PetscReal           residual_norm;
   PetscInt            continuation_stages; /* solves of the eps sequence before the target eps (0: none) */
@@ -353,6 +354,8 @@ typedef struct {
   VecScatter   bulk_scatter;                     /* the displacement at those columns (any rank's) into bulk_x */
   Vec          bulk_x;
   PetscReal    fnorm0;                          /* |F| at the start of the last SNESSolve, in the user's units */
+  PetscReal    fnorm_last;                      /* |F| at the last Newton step, in the user's units */
+  PetscBool    roundoff_stop;                   /* the last SNESSolve stopped at the round-off of its terms (SolverConverged()) */
   PetscBool    warm;                            /* the last SolverSolve() started from a given guess, not from zero */
   PetscInt64   active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
   PetscReal    fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */

@@ -10,6 +10,7 @@ import shutil
 import stat
 import subprocess
 
+import numpy as np
 import pytest
 
 from harness import BIN, ENV, OUT, ROOT, run, write_gmsh_cube, write_gmsh_square
@@ -411,3 +412,21 @@ def test_reference_of_another_problem_is_refused(case_dir):
     from harness import load
     a, _ = load(run(general + ["-bc_clamp_3_translate", "0,-0.01", "-reference", ref], "hostile/reference_same_problem")[1])
     assert a["converged"] == 1 and 0.0 < a["reference_error_h1"] < 1e-2
+
+
+def test_tolerance_below_round_off_ends_converged_at_round_off(hostile_dir):
+    """eps = 1e-9 far below h/E with -snes_rtol 1e-12 (issue 29): Newton stalled at the round-off of the penalty term
+    ((1/eps) times the displacement times the machine epsilon) and ran 57 steps to DIVERGED_MAX_IT. It now stops where a
+    step no longer halves |F| near that round-off: converged, /run stopped_at_roundoff = 1, the answer of a run to
+    -snes_rtol 1e-8 (which does not stop there)."""
+    from harness import load
+    args = ["-scene", "general", "-dm_plex_box_faces", "32,32", "-contact_faces", 1, "-bc_clamp", 3, "-bc_clamp_3_translate", "0,-0.02",
+            "-obstacle", "cylinder", "-obstacle_center", "0.5,-1", "-obstacle_radius", 1, "-young_modulus", 3, "-penalty_quadrature", "nodal",
+            "-penalty_eps", 1e-9]
+    out, h5 = run(args + ["-snes_rtol", 1e-12], "hostile/roundoff")
+    a, f = load(h5)
+    assert a["converged"] == 1 and a["stopped_at_roundoff"] == 1 and a["newton_its"] < 20 and "stopped at round-off" in out
+    b, g = load(run(args + ["-snes_rtol", 1e-8], "hostile/roundoff_ref")[1])
+    assert b["converged"] == 1 and b["stopped_at_roundoff"] == 0
+    assert abs(a["contact_force"] / b["contact_force"] - 1) < 1e-8
+    assert np.abs(f["displacement"] - g["displacement"]).max() <= 1e-8 * np.abs(g["displacement"]).max()

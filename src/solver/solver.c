@@ -145,6 +145,46 @@ PetscErrorCode SolverStopReference(const AppCtx *user, PetscReal *ref)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The size of the round-off in the residual at u: F = K u + r0 + (1/eps)[u_n - g]_+ n w sums terms much larger than F
+   itself near the solution, and double precision knows each to about PETSC_MACHINE_EPSILON of its size. The terms:
+   |diag(J)| |u| (the bulk's rows, and the penalty's (1/eps) u_n, since J holds the penalty Jacobian in its contact
+   rows), r0, and the penalty's (1/eps) g w at the penetrating nodes (its gap term, large where the obstacle is
+   far from the origin or the indentation deep). This is an estimate of the floor, not a bound: it is used only where
+   Newton has stopped making progress (SolverConverged()). */
+static PetscErrorCode SolverRoundoffFloor(SNES snes, AppCtx *user, PetscReal *floor)
+{
+  const ContactSet  *cs = &user->prob.cset;
+  Vec                X, u, D;
+  Mat                J;
+  const PetscScalar *x;
+  PetscReal          bulk, r0, gap = 0.0;
+  PetscInt           dim;
+  DM                 dm;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESGetDM(snes, &dm));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(SNESGetSolution(snes, &X));
+  PetscCall(SolverIterateDisplacement(user, X, &u));
+  PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
+  PetscCall(VecDuplicate(u, &D));
+  PetscCall(MatGetDiagonal(J, D));
+  PetscCall(VecPointwiseMult(D, D, u));
+  PetscCall(VecNorm(D, NORM_2, &bulk));
+  PetscCall(VecDestroy(&D));
+  bulk *= user->prob.snes_scale; /* J is the Jacobian of F/U in u/U: diag(J) u/U, in the user's units */
+  PetscCall(VecNorm(user->prob.r0, NORM_2, &r0));
+  if (user->opt.contact.method == CONTACT_PENALTY) {
+    PetscCall(VecGetArrayRead(u, &x));
+    for (PetscInt i = 0; i < cs->n; ++i)
+      if (ContactNodePenetration(cs, dim, i, x) > 0.0) gap += PetscSqr(cs->weight[i] * cs->gap[i] / ContactNodeEps(cs, user->prob.eps, i));
+    PetscCall(VecRestoreArrayRead(u, &x));
+    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &gap, 1, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
+  }
+  *floor = PETSC_MACHINE_EPSILON * PetscSqrtReal(bulk * bulk + r0 * r0 + gap);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm, SNESConvergedReason *reason,
                                       void *ctx)
 {
@@ -163,6 +203,22 @@ static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, P
     *reason = f <= rtol * ref ? SNES_CONVERGED_FNORM_RELATIVE : SNES_CONVERGED_ITERATING;
   }
   if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->opt.contact.load_rtol * user->prob.load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
+  /* A tolerance below what double precision can reach: Newton stalls at the round-off of the terms the residual sums
+     (with eps far below h/E, (1/eps) times the displacement times the machine epsilon). Where a step did not halve |F|
+     and |F| is within 100 times the estimated round-off (SolverRoundoffFloor()), it stops, converged at round-off,
+     instead of running to the iteration limit; /run says so (stopped_at_roundoff). A step that still makes progress is
+     never stopped here. */
+  if (it == 0) user->prob.roundoff_stop = PETSC_FALSE;
+  if (*reason <= 0 && it > 0 && !PetscIsInfOrNanReal(f) && f > 0.5 * user->prob.fnorm_last) {
+    PetscReal floor;
+
+    PetscCall(SolverRoundoffFloor(snes, user, &floor));
+    if (f <= 100.0 * floor) {
+      *reason                  = SNES_CONVERGED_FNORM_ABS;
+      user->prob.roundoff_stop = PETSC_TRUE;
+    }
+  }
+  user->prob.fnorm_last = f;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -403,8 +459,9 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   PetscCall(SolverStopReference(user, &ref));
   user->rec.stats.residual_reduced =
       (PetscBool)(user->rec.stats.residual_norm <= rtol * ref ||
-                  user->rec.stats.residual_norm <= user->opt.contact.load_rtol * user->prob.load_norm || fnorm <= atol);
-  user->rec.stats.converged = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
+                  user->rec.stats.residual_norm <= user->opt.contact.load_rtol * user->prob.load_norm || fnorm <= atol || user->prob.roundoff_stop);
+  user->rec.stats.roundoff_stop = user->prob.roundoff_stop;
+  user->rec.stats.converged     = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
   PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
   user->rec.stats.pc_builds  = user->prob.pc_reuse.enabled ? user->prob.pc_reuse.builds : *newton; /* without reuse: one per Newton step */
   user->rec.stats.pc_updates = user->prob.pc_reuse.updates;
