@@ -40,7 +40,10 @@ build/%.o: src/%.c
 build/known_options.inc: $(SRC)
 	@mkdir -p build
 	@grep -ohE '"-[a-z][a-z0-9_]*"' $(SRC) | sort -u | sed 's/$$/,/' > $@
-build/app/options_check.o build-asan/app/options_check.o: build/known_options.inc
+build/flag_options.inc: $(SRC)
+	@mkdir -p build
+	@grep -ohE 'PetscOptions(Get)?Bool\((NULL, *NULL, *)?"-[a-z][a-z0-9_]*"' $(SRC) | grep -oE '"-[a-z0-9_]+"' | sort -u | sed 's/$$/,/' > $@
+build/app/options_check.o build-asan/app/options_check.o: build/known_options.inc build/flag_options.inc
 
 $(BIN): $(OBJ)
 	@mkdir -p bin

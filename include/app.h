@@ -12,6 +12,7 @@ PetscErrorCode OptionsCheckFiniteArray(MPI_Comm comm, const char name[], PetscIn
 PetscErrorCode OptionsCountListValues(const char name[], PetscInt *n);
 PetscErrorCode OptionsCheckPrefixesUsed(MPI_Comm comm, const char prefixes[]);
 PetscErrorCode OptionsCheckAllUsed(MPI_Comm comm, PetscBool before_solve);
+PetscErrorCode OptionsCheckValuesGiven(MPI_Comm comm);
 PetscErrorCode OptionsReadVector(CompatOptionItems PetscOptionsObject, MPI_Comm comm, const char name[], const char help[], PetscInt dim,
                                  PetscReal v[], PetscBool *set);
 

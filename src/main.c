@@ -110,6 +110,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(PetscTime(&t0));
   PetscCall(PetscMemzero(&user, sizeof(user)));
   PetscCall(OutputFileInstallCleanup());
+  PetscCall(OptionsCheckValuesGiven(comm)); /* -young_modulus without its value is not the default */
   PetscCall(SceneRegisterAll());
   PetscCall(SceneGetOptions(comm, user.opt.scene_name, sizeof(user.opt.scene_name)));
   PetscCall(ElasticityGetOptions(comm, &user.opt.material, &user.opt.degree, &user.opt.section_check));

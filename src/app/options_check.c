@@ -1,11 +1,15 @@
 /* Checks of option values shared by the modules' *GetOptions: every real option must be a finite number
    (PETSc parses "inf" and "nan" as reals, which would run a whole solve into NaN without naming the option). */
+#include <string.h>
+
 #include "app.h"
 
 /* The options the project reads (every "-name" string of src/, listed at build time into build/known_options.inc by the
    Makefile) and PETSc's options a run of this solver commonly gives: the names a misspelling is compared with. */
-static const char *const known_options[] = {
+static const char *const project_options[] = {
 #include "known_options.inc"
+};
+static const char *const petsc_options[] = {
     "-snes_rtol",
     "-snes_atol",
     "-snes_stol",
@@ -65,6 +69,114 @@ static const char *const known_options[] = {
     "-error_verbose",
 };
 
+/* The project's options that are flags (read with PetscOptionsBool(), listed at build time into build/flag_options.inc),
+   which may be given without a value; every other option of the project takes one. */
+static const char *const flag_options[] = {
+#include "flag_options.inc"
+};
+
+/* PETSc's options of the list above that take a value, which PETSc ignores when given without one. */
+static const char *const petsc_value_options[] = {
+    "-snes_rtol",
+    "-snes_atol",
+    "-snes_stol",
+    "-snes_max_it",
+    "-snes_type",
+    "-snes_linesearch_type",
+    "-snes_ksp_ew_version",
+    "-ksp_type",
+    "-ksp_rtol",
+    "-ksp_atol",
+    "-ksp_max_it",
+    "-ksp_norm_type",
+    "-ksp_gmres_restart",
+    "-pc_type",
+    "-pc_factor_mat_solver_type",
+    "-pc_gamg_threshold",
+    "-pc_gamg_agg_nsmooths",
+    "-pc_hypre_type",
+    "-pc_mg_levels",
+    "-mg_levels_ksp_type",
+    "-mg_levels_pc_type",
+    "-mg_levels_ksp_max_it",
+    "-mg_coarse_pc_type",
+    "-mg_coarse_ksp_type",
+    "-mat_mumps_icntl_14",
+    "-dm_plex_filename",
+    "-dm_plex_dim",
+    "-dm_plex_box_faces",
+    "-dm_plex_box_lower",
+    "-dm_plex_box_upper",
+    "-dm_refine",
+    "-dm_mat_type",
+    "-displacement_petscspace_degree",
+    "-petscpartitioner_type",
+    "-options_file",
+};
+
+static PetscBool InList(const char name[], const char *const list[], size_t n)
+{
+  for (size_t k = 0; k < n; ++k)
+    if (!strcmp(name, list[k])) return PETSC_TRUE;
+  return PETSC_FALSE;
+}
+
+/* Whether the option (with its dash) needs a value: every face-set option (-bc_...), the project's own options but its
+   flags, and PETSc's options of petsc_value_options (known_options.inc also holds PETSc names the sources mention, some
+   of them flags: those go by petsc_value_options alone). */
+static PetscBool TakesValue(const char name[])
+{
+  const char *const petsc_prefixes[] = {"-snes_",   "-ksp_",   "-pc_",     "-mg_",  "-dm_",   "-mat_",          "-log", "-malloc",
+                                        "-options", "-memory", "-objects", "-help", "-petsc", "-displacement_", "-name"};
+
+  if (!strncmp(name, "-bc_", 4)) return PETSC_TRUE;
+  if (InList(name, petsc_value_options, sizeof(petsc_value_options) / sizeof(petsc_value_options[0]))) return PETSC_TRUE;
+  for (size_t k = 0; k < sizeof(petsc_prefixes) / sizeof(petsc_prefixes[0]); ++k)
+    if (!strncmp(name, petsc_prefixes[k], strlen(petsc_prefixes[k]))) return PETSC_FALSE;
+  if (InList(name, flag_options, sizeof(flag_options) / sizeof(flag_options[0]))) return PETSC_FALSE;
+  return InList(name, project_options, sizeof(project_options) / sizeof(project_options[0]));
+}
+
+/* Refuses an option that needs a value and was given without one (`-young_modulus` alone, or `young_modulus:` empty in
+   a YAML file): PETSc's readers leave the default then, and the run would go on as if the option were not there. The
+   token after an option is its value unless it is itself an option name (PetscOptionsValidKey(), as PETSc's parser
+   decides: `-inf` and `-1` are values). Before any module reads its options. */
+PetscErrorCode OptionsCheckValuesGiven(MPI_Comm comm)
+{
+  char *all, *tok, missing[1024] = "";
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetAll(NULL, &all)); /* "-name value -name -name value ..." */
+  tok = all;
+  while (*tok == ' ') ++tok;
+  while (*tok) {
+    char     *next = tok + strcspn(tok, " ");
+    PetscBool key, next_key = PETSC_TRUE;
+
+    if (*next) *next++ = 0;
+    while (*next == ' ') ++next;
+    PetscCall(PetscOptionsValidKey(tok, &key));
+    if (*next) {
+      char *end = next + strcspn(next, " "), saved = *end;
+
+      *end = 0; /* the next token alone, then back as it was */
+      PetscCall(PetscOptionsValidKey(next, &next_key));
+      *end = saved;
+    }
+    if (key && next_key && TakesValue(tok) && strlen(missing) + strlen(tok) + 2 < sizeof(missing)) {
+      PetscCall(PetscStrlcat(missing, " ", sizeof(missing)));
+      PetscCall(PetscStrlcat(missing, tok, sizeof(missing)));
+    }
+    tok = next;
+  }
+  PetscCall(PetscFree(all));
+  PetscCheck(!missing[0], comm, PETSC_ERR_USER_INPUT,
+             "option(s) given without a value:%s (a value is needed: a number, a list a,b,c or a name, see -help; in a YAML file, "
+             "`name: value`)",
+             missing);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The edit distance of a and b (insertions, deletions, substitutions and transpositions of neighbours, each 1). */
 static PetscInt EditDistance(const char a[], const char b[])
 {
@@ -96,12 +208,14 @@ static PetscErrorCode AppendWithSuggestion(const char name[], char list[], size_
   PetscFunctionBeginUser;
   PetscCall(PetscSNPrintf(dashed, sizeof(dashed), "-%s", name));
   limit = PetscMax(2, (PetscInt)strlen(dashed) / 5);
-  for (size_t k = 0; k < sizeof(known_options) / sizeof(known_options[0]); ++k) {
-    const PetscInt d = EditDistance(dashed, known_options[k]);
+  for (size_t k = 0; k < sizeof(project_options) / sizeof(project_options[0]) + sizeof(petsc_options) / sizeof(petsc_options[0]); ++k) {
+    const size_t      np    = sizeof(project_options) / sizeof(project_options[0]);
+    const char *const known = k < np ? project_options[k] : petsc_options[k - np];
+    const PetscInt    d     = EditDistance(dashed, known);
 
     if (d < best_d) {
       best_d = d;
-      best   = known_options[k];
+      best   = known;
     }
   }
   PetscCall(PetscStrlcat(list, " ", len));
