@@ -172,7 +172,7 @@ static PetscErrorCode SolverRoundoffFloor(SNES snes, AppCtx *user, PetscReal *fl
   PetscCall(VecPointwiseMult(D, D, u));
   PetscCall(VecNorm(D, NORM_2, &bulk));
   PetscCall(VecDestroy(&D));
-  bulk *= user->prob.snes_scale; /* J is the Jacobian of F/U in u/U: diag(J) u/U, in the user's units */
+  /* J is the Jacobian of F/U in u/U, that is of F in u: diag(J) u is in the user's units, as u (U x~) is */
   PetscCall(VecNorm(user->prob.r0, NORM_2, &r0));
   if (user->opt.contact.method == CONTACT_PENALTY) {
     PetscCall(VecGetArrayRead(u, &x));
