@@ -1,6 +1,7 @@
 """Property-based fuzzing of the problem's option families (make test): random but type-aware values of the face sets
 (names, numbers, and names no face carries), vectors of every length, slip components in and out of range, obstacles
-with and without their data, eps, the material and misspelled options, on small Gmsh meshes of the unit square and cube
+with and without their data, eps, the material, E from 1e-6 to 1e16 and loads from 1e-9 to 1e12 times their values and misspelled
+options, on small Gmsh meshes of the unit square and cube
 whose sides are named (so the resultant of the loads is known in closed form).
 
 Every run must end in one of three ways:
@@ -229,6 +230,18 @@ def problems(draw):
         opts["-poisson_ratio"], _ = site(good_real(-0.5, 0.45), st.sampled_from(["0.5", "0.6", "-1", "-1.5", "nan", "x"]))
     if site.faults > 0 and draw(st.integers(0, 5)) == 0:
         opts[draw(st.sampled_from(["-bc_clam", "-contact_face", "-snes_rtoll", "-obstacle_radious", "-penalty_eps_0"]))] = "1"
+    if draw(st.integers(0, 2)) == 0:  # other units: E times 10^a, every load times 10^b (the displacement 10^(b-a))
+        scale_e, scale_load = 10.0 ** draw(st.integers(-6, 16)), 10.0 ** draw(st.integers(-9, 12))
+        for key in list(opts):
+            factor = scale_e if key == "-young_modulus" else scale_load if key == "-body_force" or key.startswith(("-bc_traction_", "-bc_pressure_")) else None
+            if factor is not None:
+                try:
+                    opts[key] = ",".join(f"{float(x) * factor:.6g}" for x in opts[key].split(","))
+                except ValueError:
+                    pass  # a bad value stays as drawn
+        if "-young_modulus" not in opts:
+            opts["-young_modulus"] = f"{scale_e:g}"
+        load = load * scale_load
     return dim, opts, (load if known else None)
 
 

@@ -174,5 +174,12 @@ PetscErrorCode ContactComputeEps(AppCtx *user)
     user->prob.eps = user->opt.contact.eps_fixed;
   else
     user->prob.eps = user->opt.contact.eps0 * PetscPowReal(user->prob.h, user->opt.contact.eps_power) / ContactPenaltyModulus(user);
+  /* the penalty term multiplies by 1/eps: an eps that underflows (eps0 = 1e-320) or overflows would make it inf or 0 */
+  PetscCheck(user->opt.contact.method != CONTACT_PENALTY || (user->prob.eps >= 1e-290 && user->prob.eps <= 1e290), PETSC_COMM_WORLD,
+             PETSC_ERR_USER_INPUT,
+             "eps = %g (-penalty_eps0 %g, -penalty_eps %g, h = %g, modulus %g) is outside [1e-290, 1e290]: the penalty 1/eps would overflow "
+             "or vanish in double precision; give another -penalty_eps0 or -penalty_eps",
+             (double)user->prob.eps, (double)user->opt.contact.eps0, (double)user->opt.contact.eps_fixed, (double)user->prob.h,
+             (double)ContactPenaltyModulus(user));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
