@@ -39,7 +39,7 @@ def run_one(case, mesh, preset, eps0, ranks, partitioner, outdir):
     r = run_mpi(cmd, timeout=900)
     row = {"case": case, "preset": preset, "eps0": eps0, "ranks": ranks, "partitioner": partitioner, "wall": time.time() - t0}
     if r.returncode not in (0, 3) or not os.path.exists(out):
-        row.update(converged=0, reason=f"exit {r.returncode}: {error_line(r.text)}")
+        row.update(converged=0, reason=f"exit {r.returncode}: {error_line(r.output)}")
         return row, cmd
     a = read_run(out)
     row.update(converged=int(a["converged"]), reason=a["snes_reason_code"], newton=a["newton_its_total"],
