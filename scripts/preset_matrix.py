@@ -7,6 +7,7 @@ and the preconditioner rebuilds after a breakdown (/run pc_breakdowns), and the 
 
   preset_matrix.py [--out bench/preset_matrix.md] [--cases sphere,sphere-indenter] [--eps0 1,1e-2,1e-4]
                    [--presets default,gamg,hypre] [--ranks 1,2,3,4] [--partitioners metis,ptscotch] [--h-near 0.02]
+                   [--outdir output/preset_matrix]
 
 Exit status 1 if a run did not converge (tests/test_reproducible.py runs a subset).
 """
@@ -56,8 +57,9 @@ def main():
     ap.add_argument("--ranks", default="1,2,3,4")
     ap.add_argument("--partitioners", default="metis,ptscotch")
     ap.add_argument("--h-near", type=float, default=0.02)
+    ap.add_argument("--outdir", default=os.path.join(ROOT, "output", "preset_matrix"), help="where the meshes and runs go")
     args = ap.parse_args()
-    outdir = os.path.join(ROOT, "output", "preset_matrix")
+    outdir = args.outdir
     os.makedirs(outdir, exist_ok=True)
     rows, failed = [], []
     for case in args.cases.split(","):
