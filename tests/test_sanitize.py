@@ -22,7 +22,7 @@ CASES = {
     "reference_vi": (1, ["-dm_plex_box_faces", "8,8", "-contact_method", "vi", "-reference", "tests/out/asan/square_penalty.h5"], 0),
     # GAMG with its coarse-level updates, the eps sweep with its step guess, Eisenstat-Walker's forcing terms
     "gamg_update_sweep_np2": (2, ["-dm_plex_box_faces", "16,16", "-options_file", "options/solvers/gamg.yaml", "-penalty_eps0_sweep", "1,0.1,0.01"], 0),
-    "geometric_multigrid": (1, ["-dm_plex_box_faces", "16,16", "-options_file", "options/solvers/mg.yaml"], 0),
+    "geometric_multigrid": (1, ["-dm_plex_box_faces", "16,16", "-contact_coarse_levels", 2, "-options_file", "options/solvers/mg.yaml"], 0),
     # the general scene on a Gmsh mesh with named faces: every boundary family, a body force, a curved obstacle
     "gmsh_names_cylinder": (1, ["-scene", "general", "-dm_plex_filename", "tests/out/asan/named_square.msh", "-contact_faces", "bottom",
                                 "-bc_clamp", "top", "-bc_clamp_top_translate", "0,-0.01", "-bc_slip", "left", "-bc_slip_left_components", 0,
