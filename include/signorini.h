@@ -113,6 +113,7 @@ typedef struct {
   PetscBool         cycle_damping;       /* damp the Newton step when the active set cycles */
   PetscBool         pc_reuse;            /* reuse the preconditioner/factorization while few contact nodes change */
   PetscInt          pc_reuse_changes;    /*   at most this many changed nodes since the build */
+  PetscBool         pc_recovery;         /* go on after a preconditioner breakdown (pc_recovery.c) */
   PetscBool         pc_update;           /* multigrid (GAMG): the coarse operators follow the Jacobian instead of rebuilds */
   PetscBool         pc_update_check;     /*   and each update is compared with the full Galerkin products */
   PetscBool         pc_update_esteig;    /*   and the finest smoother estimates its eigenvalues again at each update */
@@ -137,6 +138,7 @@ typedef struct {
   /* -contact_pc_update: after the first build of a GAMG hierarchy, each new Jacobian changes the coarse operators by
      the Galerkin products of its change, which lives in the contact rows only (the bulk matrix is constant) */
   PetscBool    update;     /* the hierarchy exists and follows the Jacobian */
+  PetscBool    no_update;  /* updates given up after a preconditioner breakdown (pc_recovery.c): builds only */
   PetscBool    record;     /* the Jacobian being assembled is the one of a build: record its contact rows */
   PetscBool    recorded;   /* they are (on every rank alike) */
   PetscInt     updates;    /* updates so far */
@@ -170,6 +172,11 @@ typedef struct {
   PetscReal tform[4];         /* Chebyshev's transform of estimates into its interval (-ksp_chebyshev_esteig) */
   Vec       pdiag, pcols;     /* the penalty term's diagonal, and its values at the contact rows' columns */
 } PcReuse;
+
+/* State of the recovery from preconditioner breakdowns (pc_recovery.c). */
+typedef struct {
+  PetscInt stage; /* recovery steps taken: 0 none, 1 rebuilt, 2 GMRES, 3 direct */
+} PcRecovery;
 
 /* The nodes of Gamma_C owned by this rank with at least one free component: the unknowns the contact acts on. */
 typedef struct {
@@ -255,6 +262,8 @@ typedef struct {
   PetscInt            active_set_cycles;   /* active-set cycles detected (and damped) in the Newton iterations */
   PetscInt            pc_builds;           /* preconditioner (factorization) builds of the Newton steps */
   PetscInt            pc_updates;          /* updates of a GAMG hierarchy's coarse operators instead of builds (-contact_pc_update) */
+  PetscInt            pc_breakdowns;       /* preconditioner breakdowns recovered from (pc_recovery.c), */
+  char                pc_recovery[512];    /*   and what was done, "; "-separated */
   PetscBool           ksp_ew;              /* Eisenstat-Walker linear tolerances (-snes_ksp_ew) */
   Bandwidth           bandwidth;
   PetscReal           condition_1norm;                      /* estimate of cond_1 of the final Jacobian, NaN if not computed */
@@ -341,6 +350,7 @@ typedef struct {
   PetscReal       snes_scale;         /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
   Vec             work;               /* U x~: the displacement of the SNES iterate x~ */
   PcReuse         pc_reuse;
+  PcRecovery      pc_recovery;
   SolverForcing   forcing;
   SolverStepGuess step_guess;
   /* The penalty Jacobian lives in K itself (one matrix; only the rows of the contact dofs differ): K's own values of

@@ -58,6 +58,10 @@ PetscErrorCode FineSmootherSetUp(KSP ksp);
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X);
 PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user);
 PetscErrorCode PcReuseDestroy(AppCtx *user);
+PetscErrorCode PcReuseReset(AppCtx *user);
+
+/* pc_recovery.c */
+PetscErrorCode PcRecoveryTry(SNES snes, AppCtx *user, PetscBool *retry);
 PetscErrorCode SmootherBoundFinest(PC pc, PetscInt nlevels, AppCtx *user, const PetscScalar jvals[], PetscBool check);
 
 /* assembly_p1.c */

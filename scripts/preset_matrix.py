@@ -7,6 +7,7 @@ and the preconditioner rebuilds after a breakdown (/run pc_breakdowns), and the 
 
   preset_matrix.py [--out bench/preset_matrix.md] [--cases sphere,sphere-indenter] [--eps0 1,1e-2,1e-4]
                    [--presets default,gamg,hypre] [--ranks 1,2,3,4] [--partitioners metis,ptscotch] [--h-near 0.02]
+                   [--outdir output/preset_matrix]
 
 Exit status 1 if a run did not converge (tests/test_reproducible.py runs a subset).
 """
@@ -39,7 +40,7 @@ def run_one(case, mesh, preset, eps0, ranks, partitioner, outdir):
     r = run_mpi(cmd, timeout=900)
     row = {"case": case, "preset": preset, "eps0": eps0, "ranks": ranks, "partitioner": partitioner, "wall": time.time() - t0}
     if r.returncode not in (0, 3) or not os.path.exists(out):
-        row.update(converged=0, reason=f"exit {r.returncode}: {error_line(r.text)}")
+        row.update(converged=0, reason=f"exit {r.returncode}: {error_line(r.output)}")
         return row, cmd
     a = read_run(out)
     row.update(converged=int(a["converged"]), reason=a["snes_reason_code"], newton=a["newton_its_total"],
@@ -56,8 +57,9 @@ def main():
     ap.add_argument("--ranks", default="1,2,3,4")
     ap.add_argument("--partitioners", default="metis,ptscotch")
     ap.add_argument("--h-near", type=float, default=0.02)
+    ap.add_argument("--outdir", default=os.path.join(ROOT, "output", "preset_matrix"), help="where the meshes and runs go")
     args = ap.parse_args()
-    outdir = os.path.join(ROOT, "output", "preset_matrix")
+    outdir = args.outdir
     os.makedirs(outdir, exist_ok=True)
     rows, failed = [], []
     for case in args.cases.split(","):

@@ -64,6 +64,7 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
   if (user->rec.diagnostics_failed[0])
     PetscCall(
         PetscPrintf(comm, "  WARNING: written without a diagnostic that failed after the solve (exit status 4): %s\n", user->rec.diagnostics_failed));
+  if (s->pc_breakdowns) PetscCall(PetscPrintf(comm, "  preconditioner breakdowns: %" PetscInt_FMT " (%s)\n", s->pc_breakdowns, s->pc_recovery));
   if (s->continuation_stages)
     PetscCall(PetscPrintf(comm, "  eps continuation: %" PetscInt_FMT " solve(s) from eps = h/M before the target eps (counted in the Newton steps)\n",
                           s->continuation_stages));

@@ -42,6 +42,11 @@ def _square(path, order=1, recombine_right=False, interior_line=False):
         gmsh.finalize()
 
 
+def write_named_square(path):
+    """The unit square in triangles, its sides named bottom (1), right (2), top (3), left (4)."""
+    _square(path)
+
+
 def write_mixed(path):
     _square(path, recombine_right=True)
 

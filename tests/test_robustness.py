@@ -45,10 +45,11 @@ def test_condition_estimate_grows_like_one_over_eps():
 def test_iterative_solver_failure_at_small_eps_is_loud():
     """CG + GAMG with PETSc 3.18's default smoother bounds (-pc_gamg_use_sa_esteig 1, which options/solvers/gamg.yaml
     turns off) and the whole prolongator (-contact_pc_update_truncate 0; with the truncation it converges) cannot solve
-    the Jacobian at eps = 1e-8 h: the run must end with converged = 0, the reason, the residual and exit status 3,
+    the Jacobian at eps = 1e-8 h (a breakdown, DIVERGED_INDEFINITE_PC, which -contact_pc_recovery 0 leaves a failure:
+    tests/test_pc_recovery.py recovers from it): the run must end with converged = 0, the reason, the residual and exit status 3,
     never with a result flagged converged."""
     args = SQUARE + ["-dm_plex_box_faces", "32,32", "-options_file", "options/solvers/gamg.yaml", "-pc_gamg_use_sa_esteig", "1",
-                     "-contact_pc_update_truncate", "0", "-penalty_eps0", "1e-8"]
+                     "-contact_pc_update_truncate", "0", "-penalty_eps0", "1e-8", "-contact_pc_recovery", "0"]
     out, h5 = run(args, "gamg_small_eps", expect_rc=3)
     a, _ = load(h5)
     assert a["converged"] == 0 and a["snes_reason"].startswith("DIVERGED"), a["snes_reason"]

@@ -10,6 +10,7 @@ import subprocess
 import pytest
 
 from harness import ENV, OUT, ROOT
+from hostile_meshes import write_named_square
 
 ASAN_BIN = os.path.join(ROOT, "bin", "signorini-asan")
 CASES = {
@@ -18,6 +19,20 @@ CASES = {
     "nodal_3d_grid_sequence": (1, ["-dm_plex_dim", 3, "-dm_plex_box_faces", "2,2,2", "-penalty_quadrature", "nodal", "-contact_grid_sequence", 1], 0),
     "mms_sweep_metis_np2": (2, ["-scene", "mms", "-dm_plex_box_faces", "8,8", "-penalty_eps0_sweep", "1,0.01", "-partitioner", "metis"], 0),
     "quads_p2_fe_assembly": (1, ["-dm_plex_simplex", 0, "-dm_plex_box_faces", "4,4", "-displacement_petscspace_degree", 2], 0),
+    "reference_vi": (1, ["-dm_plex_box_faces", "8,8", "-contact_method", "vi", "-reference", "tests/out/asan/square_penalty.h5"], 0),
+    # GAMG with its coarse-level updates, the eps sweep with its step guess, Eisenstat-Walker's forcing terms
+    "gamg_update_sweep_np2": (2, ["-dm_plex_box_faces", "16,16", "-options_file", "options/solvers/gamg.yaml", "-penalty_eps0_sweep", "1,0.1,0.01"], 0),
+    "geometric_multigrid": (1, ["-dm_plex_box_faces", "16,16", "-contact_coarse_levels", 2, "-options_file", "options/solvers/mg.yaml"], 0),
+    # the general scene on a Gmsh mesh with named faces: every boundary family, a body force, a curved obstacle
+    "gmsh_names_cylinder": (1, ["-scene", "general", "-dm_plex_filename", "tests/out/asan/named_square.msh", "-contact_faces", "bottom",
+                                "-bc_clamp", "top", "-bc_clamp_top_translate", "0,-0.01", "-bc_slip", "left", "-bc_slip_left_components", 0,
+                                "-bc_traction", "right", "-bc_traction_right", "0.01,0", "-body_force", "0,-0.01", "-obstacle", "cylinder",
+                                "-obstacle_center", "0.5,-2", "-obstacle_radius", 2], 0),
+    "sphere_3d_pressure_np2": (2, ["-scene", "general", "-dm_plex_dim", 3, "-dm_plex_box_faces", "2,2,2", "-contact_faces", 1, "-bc_clamp", 2,
+                                   "-bc_clamp_2_translate", "0,0,-0.01", "-bc_pressure", 3, "-bc_pressure_3", 0.001, "-obstacle", "sphere",
+                                   "-obstacle_center", "0.5,0.5,-2", "-obstacle_radius", 2], 0),
+    # a preconditioner breakdown at every multigrid build, recovered by a direct solve (src/solver/pc_recovery.c)
+    "pc_recovery": (1, ["-dm_plex_box_faces", "16,16", "-options_file", "options/solvers/gamg.yaml", "-mg_levels_ksp_chebyshev_esteig", "0,0.05,0,0.3"], 0),
     "failed_solve": (1, ["-dm_plex_box_faces", "8,8", "-snes_max_it", 1], 3),
     "bad_input": (1, ["-dm_plex_box_faces", "8,8", "-young_modulus", "nan"], None),
 }
@@ -29,6 +44,7 @@ def test_sanitizers_report_nothing():
     assert p.returncode == 0, p.stdout[-3000:]
     env = dict(ENV, ASAN_OPTIONS="detect_leaks=0", UBSAN_OPTIONS="print_stacktrace=1")
     os.makedirs(os.path.join(OUT, "asan"), exist_ok=True)
+    write_named_square(os.path.join(OUT, "asan", "named_square.msh"))
     for name, (np_, args, rc) in CASES.items():
         cmd = ["mpiexec", "-n", str(np_), ASAN_BIN, "-malloc_debug", "-malloc_dump", "-output", os.path.join(OUT, "asan", name + ".h5")]
         p = subprocess.run(cmd + [str(a) for a in args], cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=300)

@@ -249,6 +249,8 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteRealAttr(v, "residual_norm", s->residual_norm));
   PetscCall(WriteIntAttr(v, "residual_reduced", s->residual_reduced ? 1 : 0));
   PetscCall(WriteIntAttr(v, "stopped_at_roundoff", s->roundoff_stop ? 1 : 0)); /* Newton stalled at the round-off of its terms */
+  PetscCall(WriteIntAttr(v, "pc_breakdowns", s->pc_breakdowns));               /* preconditioner breakdowns recovered from (pc_recovery.c) */
+  if (s->pc_recovery[0]) PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "pc_recovery", PETSC_STRING, s->pc_recovery));
   PetscCall(WriteRealAttr(v, "load_norm", user->prob.load_norm));
   PetscCall(WriteRealAttr(v, "displacement_scale", user->prob.displacement_scale));
   PetscCall(WriteRealAttr(v, "time_setup", s->time_setup));

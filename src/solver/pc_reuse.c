@@ -39,7 +39,7 @@ static PetscErrorCode HierarchyLevels(SNES snes, AppCtx *user, PC *pc, PetscInt 
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(KSPGetPC(ksp, pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)*pc, PCGAMG, &is_gamg));
-  if (!is_gamg || !user->opt.contact.pc_update || !user->prob.bulk_ptr) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!is_gamg || !user->opt.contact.pc_update || user->prob.pc_reuse.no_update || !user->prob.bulk_ptr) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PCMGGetLevels(*pc, nlevels));
   for (PetscInt l = 0; l < *nlevels; ++l) {
     KSP smoother;
@@ -454,7 +454,7 @@ PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user)
   PetscInt nlevels;
 
   PetscFunctionBeginUser;
-  if (!r->enabled || !user->opt.contact.pc_update || !pb->jacobian_in_K) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!r->enabled || !user->opt.contact.pc_update || r->no_update || !pb->jacobian_in_K) PetscFunctionReturn(PETSC_SUCCESS);
   if (r->update) {
     PetscCall(HierarchyLevels(snes, user, &pc, &nlevels));
     PetscCall(UpdateHierarchy(pc, nlevels, user));
@@ -495,5 +495,23 @@ PetscErrorCode PcReuseDestroy(AppCtx *user)
   PetscCall(VecDestroy(&r->pdiag));
   PetscCall(VecDestroy(&r->pcols));
   PetscCall(PetscMemzero(r, sizeof(*r)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Forgets the build, so that the next Newton step builds the preconditioner afresh, and gives up the coarse-level
+   updates for the rest of the run (pc_recovery.c): every later preconditioner is a build, with its own smoother
+   estimates. enabled and the counts stay. */
+PetscErrorCode PcReuseReset(AppCtx *user)
+{
+  PcReuse        *r       = &user->prob.pc_reuse;
+  const PetscBool enabled = r->enabled;
+  const PetscInt  builds = r->builds, updates = r->updates;
+
+  PetscFunctionBeginUser;
+  PetscCall(PcReuseDestroy(user));
+  r->enabled   = enabled;
+  r->builds    = builds;
+  r->updates   = updates;
+  r->no_update = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

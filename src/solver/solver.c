@@ -527,6 +527,24 @@ static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* SolverSNESSolve() and RecordSolve(), then again from the last iterate after each recovery from a breakdown of the
+   preconditioner (pc_recovery.c) while one is left; the Newton steps and linear iterations of every attempt count. */
+static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *newton, PetscInt *ksp)
+{
+  PetscBool retry = PETSC_TRUE;
+
+  PetscFunctionBeginUser;
+  PetscCall(SolverSNESSolve(snes, user, u));
+  PetscCall(RecordSolve(snes, user, newton, ksp));
+  while (!user->rec.stats.converged && retry) {
+    PetscCall(PcRecoveryTry(snes, user, &retry));
+    if (!retry) break;
+    PetscCall(SolverSNESSolve(snes, user, u));
+    PetscCall(RecordSolve(snes, user, newton, ksp));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Solves from a zero initial guess (or from u, start) and records the outcome; a failed solve is recorded, not raised.
    An eps below h/M is reached by continuation: the penalty problems for eps = h/M, h/M f, h/M f^2, ... are solved in turn,
    each from the solution of the previous one, so that Newton starts near the active set and the 1/eps scale of the
@@ -555,8 +573,7 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= user->opt.contact.continuation_factor) {
       user->prob.eps = eps;
       PetscCall(ElasticityUpdateConstants(dm, user));
-      PetscCall(SolverSNESSolve(snes, user, u));
-      PetscCall(RecordSolve(snes, user, &newton, &ksp));
+      PetscCall(SolveRecovering(snes, user, u, &newton, &ksp));
       user->rec.stats.continuation_stages++;
       if (!user->rec.stats.converged) break; /* reported as the failure of the whole solve */
     }
@@ -564,8 +581,7 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
     PetscCall(ElasticityUpdateConstants(dm, user));
   }
   if (user->rec.stats.continuation_stages == 0 || user->rec.stats.converged) {
-    PetscCall(SolverSNESSolve(snes, user, u));
-    PetscCall(RecordSolve(snes, user, &newton, &ksp));
+    PetscCall(SolveRecovering(snes, user, u, &newton, &ksp));
   }
   PetscCall(PetscTime(&t1));
   user->rec.stats.time_solve += t1 - t0;
