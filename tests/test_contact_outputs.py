@@ -83,6 +83,20 @@ def test_under_resolved_contact_zone_is_warned(n, warned):
     assert ("WARNING: the contact zone spans" in out) == warned
 
 
+def test_under_resolved_contact_zone_is_warned_in_3d():
+    """The sphere of scripts/zone_resolution.py --dim 3: at 12^3 the contact zone is 2.8 cells across (the diameter of a
+    round zone of its fully pressed faces, sqrt(2 n / pi)) and the force 11% off the 40^3 one (bench/zone_resolution_3d.md):
+    warned below 6 cells."""
+    args = ["-scene", "general", "-dm_plex_dim", 3, "-dm_plex_box_faces", "12,12,12", "-contact_faces", 1, "-bc_clamp", 2,
+            "-bc_clamp_2_translate", "0,0,-0.02", "-obstacle", "sphere", "-obstacle_center", "0.5,0.5,-1", "-obstacle_radius", 1,
+            "-penalty_eps0", 0.01]
+    out, h5 = run(args, "warn_zone_3d", np_=2)
+    a, _ = load(h5)
+    assert a["converged"] == 1 and a["contact_zone_faces"] > 0
+    assert abs(a["contact_zone_cells"] - (2 * a["contact_zone_faces"] / np.pi) ** 0.5) < 1e-12
+    assert a["contact_zone_cells"] < 6 and a["warnings"] == 1 and "fewer than 6" in out
+
+
 def test_obstacle_facing_away_and_deep_overlap_are_warned():
     """A plane whose normal points into the body (the foundation given upside down), and an obstacle placed half the body
     deep: each warned in the summary and counted in /run; the default square is not."""
