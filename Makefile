@@ -23,7 +23,7 @@ SRC = $(wildcard src/*.c src/*/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test asan rates extremes tradeoff hertz bench format clean
+.PHONY: all deps run test test-long asan rates extremes tradeoff hertz bench format clean
 STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
@@ -71,6 +71,11 @@ run: deps
 test: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) -m pytest
+
+# The long tests left out of make test (pytest.ini: -m "not long"): the 2000-draw fuzz run
+test-long: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) -m pytest -m long
 
 # The paper's convergence studies (README, "Reproducing the paper"): output/studies/<name>/<name>.{csv,md,png}
 rates: deps

@@ -57,7 +57,7 @@ def main():
         for n in sizes[:-1]:
             r = runs[n]
             err = abs(r["contact_force"] / ref - 1)
-            lines.append(f"| {rule} | {n} | {r['contact_zone_cells']:.0f} | {r['contact_zone_faces']} | {r['contact_force']:.6g} | {100 * err:.2f}% |")
+            lines.append(f"| {rule} | {n} | {r['contact_zone_cells']:.1f} | {r['contact_zone_faces']} | {r['contact_force']:.6g} | {100 * err:.2f}% |")
             print(lines[-1], flush=True)
     with open(args.out, "w") as fh:
         fh.write("\n".join(lines) + "\n")

@@ -14,7 +14,7 @@ Every run must end in one of three ways:
 Any other exit (a crash, an abort, an MPI error) fails.
 
 The draws are seeded, so a failure reproduces; SIGNORINI_FUZZ_EXAMPLES sets the number of runs of the
-default test (300), and the slow-marked test runs 2000 more (pytest -m slow tests/test_fuzz.py).
+default test (300), and the long-marked test runs 2000 more (make test-long, or pytest -m long tests/test_fuzz.py).
 """
 import math
 import os
@@ -318,7 +318,7 @@ def test_fuzz_option_families(meshes):
     assert counts.get("converged", 0) >= EXAMPLES // 10 and counts.get("refused", 0) >= EXAMPLES // 10, counts
 
 
-@pytest.mark.slow
+@pytest.mark.long
 def test_fuzz_option_families_long(meshes):
     counts = fuzz(meshes, 2000, "long", 2029)
     print("fuzz outcomes:", counts)
