@@ -49,7 +49,7 @@ def main():
     lines = [f"# Force error against the cells across the contact zone\n",
              f"`{' '.join(['scripts/zone_resolution.py'] + sys.argv[1:])}`: unit {'square on a rigid cylinder' if args.dim == 2 else 'cube on a rigid sphere'} "
              f"(R = {args.radius:g}), top pushed by {args.delta:g}, eps = {args.eps0:g} h/E; the error is the contact force against the same rule's "
-             f"on {sizes[-1]}^{args.dim} (cells across the zone: the square root of the zone's faces in 3D).\n",
+             f"on {sizes[-1]}^{args.dim} (cells across the zone in 3D: the diameter of a round zone of its fully pressed faces, sqrt(2 n / pi)).\n",
              "| rule | N | cells across the zone | zone faces | contact force | error of the force |", "|---|---|---|---|---|---|"]
     for rule in ("gauss", "nodal"):
         runs = {n: solve(n, rule, args.eps0, args.radius, args.delta, outdir, args.dim, args.np) for n in sizes}
