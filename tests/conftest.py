@@ -1,5 +1,5 @@
 """pytest fixtures of the test suite: the build of bin/signorini, the output root tests/out (wiped once per session),
-a directory of its own under it for a test, and the things made once and shared (a good run, Gmsh meshes)."""
+a directory of its own under it for a test, and the MPI environment of the programs the tests start."""
 import os
 import re
 import shutil
@@ -7,7 +7,7 @@ import subprocess
 
 import pytest
 
-from harness import BIN, ENV, OUT, ROOT, write_gmsh_square
+from harness import BIN, ENV, OUT, ROOT
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -35,14 +35,6 @@ def outdir(out_root, request):
     shutil.rmtree(d, ignore_errors=True)
     os.makedirs(d)
     return d
-
-
-@pytest.fixture(scope="session")
-def no_contact_mesh(out_root):
-    """tests/out/no_contact.msh: a Gmsh square with no face on Gamma_C (a bad input named by its relative path)."""
-    path = os.path.join(out_root, "no_contact.msh")
-    write_gmsh_square(path, 4, with_contact=False)
-    return path
 
 
 @pytest.fixture(scope="session", autouse=True)

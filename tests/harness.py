@@ -1,42 +1,56 @@
-"""Shared helpers of the test suite: running the solver and reading its output back."""
+"""Shared helpers of the test suite: running the solver and reading its output back, a thin layer over the scripts'
+library (scripts/signorini: mpirun for running, runs for reading), and the Gmsh meshes the tests write."""
 import os
-import subprocess
 import sys
-
-import h5py
-import numpy as np
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
-import read_runs  # noqa: E402
+import read_runs  # noqa: E402,F401  (tests/test_output.py tests the script through harness.read_runs)
+from signorini.mpirun import MPI_ENV, run_mpi, tail  # noqa: E402
+from signorini.runs import read_output, vertex_order  # noqa: E402
 
 BIN = os.path.join(ROOT, "bin", "signorini")
 OUT = os.path.join(ROOT, "tests", "out")
-ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1", OMPI_MCA_rmaps_base_oversubscribe="1")
+ENV = dict(os.environ, **MPI_ENV)  # for the programs the tests start themselves (make, the scripts, test_fuzz.py's direct runs)
+TIMEOUT = 600  # seconds a run of the solver may take
+
+
+def command(args, np_=1, output=None):
+    """The command line of the solver on np_ ranks under mpiexec: the arguments, then -output OUTPUT when given (the
+    last of an option given twice wins)."""
+    return ["mpiexec", "-n", str(np_), BIN] + [str(a) for a in args] + ([] if output is None else ["-output", str(output)])
+
+
+def solve(args, np_=1, output=None, timeout=TIMEOUT):
+    """Runs the solver with any arguments (command()) in ROOT with the MPI environment; returns (exit status, output:
+    stdout and stderr merged). A run past the time limit is stopped, mpiexec and its ranks (signorini.mpirun.run_mpi),
+    and fails the test."""
+    cmd = command(args, np_, output)
+    r = run_mpi(cmd, timeout=timeout)
+    assert not r.timed_out, f"stopped after {timeout} s: {' '.join(cmd)}\n{tail(r.output)}"
+    return r.returncode, r.output
 
 
 def run(args, name, np_=1, expect_rc=0, output=None):
-    """Runs the solver; returns (combined output, path of the HDF5 file: tests/out/NAME.h5, or output)."""
+    """Runs the solver; returns (combined output, path of the HDF5 file: tests/out/NAME.h5, or output). Asserts the exit
+    status expect_rc (None: any)."""
     out = output or os.path.join(OUT, name + ".h5")
-    cmd = ["mpiexec", "-n", str(np_), BIN, "-output", out] + [str(a) for a in args]
-    p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=600)
+    args = ["-output", out] + list(args)
+    rc, text = solve(args, np_=np_)
     if expect_rc is not None:
-        assert p.returncode == expect_rc, f"exit code {p.returncode}, expected {expect_rc}: {' '.join(cmd)}\n{p.stdout[-3000:]}"
-    return p.stdout, out
+        assert rc == expect_rc, f"exit code {rc}, expected {expect_rc}: {' '.join(command(args, np_))}\n{text[-3000:]}"
+    return text, out
 
 
 def load(path):
-    with h5py.File(path, "r") as f:
-        attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f["run"].attrs.items()}
-        fields = {k: f["vertex_fields"][k][:] for k in f["vertex_fields"]}
-        fields["x"] = f["geometry/vertices"][:]
-    return attrs, fields
+    """(attrs, fields) of an output: /run with bytes decoded, the vertex fields in the file's order and "x", the vertex
+    coordinates (signorini.runs.read_output)."""
+    return read_output(path)
 
 
 def sorted_by_position(fields, key):
-    """Field values in a rank-independent vertex order (lexicographic in the coordinates)."""
-    order = np.lexsort(np.round(fields["x"], 12).T)
-    return fields[key][order]
+    """Field values in a rank-independent vertex order (signorini.runs.vertex_order, as runs.vertex_fields())."""
+    return fields[key][vertex_order(fields["x"])]
 
 
 def write_gmsh_square(path, n, with_contact=True, with_clamp=True, quads=False):

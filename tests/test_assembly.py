@@ -8,12 +8,11 @@ energy at the solution both ways. Every assertion checks those numbers or the so
 import glob
 import os
 import re
-import subprocess
 
 import numpy as np
 import pytest
 
-from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position
+from harness import OUT, ROOT, load, run, solve, sorted_by_position
 
 CHECK = re.compile(r"assembly check: \|\|K_p1 - K_fe\|\|_F/\|\|K_fe\|\|_F = (\S+); size (\d+)x(\d+) \(p1\) (\d+)x(\d+) \(fe\); "
                    r"type (\S+) \(p1\) (\S+) \(fe\); block size (\d+) \(p1\) (\d+) \(fe\); nonzeros (\d+) \(p1\) (\d+) \(fe\); "
@@ -136,10 +135,9 @@ def test_assembly_p1_refused_where_it_does_not_apply(name):
     args, reason = REFUSED_CASES[name]
     square = ["-options_file", "options/square.yaml", "-contact_monitor", 0, "-dm_plex_box_faces", "8,8"]
     out = os.path.join(OUT, f"assembly_refused_{name}.h5")
-    cmd = ["mpiexec", "-n", "1", BIN, "-output", out] + [str(a) for a in square + args + ["-assembly", "p1"]]
-    p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
-    assert p.returncode != 0, f"{name}: -assembly p1 accepted"
-    assert "-assembly p1 needs P1 displacements on triangles or tetrahedra, but " + reason in p.stdout, p.stdout[-2000:]
+    rc, text = solve(square + args + ["-assembly", "p1"], output=out, timeout=120)
+    assert rc != 0, f"{name}: -assembly p1 accepted"
+    assert "-assembly p1 needs P1 displacements on triangles or tetrahedra, but " + reason in text, text[-2000:]
     assert not glob.glob(out + "*"), f"{name}: output left behind"
     _, h5 = run(square + args, f"assembly_auto_{name}")
     a, _ = load(h5)

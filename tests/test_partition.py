@@ -7,12 +7,11 @@ Every assertion checks numbers computed by the solver against a bound or an inde
 import os
 import re
 import shutil
-import subprocess
 
 import numpy as np
 import pytest
 
-from harness import BIN, ENV, OUT, ROOT, load, run, sorted_by_position, write_gmsh_square
+from harness import OUT, load, run, solve, sorted_by_position, write_gmsh_square
 
 SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "false"]  # 32x32, default solver (MUMPS)
 MMS3D = ["-options_file", "options/mms.yaml", "-dm_plex_dim", 3, "-dm_plex_box_faces", "6,6,6"]
@@ -133,11 +132,10 @@ def test_box_partitioner_refuses_other_meshes():
         shutil.rmtree(d, ignore_errors=True)
         os.makedirs(d)
         out = os.path.join(d, "box_refused.h5")
-        cmd = ["mpiexec", "-n", "2", BIN, "-output", out] + SQUARE + extra + ["-partitioner", "box"]
-        p = subprocess.run([str(c) for c in cmd], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
-        assert p.returncode != 0, "-partitioner box accepted for " + what
+        rc, text = solve(SQUARE + extra + ["-partitioner", "box"], np_=2, output=out, timeout=120)
+        assert rc != 0, "-partitioner box accepted for " + what
         message = "-partitioner box splits the project's simplex box as it builds it; " + what + " needs ptscotch, metis or simple"
-        assert message in p.stdout, f"'{message}' not in:\n{p.stdout[-2000:]}"
+        assert message in text, f"'{message}' not in:\n{text[-2000:]}"
         # neither the output pair nor a temporary (.signorini-XXXXXX, src/io/output_file.c) in the output's directory
         assert os.listdir(d) == [], f"output left behind: {os.listdir(d)}"
 
@@ -149,10 +147,9 @@ def test_bad_partitioner_is_refused(n):
     shutil.rmtree(d, ignore_errors=True)
     os.makedirs(d)
     out = os.path.join(d, "out.h5")
-    cmd = ["mpiexec", "-n", str(n), BIN, "-output", out] + SQUARE + ["-partitioner", "bogus"]
-    p = subprocess.run(cmd, cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=120)
-    assert p.returncode != 0, "bad -partitioner accepted"
+    rc, text = solve(SQUARE + ["-partitioner", "bogus"], np_=n, output=out, timeout=120)
+    assert rc != 0, "bad -partitioner accepted"
     message = "Unknown option bogus for -partitioner. Available options: ptscotch metis simple box"
-    assert message in p.stdout, f"'{message}' not in:\n{p.stdout[-2000:]}"
+    assert message in text, f"'{message}' not in:\n{text[-2000:]}"
     # neither the output pair nor a temporary (.signorini-XXXXXX, src/io/output_file.c) in the output's directory
     assert os.listdir(d) == [], f"output left behind: {os.listdir(d)}"

@@ -1,6 +1,6 @@
 """Reading the solver's HDF5 outputs: the /run attributes (as plain Python or as stored), the
-vertex fields in an order that does not depend on the ranks, the per-solve history (/solves) and
-the values on the contact boundary."""
+vertex fields (in the file's order with the coordinates, or in an order that does not depend on the
+ranks), the per-solve history (/solves) and the values on the contact boundary."""
 import os
 
 import h5py
@@ -77,11 +77,27 @@ def all_columns(runs):
     return list(cols)
 
 
-def vertex_fields(path):
-    """{name: array} of /vertex_fields, the vertices sorted by position (rank-independent order)."""
+def vertex_order(x):
+    """The permutation putting the vertices of coordinates x (one row a vertex) in an order that does not depend on the
+    ranks: lexicographic in the coordinates rounded to 12 digits, the last coordinate first."""
+    return np.lexsort(np.round(x, 12).T)
+
+
+def read_output(path):
+    """(attrs, fields) of the output `path`: the /run attributes with bytes decoded (numbers stay numpy scalars), and
+    {name: array} of /vertex_fields in the file's vertex order, plus "x": /geometry/vertices (vertex_order(fields["x"])
+    sorts them)."""
     with h5py.File(path, "r") as f:
-        x = f["geometry/vertices"][:]
-        order = np.lexsort(np.round(x, 12).T)  # a vertex order that does not depend on the ranks
+        attrs = decoded_attrs(f["run"])
+        fields = {k: f["vertex_fields"][k][:] for k in f["vertex_fields"]}
+        fields["x"] = f["geometry/vertices"][:]
+    return attrs, fields
+
+
+def vertex_fields(path):
+    """{name: array} of /vertex_fields, the vertices sorted by position (vertex_order: rank-independent)."""
+    with h5py.File(path, "r") as f:
+        order = vertex_order(f["geometry/vertices"][:])
         return {k: f["vertex_fields"][k][:][order] for k in f["vertex_fields"]}
 
 
