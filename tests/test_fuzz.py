@@ -29,12 +29,11 @@ hypothesis = pytest.importorskip("hypothesis", reason="python3-hypothesis is a t
 from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 
-from harness import BIN, ENV, OUT, ROOT  # noqa: E402
+from harness import BIN, ENV, OUT, ROOT, SINGLETON_ENV  # noqa: E402
 
 FUZZ = os.path.join(OUT, "fuzz")
 EXAMPLES = int(os.environ.get("SIGNORINI_FUZZ_EXAMPLES", "300"))
-# One process without mpiexec, Open MPI told not to look for a launcher or a network: 0.08 s a run instead of 0.4 s.
-SERIAL = dict(ENV, OMPI_MCA_ess_singleton_isolated="1", OMPI_MCA_plm="isolated", OMPI_MCA_btl="self", OMPI_MCA_pml="ob1")
+SERIAL = dict(ENV, **SINGLETON_ENV)  # one process without mpiexec (harness.SINGLETON_ENV)
 
 # The sides of the meshes: name -> (physical number, outward unit normal, area). The square [0,1]^2 and the cube [0,1]^3.
 SIDES = {
