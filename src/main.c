@@ -198,7 +198,7 @@ int main(int argc, char **argv)
   PetscErrorCode ierr;
   PetscBool      converged = PETSC_FALSE, diagnostics_ok = PETSC_TRUE;
 
-  if (OptionsFilesCheckYAML(argc, argv)) return 1; /* PETSc's own message would not name the file */
+  if (OptionsFilesCheckYAML(argc, argv)) return 2; /* a refusal of the input; PETSc's own message would not name the file */
   PetscCall(PetscInitialize(&argc, &argv, NULL, help));
   PetscCall(AppErrorPushHandler());
   ierr = Run(&converged, &diagnostics_ok);

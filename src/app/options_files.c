@@ -1,9 +1,13 @@
-/* Before PetscInitialize(): every YAML options file named on the command line parses as YAML, or the run stops with a
-   message naming the file, the line and the parser's complaint. PETSc reads the options files inside PetscInitialize()
+/* Before PetscInitialize(): every options file named on the command line can be opened, and every YAML one parses as
+   YAML, or the run stops (exit status 2, as every refusal of the input) with a message naming the file, and the line
+   and the parser's complaint. PETSc reads the options files inside PetscInitialize()
    and, for a malformed YAML file, says only "YAML parser loading error". Plain C: PETSc is not initialized yet. */
+#define _DEFAULT_SOURCE /* stat() under -std=c99 */
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <yaml.h>
 #include "app.h"
 
@@ -14,7 +18,30 @@ static int IsYAMLName(const char name[])
   return (n > 5 && !strcmp(name + n - 5, ".yaml")) || (n > 4 && !strcmp(name + n - 4, ".yml"));
 }
 
-/* 0 if the file parses (or cannot be opened: PETSc names a missing file itself), 1 after printing the problem. */
+/* 0 if the file can be opened, 1 after printing the problem (PETSc would stop inside PetscInitialize() with its whole
+   error block and its "options not used" list). */
+static int CheckReadable(const char option[], const char file[], int print)
+{
+  struct stat st;
+  FILE       *fp;
+
+  if (!stat(file, &st) && S_ISDIR(st.st_mode)) {
+    if (print)
+      fprintf(stderr, "signorini: error: %s '%s': the options file is a directory\n(-error_verbose prints PETSc's error report)\n", option, file);
+    return 1;
+  }
+  fp = fopen(file, "rb");
+  if (fp) {
+    (void)fclose(fp);
+    return 0;
+  }
+  if (print)
+    fprintf(stderr, "signorini: error: %s '%s': the options file cannot be opened (%s)\n(-error_verbose prints PETSc's error report)\n", option, file,
+            strerror(errno));
+  return 1;
+}
+
+/* 0 if the file parses, 1 after printing the problem. */
 static int CheckYAMLFile(const char file[], int print)
 {
   yaml_parser_t   parser;
@@ -30,7 +57,7 @@ static int CheckYAMLFile(const char file[], int print)
   yaml_parser_set_input_file(&parser, fp);
   bad = !yaml_parser_load(&parser, &doc);
   if (bad && print)
-    fprintf(stderr, "signorini: the options file '%s' is not valid YAML: %s at line %lu, column %lu\n", file,
+    fprintf(stderr, "signorini: error: the options file '%s' is not valid YAML: %s at line %lu, column %lu\n", file,
             parser.problem ? parser.problem : "parse error", (unsigned long)parser.problem_mark.line + 1,
             (unsigned long)parser.problem_mark.column + 1);
   if (!bad) yaml_document_delete(&doc);
@@ -45,9 +72,10 @@ int OptionsFilesCheckYAML(int argc, char **argv)
   const int   print = !rank || !strcmp(rank, "0");
 
   for (int i = 1; i + 1 < argc; ++i) {
-    const int yaml_option = !strcmp(argv[i], "-options_file_yaml");
+    const int yaml_option = !strcmp(argv[i], "-options_file_yaml"), options_file = !strcmp(argv[i], "-options_file");
 
-    if ((yaml_option || (!strcmp(argv[i], "-options_file") && IsYAMLName(argv[i + 1]))) && CheckYAMLFile(argv[i + 1], print)) return 1;
+    if ((yaml_option || options_file) && CheckReadable(argv[i], argv[i + 1], print)) return 1;
+    if ((yaml_option || (options_file && IsYAMLName(argv[i + 1]))) && CheckYAMLFile(argv[i + 1], print)) return 1;
   }
   return 0;
 }
