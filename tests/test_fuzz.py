@@ -318,6 +318,7 @@ def test_fuzz_option_families(meshes):
 
 
 @pytest.mark.long
+@pytest.mark.slow
 def test_fuzz_option_families_long(meshes):
     counts = fuzz(meshes, 2000, "long", 2029)
     print("fuzz outcomes:", counts)
