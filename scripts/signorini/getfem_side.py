@@ -14,6 +14,7 @@ import time
 import numpy as np
 
 from .paths import BIN
+from .runs import vertex_order
 
 E, NU, BETA, X0 = 1.0, 0.3, 2.0, 0.6  # options/square.yaml
 BOTTOM, RIGHT, TOP, LEFT = 1, 2, 3, 4
@@ -78,8 +79,7 @@ def getfem_solve(mesh_path, eps, rtol=1e-10):
 
 
 def sorted_by_position(x, u):
-    order = np.lexsort(np.round(x, 12).T)
-    return u[order]
+    return u[vertex_order(x)]
 
 
 def signorini_cmd(mesh_path, eps, output, solver_file=None, box_faces=None):
