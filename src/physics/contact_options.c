@@ -19,10 +19,10 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscCall(PetscOptionsEnum("-penalty_quadrature", "Quadrature of the penalty term: gauss (L2 product) or nodal (lumped, vertex rule)", NULL,
                              PenaltyQuadratures, (PetscEnum)opts->quadrature, (PetscEnum *)&opts->quadrature, NULL));
   opts->eps0 = 1.0;
-  PetscCall(PetscOptionsReal("-penalty_eps0", "eps = eps0 h^power / E: the factor eps0", NULL, opts->eps0, &opts->eps0, NULL));
+  PetscCall(PetscOptionsReal("-penalty_eps0", "eps = eps0 h^power / M (M: -penalty_eps_modulus, E by default): the factor eps0", NULL, opts->eps0, &opts->eps0, NULL));
   opts->eps_power = 1.0;
   PetscCall(
-      PetscOptionsReal("-penalty_eps_power", "eps = eps0 h^power / E: the power of h, in [0, 4]", NULL, opts->eps_power, &opts->eps_power, NULL));
+      PetscOptionsReal("-penalty_eps_power", "eps = eps0 h^power / M: the power of h, in [0, 4]", NULL, opts->eps_power, &opts->eps_power, NULL));
   opts->eps_local = PETSC_TRUE;
   PetscCall(PetscOptionsBool("-penalty_eps_local",
                              "eps from the local h: the diameter of the cell at each contact face (gauss) or the largest at each node (nodal)", NULL,
@@ -109,7 +109,7 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
                              "(the guard against oversolving; 0: PETSc's terms)",
                              NULL, opts->ew_guard, &opts->ew_guard, NULL));
   PetscCall(OptionsCountListValues("-penalty_eps0_sweep", &opts->n_sweep));
-  PetscCall(PetscMalloc1(opts->n_sweep + 1, &opts->eps0_sweep));
+  PetscCall(PetscCalloc1(opts->n_sweep + 1, &opts->eps0_sweep)); /* zeros: -help shows the first as the default */
   PetscCall(PetscOptionsRealArray("-penalty_eps0_sweep", "eps0 values solved in turn on the final mesh, each from the last solution", NULL,
                                   opts->eps0_sweep, &opts->n_sweep, &sweep_set));
   if (!sweep_set) opts->n_sweep = 0;
