@@ -77,12 +77,12 @@ test-long: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) -m pytest -m long
 
-# The paper's convergence studies (README, "Reproducing the paper"): output/studies/<name>/<name>.{csv,md,png}
+# The paper's convergence studies (docs/verification.md, "Reproducing the paper"): output/studies/<name>/<name>.{csv,md,png}
 rates: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	@for s in $(STUDIES); do $(PYTHON) scripts/study.py options/studies/$$s.yaml --check || exit 1; done
 
-# Stability at the extremes (README, "Stability at the extremes"); failures of iterative solvers at tiny eps are
+# Stability at the extremes (docs/stability.md); failures of iterative solvers at tiny eps are
 # expected and reported in the tables, so extremes_eps runs without --check.
 extremes: deps
 	@$(MAKE) --no-print-directory $(BIN)
@@ -90,17 +90,17 @@ extremes: deps
 	$(PYTHON) scripts/study.py options/studies/extremes_material.yaml --check
 	$(PYTHON) scripts/study.py options/studies/extremes_loads.yaml --check
 
-# Speed against accuracy (README, "Choosing eps and the solver"): output/tradeoff/tradeoff/
+# Speed against accuracy (docs/solvers.md, "Choosing eps and the solver"): output/tradeoff/tradeoff/
 tradeoff: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/tradeoff.py options/studies/tradeoff.yaml
 
-# Hertz contact against the closed form, 2D and 3D (README, "Hertz"): output/hertz/hertz.{md,csv}, hertz_<case>.png
+# Hertz contact against the closed form, 2D and 3D (docs/verification.md, "Hertz contact against the closed form"): output/hertz/hertz.{md,csv}, hertz_<case>.png
 hertz: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/hertz.py --check 0.01
 
-# Performance (README, "Performance"): bench/{bench,getfem,bandwidth,targets}.{md,csv}, runs under bench/runs/
+# Performance (docs/solvers.md, "Performance"): bench/{bench,getfem,bandwidth,targets}.{md,csv}, runs under bench/runs/
 bench: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/bench.py options/bench/bench.yaml

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""The performance targets of README "Performance" measured in one invocation (make bench): each row is a target,
+"""The performance targets of docs/solvers.md, "Performance" measured in one invocation (make bench): each row is a target,
 the figure measured here, whether it is met, and the command behind it. Whole-process wall times and peak resident
 sets come from /usr/bin/time -v; ratios are of medians of runs alternated side by side in this invocation. The GetFEM
 row reads bench/getfem.csv (scripts/bench_getfem.py). Writes bench/targets.md and bench/targets.csv."""

@@ -73,7 +73,7 @@ def test_penalty_jacobian_curved_obstacles(outdir, case, quadrature):
 
 
 # small Hertz cases: (case, h_near, method, tolerance on a and p0); make hertz runs the finer meshes to 1%.
-# README ("Hertz contact against the closed form") says these run within 1% in 2D and 2% in 3D: the 2D cases are held
+# docs/verification.md ("Hertz contact against the closed form") says these run within 1% in 2D and 2% in 3D: the 2D cases are held
 # to 1% (measured: cylinder vi a -0.14%, p0 -0.13%; eps=h/100 -0.12%, -0.18%; cylinder-indenter eps=h/100 +0.73%, -0.87%).
 HERTZ = [("cylinder", 0.004, "vi", 0.01), ("cylinder", 0.004, "eps=h/100", 0.01), ("sphere", 0.02, "vi", 0.02),
          ("cylinder-indenter", 0.004, "eps=h/100", 0.01), ("sphere-indenter", 0.02, "eps=h/10", 0.02)]

@@ -84,7 +84,7 @@ def test_mms_3d_error_decreases():
 
 
 def test_penalty_eps_modulus_and_power():
-    """eps as /run records it against the formulas of README ("Options the project adds"), from /run's own h, E and nu:
+    """eps as /run records it against the formulas of docs/options.md ("Options the project adds"), from /run's own h, E and nu:
     -penalty_eps_modulus pwave gives eps0 h / (lambda + 2 mu), -penalty_eps_power p gives eps0 h^p / E (p = 0.5, 2, 0),
     to 1e-12 relative (the same formula in double precision)."""
     base = ["-options_file", "options/square.yaml", "-contact_monitor", "false", "-dm_plex_box_faces", "8,8", "-young_modulus", 3.0,

@@ -1,0 +1,72 @@
+"""README's table "Options the project adds" against `bin/signorini -help` (make test), so that the two cannot drift:
+every option of the project that -help prints, in runs that read them all (each scene, each obstacle, 2D and 3D, every
+boundary family, GAMG), has a row, and every option of a row is printed by -help, but for the few that -help cannot
+show (below, each with its reason)."""
+import os
+import re
+
+from harness import OUT, ROOT, solve
+
+PROJECT = re.compile(r"^-(contact_|penalty_|bc_|obstacle|scene|young_modulus|poisson_ratio|body_force|partitioner|assembly|output|reference|"
+                     r"verify_|perf_|box_|mesh_|section_|square_|patch_|mms_|dual_|mg_fine_|error_)")
+# the runs whose -help, together, shows every option of the project
+RUNS = [
+    ["-dm_plex_box_faces", "4,4"],
+    ["-dm_plex_box_faces", "4,4", "-scene", "patch"],
+    ["-dm_plex_box_faces", "4,4", "-scene", "mms"],
+    ["-dm_plex_box_faces", "4,4", "-obstacle", "sphere", "-obstacle_center", "0.5,-2", "-obstacle_radius", "2"],
+    ["-dm_plex_dim", "3", "-dm_plex_box_faces", "2,2,2", "-obstacle", "cylinder", "-obstacle_center", "0.5,0.5,-2", "-obstacle_radius", "2",
+     "-obstacle_axis", "1,0,0"],
+    ["-dm_plex_box_faces", "8,8", "-options_file", "options/solvers/gamg.yaml"],
+    ["-scene", "general", "-dm_plex_box_faces", "4,4", "-contact_faces", "1", "-bc_clamp", "3", "-bc_slip", "2", "-bc_slip_2_components", "0",
+     "-bc_traction", "4", "-bc_traction_4", "0,0"],
+    ["-scene", "general", "-dm_plex_box_faces", "4,4", "-contact_faces", "1", "-bc_clamp", "3", "-bc_pressure", "4", "-bc_pressure_4", "0"],
+]
+# options of a row that -help does not print, and why
+NOT_IN_HELP = {
+    "-error_verbose": "read before the options phase, by the error handler (PetscOptionsGetBool prints no help)",
+    "-mg_fine_ksp_*": "PETSc's smoother options under the project's prefix, read only when given",
+    "-mg_fine_pc_*": "PETSc's smoother options under the project's prefix, read only when given",
+}
+
+
+def readme_rows():
+    """The option names of the table's rows (several per row where the row names several), as written: ID for a face
+    set, * or ... for a family."""
+    text = open(os.path.join(ROOT, "README.md")).read()
+    table = text[text.index("## Options the project adds"):]
+    table = table[:table.index("\n## ")]
+    names = []
+    for line in table.splitlines():
+        if line.startswith("| `-"):
+            first = line.split("|")[1]
+            names += [tok.split()[0] for tok in re.findall(r"`(-[^`]+)`", first)]
+    return names
+
+
+def pattern(name):
+    """A row's name as a regular expression: ID a face set's number or name, * or a trailing ... any suffix."""
+    if name.endswith("*"):
+        return re.compile(re.escape(name[:-1]) + r"\w*$")
+    return re.compile("^" + re.escape(name).replace("ID", r"[A-Za-z0-9]+") + "$")
+
+
+def help_options():
+    names = set()
+    for k, args in enumerate(RUNS):
+        rc, text = solve(args + ["-help"], output=os.path.join(OUT, f"readme_help_{k}.h5"))
+        assert rc == 0, text[-2000:]
+        names |= {m for m in re.findall(r"^\s+(-[a-zA-Z][a-zA-Z0-9_]*)", text, re.M) if PROJECT.match(m)}
+    return names
+
+
+def test_readme_options_table_matches_help(out_root):
+    rows = readme_rows()
+    assert len(rows) > 40, rows
+    # a row "-dual_ksp_type, -dual_pc_type, ..." stands for the family -dual_*
+    patterns = [pattern(r) for r in rows] + [pattern("-dual_*")]
+    shown = help_options()
+    missing = sorted(o for o in shown if not any(p.match(o) for p in patterns))
+    assert not missing, f"options -help prints that README's table lacks: {missing}"
+    absent = sorted(r for r in rows if r not in NOT_IN_HELP and not any(pattern(r).match(o) for o in shown))
+    assert not absent, f"README rows that no -help prints: {absent}"
