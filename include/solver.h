@@ -17,7 +17,13 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start);
 /* |F| (user's units) that -snes_rtol is relative to in the current solve: its first, or for a warm start the load
    ||F(0)||, so that a warm start ends as tight as a start from zero */
 PetscErrorCode SolverResidualNorm(SNES snes, AppCtx *user, Vec u, PetscReal *norm);
-PetscErrorCode SolverStopReference(const AppCtx *user, PetscReal *ref);
+/* The residual that -snes_rtol reduces (SolverConverged() in solver.c, and the forcing terms of ew_forcing.c): the
+   load ||F(0)|| for a warm start (eps sweep, nested iteration), else the first residual of the solve; user's units. */
+static inline PetscErrorCode SolverStopReference(const AppCtx *user, PetscReal *ref)
+{
+  *ref = user->prob.warm ? user->prob.load_norm : user->prob.fnorm0;
+  return PETSC_SUCCESS;
+}
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
 PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
 

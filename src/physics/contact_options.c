@@ -19,7 +19,8 @@ PetscErrorCode ContactGetOptions(MPI_Comm comm, ContactOptions *opts)
   PetscCall(PetscOptionsEnum("-penalty_quadrature", "Quadrature of the penalty term: gauss (L2 product) or nodal (lumped, vertex rule)", NULL,
                              PenaltyQuadratures, (PetscEnum)opts->quadrature, (PetscEnum *)&opts->quadrature, NULL));
   opts->eps0 = 1.0;
-  PetscCall(PetscOptionsReal("-penalty_eps0", "eps = eps0 h^power / M (M: -penalty_eps_modulus, E by default): the factor eps0", NULL, opts->eps0, &opts->eps0, NULL));
+  PetscCall(PetscOptionsReal("-penalty_eps0", "eps = eps0 h^power / M (M: -penalty_eps_modulus, E by default): the factor eps0", NULL, opts->eps0,
+                             &opts->eps0, NULL));
   opts->eps_power = 1.0;
   PetscCall(
       PetscOptionsReal("-penalty_eps_power", "eps = eps0 h^power / M: the power of h, in [0, 4]", NULL, opts->eps_power, &opts->eps_power, NULL));

@@ -183,7 +183,8 @@ PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The displacement field (PetscFE, prefix displacement_), the bulk weak form and Gamma_D. */
+/* The displacement field (PetscFE, prefix displacement_) and the bulk weak form; the caller adds Gamma_D
+   (BoundaryAddDirichlet(), before anything builds the section) and then the constants (ElasticityUpdateConstants()). */
 PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user)
 {
   MPI_Comm     comm  = PetscObjectComm((PetscObject)dm);
@@ -210,9 +211,7 @@ PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user)
   }
   PetscCall(PetscDSSetJacobian(ds, 0, 0, NULL, NULL, NULL, g3_uu));
   if (scene->exact) PetscCall(PetscDSSetExactSolution(ds, 0, scene->exact, (void *)scene->constants));
-  PetscCall(BoundaryAddDirichlet(dm, user));
   PetscCall(DMSetNearNullSpaceConstructor(dm, 0, CreateRigidBodyModes));
-  PetscCall(ElasticityUpdateConstants(dm, user));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

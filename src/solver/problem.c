@@ -17,6 +17,8 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(MeshGetMaxCellDiameter(dm, &user->prob.h));
   PetscCall(ContactComputeEps(user));
   PetscCall(ElasticitySetUpDiscretization(dm, user));
+  PetscCall(BoundaryAddDirichlet(dm, user)); /* Gamma_D, before anything builds the section */
+  PetscCall(ElasticityUpdateConstants(dm, user));
   PetscCall(SectionSetUpP1(dm, user)); /* P1/Q1: the local section without PETSc's cell-type lookups */
   PetscCall(BoundaryCheckRigidMotions(dm, &user->scene));
   PetscCall(DMCreateLocalVector(dm, &user->prob.loc_bc)); /* the Dirichlet values, zero elsewhere */

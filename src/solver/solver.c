@@ -137,13 +137,8 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
    is as tight as a start from zero would give. One whose first residual exceeds the load (an interpolated guess, whose
    error is of the order of h) is not stopped by a reduction of that residual alone; one far below it (an extrapolated
    start of the eps sweep) is not held to a reduction that round-off cannot reach.
-   Every norm here is relative, so the test is the same in any units. */
-PetscErrorCode SolverStopReference(const AppCtx *user, PetscReal *ref)
-{
-  PetscFunctionBeginUser;
-  *ref = user->prob.warm ? user->prob.load_norm : user->prob.fnorm0;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
+   Every norm here is relative, so the test is the same in any units. The reference of -snes_rtol is
+   SolverStopReference() (include/solver.h), which the forcing terms (ew_forcing.c) share. */
 
 /* The size of the round-off in the residual at u: F = K u + r0 + (1/eps)[u_n - g]_+ n w sums terms much larger than F
    itself near the solution, and double precision knows each to about PETSC_MACHINE_EPSILON of its size. The terms:
