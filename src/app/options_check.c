@@ -5,113 +5,79 @@
 #include "app.h"
 
 /* The options the project reads (every "-name" string of src/, listed at build time into build/known_options.inc by the
-   Makefile) and PETSc's options a run of this solver commonly gives: the names a misspelling is compared with. */
+   Makefile) and PETSc's below: the names a misspelling is compared with. */
 static const char *const project_options[] = {
 #include "known_options.inc"
 };
-static const char *const petsc_options[] = {
-    "-snes_rtol",
-    "-snes_atol",
-    "-snes_stol",
-    "-snes_max_it",
-    "-snes_type",
-    "-snes_monitor",
-    "-snes_converged_reason",
-    "-snes_view",
-    "-snes_linesearch_type",
-    "-snes_linesearch_monitor",
-    "-snes_ksp_ew",
-    "-snes_ksp_ew_version",
-    "-snes_vi_zero_tolerance",
-    "-snes_test_jacobian",
-    "-ksp_type",
-    "-ksp_rtol",
-    "-ksp_atol",
-    "-ksp_max_it",
-    "-ksp_monitor",
-    "-ksp_converged_reason",
-    "-ksp_view",
-    "-ksp_norm_type",
-    "-ksp_initial_guess_nonzero",
-    "-ksp_gmres_restart",
-    "-pc_type",
-    "-pc_factor_mat_solver_type",
-    "-pc_gamg_threshold",
-    "-pc_gamg_agg_nsmooths",
-    "-pc_gamg_square_graph",
-    "-pc_gamg_reuse_interpolation",
-    "-pc_hypre_type",
-    "-pc_mg_levels",
-    "-pc_mg_galerkin",
-    "-mg_levels_ksp_type",
-    "-mg_levels_pc_type",
-    "-mg_levels_ksp_max_it",
-    "-mg_coarse_pc_type",
-    "-mg_coarse_ksp_type",
-    "-mat_mumps_icntl_14",
-    "-dm_plex_filename",
-    "-dm_plex_dim",
-    "-dm_plex_simplex",
-    "-dm_plex_box_faces",
-    "-dm_plex_box_lower",
-    "-dm_plex_box_upper",
-    "-dm_refine",
-    "-dm_view",
-    "-dm_mat_type",
-    "-displacement_petscspace_degree",
-    "-petscpartitioner_type",
-    "-log_view",
-    "-options_file",
-    "-options_left",
-    "-help",
-    "-malloc_debug",
-    "-malloc_dump",
-    "-error_verbose",
+/* PETSc's options a run of this solver commonly gives, and whether each takes a value (PETSc ignores one given without
+   its value; the others are flags). */
+static const struct {
+  const char *name;
+  PetscBool   value;
+} petsc_options[] = {
+    {"-snes_rtol", PETSC_TRUE},
+    {"-snes_atol", PETSC_TRUE},
+    {"-snes_stol", PETSC_TRUE},
+    {"-snes_max_it", PETSC_TRUE},
+    {"-snes_type", PETSC_TRUE},
+    {"-snes_monitor", PETSC_FALSE},
+    {"-snes_converged_reason", PETSC_FALSE},
+    {"-snes_view", PETSC_FALSE},
+    {"-snes_linesearch_type", PETSC_TRUE},
+    {"-snes_linesearch_monitor", PETSC_FALSE},
+    {"-snes_ksp_ew", PETSC_FALSE},
+    {"-snes_ksp_ew_version", PETSC_TRUE},
+    {"-snes_vi_zero_tolerance", PETSC_FALSE},
+    {"-snes_test_jacobian", PETSC_FALSE},
+    {"-ksp_type", PETSC_TRUE},
+    {"-ksp_rtol", PETSC_TRUE},
+    {"-ksp_atol", PETSC_TRUE},
+    {"-ksp_max_it", PETSC_TRUE},
+    {"-ksp_monitor", PETSC_FALSE},
+    {"-ksp_converged_reason", PETSC_FALSE},
+    {"-ksp_view", PETSC_FALSE},
+    {"-ksp_norm_type", PETSC_TRUE},
+    {"-ksp_initial_guess_nonzero", PETSC_FALSE},
+    {"-ksp_gmres_restart", PETSC_TRUE},
+    {"-pc_type", PETSC_TRUE},
+    {"-pc_factor_mat_solver_type", PETSC_TRUE},
+    {"-pc_gamg_threshold", PETSC_TRUE},
+    {"-pc_gamg_agg_nsmooths", PETSC_TRUE},
+    {"-pc_gamg_square_graph", PETSC_FALSE},
+    {"-pc_gamg_reuse_interpolation", PETSC_FALSE},
+    {"-pc_hypre_type", PETSC_TRUE},
+    {"-pc_mg_levels", PETSC_TRUE},
+    {"-pc_mg_galerkin", PETSC_FALSE},
+    {"-mg_levels_ksp_type", PETSC_TRUE},
+    {"-mg_levels_pc_type", PETSC_TRUE},
+    {"-mg_levels_ksp_max_it", PETSC_TRUE},
+    {"-mg_coarse_pc_type", PETSC_TRUE},
+    {"-mg_coarse_ksp_type", PETSC_TRUE},
+    {"-mat_mumps_icntl_14", PETSC_TRUE},
+    {"-dm_plex_filename", PETSC_TRUE},
+    {"-dm_plex_dim", PETSC_TRUE},
+    {"-dm_plex_simplex", PETSC_FALSE},
+    {"-dm_plex_box_faces", PETSC_TRUE},
+    {"-dm_plex_box_lower", PETSC_TRUE},
+    {"-dm_plex_box_upper", PETSC_TRUE},
+    {"-dm_refine", PETSC_TRUE},
+    {"-dm_view", PETSC_FALSE},
+    {"-dm_mat_type", PETSC_TRUE},
+    {"-displacement_petscspace_degree", PETSC_TRUE},
+    {"-petscpartitioner_type", PETSC_TRUE},
+    {"-log_view", PETSC_FALSE},
+    {"-options_file", PETSC_TRUE},
+    {"-options_left", PETSC_FALSE},
+    {"-help", PETSC_FALSE},
+    {"-malloc_debug", PETSC_FALSE},
+    {"-malloc_dump", PETSC_FALSE},
+    {"-error_verbose", PETSC_FALSE},
 };
 
 /* The project's options that are flags (read with PetscOptionsBool(), listed at build time into build/flag_options.inc),
    which may be given without a value; every other option of the project takes one. */
 static const char *const flag_options[] = {
 #include "flag_options.inc"
-};
-
-/* PETSc's options of the list above that take a value, which PETSc ignores when given without one. */
-static const char *const petsc_value_options[] = {
-    "-snes_rtol",
-    "-snes_atol",
-    "-snes_stol",
-    "-snes_max_it",
-    "-snes_type",
-    "-snes_linesearch_type",
-    "-snes_ksp_ew_version",
-    "-ksp_type",
-    "-ksp_rtol",
-    "-ksp_atol",
-    "-ksp_max_it",
-    "-ksp_norm_type",
-    "-ksp_gmres_restart",
-    "-pc_type",
-    "-pc_factor_mat_solver_type",
-    "-pc_gamg_threshold",
-    "-pc_gamg_agg_nsmooths",
-    "-pc_hypre_type",
-    "-pc_mg_levels",
-    "-mg_levels_ksp_type",
-    "-mg_levels_pc_type",
-    "-mg_levels_ksp_max_it",
-    "-mg_coarse_pc_type",
-    "-mg_coarse_ksp_type",
-    "-mat_mumps_icntl_14",
-    "-dm_plex_filename",
-    "-dm_plex_dim",
-    "-dm_plex_box_faces",
-    "-dm_plex_box_lower",
-    "-dm_plex_box_upper",
-    "-dm_refine",
-    "-dm_mat_type",
-    "-displacement_petscspace_degree",
-    "-petscpartitioner_type",
-    "-options_file",
 };
 
 static PetscBool InList(const char name[], const char *const list[], size_t n)
@@ -122,15 +88,16 @@ static PetscBool InList(const char name[], const char *const list[], size_t n)
 }
 
 /* Whether the option (with its dash) needs a value: every face-set option (-bc_...), the project's own options but its
-   flags, and PETSc's options of petsc_value_options (known_options.inc also holds PETSc names the sources mention, some
-   of them flags: those go by petsc_value_options alone). */
+   flags, and PETSc's options of petsc_options that take one (known_options.inc also holds PETSc names the sources
+   mention, some of them flags: those go by petsc_options alone). */
 static PetscBool TakesValue(const char name[])
 {
   const char *const petsc_prefixes[] = {"-snes_",   "-ksp_",   "-pc_",     "-mg_",  "-dm_",   "-mat_",          "-log", "-malloc",
                                         "-options", "-memory", "-objects", "-help", "-petsc", "-displacement_", "-name"};
 
   if (!strncmp(name, "-bc_", 4)) return PETSC_TRUE;
-  if (InList(name, petsc_value_options, sizeof(petsc_value_options) / sizeof(petsc_value_options[0]))) return PETSC_TRUE;
+  for (size_t k = 0; k < sizeof(petsc_options) / sizeof(petsc_options[0]); ++k)
+    if (!strcmp(name, petsc_options[k].name)) return petsc_options[k].value;
   for (size_t k = 0; k < sizeof(petsc_prefixes) / sizeof(petsc_prefixes[0]); ++k)
     if (!strncmp(name, petsc_prefixes[k], strlen(petsc_prefixes[k]))) return PETSC_FALSE;
   if (InList(name, flag_options, sizeof(flag_options) / sizeof(flag_options[0]))) return PETSC_FALSE;
@@ -210,7 +177,7 @@ static PetscErrorCode AppendWithSuggestion(const char name[], char list[], size_
   limit = PetscMax(2, (PetscInt)strlen(dashed) / 5);
   for (size_t k = 0; k < sizeof(project_options) / sizeof(project_options[0]) + sizeof(petsc_options) / sizeof(petsc_options[0]); ++k) {
     const size_t      np    = sizeof(project_options) / sizeof(project_options[0]);
-    const char *const known = k < np ? project_options[k] : petsc_options[k - np];
+    const char *const known = k < np ? project_options[k] : petsc_options[k - np].name;
     const PetscInt    d     = EditDistance(dashed, known);
 
     if (d < best_d) {
