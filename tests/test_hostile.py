@@ -1,5 +1,5 @@
 """Hostile input (make test), the one catalogue of bad input: every case is refused with exit status 2 (a refusal of
-the user's input; the exceptions, each with its reason: STATUS below and the full disk) and a message that names the
+the user's input; the one exception, with its reason: the full disk) and a message that names the
 option or the file, and leaves the previous good output at the same path byte for byte as it was, with no temporary
 file beside it.
 
@@ -66,11 +66,6 @@ def case_dir(good_output):
         shutil.copy2(good_output["xdmf"], os.path.join(d, "result.xdmf"))
         return d
     return make
-
-
-# Refusals that do not exit with status 2 (none now: the options files, checked before PetscInitialize() by
-# src/app/options_files.c, are refused with status 2 too).
-STATUS = {}
 
 
 def refuse(d, args, message, output=None, np_=1, status=2):
@@ -216,7 +211,7 @@ def test_hostile_file(case_dir, name, file, writer, args, message, relative):
     if writer:
         writer(path)
     given = os.path.relpath(path, ROOT) if relative else path
-    refuse(d, args(given), message(given), status=STATUS.get(name, 2))
+    refuse(d, args(given), message(given))
 
 
 def test_hostile_reference_files(case_dir):

@@ -7,10 +7,10 @@
      behind it, which the penalty pushes the body through.
    - After the solve, the resolution: how many cells span the contact zone along Gamma_C (the faces where the contact
      acts at every node: their number in 2D, the diameter in cells of a round zone of that many faces in 3D), warned
-     below 4 in 2D and 6 in 3D, where the Gauss rule's force is within about 2% and 3% of a fine mesh's. A zone of a few cells is a discretization
-   artefact: the force and the penetration no longer follow eps (docs/running.md, "Warnings"; the threshold is measured by scripts/zone_resolution.py,
-   bench/zone_resolution.md).
- */
+     below 4 in 2D and 6 in 3D, where the Gauss rule's force is within about 2% and 3% of a fine mesh's. A zone of a
+     few cells is a discretization artefact: the force and the penetration no longer follow eps (docs/running.md,
+     "Warnings"; the thresholds are measured by scripts/zone_resolution.py, bench/zone_resolution.md and
+     bench/zone_resolution_3d.md). */
 #include "mesh.h"
 #include "obstacle.h"
 #include "physics.h"
