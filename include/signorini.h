@@ -29,9 +29,7 @@ typedef enum {
   CONST_SCENE_MAX  = CONST_SCENE + 8
 } ConstantIndex;
 
-typedef enum { CONTACT_PENALTY, CONTACT_VI, CONTACT_NONE } ContactMethod;
 #define CONTACT_HISTORY 256 /* Newton steps whose active sets are kept for the cycle detection */
-extern const char *const ContactMethods[];
 typedef enum { PENALTY_QUADRATURE_GAUSS, PENALTY_QUADRATURE_NODAL } PenaltyQuadrature;
 extern const char *const PenaltyQuadratures[];
 typedef enum { ASSEMBLY_AUTO, ASSEMBLY_FE, ASSEMBLY_P1 } AssemblyType; /* -assembly: how the bulk matrix K is assembled */
@@ -99,34 +97,38 @@ typedef struct {
 
 typedef PetscErrorCode (*SceneCreateFn)(DM dm, const Material *mat, Scene *scene);
 
-/* Options of the contact treatment and the penalty parameter. */
+/* Options of the contact treatment and the penalty parameter (read by ContactSetFromOptions(), include/contact.h). */
 typedef struct {
-  ContactMethod     method;
+  char              method[64]; /* the Contact type, -contact_method */
   PenaltyQuadrature quadrature;
   PetscReal         eps0, eps_power, eps_fixed; /* eps = eps0 h^power / M, or eps_fixed when > 0 */
   PetscBool         eps_local;                  /* h of each contact face (Gauss) or node (nodal), not of the whole mesh */
   PenaltyModulus    modulus;                    /* M = E (young) or lambda + 2 mu (pwave) */
-  PetscBool         monitor;
-  PetscBool         continuation;        /* reach an eps below h/M through a sequence of larger ones */
-  PetscReal         continuation_factor; /* ratio of two consecutive eps of the sequence, in (0, 1) */
-  PetscBool         condition_estimate;  /* estimate the 1-norm condition number of the final Jacobian */
-  PetscBool         cycle_damping;       /* damp the Newton step when the active set cycles */
-  PetscBool         pc_reuse;            /* reuse the preconditioner/factorization while few contact nodes change */
-  PetscInt          pc_reuse_changes;    /*   at most this many changed nodes since the build */
-  PetscBool         pc_recovery;         /* go on after a preconditioner breakdown (pc_recovery.c) */
-  PetscBool         pc_update;           /* multigrid (GAMG): the coarse operators follow the Jacobian instead of rebuilds */
-  PetscBool         pc_update_check;     /*   and each update is compared with the full Galerkin products */
-  PetscBool         pc_update_esteig;    /*   and the finest smoother estimates its eigenvalues again at each update */
-  PetscReal  pc_update_truncate; /*   and the coarse spaces leave out the contact dofs whose penalty exceeds this times K's diagonal (0: none) */
-  PetscInt   grid_sequence;      /* solve on the mesh and on this many uniform refinements of it, each from the last */
-  PetscInt   coarse_levels;      /* nested iteration to the mesh: this many coarser boxes solved first (-1: automatic) */
-  PetscReal  coarse_rtol;        /*   Newton's relative tolerance there */
-  PetscBool  coarse_mg;          /*   solved with the geometric multigrid of the boxes below (resolved by GridSequenceCoarseRequest()) */
-  PetscReal  ew_guard;           /* Eisenstat-Walker's terms no smaller than this times Newton's target / |F| */
-  PetscReal *eps0_sweep;         /* eps0 values solved in turn on the final mesh, each from the last solution (any number) */
-  PetscInt   n_sweep;
-  PetscReal  load_rtol; /* Newton also stops when |F| <= load_rtol ||F(0)||: the residual is at round-off for the load */
+  PetscBool         continuation;               /* reach an eps below h/M through a sequence of larger ones */
+  PetscReal         continuation_factor;        /* ratio of two consecutive eps of the sequence, in (0, 1) */
+  PetscReal        *eps0_sweep;                 /* eps0 values solved in turn on the final mesh, each from the last solution (any number) */
+  PetscInt          n_sweep;
 } ContactOptions;
+
+/* Options of the nonlinear solve around the contact (SolverGetOptions(), src/solver/solver_options.c). */
+typedef struct {
+  PetscBool monitor;
+  PetscBool condition_estimate; /* estimate the 1-norm condition number of the final Jacobian */
+  PetscBool cycle_damping;      /* damp the Newton step when the active set cycles */
+  PetscBool pc_reuse;           /* reuse the preconditioner/factorization while few contact nodes change */
+  PetscInt  pc_reuse_changes;   /*   at most this many changed nodes since the build */
+  PetscBool pc_recovery;        /* go on after a preconditioner breakdown (pc_recovery.c) */
+  PetscBool pc_update;          /* multigrid (GAMG): the coarse operators follow the Jacobian instead of rebuilds */
+  PetscBool pc_update_check;    /*   and each update is compared with the full Galerkin products */
+  PetscBool pc_update_esteig;   /*   and the finest smoother estimates its eigenvalues again at each update */
+  PetscReal pc_update_truncate; /*   and the coarse spaces leave out the contact dofs whose penalty exceeds this times K's diagonal (0: none) */
+  PetscInt  grid_sequence;      /* solve on the mesh and on this many uniform refinements of it, each from the last */
+  PetscInt  coarse_levels;      /* nested iteration to the mesh: this many coarser boxes solved first (-1: automatic) */
+  PetscReal coarse_rtol;        /*   Newton's relative tolerance there */
+  PetscBool coarse_mg;          /*   -contact_coarse_mg as given; whether it applies is GridSequenceCoarseRequest()'s answer */
+  PetscReal ew_guard;           /* Eisenstat-Walker's terms no smaller than this times Newton's target / |F| */
+  PetscReal load_rtol;          /* Newton also stops when |F| <= load_rtol ||F(0)||: the residual is at round-off for the load */
+} SolverOptions;
 
 /* State of the preconditioner reuse (pc_reuse.c). */
 typedef struct {
@@ -169,6 +171,7 @@ typedef struct {
   PetscBool bound_read;       /* ... has been looked for */
   PetscReal est_min, est_max; /* the build's Chebyshev estimate of the extreme eigenvalues of diag(K)^-1 K */
   PetscInt  est_steps;        /* the steps of its estimator */
+  PetscBool *built_active;    /* the contact nodes' penetration when the preconditioner was last built */
   PetscReal tform[4];         /* Chebyshev's transform of estimates into its interval (-ksp_chebyshev_esteig) */
   Vec       pdiag, pcols;     /* the penalty term's diagonal, and its values at the contact rows' columns */
 } PcReuse;
@@ -191,7 +194,6 @@ typedef struct {
   PetscReal *eps_factor;   /* the node's eps over the run's eps: (h_node / h)^power, h_node the largest cell at its contact faces */
   PetscReal *weight;       /* lumped boundary mass, the integral of the node's basis function over Gamma_C */
   PetscBool *active;       /* active set at the last monitor call */
-  PetscBool *built_active; /* active set when the preconditioner was last built */
   PetscReal *pressure;     /* contact pressure -sigma_n at the node, after the solve */
   PetscReal *reaction;     /* normal reaction force of the obstacle on the node, -R . n with R = K u + r0, after the solve */
 } ContactSet;
@@ -295,7 +297,7 @@ typedef struct {
   Material       material;
   PetscInt       degree;        /* of the displacement, -displacement_petscspace_degree */
   PetscBool      section_check; /* -section_check: the P1 section compared with PETSc's */
-  ContactOptions contact;
+  SolverOptions  solver;
   VerifyOptions  verify;
   AssemblyType   assembly;       /* -assembly as given (auto, fe, p1) */
   PetscBool      assembly_check; /* -assembly_check: assemble K both ways and compare */
@@ -304,17 +306,6 @@ typedef struct {
   PetscBool      output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
   MeshBox        box;           /* the box of the mesh options, if the mesh is one */
 } RunOptions;
-
-/* The contact faces of this rank for the Gauss rule of the penalty term in closed form (P1 simplices,
-   src/physics/penalty_faces.c): PETSc's face quadrature, mapped once. */
-typedef struct {
-  PetscInt   n, nv, nq;  /* faces, vertices per face (dim), quadrature points per face */
-  PetscInt  *loff;       /* [n][nv]: offset of each vertex's displacement in the local vector */
-  PetscInt  *gidx;       /* [n][nv][dim]: global index of each component, -1 if fixed */
-  PetscReal *x, *w;      /* [n][nq][dim] the quadrature points, [n][nq] their weights (face Jacobian included) */
-  PetscReal *inv_factor; /* [n]: 1 / the eps factor of the face's cell (local eps), NULL if eps is uniform */
-  PetscReal *lambda;     /* [nq][nv]: the face's P1 basis (barycentric coordinates) at the points */
-} PenaltyFaces;
 
 /* The forcing terms of the inexact Newton (ew_forcing.c): Eisenstat-Walker's, with the guard against oversolving. */
 typedef struct {
@@ -334,19 +325,13 @@ typedef struct {
 typedef struct {
   PetscInt        level;                          /* grid sequence level of the mesh (0: the mesh built first) */
   PetscReal       setup_time;                     /* set-up time of this problem, counted with its first solve */
-  PetscReal       h, eps;                         /* the largest cell diameter, and eps = eps0 h^power / M for it (the node's: eps * eps_factor) */
-  PetscReal       eps_factor_min, eps_factor_max; /* over the contact nodes (local eps on graded meshes), all ranks */
-  PetscBool       eps_local;                      /* the factors differ by more than rounding (1e-12 relative): eps per face */
+  PetscReal       h;                              /* the largest cell diameter */
   DMLabel         face_sets;
-  ContactSet      cset;
-  PetscWeakForm   wf_penalty;         /* the penalty term on Gamma_C, kept out of the bulk weak form */
-  PenaltyFaces    penalty_faces;      /* the same term in closed form (P1 simplices, -assembly p1) */
   Vec             loc_bc;             /* local vector holding the Dirichlet values, zero elsewhere */
   AssemblyType    assembly;           /* how K is assembled: fe or p1 (-assembly auto resolved) */
   Mat             K;                  /* bulk elastic operator, assembled once */
   Vec             r0;                 /* bulk residual at u = 0 (loads and Dirichlet lifting) */
   Vec             loc_r0;             /* the same, local, with the rows of the fixed components (for the supports' reactions) */
-  Vec             xl, xu;             /* SNESVI bounds */
   PetscReal       load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
   PetscReal       displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */
   PetscReal       snes_scale;         /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
@@ -355,16 +340,6 @@ typedef struct {
   PcRecovery      pc_recovery;
   SolverForcing   forcing;
   SolverStepGuess step_guess;
-  /* The penalty Jacobian lives in K itself (one matrix; only the rows of the contact dofs differ): K's own values of
-     those rows are kept here, and put back before K is used as the bulk operator (PenaltyBulkOperator()). */
-  PetscBool    jacobian_in_K;                    /* K holds K + the penalty Jacobian in those rows */
-  PetscInt     nbulk_rows;                       /* owned rows of the contact dofs */
-  PetscInt    *bulk_rows, *bulk_ptr, *bulk_cols; /* their global numbers, and their columns in CSR form */
-  PetscScalar *bulk_vals;                        /* and K's values there */
-  PetscInt    *bulk_diag;                        /* each row's diagonal entry (bulk_ptr numbering) */
-  PetscInt    *bulk_lcols;                       /* each column's place in bulk_x */
-  VecScatter   bulk_scatter;                     /* the displacement at those columns (any rank's) into bulk_x */
-  Vec          bulk_x;
   PetscReal    fnorm0;                          /* |F| at the start of the last SNESSolve, in the user's units */
   PetscReal    fnorm_last;                      /* |F| at the last Newton step, in the user's units */
   PetscBool    roundoff_stop;                   /* the last SNESSolve stopped at the round-off of its terms (SolverConverged()) */
@@ -393,8 +368,10 @@ typedef struct {
 
 /* The state of a run, by concern: its options, its scene, the problem on the current mesh, the hierarchy of the meshes
    solved before it, and its record. */
+typedef struct _p_Contact *Contact; /* include/contact.h */
 typedef struct {
   RunOptions opt;
+  Contact    contact; /* created and read from the options once, set up on the mesh of each problem */
   Scene      scene;
   Problem    prob;
   Multigrid  mg;

@@ -36,7 +36,8 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
    -contact_coarse_mg) a coarser box costs little and is one more level of the hierarchy (a smaller coarse factorization). */
 #define GRID_SEQUENCE_MIN_FACES 64
 #define GRID_SEQUENCE_MIN_FACES_MG 16
-PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, RunOptions *opt, PetscInt *request, PetscInt *min_faces);
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, RunOptions *opt, PetscInt *request, PetscInt *min_faces);
+PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts);
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 

@@ -4,6 +4,7 @@ static const char help[] =
 
 #include <sys/resource.h>
 #include "app.h"
+#include "contact.h"
 #include "scenes.h"
 #include "mesh.h"
 #include "physics.h"
@@ -22,14 +23,8 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetSize(u, &ndofs));
   PetscCallMPI(MPI_Comm_size(comm, &size));
-  PetscCall(PetscPrintf(comm, "scene %s, %" PetscInt_FMT "D, method %s", user->scene.name, dim, ContactMethods[user->opt.contact.method]));
-  if (user->opt.contact.method == CONTACT_PENALTY) {
-    PetscCall(PetscPrintf(comm, " (%s quadrature, eps = %g", PenaltyQuadratures[user->opt.contact.quadrature], (double)user->prob.eps));
-    if (user->prob.eps_local)
-      PetscCall(PetscPrintf(comm, ", local %g to %g", (double)(user->prob.eps * user->prob.eps_factor_min),
-                            (double)(user->prob.eps * user->prob.eps_factor_max)));
-    PetscCall(PetscPrintf(comm, ")"));
-  }
+  PetscCall(PetscPrintf(comm, "scene %s, %" PetscInt_FMT "D, ", user->scene.name, dim));
+  PetscCall(ContactView(user->contact, PETSC_VIEWER_STDOUT_(comm))); /* method penalty (gauss quadrature, eps = ...) */
   PetscCall(
       PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, h = %g, %d rank(s)\n", user->opt.degree, ndofs, (double)user->prob.h, size));
   PetscCall(PetscPrintf(comm,
@@ -115,7 +110,9 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(SceneRegisterAll());
   PetscCall(SceneGetOptions(comm, user.opt.scene_name, sizeof(user.opt.scene_name)));
   PetscCall(ElasticityGetOptions(comm, &user.opt.material, &user.opt.degree, &user.opt.section_check));
-  PetscCall(ContactGetOptions(comm, &user.opt.contact));
+  PetscCall(ContactCreate(comm, &user.contact));
+  PetscCall(ContactSetFromOptions(user.contact)); /* -contact_method, -penalty_* */
+  PetscCall(SolverGetOptions(comm, &user.opt.solver));
   PetscCall(VerifyGetOptions(comm, &user.opt.verify));
   PetscCall(AssemblyGetOptions(comm, &user.opt.assembly, &user.opt.assembly_check));
   PetscCall(OutputGetOptions(comm, &user.opt));
@@ -124,8 +121,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   {
     PetscInt coarse_request, coarse_min_faces;
 
-    PetscCall(GridSequenceCoarseRequest(comm, &user.opt, &coarse_request, &coarse_min_faces));
-    PetscCall(MeshCreate(comm, user.opt.contact.grid_sequence, coarse_request, coarse_min_faces, &user.opt.box, &dm));
+    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &user.opt, &coarse_request, &coarse_min_faces));
+    PetscCall(MeshCreate(comm, user.opt.solver.grid_sequence, coarse_request, coarse_min_faces, &user.opt.box, &dm));
   }
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition)); /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(user.opt.scene_name, dm, &user.opt.material, &user.scene)); /* its options, once for every level */
@@ -185,7 +182,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(ProblemDestroy(&user, &snes));
   PetscCall(MultigridDestroy(&user.mg));
   PetscCall(DMDestroy(&dm));
-  PetscCall(ContactOptionsDestroy(&user.opt.contact));
+  PetscCall(ContactDestroy(&user.contact));
+  PetscCall(ContactFinalizePackage());
   PetscCall(PetscFree(user.rec.records));
   PetscCall(SceneFinalize());
   *converged      = user.rec.stats.converged;

@@ -54,7 +54,7 @@ static PetscErrorCode ViewVertexField(Vec v, PetscInt nc, PetscViewer viewer)
    and the exact solution and error when the scene has one. */
 static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscViewer viewer)
 {
-  const ContactSet  *cs   = &user->prob.cset;
+  const ContactSet  *cs;
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
   DM                 cdm;
   Vec                locU, disp, pressure, gap, mask, react, area, exact = NULL, error = NULL, coords;
@@ -64,6 +64,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscScalar       *d, *p, *g, *m, *fr, *ar, *ex = NULL, *er = NULL;
 
   PetscFunctionBeginUser;
+  PetscCall(ContactGetSet(user->contact, &cs));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
   PetscCall(MeshOwnedIndex(dm, vStart, vEnd, &index, &nowned)); /* plain vectors over the owned vertices, no DM clone */
@@ -141,7 +142,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
     goff = index[cs->point[i] - vStart];
     if (goff < 0) continue; /* owned by another rank */
     p[goff]  = cs->pressure[i];
-    g[goff]  = -ContactNodePenetration(&user->prob.cset, dim, i, x);
+    g[goff]  = -ContactNodePenetration(cs, dim, i, x);
     m[goff]  = 1.0;
     fr[goff] = cs->reaction[i];
     ar[goff] = cs->weight[i];
@@ -210,18 +211,27 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   const RunStats *s = &user->rec.stats;
   PetscMPIInt     size;
   PetscInt        dim, ndofs;
-  char            method[64];
+  ContactType           method;
+  const ContactOptions *copt;
+  PetscReal             eps = 0.0, eps_min = 0.0, eps_max = 0.0;
+  const ContactSet     *cs;
 
   PetscFunctionBeginUser;
+  PetscCall(ContactGetType(user->contact, &method));
+  PetscCall(ContactGetOptions(user->contact, &copt));
+  PetscCall(ContactGetSet(user->contact, &cs));
+  if (ContactHasPenalty(user->contact)) { /* 0 for the types without eps */
+    PetscCall(ContactGetEps(user->contact, &eps));
+    PetscCall(ContactGetEpsRange(user->contact, &eps_min, &eps_max, NULL));
+  }
   PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)dm), &size));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetSize(u, &ndofs));
-  PetscCall(PetscStrncpy(method, ContactMethods[user->opt.contact.method], sizeof(method)));
   PetscCall(PetscViewerHDF5WriteGroup(v, "/run"));
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "scene", PETSC_STRING, user->scene.name));
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "method", PETSC_STRING, method));
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_quadrature", PETSC_STRING, PenaltyQuadratures[user->opt.contact.quadrature]));
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_eps_modulus", PETSC_STRING, PenaltyModuli[user->opt.contact.modulus]));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_quadrature", PETSC_STRING, PenaltyQuadratures[copt->quadrature]));
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_eps_modulus", PETSC_STRING, PenaltyModuli[copt->modulus]));
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "assembly", PETSC_STRING, AssemblyTypes[user->prob.assembly]));
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "snes_reason", PETSC_STRING, SNESConvergedReasons[s->reason]));
   PetscCall(WriteIntAttr(v, "dim", dim));
@@ -231,9 +241,9 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteIntAttr(v, "n_vertices", nverts));
   PetscCall(WriteIntAttr(v, "n_dofs", ndofs));
   PetscCall(WriteRealAttr(v, "h", user->prob.h));
-  PetscCall(WriteRealAttr(v, "eps", user->opt.contact.method == CONTACT_PENALTY ? user->prob.eps : 0.0));
-  PetscCall(WriteRealAttr(v, "eps_min", user->opt.contact.method == CONTACT_PENALTY ? user->prob.eps * user->prob.eps_factor_min : 0.0));
-  PetscCall(WriteRealAttr(v, "eps_max", user->opt.contact.method == CONTACT_PENALTY ? user->prob.eps * user->prob.eps_factor_max : 0.0));
+  PetscCall(WriteRealAttr(v, "eps", eps));
+  PetscCall(WriteRealAttr(v, "eps_min", eps_min));
+  PetscCall(WriteRealAttr(v, "eps_max", eps_max));
   PetscCall(WriteRealAttr(v, "young_modulus", user->opt.material.young_modulus));
   PetscCall(WriteRealAttr(v, "poisson_ratio", user->opt.material.poisson_ratio));
   PetscCall(WriteIntAttr(v, "converged", s->converged ? 1 : 0));
@@ -242,9 +252,9 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteIntAttr(v, "ksp_its", s->ksp_its));
   PetscCall(WriteIntAttr(v, "newton_its_total", s->newton_its_total));
   PetscCall(WriteIntAttr(v, "ksp_its_total", s->ksp_its_total));
-  PetscCall(WriteIntAttr(v, "grid_sequence", user->opt.contact.grid_sequence));
+  PetscCall(WriteIntAttr(v, "grid_sequence", user->opt.solver.grid_sequence));
   PetscCall(WriteIntAttr(v, "coarse_levels", user->opt.box.coarse_levels));
-  PetscCall(WriteIntAttr(v, "coarse_mg", user->opt.contact.coarse_mg && user->opt.box.coarse_levels > 0 ? 1 : 0)); /* -contact_coarse_mg applied */
+  PetscCall(WriteIntAttr(v, "coarse_mg", user->opt.solver.coarse_mg && user->opt.box.coarse_levels > 0 ? 1 : 0)); /* -contact_coarse_mg applied */
   PetscCall(WriteIntAttr(v, "n_solves", user->rec.nrecords));
   PetscCall(WriteRealAttr(v, "residual_norm", s->residual_norm));
   PetscCall(WriteIntAttr(v, "residual_reduced", s->residual_reduced ? 1 : 0));
@@ -285,7 +295,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "problem", PETSC_STRING, problem)); /* what -reference compares */
   }
   {
-    PetscInt n = user->prob.cset.n, ntotal;
+    PetscInt n = cs->n, ntotal;
 
     PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
     PetscCall(WriteIntAttr(v, "contact_nodes", ntotal)); /* the free nodes of Gamma_C the contact acts on, each counted once */
@@ -322,7 +332,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "partitioner", PETSC_STRING, MeshPartitionerTypes[s->partition.partitioner]));
   PetscCall(WriteIntAttr(v, "partition_edge_cut", s->partition.edge_cut));
   PetscCall(WriteRealAttr(v, "partition_imbalance", s->partition.imbalance));
-  if (user->opt.contact.condition_estimate) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm)); /* NaN: the estimate failed */
+  if (user->opt.solver.condition_estimate) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm)); /* NaN: the estimate failed */
   PetscCall(WriteRealAttr(v, "peak_memory_mb", s->peak_memory_mb));
   PetscCall(WriteRealAttr(v, "peak_memory_total_mb", s->peak_memory_total_mb));
   PetscCall(WriteRealAttr(v, "penetration_l2", user->rec.errors.penetration_l2));

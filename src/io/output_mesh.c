@@ -1,7 +1,6 @@
 /* The mesh of the HDF5 file, /geometry/vertices and /viz/topology/cells, as DMView() writes them with the format
-   PETSC_VIEWER_HDF5_VIZ (PETSc 3.18's legacy coordinates and XDMF topology), without its two closures per cell: at
-   512 x 512 DMView() took 1.2 s, as long as the whole set-up of the problem. Meshes whose cells are not all of one type,
-   or that are periodic, are left to DMView(). */
+   PETSC_VIEWER_HDF5_VIZ (PETSc 3.18's legacy coordinates and XDMF topology), without its two closures per cell.
+   Meshes whose cells are not all of one type, or that are periodic, are left to DMView(). */
 #include <petscsf.h>
 #include <petscviewerhdf5.h>
 #include "mesh.h"

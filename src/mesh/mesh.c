@@ -6,8 +6,8 @@
 #include "mesh.h"
 
 /* Refuses, before anything is allocated, a mesh of ncells cells (after all refinements) that 32-bit PETSc indices
-   cannot number or that needs more memory than the machines of the run have: at least 1 kB per cell (the cheapest
-   measured run, linear elasticity with GAMG in 2D, needs 1.5 kB per cell), against the physical memory of the nodes. */
+   cannot number or that needs more memory than the machines of the run have: at least 1 kB per cell (less than the
+   cheapest run, linear elasticity with GAMG in 2D, needs), against the physical memory of the nodes. */
 PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[])
 {
   const PetscReal bytes_per_cell = 1000.0, points_per_cell = dim == 2 ? 3.0 : 4.5; /* cells, faces, edges, vertices */
@@ -80,9 +80,9 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
   PetscCall(PetscOptionsRealArray("-dm_plex_box_lower", "Lower corner of the box", "DMPlexCreateBoxMesh", lower, &nlower, NULL));
   PetscCall(PetscOptionsRealArray("-dm_plex_box_upper", "Upper corner of the box", "DMPlexCreateBoxMesh", upper, &nupper, NULL));
   /* the project's simplex box is built distributed; anything else is distributed by METIS, which gives the same
-     partition on every run of a command: PTScotch (PETSc 3.18's default here) partitioned the same mesh differently
-     from run to run (edge cuts 128, 131, 129 on an 8^3 cube on 2 ranks), and with the partition the iteration counts,
-     the final residual and, on hard problems, whether the run converged (issue 29) */
+     partition on every run of a command: PTScotch (PETSc 3.18's default here) may partition the same mesh
+     differently from run to run, and with the partition the iteration counts, the final residual and, on hard
+     problems, whether the run converges (issue 29) */
   partitioner = !has_file && simplex ? MESH_PARTITIONER_BOX : MESH_PARTITIONER_METIS;
   PetscCall(PetscOptionsEnum("-partitioner", "How the cells are distributed over the ranks", "MeshPartitionDistribute", MeshPartitionerTypes,
                              (PetscEnum)partitioner, (PetscEnum *)&partitioner, NULL));
@@ -155,10 +155,9 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
   }
   /* The serial mesh on rank 0 (a file, the project's simplex box, PETSc's tensor box), distributed by
      MeshPartitionDistribute() with the partitioner of -partitioner; PETSc's own DM options are applied to the
-     distributed mesh last (DMSetFromOptions()), so that -dm_refine refines it on all ranks (at 1M unknowns a serial
-     refinement before the distribution cost more than the whole elastic solve on 2 ranks). PETSc reads HDF5 meshes in
-     parallel, in pieces that are only consistent after its own distribution (without it the solution is wrong): they
-     get both. */
+     distributed mesh last (DMSetFromOptions()), so that -dm_refine refines it on all ranks, not the whole mesh on
+     rank 0 before its distribution. PETSc reads HDF5 meshes in parallel, in pieces that are only consistent after its
+     own distribution (without it the solution is wrong): they get both. */
   if (has_file) {
     PetscInt  fdim, cStart, cEnd, n;
     PetscReal ncells;
@@ -235,10 +234,9 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
 
 /* PETSc 3.18 looks a point's cell type up in the "celltype" label (DMPlexGetCellType(), called for every point of every
    DMPlexGetTransitiveClosure()). Its DMPlexGetGhostCellStratum(), which the section's creation and the insertion of
-   Dirichlet values call, turns every stratum of that label into a hash set after reading it: a lookup then costs about
-   120 ns on a 512 x 512 mesh, against 20 ns on the sorted (here contiguous) lists PETSc makes of them
-   on request. This asks for each stratum, so that the closure loops that follow get the fast lookup. The label's
-   content is unchanged. */
+   Dirichlet values call, turns every stratum of that label into a hash set after reading it: a lookup then queries a
+   hash set, slower than a search of the sorted (here contiguous) lists PETSc makes of them on request. This asks for
+   each stratum, so that the closure loops that follow get the fast lookup. The label's content is unchanged. */
 PetscErrorCode MeshIndexCellTypes(DM dm)
 {
   DMLabel         label;
@@ -290,7 +288,7 @@ PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam)
 
 /* h: the largest cell diameter (largest distance between two vertices of a cell) over all ranks. The diameter of a
    simplex is its longest edge: on an interpolated simplex mesh the edges are visited once, not the closure of every
-   cell (0.5 s at 512 x 512). */
+   cell. */
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h)
 {
   DM           cdm;

@@ -188,8 +188,8 @@ PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal
 /* With box (the 2D simplex box of the options, not refined by -dm_refine; on several ranks built in slabs of rows, each
    slab boundary a row of the coarsest box, so that a rank's fine slab is the refinement of its coarse slab and every
    local fine vertex has its source among the local coarse points), the next level of a grid sequence
-   as the box of twice as many cells per side, built directly (PETSc's regular refinement, DMPlexTransformApply(), took
-   1.6 s of a 9.4 s nested run at 512 x 512). In 2D that box is the regular refinement of the coarse one, numbered as a
+   as the box of twice as many cells per side, built directly (cheaper than PETSc's general regular refinement,
+   DMPlexTransformApply()). In 2D that box is the regular refinement of the coarse one, numbered as a
    direct run of that many cells numbers it (each triangle split in four at its edges' midpoints gives the fine box's
    triangles; in 3D PETSc splits a tetrahedron along another diagonal than the fine Kuhn box, so 3D keeps the
    refinement). Every fine vertex is a coarse vertex or the midpoint of a coarse edge (a side or a diagonal):

@@ -1,6 +1,6 @@
 /* Closures and stars without PETSc 3.18's cell-type lookups. DMPlexGetTransitiveClosure() asks the "celltype" label for
-   the type of every point it meets, and PETSc keeps that label's strata as hash sets during most of the set-up: about
-   100 ns a lookup, which made the closure per cell the largest cost of the P1 residual at 512 x 512. In a mesh whose
+   the type of every point it meets, and PETSc keeps that label's strata as hash sets during most of the set-up: a
+   hash-set query for every point of every closure. In a mesh whose
    points of each depth all have one type (simplices, or tensor cells, interpolated), the type follows from the depth,
    and this is PETSc's breadth-first walk with the same arrangements and orientations, so it lists the same points in
    the same order. Any other mesh takes DMPlexGetTransitiveClosure() itself. */

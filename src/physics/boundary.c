@@ -73,8 +73,8 @@ PetscErrorCode BoundaryAddDirichlet(DM dm, AppCtx *user)
    them: face set after face set in the order of BoundaryAddDirichlet(), each writing its fixed components at every
    vertex of its faces' closures. With P1/Q1 displacements (unknowns at the vertices only) this is the value of the
    condition at the vertex, which PETSc's projection computes through each face's reference map (the same up to
-   round-off in the position); it avoids that projection's three passes over the cell-type label (0.35 s at
-   512 x 512). Higher degrees take DMPlexInsertBoundaryValues(). */
+   round-off in the position); it avoids that projection's three passes over the cell-type label. Higher
+   degrees take DMPlexInsertBoundaryValues(). */
 PetscErrorCode BoundaryInsertDirichlet(DM dm, const AppCtx *user, Vec loc)
 {
   PetscSection       lsec, csec;
@@ -202,8 +202,8 @@ PetscErrorCode BoundaryAddLoads(DM dm, AppCtx *user, Vec r0)
 }
 
 /* locF = loc_r0 + K (u - u_D), exact on the fixed components: the closed-form stiffness of the P1 simplices that have
-   a fixed component times the free part of u (zero on the fixed components). Cheap: the cells at Gamma_D only, where
-   the whole residual by PetscFE cost 2.4 s at 512 x 512. */
+   a fixed component times the free part of u (zero on the fixed components). Cheap: the cells at Gamma_D only, not
+   the whole residual by PetscFE. */
 static PetscErrorCode AddFixedRowsP1(DM dm, AppCtx *user, Vec u, Vec locF)
 {
   Vec locU;

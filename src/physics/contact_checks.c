@@ -42,7 +42,7 @@ PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
   PetscReal      sums[3] = {0.0, 0.0, 0.0}, overlap = 0.0; /* area, area facing away, area overlapping */
 
   PetscFunctionBeginUser;
-  if (user->opt.contact.method == CONTACT_NONE) PetscFunctionReturn(PETSC_SUCCESS);
+  if (ContactIsNone(user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
   for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
@@ -96,11 +96,12 @@ PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user)
 {
   MPI_Comm          comm = PetscObjectComm((PetscObject)dm);
   ContactChecks    *ck   = &user->rec.stats.checks;
-  const ContactSet *cs   = &user->prob.cset;
+  const ContactSet *cs;
   PetscInt          dim, nzone = 0, (*pairs)[2];
 
   PetscFunctionBeginUser;
-  if (user->opt.contact.method == CONTACT_NONE) PetscFunctionReturn(PETSC_SUCCESS);
+  if (ContactIsNone(user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetSet(user->contact, &cs));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(PetscMalloc1(cs->n + 1, &pairs)); /* (point, node) sorted by point: a face's nodes found by bisection */
   for (PetscInt i = 0; i < cs->n; ++i) {

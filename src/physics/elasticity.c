@@ -162,7 +162,8 @@ PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degr
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Writes the material, penalty, obstacle, body force and scene parameters into the constants[] of the kernels. */
+/* Writes the material, obstacle, body force and scene parameters into the constants[] of the kernels; the penalty's
+   1/eps is the contact's to set (ContactSetEps()), after this. */
 PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user)
 {
   PetscDS     ds;
@@ -171,7 +172,7 @@ PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user)
   PetscFunctionBeginUser;
   c[CONST_LAMBDA]  = user->opt.material.lambda;
   c[CONST_MU]      = user->opt.material.mu;
-  c[CONST_PENALTY] = (user->opt.contact.method == CONTACT_PENALTY) ? 1.0 / user->prob.eps : 0.0;
+  c[CONST_PENALTY] = 0.0; /* 1/eps, set by the contact (ContactSetEps()) */
   ObstaclePack(&user->scene.obstacle, &c[CONST_OBSTACLE]);
   for (PetscInt k = 0; k < 3; ++k) {
     c[CONST_BODY_FORCE + k] = user->scene.bcs.body_force[k];

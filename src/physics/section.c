@@ -1,8 +1,8 @@
 /* The local section of P1/Q1 displacements (dim unknowns at each vertex, the Dirichlet components constrained), built
    as DMCreateLocalSection() builds it, in the same order of calls, but without its cell-type lookup for every mesh
-   point: PETSc 3.18 makes that label's strata hash sets just before (DMPlexGetGhostCellStratum()), and the lookups took
-   0.3 s at 512 x 512, a fifth of the set-up. Other discretizations (higher degrees, several fields, anchors) are left
-   to PETSc. -section_check builds both and compares them (PetscSectionCompare()). */
+   point: PETSc 3.18 makes that label's strata hash sets just before (DMPlexGetGhostCellStratum()), so each lookup is a
+   hash-set query. Other discretizations (higher degrees, several fields, anchors) are left to PETSc. -section_check
+   builds both and compares them (PetscSectionCompare()). */
 #include "physics.h"
 
 /* The points of the essential condition bd (its label's strata, cells left out) and its components (NULL: all). */

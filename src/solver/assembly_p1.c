@@ -114,8 +114,8 @@ static PetscErrorCode AssemblyP1VertexIndices(DM dm, PetscInt **vidx)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The dim + 1 vertices of each local cell, [cells][dim + 1], by walking the cones down to the vertices (faster than
-   DMPlexGetTransitiveClosure(), which dominated the preallocation). */
+/* The dim + 1 vertices of each local cell, [cells][dim + 1], by walking the cones down to the vertices (without
+   DMPlexGetTransitiveClosure()'s cell-type lookup for every point). */
 static PetscErrorCode AssemblyP1CellVertices(DM dm, PetscInt **cverts)
 {
   PetscInt     dim, cStart, cEnd, vStart, vEnd, *cones;

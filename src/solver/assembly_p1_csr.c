@@ -1,7 +1,7 @@
 /* K on one rank as SeqAIJ, built in its own CSR arrays and handed to PETSc (MatCreateSeqAIJWithArrays()): the pattern
    from the mesh's edges (two vertices of a simplex mesh share a cell exactly when an edge joins them), the element
    matrices added in place, cell by cell in the order MatSetValues() would add them, so the values are the same to the
-   bit. MatSetValues() spent about 1 microsecond per triangle finding each entry in its rows (0.5 s at 512 x 512), and
+   bit. MatSetValues() searches the row for each entry it adds, and
    MatSeqAIJSetPreallocationCSR() inserts a given pattern row by row through it. The arrays belong to a container
    composed with K and are freed with it. Applies where every vertex is free or fully constrained (a block per vertex). */
 #include <petscdmplex.h>

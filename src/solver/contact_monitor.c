@@ -1,30 +1,6 @@
 /* Active set of Gamma_C and the per-Newton-step contact monitor (-contact_monitor). */
-#include "physics.h"
+#include "contact.h"
 #include "solver.h"
-
-/* An order-independent hash of the active vertices of Gamma_C, the same on any number of ranks. */
-static PetscErrorCode ActiveSetHash(AppCtx *user, Vec X, PetscInt64 *hash)
-{
-  const PetscScalar *x;
-  PetscInt           dim, rstart;
-  PetscInt64         local = 0;
-  DM                 dm;
-
-  PetscFunctionBeginUser;
-  PetscCall(VecGetDM(X, &dm));
-  PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(VecGetOwnershipRange(X, &rstart, NULL));
-  PetscCall(VecGetArrayRead(X, &x));
-  for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
-    const unsigned long long g = (unsigned long long)(rstart + user->prob.cset.global_off[i]);
-
-    if (user->prob.cset.is_vertex[i] && ContactNodePenetration(&user->prob.cset, dim, i, x) > 0.0)
-      local = (PetscInt64)((unsigned long long)local + ((g + 1) * 0x9E3779B97F4A7C15ULL ^ (g << 17)) % 0x7FFFFFFFFFFFULL);
-  }
-  PetscCall(VecRestoreArrayRead(X, &x));
-  PetscCall(MPIU_Allreduce(&local, hash, 1, MPIU_INT64, MPI_SUM, PetscObjectComm((PetscObject)dm)));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
 
 /* Semismooth Newton on the penalty problem can cycle between active sets. When the active set of this step is one
    already met two or more steps back (and not the previous one) with no less than half its residual, the cycle is
@@ -38,19 +14,19 @@ static PetscErrorCode DetectActiveSetCycle(SNES snes, AppCtx *user, PetscInt it,
   PetscFunctionBeginUser;
   PetscCall(SNESGetLineSearch(snes, &ls));
   PetscCall(SNESLineSearchSetDamping(ls, 1.0));
-  PetscCall(ActiveSetHash(user, X, &hash));
+  PetscCall(ContactPenetrationHash(user->contact, X, &hash));
   if (it >= CONTACT_HISTORY) PetscFunctionReturn(PETSC_SUCCESS);
   user->prob.active_history[it] = hash;
   user->prob.fnorm_history[it]  = fnorm;
   for (PetscInt j = it - 2; j >= 0; --j) {
     if (user->prob.active_history[j] != hash || user->prob.active_history[it - 1] == hash || fnorm < 0.5 * user->prob.fnorm_history[j]) continue;
     user->rec.stats.active_set_cycles++;
-    if (user->opt.contact.cycle_damping) PetscCall(SNESLineSearchSetDamping(ls, 0.5));
+    if (user->opt.solver.cycle_damping) PetscCall(SNESLineSearchSetDamping(ls, 0.5));
     PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes),
                           "  active-set cycle: Newton step %" PetscInt_FMT " is back at the active set of step %" PetscInt_FMT
                           " (|F| %g, then %g)%s\n",
                           it, j, (double)user->prob.fnorm_history[j], (double)fnorm,
-                          user->opt.contact.cycle_damping ? "; the next step is damped by 1/2" : "; not damped (-contact_cycle_damping 0)"));
+                          user->opt.solver.cycle_damping ? "; the next step is damped by 1/2" : "; not damped (-contact_cycle_damping 0)"));
     break;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -68,9 +44,9 @@ PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm_scaled, vo
   user->rec.stats.residual_norm = fnorm;
   PetscCall(SNESGetSolution(snes, &Xs));
   PetscCall(SolverIterateDisplacement(user, Xs, &X));
-  if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(DetectActiveSetCycle(snes, user, it, fnorm, X));
-  if (!user->opt.contact.monitor) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(ContactCountActive(user, X, PETSC_TRUE, &active, &entered, &left));
+  if (ContactHasPenalty(user->contact)) PetscCall(DetectActiveSetCycle(snes, user, it, fnorm, X));
+  if (!user->opt.solver.monitor) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactCountActive(user->contact, X, user->prob.displacement_scale, PETSC_TRUE, &active, &entered, &left));
   PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes),
                         "  %3" PetscInt_FMT " contact: |F| %12.6e  active vertices %6" PetscInt_FMT "  entered %5" PetscInt_FMT
                         "  left %5" PetscInt_FMT "\n",

@@ -7,7 +7,7 @@
    penetration, whose 1/eps multiple is most of the residual after a step of eps, is predicted instead of carried
    over (256 x 256, eps down by 10 per value: first residuals of 2e-5 to 2e-8 instead of 0.16). The second value starts
    on the tangent of the solution path at the first (TangentDirection()). */
-#include "physics.h"
+#include "contact.h"
 #include "solver.h"
 
 /* u <- u + factor dir if the penalty is active there at the same points as at u (the last solution) and the residual
@@ -27,7 +27,7 @@ static PetscErrorCode ExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, V
   PetscFunctionBeginUser;
   PetscCall(VecDuplicate(u, &guess));
   PetscCall(VecWAXPY(guess, factor, dir, u));
-  PetscCall(PenaltySameActivity(dm, user, u, guess, &same));
+  PetscCall(ContactSameActivity(user->contact, dm, u, guess, &same));
   PetscCall(SolverResidualNorm(snes, user, u, &f_last)); /* every start needs both: the tangent's and the secant's rules */
   PetscCall(SolverResidualNorm(snes, user, guess, &f_guess));
   if ((same && f_guess < f_last) || f_guess < relaxed * f_last)
@@ -64,7 +64,7 @@ static PetscErrorCode TangentDirection(SNES snes, DM dm, AppCtx *user, Vec u, Ve
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(VecDuplicate(u, &rhs));
   PetscCall(VecZeroEntries(rhs));
-  PetscCall(PenaltyAddResidual(dm, user, u, rhs)); /* P(u; eps_new) */
+  PetscCall(ContactAddResidual(user->contact, dm, u, rhs)); /* P(u; eps_new) */
   PetscCall(KSPCreate(PetscObjectComm((PetscObject)snes), &tangent));
   PetscCall(KSPSetType(tangent, KSPCG));
   PetscCall(KSPSetOperators(tangent, A, P));
@@ -83,27 +83,29 @@ static PetscErrorCode TangentDirection(SNES snes, DM dm, AppCtx *user, Vec u, Ve
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 {
   Vec       prev = NULL, last = NULL, dir = NULL; /* the solutions for the values before the last, and for the last */
-  PetscReal eps_prev = 0.0;
+  PetscReal             eps_prev = 0.0, eps;
+  const ContactOptions *copt;
 
   PetscFunctionBeginUser;
-  for (PetscInt k = 1; k < user->opt.contact.n_sweep && user->rec.stats.converged; ++k) {
-    const PetscReal eps_last = user->prob.eps;
+  PetscCall(ContactGetOptions(user->contact, &copt));
+  for (PetscInt k = 1; k < copt->n_sweep && user->rec.stats.converged; ++k) {
+    PetscReal eps_last;
 
-    user->opt.contact.eps0 = user->opt.contact.eps0_sweep[k];
-    PetscCall(ContactComputeEps(user));
-    PetscCall(ElasticityUpdateConstants(dm, user));
+    PetscCall(ContactGetEps(user->contact, &eps_last));
+    PetscCall(ContactEpsFromFactor(user->contact, copt->eps0_sweep[k], &eps));
+    PetscCall(ContactSetEps(user->contact, dm, eps));
     if (!last) PetscCall(VecDuplicate(u, &last));
     if (!dir) PetscCall(VecDuplicate(u, &dir));
     PetscCall(VecCopy(u, last));
     if (k > 1 && eps_last != eps_prev) { /* the secant of the last two solutions */
       PetscCall(VecWAXPY(dir, -1.0, prev, u));
-      PetscCall(ExtrapolatedStart(snes, dm, user, u, dir, (user->prob.eps - eps_last) / (eps_last - eps_prev), 0.0, PETSC_TRUE));
-    } else if (k == 1 && user->opt.contact.method == CONTACT_PENALTY && user->prob.eps != eps_last) { /* the tangent */
+      PetscCall(ExtrapolatedStart(snes, dm, user, u, dir, (eps - eps_last) / (eps_last - eps_prev), 0.0, PETSC_TRUE));
+    } else if (k == 1 && ContactHasPenalty(user->contact) && eps != eps_last) { /* the tangent */
       PetscBool ok = PETSC_FALSE;
 
       PetscCall(TangentDirection(snes, dm, user, u, dir, &ok));
       if (ok)
-        PetscCall(ExtrapolatedStart(snes, dm, user, u, dir, (user->prob.eps - eps_last) * user->prob.eps / (eps_last * eps_last), 1e-2, PETSC_FALSE));
+        PetscCall(ExtrapolatedStart(snes, dm, user, u, dir, (eps - eps_last) * eps / (eps_last * eps_last), 1e-2, PETSC_FALSE));
     }
     if (!prev) PetscCall(VecDuplicate(u, &prev));
     PetscCall(VecSwap(prev, last));

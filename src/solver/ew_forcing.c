@@ -2,8 +2,8 @@
    safeguard against oversolving of Eisenstat and Walker (1996) and Kelley (1995, 6.3): the linear solve of a Newton
    step need not reduce its residual below guard * target / |F|, where target is the |F| at which Newton stops
    (-snes_rtol times |F| at the start, or times the load for a warm start). Near the solution version 2's terms fall
-   superlinearly, and the last linear solve went several orders of magnitude below what Newton needed (512 x 512:
-   13 CG iterations to 7e-6 where 1e-4 sufficed). The guard only loosens a term, never beyond -snes_ksp_ew_rtolmax.
+   superlinearly, so the last linear solve can go orders of magnitude below what Newton needs. The guard only loosens a
+   term, never beyond -snes_ksp_ew_rtolmax.
    This pre-solve (part of SolverPreSolve() in solver.c) replaces PETSc's (KSPPreSolve_SNESEW(), installed with the
    SNES's KSP); without the guard its terms are PETSc's exactly. Other versions (-snes_ksp_ew_version) keep PETSc's. */
 #include "solver.h"
@@ -65,6 +65,6 @@ PetscErrorCode SolverForcingSetUp(SNES snes, AppCtx *user, PetscBool *petsc_pres
   *petsc_presolve = (PetscBool)(version != 2);
   if (version != 2) PetscFunctionReturn(PETSC_SUCCESS);
   user->prob.forcing.snes  = snes;
-  user->prob.forcing.guard = user->opt.contact.ew_guard;
+  user->prob.forcing.guard = user->opt.solver.ew_guard;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -6,6 +6,7 @@
    from the coarse solution it needs only a few on each level. A failed level of -contact_grid_sequence ends the
    sequence: the output is that level's, flagged as not converged. A failed coarser box of -contact_coarse_levels is
    reported and the next level starts from zero: the mesh of the options is always solved. */
+#include "contact.h"
 #include "mesh.h"
 #include "solver.h"
 
@@ -56,13 +57,13 @@ static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
   PetscFunctionBeginUser;
   if (user->prob.level >= user->opt.box.coarse_levels) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
-  if (user->opt.contact.coarse_rtol > rtol) PetscCall(SNESSetTolerances(snes, atol, user->opt.contact.coarse_rtol, stol, maxit, maxf));
+  if (user->opt.solver.coarse_rtol > rtol) PetscCall(SNESSetTolerances(snes, atol, user->opt.solver.coarse_rtol, stol, maxit, maxf));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, RunOptions *opt, PetscInt *request, PetscInt *min_faces)
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, RunOptions *opt, PetscInt *request, PetscInt *min_faces)
 {
-  const PetscInt k           = opt->contact.coarse_levels;
+  const PetscInt k           = opt->solver.coarse_levels;
   char           pc_type[64] = "";
   PetscBool      given, is_mg, is_factor;
 
@@ -75,17 +76,17 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, RunOptions *opt, PetscIn
   /* -contact_coarse_mg: with an iterative preconditioner that is not already the boxes' multigrid (without -pc_type, the
      default is MUMPS's factorization, which a coarser box's small matrix does not make expensive); not with SNESVI, whose
      reduced system (vinewtonrsls) no PCMG can follow and whose vinewtonssls Jacobian CG cannot take */
-  opt->contact.coarse_mg = (PetscBool)(opt->contact.coarse_mg && given && !is_mg && !is_factor && opt->contact.method != CONTACT_VI);
+  opt->solver.coarse_mg = (PetscBool)(opt->solver.coarse_mg && given && !is_mg && !is_factor && !ContactHasBounds(ct));
   *request               = k;
-  *min_faces             = (is_mg || opt->contact.coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
+  *min_faces             = (is_mg || opt->solver.coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
   /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels) */
-  if (k < 0 && (!(opt->contact.method == CONTACT_PENALTY || (opt->contact.method == CONTACT_NONE && is_mg)) || opt->degree != 1)) *request = 0;
+  if (k < 0 && (!(ContactHasPenalty(ct) || (ContactIsNone(ct) && is_mg)) || opt->degree != 1)) *request = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
 {
-  const PetscInt nlevels = user->opt.box.coarse_levels + user->opt.contact.grid_sequence;
+  const PetscInt nlevels = user->opt.box.coarse_levels + user->opt.solver.grid_sequence;
 
   PetscFunctionBeginUser;
   PetscCall(GridSequenceSetTolerance(*snes, user));

@@ -12,7 +12,7 @@
 /* Whether the problem's mesh is a coarser box of nested iteration solved under -contact_coarse_mg. */
 static inline PetscBool MultigridOnCoarseBox(const AppCtx *user)
 {
-  return (PetscBool)(user->opt.contact.coarse_mg && user->prob.level < user->opt.box.coarse_levels);
+  return (PetscBool)(user->opt.solver.coarse_mg && user->prob.level < user->opt.box.coarse_levels);
 }
 
 /* With -pc_type mg (the PC of snes, the fine mesh's problem) and P1/Q1, adds the interpolation from coarse to fine,
@@ -108,7 +108,7 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
   if (!is_mg) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCheck(mg->n > 0 || user->prob.level < user->opt.box.coarse_levels + user->opt.contact.grid_sequence, PetscObjectComm((PetscObject)snes),
+  PetscCheck(mg->n > 0 || user->prob.level < user->opt.box.coarse_levels + user->opt.solver.grid_sequence, PetscObjectComm((PetscObject)snes),
              PETSC_ERR_USER_INPUT,
              "-pc_type mg takes its levels from nested meshes, and this mesh has none: use the 2D simplex box (-dm_plex_box_faces, "
              "-contact_coarse_levels) or -contact_grid_sequence N, or another -pc_type");

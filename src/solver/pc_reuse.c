@@ -14,14 +14,18 @@
 /* Number of contact nodes (over all ranks) whose state differs from the state at the last build. */
 static PetscErrorCode CountChanges(AppCtx *user, PetscInt dim, const PetscScalar x[], PetscBool record, PetscInt *changes)
 {
-  PetscInt local = 0;
+  PcReuse          *r     = &user->prob.pc_reuse;
+  PetscInt          local = 0;
+  const ContactSet *cs;
 
   PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
-    const PetscBool on = (PetscBool)(ContactNodePenetration(&user->prob.cset, dim, i, x) > 0.0);
+  PetscCall(ContactGetSet(user->contact, &cs));
+  if (!r->built_active) PetscCall(PetscCalloc1(cs->n + 1, &r->built_active)); /* no node penetrated before the first build */
+  for (PetscInt i = 0; i < cs->n; ++i) {
+    const PetscBool on = (PetscBool)(ContactNodePenetration(cs, dim, i, x) > 0.0);
 
-    local += on != user->prob.cset.built_active[i];
-    if (record) user->prob.cset.built_active[i] = on;
+    local += on != r->built_active[i];
+    if (record) r->built_active[i] = on;
   }
   PetscCall(MPIU_Allreduce(&local, changes, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)user->prob.K)));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -39,7 +43,7 @@ static PetscErrorCode HierarchyLevels(SNES snes, AppCtx *user, PC *pc, PetscInt 
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(KSPGetPC(ksp, pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)*pc, PCGAMG, &is_gamg));
-  if (!is_gamg || !user->opt.contact.pc_update || user->prob.pc_reuse.no_update || !user->prob.bulk_ptr) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!is_gamg || !user->opt.solver.pc_update || user->prob.pc_reuse.no_update || !ContactBulkRowsOf(user->contact) || !ContactBulkRowsOf(user->contact)->ptr) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PCMGGetLevels(*pc, nlevels));
   for (PetscInt l = 0; l < *nlevels; ++l) {
     KSP smoother;
@@ -56,17 +60,18 @@ static PetscErrorCode HierarchyLevels(SNES snes, AppCtx *user, PC *pc, PetscInt 
 static PetscErrorCode ContactRowValues(AppCtx *user, PetscScalar vals[])
 {
   Problem *pb = &user->prob;
+  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
 
   PetscFunctionBeginUser;
-  for (PetscInt r = 0; r < pb->nbulk_rows; ++r) {
+  for (PetscInt r = 0; r < br->n; ++r) {
     const PetscScalar *v;
     PetscInt           ncols;
 
-    PetscCall(MatGetRow(pb->K, pb->bulk_rows[r], &ncols, NULL, &v));
-    PetscCheck(ncols == pb->bulk_ptr[r + 1] - pb->bulk_ptr[r], PETSC_COMM_SELF, PETSC_ERR_PLIB,
-               "the Jacobian's row %" PetscInt_FMT " left K's pattern", pb->bulk_rows[r]);
-    PetscCall(PetscArraycpy(&vals[pb->bulk_ptr[r]], v, ncols));
-    PetscCall(MatRestoreRow(pb->K, pb->bulk_rows[r], &ncols, NULL, &v));
+    PetscCall(MatGetRow(pb->K, br->rows[r], &ncols, NULL, &v));
+    PetscCheck(ncols == br->ptr[r + 1] - br->ptr[r], PETSC_COMM_SELF, PETSC_ERR_PLIB,
+               "the Jacobian's row %" PetscInt_FMT " left K's pattern", br->rows[r]);
+    PetscCall(PetscArraycpy(&vals[br->ptr[r]], v, ncols));
+    PetscCall(MatRestoreRow(pb->K, br->rows[r], &ncols, NULL, &v));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -93,13 +98,13 @@ static PetscErrorCode DestroyProducts(PcReuse *r)
 }
 
 /* The marks of the contact rows (1, or 2 in Z) at their columns, from any rank. */
-static PetscErrorCode ScatterMarks(Problem *pb)
+static PetscErrorCode ScatterMarks(Problem *pb, const ContactBulkRows *br)
 {
   PcReuse *r = &pb->pc_reuse;
 
   PetscFunctionBeginUser;
-  PetscCall(VecScatterBegin(pb->bulk_scatter, r->zmark, r->zcols, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecScatterEnd(pb->bulk_scatter, r->zmark, r->zcols, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterBegin(br->scatter, r->zmark, r->zcols, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(br->scatter, r->zmark, r->zcols, INSERT_VALUES, SCATTER_FORWARD));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -108,28 +113,29 @@ static PetscErrorCode ScatterMarks(Problem *pb)
 static PetscErrorCode MirrorsSetUp(AppCtx *user)
 {
   Problem           *pb = &user->prob;
+  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
   PcReuse           *r  = &pb->pc_reuse;
   PetscInt           n  = 0;
   const PetscScalar *mark;
 
   PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(pb->K, &r->zmark, NULL));
-  PetscCall(VecDuplicate(pb->bulk_x, &r->zcols));
-  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) PetscCall(VecSetValue(r->zmark, pb->bulk_rows[row], 1.0, INSERT_VALUES));
+  PetscCall(VecDuplicate(br->x, &r->zcols));
+  for (PetscInt row = 0; row < br->n; ++row) PetscCall(VecSetValue(r->zmark, br->rows[row], 1.0, INSERT_VALUES));
   PetscCall(VecAssemblyBegin(r->zmark));
   PetscCall(VecAssemblyEnd(r->zmark));
-  PetscCall(ScatterMarks(pb));
+  PetscCall(ScatterMarks(pb, br));
   PetscCall(VecGetArrayRead(r->zcols, &mark));
-  for (PetscInt k = 0; k < pb->bulk_ptr[pb->nbulk_rows]; ++k) n += PetscRealPart(mark[pb->bulk_lcols[k]]) == 0.0;
+  for (PetscInt k = 0; k < br->ptr[br->n]; ++k) n += PetscRealPart(mark[br->lcols[k]]) == 0.0;
   PetscCall(PetscMalloc2(n, &r->mirror_k, n, &r->mirror_at));
   r->nmirror = 0;
-  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
-    const PetscInt kd = pb->bulk_diag[row];
+  for (PetscInt row = 0; row < br->n; ++row) {
+    const PetscInt kd = br->diag[row];
 
-    for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k)
-      if (PetscRealPart(mark[pb->bulk_lcols[k]]) == 0.0) {
+    for (PetscInt k = br->ptr[row]; k < br->ptr[row + 1]; ++k)
+      if (PetscRealPart(mark[br->lcols[k]]) == 0.0) {
         r->mirror_k[r->nmirror]  = k;
-        r->mirror_at[r->nmirror] = pb->bulk_lcols[kd];
+        r->mirror_at[r->nmirror] = br->lcols[kd];
         r->nmirror++;
       }
   }
@@ -145,9 +151,10 @@ static PetscErrorCode MirrorsSetUp(AppCtx *user)
 static PetscErrorCode EffectiveValues(AppCtx *user, const PetscScalar jvals[], PetscScalar eff[])
 {
   Problem           *pb    = &user->prob;
+  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
   PcReuse           *r     = &pb->pc_reuse;
-  const PetscInt     nnz   = pb->bulk_ptr[pb->nbulk_rows];
-  const PetscReal    ratio = user->opt.contact.pc_update_truncate;
+  const PetscInt     nnz   = br->ptr[br->n];
+  const PetscReal    ratio = user->opt.solver.pc_update_truncate;
   const PetscScalar *mark;
 
   PetscFunctionBeginUser;
@@ -156,23 +163,23 @@ static PetscErrorCode EffectiveValues(AppCtx *user, const PetscScalar jvals[], P
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   r->nz = 0;
-  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
-    const PetscInt  kd   = pb->bulk_diag[row];
-    const PetscBool in_z = (PetscBool)(PetscRealPart(jvals[kd] - pb->bulk_vals[kd]) > ratio * PetscRealPart(pb->bulk_vals[kd]));
-    if (in_z) r->zrows[r->nz++] = pb->bulk_rows[row];
-    PetscCall(VecSetValue(r->zmark, pb->bulk_rows[row], in_z ? 2.0 : 1.0, INSERT_VALUES));
+  for (PetscInt row = 0; row < br->n; ++row) {
+    const PetscInt  kd   = br->diag[row];
+    const PetscBool in_z = (PetscBool)(PetscRealPart(jvals[kd] - br->vals[kd]) > ratio * PetscRealPart(br->vals[kd]));
+    if (in_z) r->zrows[r->nz++] = br->rows[row];
+    PetscCall(VecSetValue(r->zmark, br->rows[row], in_z ? 2.0 : 1.0, INSERT_VALUES));
   }
   PetscCall(VecAssemblyBegin(r->zmark));
   PetscCall(VecAssemblyEnd(r->zmark));
-  PetscCall(ScatterMarks(pb));
+  PetscCall(ScatterMarks(pb, br));
   PetscCall(VecGetArrayRead(r->zcols, &mark));
-  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
-    const PetscInt kd = pb->bulk_diag[row];
+  for (PetscInt row = 0; row < br->n; ++row) {
+    const PetscInt kd = br->diag[row];
 
-    for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k)
-      eff[k] = PetscRealPart(mark[pb->bulk_lcols[kd]]) == 2.0 || PetscRealPart(mark[pb->bulk_lcols[k]]) == 2.0 ? 0.0 : jvals[k];
+    for (PetscInt k = br->ptr[row]; k < br->ptr[row + 1]; ++k)
+      eff[k] = PetscRealPart(mark[br->lcols[kd]]) == 2.0 || PetscRealPart(mark[br->lcols[k]]) == 2.0 ? 0.0 : jvals[k];
   }
-  for (PetscInt t = 0; t < r->nmirror; ++t) eff[nnz + t] = PetscRealPart(mark[r->mirror_at[t]]) == 2.0 ? 0.0 : pb->bulk_vals[r->mirror_k[t]];
+  for (PetscInt t = 0; t < r->nmirror; ++t) eff[nnz + t] = PetscRealPart(mark[r->mirror_at[t]]) == 2.0 ? 0.0 : br->vals[r->mirror_k[t]];
   PetscCall(VecRestoreArrayRead(r->zcols, &mark));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -181,12 +188,13 @@ static PetscErrorCode EffectiveValues(AppCtx *user, const PetscScalar jvals[], P
 static PetscErrorCode ProlongatorRowsSave(PC pc, AppCtx *user)
 {
   Problem *pb = &user->prob;
+  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
   PcReuse *r  = &pb->pc_reuse;
 
   PetscFunctionBeginUser;
   PetscCall(PCMGGetInterpolation(pc, r->nlevels - 1, &r->rfine));
   PetscCall(PetscObjectReference((PetscObject)r->rfine));
-  PetscCall(PenaltyCopyRows(r->rfine, pb->nbulk_rows, pb->bulk_rows, &r->rrow_ptr, &r->rrow_cols, &r->rrow_vals));
+  PetscCall(ContactCopyRows(r->rfine, br->n, br->rows, &r->rrow_ptr, &r->rrow_cols, &r->rrow_vals));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -194,20 +202,21 @@ static PetscErrorCode ProlongatorRowsSave(PC pc, AppCtx *user)
 static PetscErrorCode ProlongatorRowsSet(AppCtx *user, PetscBool all)
 {
   Problem     *pb = &user->prob;
+  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
   PcReuse     *r  = &pb->pc_reuse;
   PetscScalar *zero;
   PetscInt     iz = 0, nmax = 0;
 
   PetscFunctionBeginUser;
   if (!r->rfine) PetscFunctionReturn(PETSC_SUCCESS);
-  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) nmax = PetscMax(nmax, r->rrow_ptr[row + 1] - r->rrow_ptr[row]);
+  for (PetscInt row = 0; row < br->n; ++row) nmax = PetscMax(nmax, r->rrow_ptr[row + 1] - r->rrow_ptr[row]);
   PetscCall(PetscCalloc1(nmax, &zero));
-  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
+  for (PetscInt row = 0; row < br->n; ++row) {
     const PetscInt  n    = r->rrow_ptr[row + 1] - r->rrow_ptr[row];
-    const PetscBool in_z = (PetscBool)(!all && iz < r->nz && r->zrows[iz] == pb->bulk_rows[row]); /* zrows follow the rows' order */
+    const PetscBool in_z = (PetscBool)(!all && iz < r->nz && r->zrows[iz] == br->rows[row]); /* zrows follow the rows' order */
 
     iz += in_z;
-    PetscCall(MatSetValues(r->rfine, 1, &pb->bulk_rows[row], n, &r->rrow_cols[r->rrow_ptr[row]], in_z ? zero : &r->rrow_vals[r->rrow_ptr[row]],
+    PetscCall(MatSetValues(r->rfine, 1, &br->rows[row], n, &r->rrow_cols[r->rrow_ptr[row]], in_z ? zero : &r->rrow_vals[r->rrow_ptr[row]],
                            INSERT_VALUES));
   }
   PetscCall(PetscFree(zero));
@@ -222,8 +231,8 @@ static PetscErrorCode ProlongatorRowsSet(AppCtx *user, PetscBool all)
 static PetscErrorCode FinestProductSetUp(PC pc, AppCtx *user)
 {
   PcReuse        *r   = &user->prob.pc_reuse;
-  Problem        *pb  = &user->prob;
-  const PetscInt  nnz = pb->bulk_ptr[pb->nbulk_rows];
+  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
+  const PetscInt  nnz = br->ptr[br->n];
   PetscInt        nS  = nnz, N1, n1, *S, *coo_i, *coo_j, nrows;
   const PetscInt *ia, *ja;
   PetscBool       done;
@@ -236,7 +245,7 @@ static PetscErrorCode FinestProductSetUp(PC pc, AppCtx *user)
   PetscCall(MatGetSize(R, NULL, &N1));
   PetscCall(MatGetLocalSize(R, NULL, &n1));
   PetscCall(PetscMalloc1(nnz, &S));
-  PetscCall(PetscArraycpy(S, pb->bulk_cols, nnz));
+  PetscCall(PetscArraycpy(S, br->cols, nnz));
   PetscCall(PetscSortRemoveDupsInt(&nS, S)); /* the order of bulk_lcols */
   PetscCall(ISCreateGeneral(PETSC_COMM_SELF, nS, S, PETSC_OWN_POINTER, &is_rows));
   PetscCall(ISCreateStride(PETSC_COMM_SELF, N1, 0, 1, &is_cols));
@@ -244,22 +253,22 @@ static PetscErrorCode FinestProductSetUp(PC pc, AppCtx *user)
   r->rlocal = sub[0];
   PetscCall(PetscFree(sub));
   /* with the truncation, the columns S that are no contact row (on any rank) get the mirrors of their entries */
-  if (user->opt.contact.pc_update_truncate > 0.0) {
+  if (user->opt.solver.pc_update_truncate > 0.0) {
     PetscCall(MirrorsSetUp(user));
     PetscCall(ProlongatorRowsSave(pc, user));
   }
   /* D_S in COO form: the contact rows' places in S, their columns' places (bulk_lcols); then the mirrors */
   PetscCall(PetscMalloc2(nnz + r->nmirror, &coo_i, nnz + r->nmirror, &coo_j));
-  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) {
-    const PetscInt at = pb->bulk_lcols[pb->bulk_diag[row]]; /* the row's own place in S */
+  for (PetscInt row = 0; row < br->n; ++row) {
+    const PetscInt at = br->lcols[br->diag[row]]; /* the row's own place in S */
 
-    for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k) {
+    for (PetscInt k = br->ptr[row]; k < br->ptr[row + 1]; ++k) {
       coo_i[k] = at;
-      coo_j[k] = pb->bulk_lcols[k];
+      coo_j[k] = br->lcols[k];
     }
   }
   for (PetscInt t = 0; t < r->nmirror; ++t) {
-    coo_i[nnz + t] = pb->bulk_lcols[r->mirror_k[t]];
+    coo_i[nnz + t] = br->lcols[r->mirror_k[t]];
     coo_j[nnz + t] = r->mirror_at[t];
   }
   PetscCall(MatCreate(PETSC_COMM_SELF, &r->dlocal));
@@ -268,9 +277,9 @@ static PetscErrorCode FinestProductSetUp(PC pc, AppCtx *user)
   PetscCall(MatSetPreallocationCOO(r->dlocal, nnz + r->nmirror, coo_i, coo_j));
   PetscCall(PetscFree2(coo_i, coo_j));
   /* the coarse operators hold the build's Jacobian, nothing left out */
-  PetscCall(PetscMalloc3(nnz + r->nmirror, &r->eff_vals, nnz + r->nmirror, &r->eff_dvals, pb->nbulk_rows, &r->zrows));
+  PetscCall(PetscMalloc3(nnz + r->nmirror, &r->eff_vals, nnz + r->nmirror, &r->eff_dvals, br->n, &r->zrows));
   PetscCall(PetscArraycpy(r->eff_vals, r->built_vals, nnz));
-  for (PetscInt t = 0; t < r->nmirror; ++t) r->eff_vals[nnz + t] = pb->bulk_vals[r->mirror_k[t]];
+  for (PetscInt t = 0; t < r->nmirror; ++t) r->eff_vals[nnz + t] = br->vals[r->mirror_k[t]];
   PetscCall(PetscArrayzero(r->eff_dvals, nnz + r->nmirror));
   PetscCall(MatSetValuesCOO(r->dlocal, r->eff_dvals, INSERT_VALUES));
   PetscCall(MatPtAP(r->dlocal, r->rlocal, MAT_INITIAL_MATRIX, PETSC_DEFAULT, &r->clocal));
@@ -328,8 +337,8 @@ static PetscErrorCode CheckHierarchy(PC pc, PetscInt nlevels, PcReuse *r)
 static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
 {
   PcReuse  *r    = &user->prob.pc_reuse;
-  Problem  *pb   = &user->prob;
-  PetscInt  nnz  = pb->bulk_ptr[pb->nbulk_rows];
+  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
+  PetscInt  nnz  = br->ptr[br->n];
   PetscReal dmax = 0.0;
 
   PetscFunctionBeginUser;
@@ -374,7 +383,7 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
     PetscCall(KSPGetOperators(smoother, &A, NULL));
     PetscCall(MatAXPY(A, 1.0, r->dcoarse[l - 1], SUBSET_NONZERO_PATTERN));
   }
-  if (user->opt.contact.pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r));
+  if (user->opt.solver.pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r));
   /* every level's operator is new: its Chebyshev smoother estimates its eigenvalues again, its Jacobi or LU sets up
      again (KSPSetOperators() marks the new matrix, as a rebuild would) */
   for (PetscInt l = 0; l < nlevels; ++l) {
@@ -386,7 +395,7 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
     PetscCall(KSPSetOperators(smoother, A, A));
   }
   /* except the finest level's Chebyshev interval, which a bound keeps (smoother_bound.c) */
-  if (!user->opt.contact.pc_update_esteig) PetscCall(SmootherBoundFinest(pc, nlevels, user, r->built_vals, user->opt.contact.pc_update_check));
+  if (!user->opt.solver.pc_update_esteig) PetscCall(SmootherBoundFinest(pc, nlevels, user, r->built_vals, user->opt.solver.pc_update_check));
   r->updates++;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -401,6 +410,7 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
   PetscBool          rebuild;
   const PetscScalar *x;
+  PetscReal          eps;
 
   PetscFunctionBeginUser;
   if (!r->enabled) PetscFunctionReturn(PETSC_SUCCESS);
@@ -419,19 +429,20 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
     }
   }
   PetscCall(VecGetArrayRead(X, &x));
-  rebuild = (PetscBool)(!r->built || r->eps != user->prob.eps);
+  PetscCall(ContactGetEps(user->contact, &eps));
+  rebuild = (PetscBool)(!r->built || r->eps != eps);
   if (!rebuild) {
     PetscCall(CountChanges(user, dim, x, PETSC_FALSE, &changes));
     PetscCall(KSPGetIterationNumber(ksp, &its));
     PetscCall(KSPGetConvergedReason(ksp, &reason));
     /* rebuild after a failed solve, or when the last solve needed twice the iterations of the first after the build */
     rebuild =
-        (PetscBool)(changes > user->opt.contact.pc_reuse_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
+        (PetscBool)(changes > user->opt.solver.pc_reuse_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
   }
   if (rebuild) {
     PetscCall(CountChanges(user, dim, x, PETSC_TRUE, &changes));
     r->built           = PETSC_TRUE;
-    r->eps             = user->prob.eps;
+    r->eps             = eps;
     r->its_after_build = -1; /* set by the next call */
     r->builds++;
     r->record = PETSC_TRUE;
@@ -449,12 +460,12 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
 PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user)
 {
   PcReuse *r  = &user->prob.pc_reuse;
-  Problem *pb = &user->prob;
+  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
   PC       pc;
   PetscInt nlevels;
 
   PetscFunctionBeginUser;
-  if (!r->enabled || !user->opt.contact.pc_update || r->no_update || !pb->jacobian_in_K) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!r->enabled || !user->opt.solver.pc_update || r->no_update || !br->jacobian_in_K) PetscFunctionReturn(PETSC_SUCCESS);
   if (r->update) {
     PetscCall(HierarchyLevels(snes, user, &pc, &nlevels));
     PetscCall(UpdateHierarchy(pc, nlevels, user));
@@ -467,15 +478,15 @@ PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user)
     PetscCall(KSPGetPC(ksp, &pc));
     PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &is_gamg));
     if (!is_gamg) PetscFunctionReturn(PETSC_SUCCESS);
-    if (!r->recorded) PetscCall(PetscMalloc2(pb->bulk_ptr[pb->nbulk_rows], &r->built_vals, pb->bulk_ptr[pb->nbulk_rows], &r->dvals));
+    if (!r->recorded) PetscCall(PetscMalloc2(br->ptr[br->n], &r->built_vals, br->ptr[br->n], &r->dvals));
     r->recorded = PETSC_TRUE;
     PetscCall(ContactRowValues(user, r->built_vals));
     {
-      const PetscInt nnz  = pb->bulk_ptr[pb->nbulk_rows];
+      const PetscInt nnz  = br->ptr[br->n];
       PetscBool      on_K = PETSC_TRUE;
 
       PetscCheck(!r->bound_set, PetscObjectComm((PetscObject)pc), PETSC_ERR_PLIB, "a rebuild after the finest smoother's interval was bounded");
-      for (PetscInt k = 0; k < nnz && on_K; ++k) on_K = (PetscBool)(r->built_vals[k] == pb->bulk_vals[k]);
+      for (PetscInt k = 0; k < nnz && on_K; ++k) on_K = (PetscBool)(r->built_vals[k] == br->vals[k]);
       PetscCall(MPIU_Allreduce(&on_K, &r->built_on_K, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)pc)));
     }
     PetscCall(ProlongatorRowsSet(user, PETSC_TRUE)); /* GAMG may reuse its prolongators: give them back whole */
@@ -494,6 +505,7 @@ PetscErrorCode PcReuseDestroy(AppCtx *user)
   PetscCall(PetscFree2(r->built_vals, r->dvals));
   PetscCall(VecDestroy(&r->pdiag));
   PetscCall(VecDestroy(&r->pcols));
+  PetscCall(PetscFree(r->built_active));
   PetscCall(PetscMemzero(r, sizeof(*r)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -1,5 +1,6 @@
 /* The discrete problem on one mesh: everything that depends on the mesh, set up and destroyed as a unit
    (the grid sequencing sets up one per level). */
+#include "contact.h"
 #include "mesh.h"
 #include "physics.h"
 #include "solver.h"
@@ -15,7 +16,6 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(BoundaryCheckFaceSets(dm, &user->scene));
   PetscCall(DMGetLabel(dm, "Face Sets", &user->prob.face_sets));
   PetscCall(MeshGetMaxCellDiameter(dm, &user->prob.h));
-  PetscCall(ContactComputeEps(user));
   PetscCall(ElasticitySetUpDiscretization(dm, user));
   PetscCall(BoundaryAddDirichlet(dm, user)); /* Gamma_D, before anything builds the section */
   PetscCall(ElasticityUpdateConstants(dm, user));
@@ -27,10 +27,21 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(BoundaryInsertDirichlet(dm, user, user->prob.loc_bc));
   PetscCall(AssemblyResolve(dm, user));                                      /* -assembly auto: fe or p1 for this mesh */
   if (user->prob.assembly == ASSEMBLY_FE) PetscCall(MeshIndexCellTypes(dm)); /* before PetscFE's closure per cell */
-  PetscCall(ContactSetCreate(dm, user, &user->prob.cset));
-  if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltySetUp(dm, user));
+  {
+    ContactProblem cp;
+
+    cp.bcs            = &user->scene.bcs;
+    cp.obstacle       = &user->scene.obstacle;
+    cp.material       = &user->opt.material;
+    cp.degree         = user->opt.degree;
+    cp.h              = user->prob.h;
+    cp.assembly       = user->prob.assembly; /* resolved above */
+    cp.assembly_check = user->opt.assembly_check;
+    cp.loc_bc         = user->prob.loc_bc;
+    cp.like           = user->prob.r0;
+    PetscCall(ContactSetUp(user->contact, dm, &cp)); /* the contact set, eps, the penalty's faces or SNESVI's bounds */
+  }
   PetscCall(SolverAssembleBulk(dm, user));
-  PetscCall(PenaltyFacesSetUp(dm, user)); /* with -assembly p1, resolved above */
   PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
   PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0));
   PetscCall(SolverComputeScales(dm, user));
@@ -48,14 +59,9 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes)
   PetscCall(MatDestroy(&user->prob.K));
   PetscCall(VecDestroy(&user->prob.r0));
   PetscCall(VecDestroy(&user->prob.loc_r0));
-  PetscCall(VecDestroy(&user->prob.xl));
-  PetscCall(VecDestroy(&user->prob.xu));
   PetscCall(VecDestroy(&user->prob.loc_bc));
   PetscCall(VecDestroy(&user->prob.work));
-  PetscCall(PetscWeakFormDestroy(&user->prob.wf_penalty));
-  PetscCall(PenaltyFacesDestroy(&user->prob.penalty_faces));
-  PetscCall(ContactSetDestroy(&user->prob.cset));
-  PetscCall(PenaltyFreeBulkRows(user));
+  PetscCall(ContactReset(user->contact));
   PetscCall(PcReuseDestroy(user));
   PetscCall(SolverStepGuessDrop(user));
   PetscFunctionReturn(PETSC_SUCCESS);

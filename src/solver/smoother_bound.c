@@ -6,8 +6,9 @@
    lambda_K the top eigenvalue of D_K^-1 K and beta that of D_P^-1/2 P D_P^-1/2, which Gershgorin bounds by the largest
    row sum of |p_ij| / sqrt(p_ii p_jj). So lambda_max(D_J^-1 J) <= max(lambda_K, beta): Chebyshev's estimate of lambda_K,
    made at the build on K, serves every later Newton step while beta stays below it, and beta replaces it when it does
-   not. An estimate costs ten products with the finest matrix (0.1 s at 512 x 512, at each update); the bound, a pass
+   not. An estimate costs ten products with the finest matrix at each update; the bound, a pass
    over the contact rows. The coarse levels still estimate again: their estimates cost little. */
+#include "contact.h"
 #include "solver.h"
 
 /* The finest level's smoother if it is Chebyshev with point Jacobi (the case the bound covers), else NULL. */
@@ -91,6 +92,7 @@ static PetscErrorCode FreshEstimate(Mat A, PetscInt steps, PetscReal *emin, Pets
 static PetscErrorCode PenaltyBound(AppCtx *user, const PetscScalar jvals[], PetscReal *beta)
 {
   Problem           *pb = &user->prob;
+  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
   PcReuse           *r  = &pb->pc_reuse;
   PetscInt           rstart;
   PetscScalar       *d;
@@ -100,22 +102,22 @@ static PetscErrorCode PenaltyBound(AppCtx *user, const PetscScalar jvals[], Pets
   PetscFunctionBeginUser;
   if (!r->pdiag) {
     PetscCall(MatCreateVecs(pb->K, &r->pdiag, NULL));
-    PetscCall(VecDuplicate(pb->bulk_x, &r->pcols));
+    PetscCall(VecDuplicate(br->x, &r->pcols));
   }
   PetscCall(MatGetOwnershipRange(pb->K, &rstart, NULL));
   PetscCall(VecSet(r->pdiag, 0.0));
   PetscCall(VecGetArray(r->pdiag, &d));
-  for (PetscInt row = 0; row < pb->nbulk_rows; ++row) d[pb->bulk_rows[row] - rstart] = jvals[pb->bulk_diag[row]] - pb->bulk_vals[pb->bulk_diag[row]];
+  for (PetscInt row = 0; row < br->n; ++row) d[br->rows[row] - rstart] = jvals[br->diag[row]] - br->vals[br->diag[row]];
   PetscCall(VecRestoreArray(r->pdiag, &d));
-  PetscCall(VecScatterBegin(pb->bulk_scatter, r->pdiag, r->pcols, INSERT_VALUES, SCATTER_FORWARD));
-  PetscCall(VecScatterEnd(pb->bulk_scatter, r->pdiag, r->pcols, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterBegin(br->scatter, r->pdiag, r->pcols, INSERT_VALUES, SCATTER_FORWARD));
+  PetscCall(VecScatterEnd(br->scatter, r->pdiag, r->pcols, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecGetArrayRead(r->pcols, &dcol));
-  for (PetscInt row = 0; row < pb->nbulk_rows && local < PETSC_MAX_REAL; ++row) {
-    const PetscReal pii = PetscRealPart(jvals[pb->bulk_diag[row]] - pb->bulk_vals[pb->bulk_diag[row]]);
+  for (PetscInt row = 0; row < br->n && local < PETSC_MAX_REAL; ++row) {
+    const PetscReal pii = PetscRealPart(jvals[br->diag[row]] - br->vals[br->diag[row]]);
     PetscReal       sum = 0.0;
 
-    for (PetscInt k = pb->bulk_ptr[row]; k < pb->bulk_ptr[row + 1]; ++k) {
-      const PetscReal pij = PetscAbsScalar(jvals[k] - pb->bulk_vals[k]), pjj = PetscRealPart(dcol[pb->bulk_lcols[k]]);
+    for (PetscInt k = br->ptr[row]; k < br->ptr[row + 1]; ++k) {
+      const PetscReal pij = PetscAbsScalar(jvals[k] - br->vals[k]), pjj = PetscRealPart(dcol[br->lcols[k]]);
 
       if (pij == 0.0) continue;
       if (pii <= 0.0 || pjj <= 0.0) {

@@ -1,6 +1,7 @@
 /* The nonlinear solve. The bulk operator is linear: K and r0 = F_bulk(0) are assembled once,
    the residual is K u + r0 + (contact terms) and the Jacobian K + (contact Jacobian). */
 #include <math.h>
+#include "contact.h"
 #include "physics.h"
 #include "solver.h"
 
@@ -23,7 +24,7 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   PetscCall(MatAssemblyBegin(user->prob.K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(user->prob.K, MAT_FINAL_ASSEMBLY));
   if (user->prob.assembly == ASSEMBLY_P1)
-    PetscCall(AssemblyP1Residual(dm, user, locX, locF)); /* 0.4 s instead of PetscFE's 3.3 s at 512 x 512 */
+    PetscCall(AssemblyP1Residual(dm, user, locX, locF)); /* the same residual without PetscFE's generic cell loop */
   else
     PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
   PetscCall(VecZeroEntries(user->prob.r0));
@@ -45,7 +46,7 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
 PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R)
 {
   PetscFunctionBeginUser;
-  PetscCall(PenaltyBulkMult(user, X, R)); /* K X, also while K holds the penalty Jacobian (which it leaves alone) */
+  PetscCall(ContactBulkMult(user->contact, user->prob.K, X, R)); /* K X, also while K holds the penalty Jacobian (which it leaves alone) */
   PetscCall(VecAXPY(R, 1.0, user->prob.r0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -70,7 +71,7 @@ static PetscErrorCode SolverResidual(DM dm, AppCtx *user, Vec u, Vec F)
 {
   PetscFunctionBeginUser;
   PetscCall(SolverBulkResidual(user, u, F));
-  if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltyAddResidual(dm, user, u, F));
+  PetscCall(ContactAddResidual(user->contact, dm, u, F));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -112,16 +113,9 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
   PetscFunctionBeginUser;
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(SolverIterateDisplacement(user, X, &u));
-  if (user->opt.contact.method == CONTACT_PENALTY) {
+  if (ContactHasPenalty(user->contact)) {
     PetscCall(PcReuseDecide(snes, dm, user, u));
-    if (P == user->prob.K)
-      PetscCall(PenaltyJacobianInK(dm, user, u)); /* P is K itself: one matrix */
-    else {                                        /* a copy of K (SBAIJ: no row access) */
-      PetscCall(MatCopy(user->prob.K, P, SAME_NONZERO_PATTERN));
-      PetscCall(PenaltyAddJacobian(dm, user, u, P));
-      PetscCall(MatAssemblyBegin(P, MAT_FINAL_ASSEMBLY));
-      PetscCall(MatAssemblyEnd(P, MAT_FINAL_ASSEMBLY));
-    }
+    PetscCall(ContactComputeJacobian(user->contact, dm, u, user->prob.K, P)); /* P is K itself, or a copy (SBAIJ: no row access) */
     PetscCall(PcReuseAfterJacobian(snes, user)); /* records the build's contact rows, or updates the GAMG hierarchy */
   }
   if (J != P) {
@@ -148,17 +142,11 @@ static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
    Newton has stopped making progress (SolverConverged()). */
 static PetscErrorCode SolverRoundoffFloor(SNES snes, AppCtx *user, PetscReal *floor)
 {
-  const ContactSet  *cs = &user->prob.cset;
-  Vec                X, u, D;
-  Mat                J;
-  const PetscScalar *x;
-  PetscReal          bulk, r0, gap = 0.0;
-  PetscInt           dim;
-  DM                 dm;
+  Vec       X, u, D;
+  Mat       J;
+  PetscReal bulk, r0, gap = 0.0;
 
   PetscFunctionBeginUser;
-  PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(DMGetDimension(dm, &dim));
   PetscCall(SNESGetSolution(snes, &X));
   PetscCall(SolverIterateDisplacement(user, X, &u));
   PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
@@ -169,13 +157,7 @@ static PetscErrorCode SolverRoundoffFloor(SNES snes, AppCtx *user, PetscReal *fl
   PetscCall(VecDestroy(&D));
   /* J is the Jacobian of F/U in u/U, that is of F in u: diag(J) u is in the user's units, as u (U x~) is */
   PetscCall(VecNorm(user->prob.r0, NORM_2, &r0));
-  if (user->opt.contact.method == CONTACT_PENALTY) {
-    PetscCall(VecGetArrayRead(u, &x));
-    for (PetscInt i = 0; i < cs->n; ++i)
-      if (ContactNodePenetration(cs, dim, i, x) > 0.0) gap += PetscSqr(cs->weight[i] * cs->gap[i] / ContactNodeEps(cs, user->prob.eps, i));
-    PetscCall(VecRestoreArrayRead(u, &x));
-    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &gap, 1, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
-  }
+  PetscCall(ContactRoundoffTerm(user->contact, u, &gap));
   *floor = PETSC_MACHINE_EPSILON * PetscSqrtReal(bulk * bulk + r0 * r0 + gap);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -197,7 +179,7 @@ static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, P
     PetscCall(SolverStopReference(user, &ref));
     *reason = f <= rtol * ref ? SNES_CONVERGED_FNORM_RELATIVE : SNES_CONVERGED_ITERATING;
   }
-  if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->opt.contact.load_rtol * user->prob.load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
+  if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->opt.solver.load_rtol * user->prob.load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
   /* A tolerance below what double precision can reach: Newton stalls at the round-off of the terms the residual sums
      (with eps far below h/E, (1/eps) times the displacement times the machine epsilon). Where a step did not halve |F|
      and |F| is within 100 times the estimated round-off (SolverRoundoffFloor()), it stops, converged at round-off,
@@ -205,7 +187,7 @@ static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, P
      never stopped here. */
   if (it == 0) user->prob.roundoff_stop = PETSC_FALSE;
   if (*reason <= 0 && it > 0 && !PetscIsInfOrNanReal(f) && f > 0.5 * user->prob.fnorm_last) {
-    PetscReal floor;
+    PetscReal floor = 0.0;
 
     PetscCall(SolverRoundoffFloor(snes, user, &floor));
     if (f <= 100.0 * floor) {
@@ -226,7 +208,6 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
   Vec         zero, F, KF;
   PetscScalar fkf;
   PetscReal   finf, U = 1.0;
-  Mat         K;
 
   PetscFunctionBeginUser;
   PetscCall(VecDuplicate(user->prob.r0, &user->prob.work)); /* DMCreateGlobalVector() would scan every mesh point again */
@@ -241,8 +222,7 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
              (double)user->prob.load_norm);
   if (user->prob.load_norm > 0.0) {
     PetscCall(VecNorm(F, NORM_INFINITY, &finf));
-    PetscCall(PenaltyBulkOperator(user, &K));
-    PetscCall(MatMult(K, F, KF));
+    PetscCall(ContactBulkMult(user->contact, user->prob.K, F, KF));
     PetscCall(VecDot(F, KF, &fkf));
     if (PetscRealPart(fkf) > 0.0) U = PetscSqr(user->prob.load_norm) / PetscRealPart(fkf) * finf;
     if (!(U > 0.0) || PetscIsInfOrNanReal(U)) U = 1.0;
@@ -263,7 +243,7 @@ static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
   PC pc;
 
   PetscFunctionBeginUser;
-  PetscCall(KSPSetType(ksp, user->opt.contact.method == CONTACT_PENALTY && user->opt.contact.pc_reuse ? KSPCG : KSPPREONLY));
+  PetscCall(KSPSetType(ksp, ContactHasPenalty(user->contact) && user->opt.solver.pc_reuse ? KSPCG : KSPPREONLY));
   PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCSetType(pc, PCLU));
@@ -294,9 +274,9 @@ static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &is_factor, PCLU, PCCHOLESKY, ""));
   if (is_factor) PetscFunctionReturn(PETSC_SUCCESS); /* a factorization: CG converges in one or a few iterations anyway */
   PetscCall(PetscOptionsHasName(NULL, NULL, "-ksp_norm_type", &set));
-  if (is_cg && !set && user->opt.contact.method == CONTACT_NONE) PetscCall(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED));
+  if (is_cg && !set && ContactIsNone(user->contact)) PetscCall(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED));
   PetscCall(PetscOptionsHasName(NULL, NULL, "-snes_ksp_ew", &set));
-  if (!set && user->opt.contact.method == CONTACT_PENALTY) {
+  if (!set && ContactHasPenalty(user->contact)) {
     PetscCall(SNESKSPSetUseEW(snes, PETSC_TRUE));
     PetscCall(PetscOptionsHasName(NULL, NULL, "-snes_ksp_ew_rtolmax", &set));
     if (!set)
@@ -335,10 +315,10 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   {
     PetscBool sbaij;
 
-    /* the Jacobian is K itself: for the penalty method K + P in the contact rows (PenaltyJacobianInK()); a symmetric
+    /* the Jacobian is K itself: for the penalty method K + P in the contact rows (ContactComputeJacobian()); a symmetric
        block matrix gives no access to its rows below the diagonal, so there the penalty Jacobian is a copy of K */
     PetscCall(PetscObjectTypeCompareAny((PetscObject)user->prob.K, &sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
-    if (user->opt.contact.method == CONTACT_PENALTY && sbaij) {
+    if (ContactHasPenalty(user->contact) && sbaij) {
       MatNullSpace rigid;
 
       PetscCall(MatDuplicate(user->prob.K, MAT_COPY_VALUES, &J));
@@ -351,33 +331,19 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
       PetscCall(PetscObjectReference((PetscObject)J));
       /* K and K + the penalty Jacobian are symmetric positive definite (semi-definite at worst; CG needs it anyway):
          PETSc then estimates eigenvalues by CG (Lanczos) rather than GMRES, as GAMG's Chebyshev smoothers do on the
-         finest level (GMRES kept 10 vectors of that size: 51 MB at 512 x 512) */
+         finest level, without GMRES's 10 vectors of the finest size */
       PetscCall(PetscObjectTypeCompareAny((PetscObject)J, &is_aij, MATSEQAIJ, MATMPIAIJ, ""));
-      if (user->opt.contact.method != CONTACT_VI && is_aij) { /* (BAIJ in 3.18 refuses MAT_SPD_ETERNAL) */
+      if (!ContactHasBounds(user->contact) && is_aij) { /* (BAIJ in 3.18 refuses MAT_SPD_ETERNAL) */
         PetscCall(MatSetOption(J, MAT_SPD, PETSC_TRUE));
         PetscCall(MatSetOption(J, MAT_SPD_ETERNAL, PETSC_TRUE));
       }
-      if (user->opt.contact.method == CONTACT_PENALTY) PetscCall(PenaltySaveBulkRows(dm, user));
+      PetscCall(ContactPrepareOperator(user->contact, dm, J)); /* the penalty keeps K's own contact rows */
     }
   }
   PetscCall(SNESSetFunction(*snes, NULL, FormFunction, user));
   PetscCall(SNESSetJacobian(*snes, J, J, FormJacobian, user));
   PetscCall(MatDestroy(&J));
-  if (user->opt.contact.method == CONTACT_VI) {
-    PetscCall(SNESSetType(*snes, SNESVINEWTONRSLS));
-    PetscCall(VICreateBounds(dm, user));
-    PetscCall(SNESVISetVariableBounds(*snes, user->prob.xl, user->prob.xu));
-  } else {
-    SNESLineSearch ls;
-
-    PetscCall(SNESSetType(*snes, SNESNEWTONLS));
-    /* the penalty problem is the minimization of a convex energy: the critical-point line search keeps the semismooth Newton
-       converging for small eps, where backtracking on |F| stalls (32x32 mms, eps = 1e-5: bt fails, cp converges) */
-    PetscCall(SNESGetLineSearch(*snes, &ls));
-    PetscCall(SNESLineSearchSetType(ls, SNESLINESEARCHCP));
-    /* no convergence on a small step: with eps = 1e-7 (128x128 mms) it stopped Newton at |F| = 3e-4, far from the solution */
-    PetscCall(SNESSetTolerances(*snes, PETSC_DEFAULT, PETSC_DEFAULT, 0.0, PETSC_DEFAULT, PETSC_DEFAULT));
-  }
+  PetscCall(ContactSetUpSNES(user->contact, dm, *snes)); /* SNESVI with its bounds, or semismooth Newton */
   {
     SNESLineSearch ls;
 
@@ -410,7 +376,7 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscBool is_preonly;
 
     PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &is_preonly));
-    user->prob.pc_reuse.enabled = (PetscBool)(user->opt.contact.method == CONTACT_PENALTY && user->opt.contact.pc_reuse && !is_preonly);
+    user->prob.pc_reuse.enabled = (PetscBool)(ContactHasPenalty(user->contact) && user->opt.solver.pc_reuse && !is_preonly);
   }
   PetscCall(SolverSetIterativeDefaults(*snes, user));
   {
@@ -426,9 +392,13 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
         !(petsc_presolve && fine), comm, PETSC_ERR_USER_INPUT,
         "-mg_fine_ksp_type and -mg_fine_pc_type need -snes_ksp_ew_version 2 (or no Eisenstat-Walker): another version keeps PETSc's own pre-solve");
   }
-  PetscCheck(is_vi == (user->opt.contact.method == CONTACT_VI), comm, PETSC_ERR_USER_INPUT,
-             "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type,
-             ContactMethods[user->opt.contact.method]);
+  {
+    ContactType ctype;
+
+    PetscCall(ContactGetType(user->contact, &ctype));
+    PetscCheck(is_vi == ContactHasBounds(user->contact), comm, PETSC_ERR_USER_INPUT,
+               "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type, ctype);
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -454,7 +424,7 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   PetscCall(SolverStopReference(user, &ref));
   user->rec.stats.residual_reduced =
       (PetscBool)(user->rec.stats.residual_norm <= rtol * ref ||
-                  user->rec.stats.residual_norm <= user->opt.contact.load_rtol * user->prob.load_norm || fnorm <= atol || user->prob.roundoff_stop);
+                  user->rec.stats.residual_norm <= user->opt.solver.load_rtol * user->prob.load_norm || fnorm <= atol || user->prob.roundoff_stop);
   user->rec.stats.roundoff_stop = user->prob.roundoff_stop;
   user->rec.stats.converged     = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
   PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
@@ -467,9 +437,6 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
 static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal time_solve)
 {
   SolveRecord       *r;
-  const PetscScalar *x;
-  PetscInt           dim;
-  PetscReal          pen = 0.0;
   DM                 dm;
 
   PetscFunctionBeginUser;
@@ -484,15 +451,12 @@ static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal 
   }
   r = &user->rec.records[user->rec.nrecords++];
   PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(VecGetArrayRead(u, &x));
-  for (PetscInt i = 0; i < user->prob.cset.n; ++i) pen = PetscMax(pen, ContactNodePenetration(&user->prob.cset, dim, i, x));
-  PetscCall(VecRestoreArrayRead(u, &x));
-  PetscCall(MPIU_Allreduce(&pen, &r->max_penetration, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
+  PetscCall(ContactMaxNodePenetration(user->contact, u, &r->max_penetration));
   PetscCall(VecGetSize(u, &r->n_dofs));
   r->level              = user->prob.level;
   r->h                  = user->prob.h;
-  r->eps                = user->opt.contact.method == CONTACT_PENALTY ? user->prob.eps : 0.0;
+  r->eps                = 0.0;
+  if (ContactHasPenalty(user->contact)) PetscCall(ContactGetEps(user->contact, &r->eps));
   r->newton_its         = user->rec.stats.newton_its;
   r->ksp_its            = user->rec.stats.ksp_its;
   r->pc_builds          = user->rec.stats.pc_builds;
@@ -511,13 +475,11 @@ static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
   PetscFunctionBeginUser;
   user->prob.snes_scale = U;
   PetscCall(VecScale(u, 1.0 / U));
-  if (user->prob.xl) PetscCall(VecScale(user->prob.xl, 1.0 / U));
-  if (user->prob.xu) PetscCall(VecScale(user->prob.xu, 1.0 / U));
+  PetscCall(ContactScaleBounds(user->contact, 1.0 / U));
   PetscCall(SNESSolve(snes, NULL, u));
   PetscCall(SolverStepGuessDrop(user)); /* unused if no linear solve came */
   PetscCall(VecScale(u, U));
-  if (user->prob.xl) PetscCall(VecScale(user->prob.xl, U));
-  if (user->prob.xu) PetscCall(VecScale(user->prob.xu, U));
+  PetscCall(ContactScaleBounds(user->contact, U));
   user->prob.snes_scale = 1.0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -550,13 +512,17 @@ static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
 {
   const PetscBool warm       = (PetscBool)(start != SOLVER_START_ZERO);
-  const PetscReal eps_target = user->prob.eps, eps_start = user->prob.h / ContactPenaltyModulus(user);
+  PetscReal       eps_target, eps_start;
   PetscLogDouble  t0, t1;
   PetscInt        newton = 0, ksp = 0;
   DM              dm;
+  const ContactOptions *copt;
 
   PetscFunctionBeginUser;
+  PetscCall(ContactGetOptions(user->contact, &copt));
   PetscCall(SNESGetDM(snes, &dm));
+  PetscCall(ContactGetEps(user->contact, &eps_target));
+  PetscCall(ContactGetPenaltyScale(user->contact, &eps_start));
   if (!warm) PetscCall(VecZeroEntries(u));
   PetscCall(MultigridSetUpPC(snes, user)); /* -pc_type mg: the levels of the meshes solved so far */
   user->prob.warm = warm;
@@ -564,16 +530,14 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
   user->prob.pc_reuse.builds          = 0; /* counted per solve */
   user->prob.pc_reuse.updates         = 0;
   user->rec.stats.continuation_stages = 0;
-  if (start != SOLVER_START_NEARBY_EPS && user->opt.contact.method == CONTACT_PENALTY && user->opt.contact.continuation && eps_target < eps_start) {
-    for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= user->opt.contact.continuation_factor) {
-      user->prob.eps = eps;
-      PetscCall(ElasticityUpdateConstants(dm, user));
+  if (start != SOLVER_START_NEARBY_EPS && ContactHasPenalty(user->contact) && copt->continuation && eps_target < eps_start) {
+    for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= copt->continuation_factor) {
+      PetscCall(ContactSetEps(user->contact, dm, eps));
       PetscCall(SolveRecovering(snes, user, u, &newton, &ksp));
       user->rec.stats.continuation_stages++;
       if (!user->rec.stats.converged) break; /* reported as the failure of the whole solve */
     }
-    user->prob.eps = eps_target;
-    PetscCall(ElasticityUpdateConstants(dm, user));
+    PetscCall(ContactSetEps(user->contact, dm, eps_target));
   }
   if (user->rec.stats.continuation_stages == 0 || user->rec.stats.converged) {
     PetscCall(SolveRecovering(snes, user, u, &newton, &ksp));
@@ -601,10 +565,10 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
 
   PetscFunctionBeginUser;
   user->rec.stats.condition_1norm = PETSC_NAN;
-  if (!user->opt.contact.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt.solver.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
-  if (user->opt.contact.method == CONTACT_VI) {
+  if (ContactHasBounds(user->contact)) {
     J = user->prob.K;
     PetscCall(KSPCreate(PetscObjectComm((PetscObject)snes), &ksp_vi));
     PetscCall(SolverSetDefaultLinearSolver(ksp_vi, user));

@@ -3,13 +3,11 @@
    penalty's active points it is not taken as Newton's first iterate, whose Jacobian would miss them and whose steps
    the line search then cut at those kinks. Newton starts from the last solution instead, and its first linear solve,
    the step to the new eps with the last solution's active points, starts from the step the guess predicts.
-   256 x 256 with GAMG, the values 1e-2 h and 1e-3 h after h and h/10: the active points of the last solution were the
-   answer's, and the guess had lifted 3 and 1 of them (a temporary count); the two values took 2 Newton steps and 15
-   and 14 CG iterations instead of 3 and 22 each.
    The linear solve is then asked to reduce the smaller of its first residual and its right-hand side's
    (KSPConvergedDefaultSetUMIRNorm()): relative to the right-hand side alone, as PETSc measures a nonzero guess by default,
-   the forcing term was met almost at once and Newton took 4 and 5 steps. The test stays so set for later solves, where
-   it changes nothing unless the options ask for a nonzero initial guess, which it then measures the same way. */
+   a close guess meets the forcing term almost at once, and Newton, left with the guess as its step, needs more steps.
+   The test stays so set for later solves, where it changes nothing unless the options ask for a nonzero initial guess,
+   which it then measures the same way. */
 #include "solver.h"
 
 /* At the SNES's set-up: what the options asked of its KSP. */

@@ -19,19 +19,20 @@ PetscErrorCode ErrorNormsReset(ErrorNorms *e)
 /* loc_p = p n at the nodes of Gamma_C, from the nodal pressures of the contact set (zero elsewhere). */
 PetscErrorCode ErrorNormsPressureVector(DM dm, AppCtx *user, Vec loc_p)
 {
-  Vec          P;
-  PetscScalar *p;
-  PetscInt     dim;
+  Vec               P;
+  PetscScalar      *p;
+  PetscInt          dim;
+  const ContactSet *cs;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMGetGlobalVector(dm, &P));
   PetscCall(VecZeroEntries(P));
   PetscCall(VecGetArray(P, &p));
-  for (PetscInt i = 0; i < user->prob.cset.n; ++i) /* fixed components stay 0 */
+  PetscCall(ContactGetSet(user->contact, &cs));
+  for (PetscInt i = 0; i < cs->n; ++i) /* fixed components stay 0 */
     for (PetscInt c = 0; c < dim; ++c)
-      if (user->prob.cset.dof[i * dim + c] >= 0)
-        p[user->prob.cset.dof[i * dim + c]] = user->prob.cset.pressure[i] * user->prob.cset.normal[i * dim + c];
+      if (cs->dof[i * dim + c] >= 0) p[cs->dof[i * dim + c]] = cs->pressure[i] * cs->normal[i * dim + c];
   PetscCall(VecRestoreArray(P, &p));
   PetscCall(VecZeroEntries(loc_p));
   PetscCall(DMGlobalToLocal(dm, P, INSERT_VALUES, loc_p));
@@ -91,8 +92,10 @@ static PetscErrorCode IntegrateContact(DM dm, AppCtx *user, CellQuadrature *cq, 
   const PetscInt dim = cq->dim;
   PetscInt      *faces, nf;
   PetscScalar   *elem;
+  PetscReal      eps; /* of the run, for the penalty law p = [u_n - g]_+ / eps */
 
   PetscFunctionBeginUser;
+  PetscCall(ContactGetEps(user->contact, &eps));
   PetscCall(PetscMalloc1(PetscMax(cq->Nb, 1), &elem));
   for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
     PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces)); /* of this mesh, maybe a refinement of the run's */
@@ -119,7 +122,7 @@ static PetscErrorCode IntegrateContact(DM dm, AppCtx *user, CellQuadrature *cq, 
           PetscCall(CellQuadratureInterpolate(cq, ph, q, v, NULL));
           for (PetscInt k = 0; k < dim; ++k) p_h += v[k] * n[k];
         } else
-          p_h = d > 0.0 ? d / user->prob.eps : 0.0;
+          p_h = d > 0.0 ? d / eps : 0.0;
         if (t->scene) {
           PetscReal sn;
 
@@ -212,7 +215,9 @@ PetscErrorCode ErrorNormsEvaluate(DM dm, AppCtx *user, Mat K, Vec loc_uh, Vec lo
   e->penetration_l2  = PetscSqrtReal(gcontact[1]);
   e->penetration_max = PetscMax(gmax, 0.0);
   if (target) {
-    const PetscReal weight = user->opt.contact.method == CONTACT_PENALTY ? user->prob.eps : user->prob.h;
+    PetscReal weight = user->prob.h;
+
+    if (ContactHasPenalty(user->contact)) PetscCall(ContactGetEps(user->contact, &weight));
 
     e->l2                = PetscSqrtReal(gbulk[0]);
     e->h1_semi           = PetscSqrtReal(gbulk[1]);
@@ -230,7 +235,6 @@ PetscErrorCode ErrorNormsEvaluate(DM dm, AppCtx *user, Mat K, Vec loc_uh, Vec lo
 PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
 {
   Vec         loc_uh, loc_ph = NULL;
-  Mat         K;
   ErrorTarget exact = {&user->scene, NULL, NULL};
 
   PetscFunctionBeginUser;
@@ -239,12 +243,17 @@ PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(DMGetLocalVector(dm, &loc_uh));
   PetscCall(VecCopy(user->prob.loc_bc, loc_uh)); /* the Dirichlet values, inserted once by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc_uh));
-  if (user->opt.contact.method != CONTACT_PENALTY) {
+  if (!ContactHasPenalty(user->contact)) {
     PetscCall(DMGetLocalVector(dm, &loc_ph));
     PetscCall(ErrorNormsPressureVector(dm, user, loc_ph));
   }
-  PetscCall(PenaltyBulkOperator(user, &K)); /* the elastic operator, not the penalty Jacobian */
-  PetscCall(ErrorNormsEvaluate(dm, user, K, loc_uh, loc_ph, user->scene.exact && user->scene.exact_gradient ? &exact : NULL, &user->rec.errors));
+  if (user->scene.exact && user->scene.exact_gradient) {
+    Mat K;
+
+    PetscCall(ContactBulkOperator(user->contact, user->prob.K, &K)); /* K, or a copy without the penalty Jacobian: K is read only */
+    PetscCall(ErrorNormsEvaluate(dm, user, K, loc_uh, loc_ph, &exact, &user->rec.errors));
+    PetscCall(MatDestroy(&K));
+  } else PetscCall(ErrorNormsEvaluate(dm, user, NULL, loc_uh, loc_ph, NULL, &user->rec.errors));
   if (loc_ph) PetscCall(DMRestoreLocalVector(dm, &loc_ph));
   PetscCall(DMRestoreLocalVector(dm, &loc_uh));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -459,7 +459,7 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
              user->opt.verify.reference, ref.ncells, ncells);
 
   /* the run's displacement and, without the penalty law, its nodal pressure, on the refined mesh */
-  nvec = user->opt.contact.method == CONTACT_PENALTY ? 1 : 2;
+  nvec = ContactHasPenalty(user->contact) ? 1 : 2;
   PetscCall(DMCreateLocalVector(dm, &loc[0]));
   PetscCall(VecCopy(user->prob.loc_bc, loc[0])); /* the Dirichlet values, inserted by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc[0]));
@@ -475,10 +475,8 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(MatchReference(fine, user, &ref, loc_uref, loc_pref));
   PetscCall(ReferenceDestroy(&ref));
 
-  if (levels == 0) {                          /* the same mesh: the run's operator */
-    PetscCall(PenaltyBulkOperator(user, &K)); /* the elastic operator, not the penalty Jacobian */
-    PetscCall(PetscObjectReference((PetscObject)K));
-  } else {
+  if (levels == 0) PetscCall(ContactBulkOperator(user->contact, user->prob.K, &K)); /* the run's bulk operator, K read only */
+  else {
     Vec locX;
 
     PetscCall(DMCreateMatrix(fine, &K));

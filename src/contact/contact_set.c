@@ -1,8 +1,7 @@
 /* The nodes of Gamma_C: where the contact acts, their gap and their lumped boundary mass. */
 #include <petscsf.h>
+#include "contact_impl.h"
 #include "mesh.h"
-#include "obstacle.h"
-#include "physics.h"
 
 static void f0_bd_one(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],
                       const PetscScalar u_t[], const PetscScalar u_x[], const PetscInt aOff[], const PetscInt aOff_x[], const PetscScalar a[],
@@ -13,14 +12,14 @@ static void f0_bd_one(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt 
 }
 
 /* locF += the boundary residual of the part of wf over every contact face set (Gamma_C may be several). */
-PetscErrorCode ContactComputeBdResidual(DM dm, const AppCtx *user, PetscWeakForm wf, PetscInt part, Vec locX, Vec locF)
+PetscErrorCode ContactComputeBdResidual(Contact ct, DM dm, PetscWeakForm wf, PetscInt part, Vec locX, Vec locF)
 {
   PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < user->scene.bcs.ncontact; ++i) {
+  for (PetscInt i = 0; i < ct->nids; ++i) {
     PetscFormKey key;
 
-    key.label = user->prob.face_sets;
-    key.value = user->scene.bcs.contact_ids[i];
+    key.label = ct->face_sets;
+    key.value = ct->ids[i];
     key.field = 0;
     key.part  = part;
     PetscCall(CompatComputeBdResidualSingle(dm, wf, key, locX, locF));
@@ -29,7 +28,7 @@ PetscErrorCode ContactComputeBdResidual(DM dm, const AppCtx *user, PetscWeakForm
 }
 
 /* m_i = integral over Gamma_C of the basis function of node i, in the global vector M. */
-static PetscErrorCode ContactLumpedMass(DM dm, AppCtx *user, Vec M)
+static PetscErrorCode ContactLumpedMass(Contact ct, DM dm, Vec M)
 {
   PetscWeakForm wf;
   Vec           locX, locM;
@@ -41,9 +40,8 @@ static PetscErrorCode ContactLumpedMass(DM dm, AppCtx *user, Vec M)
   PetscCall(DMGetLocalVector(dm, &locM));
   PetscCall(VecZeroEntries(locX));
   PetscCall(VecZeroEntries(locM));
-  for (PetscInt i = 0; i < user->scene.bcs.ncontact; ++i)
-    PetscCall(PetscWeakFormSetIndexBdResidual(wf, user->prob.face_sets, user->scene.bcs.contact_ids[i], 0, 0, 0, f0_bd_one, 0, NULL));
-  PetscCall(ContactComputeBdResidual(dm, user, wf, 0, locX, locM));
+  for (PetscInt i = 0; i < ct->nids; ++i) PetscCall(PetscWeakFormSetIndexBdResidual(wf, ct->face_sets, ct->ids[i], 0, 0, 0, f0_bd_one, 0, NULL));
+  PetscCall(ContactComputeBdResidual(ct, dm, wf, 0, locX, locM));
   PetscCall(VecZeroEntries(M));
   PetscCall(DMLocalToGlobal(dm, locM, ADD_VALUES, M));
   PetscCall(DMRestoreLocalVector(dm, &locX));
@@ -53,21 +51,22 @@ static PetscErrorCode ContactLumpedMass(DM dm, AppCtx *user, Vec M)
 }
 
 /* eps at a local size h_local over eps at h: (h_local / h)^power (1 for a fixed -penalty_eps or -penalty_eps_local 0). */
-PetscReal ContactEpsFactor(const AppCtx *user, PetscReal h_local)
+PetscReal ContactEpsFactor(Contact ct, PetscReal h_local)
 {
-  if (user->opt.contact.eps_fixed > 0.0 || !user->opt.contact.eps_local || h_local <= 0.0) return 1.0;
-  return PetscPowReal(h_local / user->prob.h, user->opt.contact.eps_power);
+  if (ct->opt.eps_fixed > 0.0 || !ct->opt.eps_local || h_local <= 0.0) return 1.0;
+  return PetscPowReal(h_local / ct->h, ct->opt.eps_power);
 }
 
-PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
+/* The nodes of Gamma_C owned by this rank with a free component, and the eps factors of its faces and nodes. */
+PetscErrorCode ContactSetBuild(Contact ct, DM dm, Vec like)
 {
+  ContactSet        *cs   = &ct->set;
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
   PetscSection       lsec, gsec;
   PetscInt           dim, npts = 0, *pts = NULL, rstart;
   Vec                M;
   const PetscScalar *m, *bcv, *hn;
   Vec                H;
-  PetscScalar        obstacle[OBSTACLE_NUM_PARAMS];
   PetscReal          face_range[2] = {PETSC_MAX_REAL, PETSC_MAX_REAL}; /* min and -max of the eps factors of the contact faces */
 
   PetscFunctionBeginUser;
@@ -84,13 +83,13 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
     PetscInt          *faces, nf, pStart, pEnd;
 
     PetscCall(DMGetLocalVector(dm, &locI));
-    PetscCall(VecDuplicate(user->prob.r0, &mark));
+    PetscCall(VecDuplicate(like, &mark));
     PetscCall(VecZeroEntries(locI));
     PetscCall(DMGetLocalVector(dm, &locH));
     PetscCall(VecZeroEntries(locH));
     PetscCall(VecGetArray(locH, &lh));
-    for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
-      PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces));
+    for (PetscInt s = 0; s < ct->nids; ++s) {
+      PetscCall(MeshGetBoundaryFaces(dm, ct->ids[s], &nf, &faces));
       for (PetscInt i = 0; i < nf; ++i) {
         PetscInt *closure = NULL, ncl;
 
@@ -99,8 +98,8 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
 
         PetscCall(DMPlexGetSupport(dm, faces[i], &support));
         PetscCall(MeshCellDiameter(dm, support[0], &diam));
-        face_range[0] = PetscMin(face_range[0], ContactEpsFactor(user, diam));
-        face_range[1] = PetscMin(face_range[1], -ContactEpsFactor(user, diam));
+        face_range[0] = PetscMin(face_range[0], ContactEpsFactor(ct, diam));
+        face_range[1] = PetscMin(face_range[1], -ContactEpsFactor(ct, diam));
         PetscCall(DMPlexGetTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
         for (PetscInt j = 0; j < ncl; ++j) {
           PetscInt dof, off;
@@ -116,7 +115,7 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
       }
       PetscCall(PetscFree(faces));
     }
-    PetscCall(VecDuplicate(user->prob.r0, &H)); /* the largest cell at each node's contact faces, over all ranks */
+    PetscCall(VecDuplicate(like, &H)); /* the largest cell at each node's contact faces, over all ranks */
     PetscCall(VecZeroEntries(H));
     {
       PetscSF      sf;
@@ -135,7 +134,7 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
     PetscCall(VecZeroEntries(mark));
     PetscCall(DMLocalToGlobal(dm, locI, ADD_VALUES, mark));
     PetscCall(VecGetOwnershipRange(mark, &rstart, NULL));
-    if (user->opt.degree == 1)
+    if (ct->degree == 1)
       PetscCall(DMPlexGetDepthStratum(dm, 0, &pStart, &pEnd)); /* P1/Q1: the nodes are the vertices */
     else
       PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
@@ -155,17 +154,15 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
     PetscCall(DMRestoreLocalVector(dm, &locI));
   }
 
-  PetscCall(VecDuplicate(user->prob.r0, &M));
-  PetscCall(ContactLumpedMass(dm, user, M));
+  PetscCall(VecDuplicate(like, &M));
+  PetscCall(ContactLumpedMass(ct, dm, M));
   PetscCall(VecGetOwnershipRange(M, &rstart, NULL));
   PetscCall(VecGetArrayRead(M, &m));
-  ObstaclePack(&user->scene.obstacle, obstacle);
   PetscCall(VecGetArrayRead(H, &hn));
-  PetscCall(VecGetArrayRead(user->prob.loc_bc, &bcv));
+  PetscCall(VecGetArrayRead(ct->loc_bc, &bcv));
   PetscCall(PetscMalloc4(npts, &cs->point, npts, &cs->global_off, npts * dim, &cs->dof, npts, &cs->is_vertex));
   PetscCall(PetscMalloc3(npts * dim, &cs->fixed, npts * dim, &cs->normal, npts, &cs->eps_factor));
   PetscCall(PetscMalloc4(npts, &cs->gap, npts, &cs->weight, npts, &cs->active, npts, &cs->pressure));
-  PetscCall(PetscCalloc1(npts, &cs->built_active));
   PetscCall(PetscCalloc1(npts, &cs->reaction));
   for (PetscInt i = 0; i < npts; ++i) {
     const PetscInt  p    = pts[i];
@@ -195,23 +192,23 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
         cs->fixed[cs->n * dim + c] = 0.0;
       }
     }
-    ObstacleGapNormal(dim, obstacle, x, &cs->normal[cs->n * dim], &cs->gap[cs->n]);
+    ObstacleGapNormal(dim, ct->obstacle_packed, x, &cs->normal[cs->n * dim], &cs->gap[cs->n]);
     cs->point[cs->n]      = p;
     cs->global_off[cs->n] = goff - rstart;
     cs->is_vertex[cs->n]  = (PetscBool)(depth == 0);
-    cs->eps_factor[cs->n] = ContactEpsFactor(user, PetscRealPart(hn[goff - rstart]));
+    cs->eps_factor[cs->n] = ContactEpsFactor(ct, PetscRealPart(hn[goff - rstart]));
     cs->weight[cs->n]     = PetscRealPart(m[goff - rstart]);
     cs->active[cs->n]     = PETSC_FALSE;
     cs->pressure[cs->n]   = 0.0;
     cs->n++;
   }
-  PetscCall(VecRestoreArrayRead(user->prob.loc_bc, &bcv));
+  PetscCall(VecRestoreArrayRead(ct->loc_bc, &bcv));
   PetscCall(VecRestoreArrayRead(H, &hn));
   PetscCall(VecDestroy(&H));
   {
     PetscReal range[2] = {PETSC_MAX_REAL, PETSC_MAX_REAL}, grange[2];
 
-    if (user->opt.contact.quadrature == PENALTY_QUADRATURE_GAUSS) { /* eps of each face */
+    if (ct->opt.quadrature == PENALTY_QUADRATURE_GAUSS) { /* eps of each face */
       range[0] = face_range[0];
       range[1] = face_range[1];
     } else /* eps of each node */
@@ -220,10 +217,10 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
         range[1] = PetscMin(range[1], -cs->eps_factor[i]);
       }
     PetscCall(MPIU_Allreduce(range, grange, 2, MPIU_REAL, MPIU_MIN, comm));
-    user->prob.eps_factor_min = grange[0];
-    user->prob.eps_factor_max = -grange[1];
+    ct->eps_factor_min = grange[0];
+    ct->eps_factor_max = -grange[1];
     /* the cells of a uniform mesh differ in diameter by rounding (a 3D Kuhn box by 1e-16): one eps there */
-    user->prob.eps_local = (PetscBool)(user->prob.eps_factor_max - user->prob.eps_factor_min > 1e-12 * user->prob.eps_factor_max);
+    ct->eps_local = (PetscBool)(ct->eps_factor_max - ct->eps_factor_min > 1e-12 * ct->eps_factor_max);
   }
   PetscCall(VecRestoreArrayRead(M, &m));
   PetscCall(VecDestroy(&M));
@@ -231,45 +228,91 @@ PetscErrorCode ContactSetCreate(DM dm, AppCtx *user, ContactSet *cs)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode ContactSetDestroy(ContactSet *cs)
+PetscErrorCode ContactSetFree(ContactSet *cs)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscFree4(cs->point, cs->global_off, cs->dof, cs->is_vertex));
   PetscCall(PetscFree3(cs->fixed, cs->normal, cs->eps_factor));
   PetscCall(PetscFree4(cs->gap, cs->weight, cs->active, cs->pressure));
-  PetscCall(PetscFree(cs->built_active));
   PetscCall(PetscFree(cs->reaction));
   cs->n = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* A vertex of Gamma_C is active when it penetrates (penalty) or sits on its bound (vi).
-   With update, the active flags are stored and the vertices that entered and left are counted. */
-PetscErrorCode ContactCountActive(AppCtx *user, Vec X, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left)
+/* A vertex of Gamma_C is active when it penetrates (penalty) or sits on its bound (vi: within tol_scale * 1e-10, tol_scale
+   the size of the displacement); no vertex is active without contact. With update, the active flags are stored and the
+   vertices that entered and left are counted. */
+PetscErrorCode ContactCountActive(Contact ct, Vec X, PetscReal tol_scale, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left)
 {
-  const PetscReal    tol = user->opt.contact.method == CONTACT_VI ? 1e-10 * user->prob.displacement_scale : 0.0; /* on the bound, for vi */
+  ContactSet        *cs  = &ct->set;
+  const PetscReal    tol = ct->has_bounds ? 1e-10 * tol_scale : 0.0;
+  const PetscBool    any = (PetscBool)(ct->has_penalty || ct->has_bounds);
   const PetscScalar *x;
-  PetscInt           dim, local[3] = {0, 0, 0}, global[3];
-  DM                 dm;
+  PetscInt           local[3] = {0, 0, 0}, global[3];
 
   PetscFunctionBeginUser;
-  PetscCall(VecGetDM(X, &dm));
-  PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetArrayRead(X, &x));
-  for (PetscInt i = 0; i < user->prob.cset.n; ++i) {
+  for (PetscInt i = 0; i < cs->n; ++i) {
     PetscBool on;
 
-    if (!user->prob.cset.is_vertex[i]) continue;
-    on = (PetscBool)(user->opt.contact.method != CONTACT_NONE && ContactNodePenetration(&user->prob.cset, dim, i, x) > -tol);
+    if (!cs->is_vertex[i]) continue;
+    on = (PetscBool)(any && ContactNodePenetration(cs, ct->dim, i, x) > -tol);
     local[0] += on;
-    local[1] += on && !user->prob.cset.active[i];
-    local[2] += !on && user->prob.cset.active[i];
-    if (update) user->prob.cset.active[i] = on;
+    local[1] += on && !cs->active[i];
+    local[2] += !on && cs->active[i];
+    if (update) cs->active[i] = on;
   }
   PetscCall(VecRestoreArrayRead(X, &x));
-  PetscCall(MPIU_Allreduce(local, global, 3, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
+  PetscCall(MPIU_Allreduce(local, global, 3, MPIU_INT, MPI_SUM, ct->comm));
   *active = global[0];
   if (entered) *entered = global[1];
   if (left) *left = global[2];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* An order-independent hash of the penetrating vertices of Gamma_C, the same on any number of ranks. */
+PetscErrorCode ContactPenetrationHash(Contact ct, Vec X, PetscInt64 *hash)
+{
+  const ContactSet  *cs = &ct->set;
+  const PetscScalar *x;
+  PetscInt           rstart;
+  PetscInt64         local = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetOwnershipRange(X, &rstart, NULL));
+  PetscCall(VecGetArrayRead(X, &x));
+  for (PetscInt i = 0; i < cs->n; ++i) {
+    const unsigned long long g = (unsigned long long)(rstart + cs->global_off[i]);
+
+    if (cs->is_vertex[i] && ContactNodePenetration(cs, ct->dim, i, x) > 0.0)
+      local = (PetscInt64)((unsigned long long)local + ((g + 1) * 0x9E3779B97F4A7C15ULL ^ (g << 17)) % 0x7FFFFFFFFFFFULL);
+  }
+  PetscCall(VecRestoreArrayRead(X, &x));
+  PetscCall(MPIU_Allreduce(&local, hash, 1, MPIU_INT64, MPI_SUM, ct->comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The largest penetration u . n - g over the contact nodes of every rank (0 if none penetrates). */
+PetscErrorCode ContactMaxNodePenetration(Contact ct, Vec u, PetscReal *dmax)
+{
+  const PetscScalar *x;
+  PetscReal          pen = 0.0;
+
+  PetscFunctionBeginUser;
+  PetscCall(VecGetArrayRead(u, &x));
+  for (PetscInt i = 0; i < ct->set.n; ++i) pen = PetscMax(pen, ContactNodePenetration(&ct->set, ct->dim, i, x));
+  PetscCall(VecRestoreArrayRead(u, &x));
+  PetscCall(MPIU_Allreduce(&pen, dmax, 1, MPIU_REAL, MPIU_MAX, ct->comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Local solution with the Dirichlet values inserted, for the boundary integrals: the values are copied from the vector
+   the problem filled once, not projected again over Gamma_D at every call. */
+PetscErrorCode ContactGetLocalSolution(Contact ct, DM dm, Vec X, Vec *locX)
+{
+  PetscFunctionBeginUser;
+  PetscCall(DMGetLocalVector(dm, locX));
+  PetscCall(VecCopy(ct->loc_bc, *locX));
+  PetscCall(DMGlobalToLocal(dm, X, INSERT_VALUES, *locX));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

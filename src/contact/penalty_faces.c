@@ -1,12 +1,12 @@
 /* The Gauss rule of the penalty term on P1 simplices in closed form: PETSc's face quadrature and the same pointwise
-   kernels (include/penalty_kernels.h), each face's points and weights computed once. PETSc's boundary integration
+   kernels (src/contact/penalty_kernels.h), each face's points and weights computed once. PETSc's boundary integration
    (DMPlexComputeBdJacobianSingle()) spends about 100 us per face and call in 3D in its generic element loops: with
    eps = h on 34^3 tetrahedra, 2.4 s of a 7.6 s solve. The numbers are PETSc 3.18's to round-off (-assembly_check):
    the kernel sees the point x of the face's own map, the displacement and the test functions are the support cell's
    basis at its reference face's points, as PETSc evaluates them. On a face whose orientation in its cell is not the
    identity (3D refinement makes such faces) those are other points of the same face; PETSc's choice is kept. */
+#include "penalty.h"
 #include "penalty_kernels.h"
-#include "physics.h"
 #include "mesh.h"
 
 /* ref_face[i * dim + k]: the k-th vertex of face i of PETSc's reference simplex (in the face's closure order), as an
@@ -40,10 +40,9 @@ static PetscErrorCode ReferenceFaceVertices(PetscInt dim, PetscInt ref_face[])
 
 /* The faces of every contact face set (a face in two sets counts twice, as in PETSc's integration per set), mapped
    once per mesh; nothing unless the penalty term has the Gauss rule and K the P1 assembly (the closed form's cases). */
-PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user)
+PetscErrorCode PenaltyFacesSetUp(Contact ct, DM dm, PenaltyFaces *pf)
 {
-  PenaltyFaces    *pf        = &user->prob.penalty_faces;
-  const PetscBool  local_eps = user->prob.eps_local;
+  const PetscBool  local_eps = ct->eps_local;
   PetscSection     lsec, gsec;
   PetscObject      fe;
   PetscQuadrature  quad;
@@ -53,8 +52,7 @@ PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user)
 
   PetscFunctionBeginUser;
   PetscCall(PenaltyFacesDestroy(pf));
-  if (user->opt.contact.method != CONTACT_PENALTY || user->opt.contact.quadrature != PENALTY_QUADRATURE_GAUSS || user->prob.assembly != ASSEMBLY_P1)
-    PetscFunctionReturn(PETSC_SUCCESS);
+  if (ct->opt.quadrature != PENALTY_QUADRATURE_GAUSS || ct->assembly != ASSEMBLY_P1) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMGetLocalSection(dm, &lsec));
   PetscCall(DMGetGlobalSection(dm, &gsec));
@@ -65,9 +63,9 @@ PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user)
   PetscCheck(qdim == dim - 1 && qnc == 1, PetscObjectComm((PetscObject)dm), PETSC_ERR_PLIB, "unexpected face quadrature");
   pf->nv = dim;
   PetscCall(ReferenceFaceVertices(dim, ref_face));
-  PetscCall(PetscMalloc2(user->scene.bcs.ncontact, &faces, user->scene.bcs.ncontact, &nf));
-  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
-    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf[s], &faces[s]));
+  PetscCall(PetscMalloc2(ct->nids, &faces, ct->nids, &nf));
+  for (PetscInt s = 0; s < ct->nids; ++s) {
+    PetscCall(MeshGetBoundaryFaces(dm, ct->ids[s], &nf[s], &faces[s]));
     nfaces += nf[s];
   }
   pf->n = nfaces;
@@ -83,7 +81,7 @@ PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user)
     }
     pf->lambda[q * dim] = 1.0 - sum;
   }
-  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s)
+  for (PetscInt s = 0; s < ct->nids; ++s)
     for (PetscInt i = 0; i < nf[s]; ++i, ++e) {
       const PetscInt  f = faces[s][i];
       const PetscInt *support, *cone;
@@ -121,10 +119,10 @@ PetscErrorCode PenaltyFacesSetUp(DM dm, AppCtx *user)
         PetscReal diam;
 
         PetscCall(MeshCellDiameter(dm, support[0], &diam));
-        pf->inv_factor[e] = 1.0 / ContactEpsFactor(user, diam);
+        pf->inv_factor[e] = 1.0 / ContactEpsFactor(ct, diam);
       }
     }
-  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) PetscCall(PetscFree(faces[s]));
+  for (PetscInt s = 0; s < ct->nids; ++s) PetscCall(PetscFree(faces[s]));
   PetscCall(PetscFree2(faces, nf));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -160,9 +158,8 @@ static PetscErrorCode FaceKernelData(DM dm, PetscInt *dim, PetscInt *ncst, const
 
 /* Without energy: locF += the penalty term (f0_bd_penalty) at the local solution locX. With energy: *energy = this
    rank's integral of the energy density (f0_bd_penalty_energy), and locF is not touched. */
-static PetscErrorCode PenaltyFacesIntegrate(DM dm, const AppCtx *user, Vec locX, Vec locF, PetscReal *energy)
+static PetscErrorCode PenaltyFacesIntegrate(const PenaltyFaces *pf, DM dm, Vec locX, Vec locF, PetscReal *energy)
 {
-  const PenaltyFaces *pf       = &user->prob.penalty_faces;
   const PetscInt      zero[1]  = {0};
   const PetscReal     nzero[3] = {0.0, 0.0, 0.0};
   const PetscScalar  *x, *cst;
@@ -204,24 +201,23 @@ static PetscErrorCode PenaltyFacesIntegrate(DM dm, const AppCtx *user, Vec locX,
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode PenaltyFacesResidual(DM dm, AppCtx *user, Vec locX, Vec locF)
+PetscErrorCode PenaltyFacesResidual(const PenaltyFaces *pf, DM dm, Vec locX, Vec locF)
 {
   PetscFunctionBeginUser;
-  PetscCall(PenaltyFacesIntegrate(dm, user, locX, locF, NULL));
+  PetscCall(PenaltyFacesIntegrate(pf, dm, locX, locF, NULL));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode PenaltyFacesEnergy(DM dm, AppCtx *user, Vec locX, PetscReal *energy)
+PetscErrorCode PenaltyFacesEnergy(const PenaltyFaces *pf, DM dm, Vec locX, PetscReal *energy)
 {
   PetscFunctionBeginUser;
-  PetscCall(PenaltyFacesIntegrate(dm, user, locX, NULL, energy));
+  PetscCall(PenaltyFacesIntegrate(pf, dm, locX, NULL, energy));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The largest u_n - g at the Gauss points of this rank's contact faces (-PETSC_MAX_REAL if it has none). */
-PetscErrorCode PenaltyFacesMaxPenetration(DM dm, AppCtx *user, Vec locX, PetscReal *dmax)
+PetscErrorCode PenaltyFacesMaxPenetration(const PenaltyFaces *pf, DM dm, Vec locX, PetscReal *dmax)
 {
-  const PenaltyFaces *pf = &user->prob.penalty_faces;
   const PetscScalar  *x, *cst;
   PetscInt            dim, ncst;
 
@@ -261,9 +257,8 @@ static inline PetscBool FacePointKernel(const PenaltyFaces *pf, PetscInt dim, Pe
 
 /* J += the penalty Jacobian at locX (ADD_VALUES into the global rows, any rank's; the caller assembles J). A face
    without a penetrating point adds nothing and is skipped. */
-PetscErrorCode PenaltyFacesJacobian(DM dm, AppCtx *user, Vec locX, Mat J)
+PetscErrorCode PenaltyFacesJacobian(const PenaltyFaces *pf, DM dm, Vec locX, Mat J)
 {
-  const PenaltyFaces *pf = &user->prob.penalty_faces;
   const PetscScalar  *x, *cst;
   PetscInt            dim, ncst;
 
@@ -297,9 +292,8 @@ PetscErrorCode PenaltyFacesJacobian(DM dm, AppCtx *user, Vec locX, Mat J)
 
 /* Whether the Gauss points penetrating at locA are those penetrating at locB (this rank's faces): where the Jacobian's
    kernel is nonzero at one and not at the other, Newton's model at one misses a kink that the other crosses. */
-PetscErrorCode PenaltyFacesSameActivity(DM dm, AppCtx *user, Vec locA, Vec locB, PetscBool *same)
+PetscErrorCode PenaltyFacesSameActivity(const PenaltyFaces *pf, DM dm, Vec locA, Vec locB, PetscBool *same)
 {
-  const PenaltyFaces *pf = &user->prob.penalty_faces;
   const PetscScalar  *xa, *xb, *cst;
   PetscInt            dim, ncst;
 

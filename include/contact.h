@@ -1,0 +1,121 @@
+/* The contact treatment on Gamma_C as one object with registered types, in the manner of PETSc's KSP and PC
+   (src/contact/): -contact_method picks the type by name, and a new method is one file that registers itself.
+
+   Types:
+     penalty  (1/eps) int [u . n - g]_+ v . n, with the Gauss rule (the paper's L2 product) or the nodal rule
+              (-penalty_quadrature), eps = eps0 h^power / M (Chouly & Hild 2013, eps = h in Corollary 3.3);
+     vi       the exact constraint u . n <= g as bounds of SNESVI, the reference for the penalty;
+     none     no contact: the linear elastic problem.
+
+   The object owns what the contact needs on one mesh: the contact set (the nodes of Gamma_C, their gaps, normals and
+   lumped masses), eps with its local factors, the penalty's faces and weak form, the rows of K that the penalty
+   Jacobian changes, and the SNESVI bounds. It is created and read from the options once, set up on each mesh of the
+   run (ContactSetUp()), reset when the mesh changes, destroyed at the end. */
+#pragma once
+#include "signorini.h"
+
+typedef const char        *ContactType;
+#define CONTACTPENALTY "penalty"
+#define CONTACTVI      "vi"
+#define CONTACTNONE    "none"
+
+/* What the contact needs of the problem on one mesh, given to ContactSetUp() (read during the call; loc_bc is kept
+   with a reference). */
+typedef struct {
+  const BoundarySet *bcs;            /* Gamma_C: the face sets of -contact_faces */
+  const Obstacle    *obstacle;       /* the rigid obstacle */
+  const Material    *material;       /* M of eps = eps0 h^power / M */
+  PetscInt           degree;         /* of the displacement */
+  PetscReal          h;              /* the largest cell diameter of the mesh */
+  AssemblyType       assembly;       /* how K is assembled on this mesh (fe or p1): p1 with the Gauss rule is its closed form */
+  PetscBool          assembly_check; /* -assembly_check: the closed form compared with PETSc's integration */
+  Vec                loc_bc;         /* local vector of the Dirichlet values, zero elsewhere */
+  Vec                like;           /* a global vector of the mesh */
+} ContactProblem;
+
+/* The contact quantities after a solve (ContactPostProcess()), summed over the ranks. */
+typedef struct {
+  PetscReal max_penetration; /* over the nodes and the rule's points */
+  PetscReal force;           /* the obstacle's normal force, the sum of the nodal reactions */
+  PetscReal force_vector[3]; /* the obstacle's force on the body: the sum of R = K u + r0 over the contact nodes */
+  PetscInt  active_vertices; /* where the rule's force acts (penalty), or on the bound (vi) */
+  PetscReal energy;          /* the contact term's energy: (1/2eps) int [u_n - g]_+^2 for the penalty, 0 otherwise */
+} ContactResult;
+
+/* contact.c: the object and its registry */
+PetscErrorCode ContactRegister(const char name[], PetscErrorCode (*create)(Contact));
+PetscErrorCode ContactFinalizePackage(void);
+PetscErrorCode ContactCreate(MPI_Comm comm, Contact *ct);
+PetscErrorCode ContactSetFromOptions(Contact ct);
+PetscErrorCode ContactDestroy(Contact *ct);
+PetscErrorCode ContactGetType(Contact ct, ContactType *type);
+PetscErrorCode ContactGetOptions(Contact ct, const ContactOptions **opt);
+PetscErrorCode ContactSetUp(Contact ct, DM dm, const ContactProblem *pb);
+PetscErrorCode ContactReset(Contact ct);
+PetscErrorCode ContactView(Contact ct, PetscViewer viewer);
+
+/* What the type does, asked instead of its name: */
+PetscBool ContactHasPenalty(Contact ct); /* a penalty term with eps: the Jacobian differs from K in the contact rows */
+PetscBool ContactHasBounds(Contact ct);  /* SNESVI's bounds: the exact constraint */
+PetscBool ContactIsNone(Contact ct);     /* no contact term: the linear elastic problem */
+
+/* eps: computed from the options on each mesh (ContactSetUp()), changed by the continuation and the sweep through
+   ContactSetEps(), which also updates the kernels' constants[CONST_PENALTY] = 1/eps; every reader of eps reads it here. */
+PetscErrorCode ContactEpsFromFactor(Contact ct, PetscReal eps0, PetscReal *eps);
+PetscErrorCode ContactSetEps(Contact ct, DM dm, PetscReal eps);
+PetscErrorCode ContactGetEps(Contact ct, PetscReal *eps);
+PetscErrorCode ContactGetEpsRange(Contact ct, PetscReal *eps_min, PetscReal *eps_max, PetscBool *local);
+PetscErrorCode ContactGetPenaltyScale(Contact ct, PetscReal *eps_start);
+PetscErrorCode ContactGetSet(Contact ct, const ContactSet **cs);
+
+/* The terms of the nonlinear problem: F(u) = K u + r0 + (contact term), J = K + (contact Jacobian). */
+PetscErrorCode ContactAddResidual(Contact ct, DM dm, Vec u, Vec F);
+PetscErrorCode ContactComputeJacobian(Contact ct, DM dm, Vec u, Mat K, Mat P);
+PetscErrorCode ContactPrepareOperator(Contact ct, DM dm, Mat K);
+PetscErrorCode ContactBulkMult(Contact ct, Mat K, Vec X, Vec R);
+PetscErrorCode ContactBulkOperator(Contact ct, Mat K, Mat *Kb);
+PetscErrorCode ContactEnergy(Contact ct, DM dm, Vec u, PetscReal *energy);
+PetscErrorCode ContactSetUpSNES(Contact ct, DM dm, SNES snes);
+PetscErrorCode ContactScaleBounds(Contact ct, PetscReal s);
+PetscErrorCode ContactRoundoffTerm(Contact ct, Vec u, PetscReal *sum_sq);
+PetscErrorCode ContactSameActivity(Contact ct, DM dm, Vec X, Vec Y, PetscBool *same);
+
+/* The state of the contact nodes at an iterate (contact_set.c) */
+PetscErrorCode ContactCountActive(Contact ct, Vec X, PetscReal tol_scale, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left);
+PetscErrorCode ContactPenetrationHash(Contact ct, Vec X, PetscInt64 *hash);
+PetscErrorCode ContactMaxNodePenetration(Contact ct, Vec u, PetscReal *dmax);
+
+/* After the solve: the pressure and the reaction at each node (kept in the contact set), the force, the active set, the energy */
+PetscErrorCode ContactPostProcess(Contact ct, DM dm, Mat K, Vec r0, Vec u, PetscReal tol_scale, ContactResult *res);
+
+/* The rows of K that the penalty Jacobian changes (penalty.c, bulk_rows.c): read by the GAMG updates (src/solver/pc_reuse.c) */
+typedef struct {
+  PetscInt     n;                 /* owned rows of the contact dofs */
+  PetscInt    *rows, *ptr, *cols; /* their global numbers, and their columns in CSR form */
+  PetscScalar *vals;              /* K's own values there */
+  PetscInt    *diag;              /* each row's diagonal entry (ptr numbering) */
+  PetscInt    *lcols;             /* each column's place in x */
+  VecScatter   scatter;           /* the displacement at those columns (any rank's) into x */
+  Vec          x;
+  PetscBool    jacobian_in_K; /* K holds K + the penalty Jacobian in those rows */
+} ContactBulkRows;
+const ContactBulkRows *ContactBulkRowsOf(Contact ct); /* NULL without a penalty term; rows->ptr NULL before they are saved */
+PetscErrorCode ContactCopyRows(Mat A, PetscInt n, const PetscInt rows[], PetscInt **ptr, PetscInt **cols, PetscScalar **vals);
+
+/* Penetration u . n - g of contact node i, from the owned part x[] of a global vector (fixed components: their values). */
+static inline PetscReal ContactNodePenetration(const ContactSet *cs, PetscInt dim, PetscInt i, const PetscScalar x[])
+{
+  PetscReal un = 0.0;
+
+  for (PetscInt c = 0; c < dim; ++c) {
+    const PetscInt k = cs->dof[i * dim + c];
+    un += (k >= 0 ? PetscRealPart(x[k]) : cs->fixed[i * dim + c]) * cs->normal[i * dim + c];
+  }
+  return un - cs->gap[i];
+}
+
+/* The penalty parameter of contact node i: the run's eps scaled to the node's local mesh size. */
+static inline PetscReal ContactNodeEps(const ContactSet *cs, PetscReal eps, PetscInt i)
+{
+  return eps * cs->eps_factor[i];
+}
