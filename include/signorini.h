@@ -110,8 +110,32 @@ typedef struct {
   PetscInt          n_sweep;
 } ContactOptions;
 
+/* PETSc's own options whose presence changes the project's defaults ("where the options say nothing"), read with the
+   rest in the options phase (SolverGetOptions()), for each options prefix the solver's objects can have: the solve's
+   KSP (no prefix) and the coarser boxes' KSP ("contact_coarse_", src/solver/multigrid.c). */
+#define SOLVER_KSP_PREFIXES 2
+#define MULTIGRID_MAX_LEVELS 16 /* levels of a multigrid preconditioner the solver follows */
+typedef struct {
+  PetscBool mat_type;                                /* -mat_type */
+  PetscBool snes_ksp_ew, snes_ksp_ew_rtolmax;        /* -snes_ksp_ew, -snes_ksp_ew_rtolmax */
+  PetscBool pc_type_given;                           /* -pc_type, */
+  char      pc_type[64];                             /*   its value */
+  PetscBool ksp_norm_type[SOLVER_KSP_PREFIXES];      /* -ksp_norm_type */
+  PetscBool use_initial_rnorm[SOLVER_KSP_PREFIXES];  /* -ksp_converged_use_initial_residual_norm */
+  PetscBool pc_mg_levels[SOLVER_KSP_PREFIXES];       /* -pc_mg_levels */
+  PetscBool pc_mg_galerkin[SOLVER_KSP_PREFIXES];     /* -pc_mg_galerkin */
+  PetscBool fine_ksp_type[SOLVER_KSP_PREFIXES];      /* -mg_fine_ksp_type */
+  PetscBool fine_pc_type[SOLVER_KSP_PREFIXES];       /* -mg_fine_pc_type */
+  /* -ksp_chebyshev_esteig of each multigrid smoother's prefix: mg_fine_, and mg_levels_N_ (PETSc's name of level N, which
+     also finds -mg_levels_ksp_chebyshev_esteig), under each KSP prefix */
+  char      esteig_prefix[SOLVER_KSP_PREFIXES * (MULTIGRID_MAX_LEVELS + 1)][48];
+  PetscInt  esteig_n[SOLVER_KSP_PREFIXES * (MULTIGRID_MAX_LEVELS + 1)]; /* how many values (0: not given) */
+  PetscReal esteig[SOLVER_KSP_PREFIXES * (MULTIGRID_MAX_LEVELS + 1)][4];
+} SolverGiven;
+
 /* Options of the nonlinear solve around the contact (SolverGetOptions(), src/solver/solver_options.c). */
 typedef struct {
+  SolverGiven given;
   PetscBool monitor;
   PetscBool condition_estimate; /* estimate the 1-norm condition number of the final Jacobian */
   PetscBool cycle_damping;      /* damp the Newton step when the active set cycles */
@@ -304,7 +328,6 @@ typedef struct {
   PetscBool      perf_bandwidth; /* -perf_bandwidth: measure the memory bandwidths after the solve */
   char           output[PETSC_MAX_PATH_LEN];
   PetscBool      output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
-  MeshBox        box;           /* the box of the mesh options, if the mesh is one */
 } RunOptions;
 
 /* The forcing terms of the inexact Newton (ew_forcing.c): Eisenstat-Walker's, with the guard against oversolving. */
@@ -360,18 +383,19 @@ typedef struct {
 
 /* The interpolations between the nested meshes solved so far (src/solver/multigrid.c): the levels of a geometric
    multigrid (-pc_type mg) on the mesh of the current problem, which has n + 1 of them. */
-#define MULTIGRID_MAX_LEVELS 16
 typedef struct {
   PetscInt n;
-  Mat      interp[MULTIGRID_MAX_LEVELS]; /* [l]: from the global vector of mesh l to that of mesh l + 1 */
+  Mat       interp[MULTIGRID_MAX_LEVELS]; /* [l]: from the global vector of mesh l to that of mesh l + 1 */
+  PetscBool coarse_mg; /* the coarser boxes are solved with the geometric multigrid of the boxes below (GridSequenceCoarseRequest()) */
 } Multigrid;
 
 /* The state of a run, by concern: its options, its scene, the problem on the current mesh, the hierarchy of the meshes
    solved before it, and its record. */
 typedef struct _p_Contact *Contact; /* include/contact.h */
 typedef struct {
-  RunOptions opt;
-  Contact    contact; /* created and read from the options once, set up on the mesh of each problem */
+  const RunOptions *opt;     /* read once before any set-up, then read only */
+  Contact           contact; /* created and read from the options once, set up on the mesh of each problem */
+  MeshBox           box;     /* the simplex box of the mesh options, if the mesh is one (MeshCreate()) */
   Scene      scene;
   Problem    prob;
   Multigrid  mg;

@@ -36,8 +36,10 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
    -contact_coarse_mg) a coarser box costs little and is one more level of the hierarchy (a smaller coarse factorization). */
 #define GRID_SEQUENCE_MIN_FACES 64
 #define GRID_SEQUENCE_MIN_FACES_MG 16
-PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, RunOptions *opt, PetscInt *request, PetscInt *min_faces);
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt *min_faces, PetscBool *coarse_mg);
 PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts);
+PetscErrorCode SolverGivenIndex(const char prefix[], PetscInt *k);
+PetscErrorCode SolverGivenEsteig(const SolverGiven *g, const char prefix[], PetscInt *n, PetscReal t[]);
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 
@@ -58,8 +60,8 @@ PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, AppCtx *user);
 PetscErrorCode SolverStepGuessDrop(AppCtx *user);
 
 /* fine_smoother.c: -mg_fine_ksp_*, -mg_fine_pc_* */
-PetscErrorCode FineSmootherGiven(KSP ksp, PetscBool *given);
-PetscErrorCode FineSmootherSetUp(KSP ksp);
+PetscErrorCode FineSmootherGiven(KSP ksp, const SolverGiven *g, PetscBool *given);
+PetscErrorCode FineSmootherSetUp(KSP ksp, const SolverGiven *g);
 
 /* pc_reuse.c */
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X);
@@ -83,7 +85,7 @@ PetscErrorCode AssemblyP1BlockPattern(DM dm, PetscInt bs, PetscInt nb, const Pet
 PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
                                       PetscBool *done);
 PetscErrorCode AssemblyP1CSRAllocated(Mat K, PetscLogDouble *nz);
-PetscErrorCode AssemblyP1CSRApplies(DM dm, PetscInt bs, PetscBool *applies);
+PetscErrorCode AssemblyP1CSRApplies(DM dm, PetscInt bs, PetscBool mat_type_given, PetscBool *applies);
 PetscErrorCode AssemblyP1CellCoordinates(PetscSection csection, const PetscScalar xa[], PetscInt dim, const PetscInt verts[], PetscReal x[]);
 PetscErrorCode AssemblyP1CSRCompose(Mat K, PetscInt *i, PetscInt *j, PetscScalar *a, PetscInt *oi, PetscInt *oj, PetscScalar *oa);
 

@@ -26,7 +26,7 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
   PetscCall(PetscPrintf(comm, "scene %s, %" PetscInt_FMT "D, ", user->scene.name, dim));
   PetscCall(ContactView(user->contact, PETSC_VIEWER_STDOUT_(comm))); /* method penalty (gauss quadrature, eps = ...) */
   PetscCall(
-      PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, h = %g, %d rank(s)\n", user->opt.degree, ndofs, (double)user->prob.h, size));
+      PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, h = %g, %d rank(s)\n", user->opt->degree, ndofs, (double)user->prob.h, size));
   PetscCall(PetscPrintf(comm,
                         "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, %" PetscInt_FMT " preconditioner builds",
                         SNESConvergedReasons[s->reason], s->newton_its, s->ksp_its, s->pc_builds));
@@ -95,6 +95,7 @@ static PetscErrorCode RecordPeakMemory(MPI_Comm comm, RunStats *s)
 static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
 {
   AppCtx         user;
+  RunOptions     opt;
   DM             dm;
   SNES           snes;
   Vec            u;
@@ -105,27 +106,30 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   comm = PETSC_COMM_WORLD;
   PetscCall(PetscTime(&t0));
   PetscCall(PetscMemzero(&user, sizeof(user)));
+  PetscCall(PetscMemzero(&opt, sizeof(opt)));
   PetscCall(OutputFileInstallCleanup());
   PetscCall(OptionsCheckValuesGiven(comm)); /* -young_modulus without its value is not the default */
   PetscCall(SceneRegisterAll());
-  PetscCall(SceneGetOptions(comm, user.opt.scene_name, sizeof(user.opt.scene_name)));
-  PetscCall(ElasticityGetOptions(comm, &user.opt.material, &user.opt.degree, &user.opt.section_check));
+  /* the options phase: every module reads its options once, into opt, which is read only after it */
+  PetscCall(SceneGetOptions(comm, opt.scene_name, sizeof(opt.scene_name)));
+  PetscCall(ElasticityGetOptions(comm, &opt.material, &opt.degree, &opt.section_check));
   PetscCall(ContactCreate(comm, &user.contact));
   PetscCall(ContactSetFromOptions(user.contact)); /* -contact_method, -penalty_* */
-  PetscCall(SolverGetOptions(comm, &user.opt.solver));
-  PetscCall(VerifyGetOptions(comm, &user.opt.verify));
-  PetscCall(AssemblyGetOptions(comm, &user.opt.assembly, &user.opt.assembly_check));
-  PetscCall(OutputGetOptions(comm, &user.opt));
-  PetscCall(BandwidthGetOptions(comm, &user.opt.perf_bandwidth));
+  PetscCall(SolverGetOptions(comm, &opt.solver));
+  PetscCall(VerifyGetOptions(comm, &opt.verify));
+  PetscCall(AssemblyGetOptions(comm, &opt.assembly, &opt.assembly_check));
+  PetscCall(OutputGetOptions(comm, &opt));
+  PetscCall(BandwidthGetOptions(comm, &opt.perf_bandwidth));
+  user.opt = &opt;
 
   {
     PetscInt coarse_request, coarse_min_faces;
 
-    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &user.opt, &coarse_request, &coarse_min_faces));
-    PetscCall(MeshCreate(comm, user.opt.solver.grid_sequence, coarse_request, coarse_min_faces, &user.opt.box, &dm));
+    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, &coarse_request, &coarse_min_faces, &user.mg.coarse_mg));
+    PetscCall(MeshCreate(comm, opt.solver.grid_sequence, coarse_request, coarse_min_faces, &user.box, &dm));
   }
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition)); /* the partitioner; the final mesh's cut is taken after the solve */
-  PetscCall(SceneCreate(user.opt.scene_name, dm, &user.opt.material, &user.scene)); /* its options, once for every level */
+  PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(ReferenceCheckFile(dm, &user));    /* before the solve, not after it */
   PetscCall(ContactChecksGeometry(dm, &user)); /* initial overlap, an obstacle facing away: warnings */
@@ -165,7 +169,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(OptionsCheckAllUsed(comm, PETSC_FALSE)); /* the options read during the solve too */
   PetscCall(PrintSummary(dm, &user, u));
   PetscCall(OutputWriteHDF5(dm, &user, u));
-  PetscCall(PetscPrintf(comm, "  output: %s\n", user.opt.output));
+  PetscCall(PetscPrintf(comm, "  output: %s\n", opt.output));
   if (!user.rec.stats.converged && user.rec.stats.reason > 0)
     PetscCall(PetscPrintf(comm,
                           "ERROR: the nonlinear solve failed: it stopped with %s after %" PetscInt_FMT

@@ -235,7 +235,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "assembly", PETSC_STRING, AssemblyTypes[user->prob.assembly]));
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "snes_reason", PETSC_STRING, SNESConvergedReasons[s->reason]));
   PetscCall(WriteIntAttr(v, "dim", dim));
-  PetscCall(WriteIntAttr(v, "degree", user->opt.degree));
+  PetscCall(WriteIntAttr(v, "degree", user->opt->degree));
   PetscCall(WriteIntAttr(v, "nprocs", size));
   PetscCall(WriteIntAttr(v, "n_cells", ncells));
   PetscCall(WriteIntAttr(v, "n_vertices", nverts));
@@ -244,17 +244,17 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteRealAttr(v, "eps", eps));
   PetscCall(WriteRealAttr(v, "eps_min", eps_min));
   PetscCall(WriteRealAttr(v, "eps_max", eps_max));
-  PetscCall(WriteRealAttr(v, "young_modulus", user->opt.material.young_modulus));
-  PetscCall(WriteRealAttr(v, "poisson_ratio", user->opt.material.poisson_ratio));
+  PetscCall(WriteRealAttr(v, "young_modulus", user->opt->material.young_modulus));
+  PetscCall(WriteRealAttr(v, "poisson_ratio", user->opt->material.poisson_ratio));
   PetscCall(WriteIntAttr(v, "converged", s->converged ? 1 : 0));
   PetscCall(WriteIntAttr(v, "snes_reason_code", (PetscInt)s->reason));
   PetscCall(WriteIntAttr(v, "newton_its", s->newton_its));
   PetscCall(WriteIntAttr(v, "ksp_its", s->ksp_its));
   PetscCall(WriteIntAttr(v, "newton_its_total", s->newton_its_total));
   PetscCall(WriteIntAttr(v, "ksp_its_total", s->ksp_its_total));
-  PetscCall(WriteIntAttr(v, "grid_sequence", user->opt.solver.grid_sequence));
-  PetscCall(WriteIntAttr(v, "coarse_levels", user->opt.box.coarse_levels));
-  PetscCall(WriteIntAttr(v, "coarse_mg", user->opt.solver.coarse_mg && user->opt.box.coarse_levels > 0 ? 1 : 0)); /* -contact_coarse_mg applied */
+  PetscCall(WriteIntAttr(v, "grid_sequence", user->opt->solver.grid_sequence));
+  PetscCall(WriteIntAttr(v, "coarse_levels", user->box.coarse_levels));
+  PetscCall(WriteIntAttr(v, "coarse_mg", user->mg.coarse_mg && user->box.coarse_levels > 0 ? 1 : 0)); /* -contact_coarse_mg applied */
   PetscCall(WriteIntAttr(v, "n_solves", user->rec.nrecords));
   PetscCall(WriteRealAttr(v, "residual_norm", s->residual_norm));
   PetscCall(WriteIntAttr(v, "residual_reduced", s->residual_reduced ? 1 : 0));
@@ -291,7 +291,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   {
     char problem[SCENE_FINGERPRINT_LEN];
 
-    PetscCall(SceneFingerprint(&user->scene, &user->opt.material, dim, problem, sizeof(problem)));
+    PetscCall(SceneFingerprint(&user->scene, &user->opt->material, dim, problem, sizeof(problem)));
     PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "problem", PETSC_STRING, problem)); /* what -reference compares */
   }
   {
@@ -332,18 +332,18 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "partitioner", PETSC_STRING, MeshPartitionerTypes[s->partition.partitioner]));
   PetscCall(WriteIntAttr(v, "partition_edge_cut", s->partition.edge_cut));
   PetscCall(WriteRealAttr(v, "partition_imbalance", s->partition.imbalance));
-  if (user->opt.solver.condition_estimate) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm)); /* NaN: the estimate failed */
+  if (user->opt->solver.condition_estimate) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm)); /* NaN: the estimate failed */
   PetscCall(WriteRealAttr(v, "peak_memory_mb", s->peak_memory_mb));
   PetscCall(WriteRealAttr(v, "peak_memory_total_mb", s->peak_memory_total_mb));
   PetscCall(WriteRealAttr(v, "penetration_l2", user->rec.errors.penetration_l2));
   PetscCall(WriteRealAttr(v, "penetration_max", user->rec.errors.penetration_max));
   PetscCall(WriteErrorNorms(v, "error", &user->rec.errors));
   PetscCall(WriteErrorNorms(v, "reference_error", &user->rec.ref_errors));
-  if (user->opt.verify.reference[0]) {
-    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "reference", PETSC_STRING, user->opt.verify.reference));
+  if (user->opt->verify.reference[0]) {
+    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "reference", PETSC_STRING, user->opt->verify.reference));
   }
-  PetscCall(WriteIntAttr(v, "verify_quadrature_points", user->opt.verify.quad_points));
-  PetscCall(WriteIntAttr(v, "verify_quadrature_refine", user->opt.verify.quad_refine));
+  PetscCall(WriteIntAttr(v, "verify_quadrature_points", user->opt->verify.quad_points));
+  PetscCall(WriteIntAttr(v, "verify_quadrature_refine", user->opt->verify.quad_refine));
   for (PetscInt i = 0; i < user->scene.num_constants; ++i) { /* the scene's parameters, scene_0, scene_1, ... */
     char name[32];
 
@@ -444,7 +444,7 @@ static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, const char h5
 
   PetscCall(PetscViewerHDF5Open(comm, h5tmp, FILE_MODE_WRITE, &viewer));
   PetscCall(PetscViewerPushFormat(viewer, PETSC_VIEWER_HDF5_VIZ));
-  if (user->opt.output_dmview)
+  if (user->opt->output_dmview)
     PetscCall(DMView(dm, viewer));
   else
     PetscCall(OutputViewMesh(dm, viewer)); /* DMView() without its closures per cell */
@@ -464,15 +464,15 @@ PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u)
   MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
   char           dir[PETSC_MAX_PATH_LEN], base[PETSC_MAX_PATH_LEN], xdmf[PETSC_MAX_PATH_LEN], temps[2][PETSC_MAX_PATH_LEN];
   char           tdir[PETSC_MAX_PATH_LEN], h5tmp[PETSC_MAX_PATH_LEN], xdmftmp[PETSC_MAX_PATH_LEN];
-  const char    *targets[2] = {xdmf, user->opt.output};
+  const char    *targets[2] = {xdmf, user->opt->output};
   PetscErrorCode ierr;
   int            cwd, err = 0, local_failed, failed;
   H5E_auto2_t    h5_func;
   void          *h5_data;
 
   PetscFunctionBeginUser;
-  PetscCall(OutputFileSplitPath(user->opt.output, dir, sizeof(dir), base, sizeof(base)));
-  PetscCall(OutputFileXdmfName(user->opt.output, xdmf, sizeof(xdmf)));
+  PetscCall(OutputFileSplitPath(user->opt->output, dir, sizeof(dir), base, sizeof(base)));
+  PetscCall(OutputFileXdmfName(user->opt->output, xdmf, sizeof(xdmf)));
   PetscCall(OutputFileCreateTemps(comm, dir, 2, temps));                                  /* [0] the XDMF file, [1] the HDF5 file */
   PetscCall(OutputFileSplitPath(temps[0], tdir, sizeof(tdir), xdmftmp, sizeof(xdmftmp))); /* names inside dir */
   PetscCall(OutputFileSplitPath(temps[1], tdir, sizeof(tdir), h5tmp, sizeof(h5tmp)));
@@ -501,7 +501,7 @@ PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u)
       PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", strerror(err)));
     else if (ierr)
       PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", specific && specific[0] ? specific : text));
-    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot write the output file %s: %s", user->opt.output, cause);
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot write the output file %s: %s", user->opt->output, cause);
   }
   PetscCall(OutputFileCommit(comm, dir, 2, temps, targets));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -85,7 +85,7 @@ PetscErrorCode BoundaryInsertDirichlet(DM dm, const AppCtx *user, Vec loc)
   PetscInt           dim;
 
   PetscFunctionBeginUser;
-  if (user->opt.degree != 1) {
+  if (user->opt->degree != 1) {
     PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, loc, 0.0, NULL, NULL, NULL));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
@@ -213,7 +213,7 @@ static PetscErrorCode AddFixedRowsP1(DM dm, AppCtx *user, Vec u, Vec locF)
   PetscCall(DMGetLocalVector(dm, &locU));
   PetscCall(VecZeroEntries(locU));
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, locU));
-  PetscCall(ElasticityP1AddFixedCellsStiffness(dm, &user->opt.material, locU, locF));
+  PetscCall(ElasticityP1AddFixedCellsStiffness(dm, &user->opt->material, locU, locF));
   PetscCall(DMRestoreLocalVector(dm, &locU));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -170,8 +170,8 @@ PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user)
   PetscScalar c[CONST_SCENE_MAX];
 
   PetscFunctionBeginUser;
-  c[CONST_LAMBDA]  = user->opt.material.lambda;
-  c[CONST_MU]      = user->opt.material.mu;
+  c[CONST_LAMBDA]  = user->opt->material.lambda;
+  c[CONST_MU]      = user->opt->material.mu;
   c[CONST_PENALTY] = 0.0; /* 1/eps, set by the contact (ContactSetEps()) */
   ObstaclePack(&user->scene.obstacle, &c[CONST_OBSTACLE]);
   for (PetscInt k = 0; k < 3; ++k) {
@@ -198,7 +198,7 @@ PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user)
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexIsSimplex(dm, &simplex));
-  PetscCall(PetscFECreateLagrange(comm, dim, dim, simplex, user->opt.degree, PETSC_DETERMINE, &fe)); /* the degree of ElasticityGetOptions() */
+  PetscCall(PetscFECreateLagrange(comm, dim, dim, simplex, user->opt->degree, PETSC_DETERMINE, &fe)); /* the degree of ElasticityGetOptions() */
   PetscCall(PetscObjectSetName((PetscObject)fe, "displacement"));
   PetscCall(DMSetField(dm, 0, NULL, (PetscObject)fe));
   PetscCall(PetscFEDestroy(&fe));

@@ -167,7 +167,7 @@ PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user)
   PetscCall(DMPlexGetDepth(dm, &depth));
   PetscCall(DMPlexGetCellTypeLabel(dm, &ct_label));
   PetscCall(DMLabelGetStratumSize(ct_label, DM_POLYTOPE_FV_GHOST, &ghosts));
-  if (nfields != 1 || user->opt.degree != 1 || depth != dim || ghosts) PetscFunctionReturn(PETSC_SUCCESS); /* PETSc's */
+  if (nfields != 1 || user->opt->degree != 1 || depth != dim || ghosts) PetscFunctionReturn(PETSC_SUCCESS); /* PETSc's */
   PetscCall(DMGetField(dm, 0, NULL, &disc));
   PetscCall(PetscObjectGetClassId(disc, &id));
   if (id != PETSCFE_CLASSID) PetscFunctionReturn(PETSC_SUCCESS);
@@ -178,7 +178,7 @@ PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user)
     if (anchors) PetscFunctionReturn(PETSC_SUCCESS);
   }
   fe = (PetscFE)disc;
-  if (user->opt.section_check) {
+  if (user->opt->section_check) {
     PetscCall(DMGetLocalSection(dm, &reference)); /* PETSc's, for the comparison below */
     PetscCall(PetscObjectReference((PetscObject)reference));
   }
@@ -227,6 +227,6 @@ PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user)
   }
   PetscCall(DMSetLocalSection(dm, section));
   PetscCall(PetscSectionDestroy(&section));
-  PetscCall(SectionSetUpGlobalP1(dm, user->opt.section_check)); /* src/physics/section_global.c */
+  PetscCall(SectionSetUpGlobalP1(dm, user->opt->section_check)); /* src/physics/section_global.c */
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -57,7 +57,7 @@ static PetscErrorCode AssemblyP1Applies(DM dm, const AppCtx *user, const char **
     PetscCall(DMLabelGetStratumSize(ct_label, dim == 2 ? DM_POLYTOPE_TRIANGLE : DM_POLYTOPE_TETRAHEDRON, &nsimplices));
     if (nsimplices != cEnd - cStart) code = 2;
   }
-  if (!code && user->opt.degree != 1) code = 3;
+  if (!code && user->opt->degree != 1) code = 3;
   if (!code && (nf != 1 || nc != dim || size != (vEnd - vStart) * dim)) code = 4;
   if (!code && (cdim != dim || localized || csize != (vEnd - vStart) * dim)) code = 5;
   if (!code && !known) code = 6;
@@ -88,11 +88,11 @@ PetscErrorCode AssemblyResolve(DM dm, AppCtx *user)
   const char *reason = NULL;
 
   PetscFunctionBeginUser;
-  user->prob.assembly = user->opt.assembly;
+  user->prob.assembly = user->opt->assembly;
   PetscCall(AssemblyP1Applies(dm, user, &reason));
   PetscCheck(user->prob.assembly != ASSEMBLY_P1 || !reason, comm, PETSC_ERR_USER_INPUT,
              "-assembly p1 needs P1 displacements on triangles or tetrahedra, but %s: use -assembly fe or auto", reason);
-  PetscCheck(!user->opt.assembly_check || !reason, comm, PETSC_ERR_USER_INPUT,
+  PetscCheck(!user->opt->assembly_check || !reason, comm, PETSC_ERR_USER_INPUT,
              "-assembly_check compares with the P1 assembly, which does not apply: %s", reason);
   if (user->prob.assembly == ASSEMBLY_AUTO) user->prob.assembly = reason ? ASSEMBLY_FE : ASSEMBLY_P1;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -336,7 +336,7 @@ static PetscErrorCode AssemblyP1CreateAnyMatrix(DM dm, AppCtx *user, PetscInt nl
     PetscCall(AssemblyP1CellCoordinates(csection, xa, dim, &cverts[(c - cStart) * (dim + 1)], x));
     for (PetscInt a = 0; a <= dim; ++a)
       for (PetscInt e = 0; e < dim; ++e) idx[a * dim + e] = vidx[(cverts[(c - cStart) * (dim + 1) + a] - vStart) * dim + e];
-    PetscCall(ElasticityP1ElementStiffness(dim, user->opt.material.lambda, user->opt.material.mu, x, Ke));
+    PetscCall(ElasticityP1ElementStiffness(dim, user->opt->material.lambda, user->opt->material.mu, x, Ke));
     PetscCall(MatSetValues(*K, n, idx, n, idx, Ke, ADD_VALUES));
   }
   PetscCall(VecRestoreArrayRead(coords, &xa));
@@ -469,7 +469,7 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
 
   PetscFunctionBeginUser;
   PetscCall(VecZeroEntries(locF));
-  PetscCall(ElasticityP1AddFixedCellsStiffness(dm, &user->opt.material, locX, locF));
+  PetscCall(ElasticityP1AddFixedCellsStiffness(dm, &user->opt->material, locX, locF));
   PetscCall(DMGetDS(dm, &ds));
   PetscCall(PetscDSGetResidual(ds, 0, &f0, &f1));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));

@@ -30,11 +30,11 @@ static PetscErrorCode AssemblyCSRDestroy(void *ctx)
 
 /* Whether K can be built in its own CSR arrays (here and in assembly_p1_mpiaij.c): AIJ (the DM's type, no -mat_type for
    MatSetFromOptions() to convert it to), a block of bs = dim dofs per vertex, and the edges (an interpolated mesh). */
-PetscErrorCode AssemblyP1CSRApplies(DM dm, PetscInt bs, PetscBool *applies)
+PetscErrorCode AssemblyP1CSRApplies(DM dm, PetscInt bs, PetscBool mat_type_given, PetscBool *applies)
 {
   PetscInt  dim, depth;
   MatType   mtype;
-  PetscBool aij, seqaij, mpiaij, type_set;
+  PetscBool aij, seqaij, mpiaij;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
@@ -43,8 +43,7 @@ PetscErrorCode AssemblyP1CSRApplies(DM dm, PetscInt bs, PetscBool *applies)
   PetscCall(PetscStrcmp(mtype, MATAIJ, &aij));
   PetscCall(PetscStrcmp(mtype, MATSEQAIJ, &seqaij));
   PetscCall(PetscStrcmp(mtype, MATMPIAIJ, &mpiaij));
-  PetscCall(PetscOptionsHasName(NULL, NULL, "-mat_type", &type_set));
-  *applies = (PetscBool)((aij || seqaij || mpiaij) && !type_set && bs == dim && depth == dim);
+  *applies = (PetscBool)((aij || seqaij || mpiaij) && !mat_type_given && bs == dim && depth == dim);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -159,7 +158,7 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   *done = PETSC_FALSE;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(AssemblyP1CSRApplies(dm, bs, &applies));
+  PetscCall(AssemblyP1CSRApplies(dm, bs, user->opt->solver.given.mat_type, &applies));
   if (size > 1 || !applies) PetscFunctionReturn(PETSC_SUCCESS);
   nb = nlocal / bs;
   PetscCall(AssemblyP1BlockPattern(dm, bs, nb, vidx, &bptr, &bcol));
@@ -196,7 +195,7 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
 
       blk[a] = g < 0 ? -1 : g / bs;
     }
-    PetscCall(ElasticityP1ElementStiffness(dim, user->opt.material.lambda, user->opt.material.mu, x, Ke));
+    PetscCall(ElasticityP1ElementStiffness(dim, user->opt->material.lambda, user->opt->material.mu, x, Ke));
     for (PetscInt a = 0; a <= dim; ++a) {
       const PetscInt r = blk[a], nr = r < 0 ? 0 : bptr[r + 1] - bptr[r];
 

@@ -249,7 +249,7 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   *done = PETSC_FALSE;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(AssemblyP1CSRApplies(dm, bs, &applies));
+  PetscCall(AssemblyP1CSRApplies(dm, bs, user->opt->solver.given.mat_type, &applies));
   if (size == 1 || !applies) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMemzero(&s, sizeof(s)));
   PetscCall(PetscMemzero(&grows, sizeof(grows)));
@@ -353,7 +353,7 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
 
     PetscCall(AssemblyP1CellCoordinates(csection, xa, dim, &cverts[(c - cStart) * (dim + 1)], x));
     for (PetscInt a = 0; a <= dim; ++a) vl[a] = cverts[(c - cStart) * (dim + 1) + a] - vStart;
-    PetscCall(ElasticityP1ElementStiffness(dim, user->opt.material.lambda, user->opt.material.mu, x, Ke));
+    PetscCall(ElasticityP1ElementStiffness(dim, user->opt->material.lambda, user->opt->material.mu, x, Ke));
     for (PetscInt a = 0; a <= dim; ++a) {
       const PetscInt ra = vl[a];
 

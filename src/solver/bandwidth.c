@@ -134,7 +134,7 @@ PetscErrorCode BandwidthMeasure(SNES snes, AppCtx *user)
   PetscReal    t, bytes;
 
   PetscFunctionBeginUser;
-  if (!user->opt.perf_bandwidth) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt->perf_bandwidth) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCallMPI(MPI_Comm_size(comm, &size));
   b->measured = PETSC_TRUE;
   /* the triad */

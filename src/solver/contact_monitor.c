@@ -21,12 +21,12 @@ static PetscErrorCode DetectActiveSetCycle(SNES snes, AppCtx *user, PetscInt it,
   for (PetscInt j = it - 2; j >= 0; --j) {
     if (user->prob.active_history[j] != hash || user->prob.active_history[it - 1] == hash || fnorm < 0.5 * user->prob.fnorm_history[j]) continue;
     user->rec.stats.active_set_cycles++;
-    if (user->opt.solver.cycle_damping) PetscCall(SNESLineSearchSetDamping(ls, 0.5));
+    if (user->opt->solver.cycle_damping) PetscCall(SNESLineSearchSetDamping(ls, 0.5));
     PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes),
                           "  active-set cycle: Newton step %" PetscInt_FMT " is back at the active set of step %" PetscInt_FMT
                           " (|F| %g, then %g)%s\n",
                           it, j, (double)user->prob.fnorm_history[j], (double)fnorm,
-                          user->opt.solver.cycle_damping ? "; the next step is damped by 1/2" : "; not damped (-contact_cycle_damping 0)"));
+                          user->opt->solver.cycle_damping ? "; the next step is damped by 1/2" : "; not damped (-contact_cycle_damping 0)"));
     break;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -45,7 +45,7 @@ PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm_scaled, vo
   PetscCall(SNESGetSolution(snes, &Xs));
   PetscCall(SolverIterateDisplacement(user, Xs, &X));
   if (ContactHasPenalty(user->contact)) PetscCall(DetectActiveSetCycle(snes, user, it, fnorm, X));
-  if (!user->opt.solver.monitor) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt->solver.monitor) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactCountActive(user->contact, X, user->prob.displacement_scale, PETSC_TRUE, &active, &entered, &left));
   PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes),
                         "  %3" PetscInt_FMT " contact: |F| %12.6e  active vertices %6" PetscInt_FMT "  entered %5" PetscInt_FMT

@@ -65,6 +65,6 @@ PetscErrorCode SolverForcingSetUp(SNES snes, AppCtx *user, PetscBool *petsc_pres
   *petsc_presolve = (PetscBool)(version != 2);
   if (version != 2) PetscFunctionReturn(PETSC_SUCCESS);
   user->prob.forcing.snes  = snes;
-  user->prob.forcing.guard = user->opt.solver.ew_guard;
+  user->prob.forcing.guard = user->opt->solver.ew_guard;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -16,25 +16,24 @@ static PetscErrorCode FinePrefix(PC pc, char fine[], size_t len)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Whether -mg_fine_ksp_type or -mg_fine_pc_type is given for the PC of ksp. */
-PetscErrorCode FineSmootherGiven(KSP ksp, PetscBool *given)
+/* Whether -mg_fine_ksp_type or -mg_fine_pc_type is given for the PC of ksp (read in the options phase, SolverGiven). */
+PetscErrorCode FineSmootherGiven(KSP ksp, const SolverGiven *g, PetscBool *given)
 {
-  PC        pc;
-  char      fine[256];
-  PetscBool ksp_type, pc_type;
+  PC          pc;
+  const char *prefix;
+  PetscInt    k;
 
   PetscFunctionBeginUser;
   PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(FinePrefix(pc, fine, sizeof(fine)));
-  PetscCall(PetscOptionsHasName(NULL, fine, "-ksp_type", &ksp_type));
-  PetscCall(PetscOptionsHasName(NULL, fine, "-pc_type", &pc_type));
-  *given = (PetscBool)(ksp_type || pc_type);
+  PetscCall(PCGetOptionsPrefix(pc, &prefix));
+  PetscCall(SolverGivenIndex(prefix, &k));
+  *given = (PetscBool)(g->fine_ksp_type[k] || g->fine_pc_type[k]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Before a linear solve: with a multigrid PC and -mg_fine_ options, sets the PC up (it would be next) and gives the
    finest smoother its options, unless it has them already (a rebuild may have made a new smoother). */
-PetscErrorCode FineSmootherSetUp(KSP ksp)
+PetscErrorCode FineSmootherSetUp(KSP ksp, const SolverGiven *g)
 {
   PC          pc;
   KSP         smoother;
@@ -47,7 +46,7 @@ PetscErrorCode FineSmootherSetUp(KSP ksp)
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &is_mg, PCMG, PCGAMG, ""));
   if (!is_mg) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(FineSmootherGiven(ksp, &given));
+  PetscCall(FineSmootherGiven(ksp, g, &given));
   if (!given) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(KSPSetUp(ksp)); /* the hierarchy, and its levels' smoothers */
   PetscCall(PCMGGetLevels(pc, &nlevels));

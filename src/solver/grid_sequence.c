@@ -23,15 +23,15 @@ static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *
   PetscCall(DMGlobalToLocal(*dm, *u, INSERT_VALUES, loc));
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
-  if (user->opt.box.is_box && user->opt.degree == 1) { /* the box of twice as many cells, built directly */
+  if (user->box.is_box && user->opt->degree == 1) { /* the box of twice as many cells, built directly */
     parent = NULL;
-    PetscCall(MeshCreateBoxLevel(*dm, &user->opt.box, user->prob.level, &fine, &vertex_source));
+    PetscCall(MeshCreateBoxLevel(*dm, &user->box, user->prob.level, &fine, &vertex_source));
   } else
     PetscCall(MeshRefineRegular(*dm, 1, &fine, &parent, &vertex_source));
   user->prob.level++;
   PetscCall(ProblemSetUp(fine, user, snes));
   PetscCall(MultigridAddLevel(*snes, *dm, fine, vertex_source, user)); /* with -pc_type mg */
-  if (user->opt.degree == 1)
+  if (user->opt->degree == 1)
     PetscCall(MeshInterpolateVertexSources(*dm, fine, vertex_source, loc, &fine_loc)); /* exact and fast */
   else
     PetscCall(MeshInterpolateFromParents(*dm, fine, parent, 1, &loc, &fine_loc));
@@ -55,30 +55,30 @@ static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
   PetscInt  maxit, maxf;
 
   PetscFunctionBeginUser;
-  if (user->prob.level >= user->opt.box.coarse_levels) PetscFunctionReturn(PETSC_SUCCESS);
+  if (user->prob.level >= user->box.coarse_levels) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
-  if (user->opt.solver.coarse_rtol > rtol) PetscCall(SNESSetTolerances(snes, atol, user->opt.solver.coarse_rtol, stol, maxit, maxf));
+  if (user->opt->solver.coarse_rtol > rtol) PetscCall(SNESSetTolerances(snes, atol, user->opt->solver.coarse_rtol, stol, maxit, maxf));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, RunOptions *opt, PetscInt *request, PetscInt *min_faces)
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt *min_faces, PetscBool *coarse_mg)
 {
   const PetscInt k           = opt->solver.coarse_levels;
-  char           pc_type[64] = "";
-  PetscBool      given, is_mg, is_factor;
+  const char    *pc_type     = opt->solver.given.pc_type;
+  const PetscBool given       = opt->solver.given.pc_type_given;
+  PetscBool      is_mg, is_factor;
 
   PetscFunctionBeginUser;
   PetscCheck(k <= 0 || opt->degree == 1, comm, PETSC_ERR_USER_INPUT,
              "-contact_coarse_levels %" PetscInt_FMT " needs P1 displacements, got -displacement_petscspace_degree %" PetscInt_FMT, k, opt->degree);
-  PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", pc_type, sizeof(pc_type), &given));
   PetscCall(PetscStrcmp(pc_type, PCMG, &is_mg));
   PetscCall(PetscStrInList(pc_type, PCLU "," PCCHOLESKY, ',', &is_factor));
   /* -contact_coarse_mg: with an iterative preconditioner that is not already the boxes' multigrid (without -pc_type, the
      default is MUMPS's factorization, which a coarser box's small matrix does not make expensive); not with SNESVI, whose
      reduced system (vinewtonrsls) no PCMG can follow and whose vinewtonssls Jacobian CG cannot take */
-  opt->solver.coarse_mg = (PetscBool)(opt->solver.coarse_mg && given && !is_mg && !is_factor && !ContactHasBounds(ct));
+  *coarse_mg = (PetscBool)(opt->solver.coarse_mg && given && !is_mg && !is_factor && !ContactHasBounds(ct));
   *request               = k;
-  *min_faces             = (is_mg || opt->solver.coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
+  *min_faces             = (is_mg || *coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
   /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels) */
   if (k < 0 && (!(ContactHasPenalty(ct) || (ContactIsNone(ct) && is_mg)) || opt->degree != 1)) *request = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -86,7 +86,7 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, RunOptions *
 
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
 {
-  const PetscInt nlevels = user->opt.box.coarse_levels + user->opt.solver.grid_sequence;
+  const PetscInt nlevels = user->box.coarse_levels + user->opt->solver.grid_sequence;
 
   PetscFunctionBeginUser;
   PetscCall(GridSequenceSetTolerance(*snes, user));
@@ -95,7 +95,7 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     const PetscBool failed = (PetscBool)!user->rec.stats.converged;
     PetscLogDouble  t0, t1;
 
-    if (failed && user->prob.level >= user->opt.box.coarse_levels) break; /* a failed level of -contact_grid_sequence ends it */
+    if (failed && user->prob.level >= user->box.coarse_levels) break; /* a failed level of -contact_grid_sequence ends it */
     if (failed)
       PetscCall(PetscPrintf(PetscObjectComm((PetscObject)*dm), "  nested iteration: level %" PetscInt_FMT " failed (%s), the next starts from zero\n",
                             user->prob.level, SNESConvergedReasons[user->rec.stats.reason]));

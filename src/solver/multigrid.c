@@ -12,7 +12,7 @@
 /* Whether the problem's mesh is a coarser box of nested iteration solved under -contact_coarse_mg. */
 static inline PetscBool MultigridOnCoarseBox(const AppCtx *user)
 {
-  return (PetscBool)(user->opt.solver.coarse_mg && user->prob.level < user->opt.box.coarse_levels);
+  return (PetscBool)(user->mg.coarse_mg && user->prob.level < user->box.coarse_levels);
 }
 
 /* With -pc_type mg (the PC of snes, the fine mesh's problem) and P1/Q1, adds the interpolation from coarse to fine,
@@ -34,7 +34,7 @@ PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt v
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
-  if (!is_mg || user->opt.degree != 1) { /* the coarser meshes' interpolations, if any (-contact_coarse_mg), serve no longer */
+  if (!is_mg || user->opt->degree != 1) { /* the coarser meshes' interpolations, if any (-contact_coarse_mg), serve no longer */
     PetscCall(MultigridDestroy(mg));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
@@ -99,8 +99,8 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
   const Multigrid *mg = &user->mg;
   KSP              ksp;
   PC               pc;
-  PetscBool        is_mg, set;
-  PetscInt         nlevels;
+  PetscBool        is_mg;
+  PetscInt         nlevels, k;
   const char      *prefix;
 
   PetscFunctionBeginUser;
@@ -108,13 +108,13 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
   if (!is_mg) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCheck(mg->n > 0 || user->prob.level < user->opt.box.coarse_levels + user->opt.solver.grid_sequence, PetscObjectComm((PetscObject)snes),
+  PetscCheck(mg->n > 0 || user->prob.level < user->box.coarse_levels + user->opt->solver.grid_sequence, PetscObjectComm((PetscObject)snes),
              PETSC_ERR_USER_INPUT,
              "-pc_type mg takes its levels from nested meshes, and this mesh has none: use the 2D simplex box (-dm_plex_box_faces, "
              "-contact_coarse_levels) or -contact_grid_sequence N, or another -pc_type");
   PetscCall(PCGetOptionsPrefix(pc, &prefix));
-  PetscCall(PetscOptionsHasName(NULL, prefix, "-pc_mg_levels", &set));
-  PetscCheck(!set, PetscObjectComm((PetscObject)snes), PETSC_ERR_USER_INPUT,
+  PetscCall(SolverGivenIndex(prefix, &k));
+  PetscCheck(!user->opt->solver.given.pc_mg_levels[k], PetscObjectComm((PetscObject)snes), PETSC_ERR_USER_INPUT,
              "-pc_mg_levels: the levels of -pc_type mg are the nested meshes (-contact_coarse_levels, -contact_grid_sequence)");
   PetscCall(PCMGGetLevels(pc, &nlevels));
   if (nlevels == mg->n + 1) { /* set up by an earlier solve on this mesh? */
@@ -158,8 +158,7 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
       PetscCall(KSPGetPC(smoother, &spc));
       PetscCall(PCSetType(spc, PCJACOBI));
     }
-  PetscCall(PetscOptionsHasName(NULL, prefix, "-pc_mg_galerkin", &set));
-  if (!set) PetscCall(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH));
+  if (!user->opt->solver.given.pc_mg_galerkin[k]) PetscCall(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

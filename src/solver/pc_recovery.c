@@ -108,7 +108,7 @@ PetscErrorCode PcRecoveryTry(SNES snes, AppCtx *user, PetscBool *retry)
 
   PetscFunctionBeginUser;
   *retry = PETSC_FALSE;
-  if (!user->opt.solver.pc_recovery || rec->stage >= 3) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt->solver.pc_recovery || rec->stage >= 3) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(IsBreakdown(snes, &kreason, &breakdown));
   if (!breakdown) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetKSP(snes, &ksp));

@@ -43,7 +43,7 @@ static PetscErrorCode HierarchyLevels(SNES snes, AppCtx *user, PC *pc, PetscInt 
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(KSPGetPC(ksp, pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)*pc, PCGAMG, &is_gamg));
-  if (!is_gamg || !user->opt.solver.pc_update || user->prob.pc_reuse.no_update || !ContactBulkRowsOf(user->contact) || !ContactBulkRowsOf(user->contact)->ptr) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!is_gamg || !user->opt->solver.pc_update || user->prob.pc_reuse.no_update || !ContactBulkRowsOf(user->contact) || !ContactBulkRowsOf(user->contact)->ptr) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PCMGGetLevels(*pc, nlevels));
   for (PetscInt l = 0; l < *nlevels; ++l) {
     KSP smoother;
@@ -154,7 +154,7 @@ static PetscErrorCode EffectiveValues(AppCtx *user, const PetscScalar jvals[], P
   const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
   PcReuse           *r     = &pb->pc_reuse;
   const PetscInt     nnz   = br->ptr[br->n];
-  const PetscReal    ratio = user->opt.solver.pc_update_truncate;
+  const PetscReal    ratio = user->opt->solver.pc_update_truncate;
   const PetscScalar *mark;
 
   PetscFunctionBeginUser;
@@ -253,7 +253,7 @@ static PetscErrorCode FinestProductSetUp(PC pc, AppCtx *user)
   r->rlocal = sub[0];
   PetscCall(PetscFree(sub));
   /* with the truncation, the columns S that are no contact row (on any rank) get the mirrors of their entries */
-  if (user->opt.solver.pc_update_truncate > 0.0) {
+  if (user->opt->solver.pc_update_truncate > 0.0) {
     PetscCall(MirrorsSetUp(user));
     PetscCall(ProlongatorRowsSave(pc, user));
   }
@@ -383,7 +383,7 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
     PetscCall(KSPGetOperators(smoother, &A, NULL));
     PetscCall(MatAXPY(A, 1.0, r->dcoarse[l - 1], SUBSET_NONZERO_PATTERN));
   }
-  if (user->opt.solver.pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r));
+  if (user->opt->solver.pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r));
   /* every level's operator is new: its Chebyshev smoother estimates its eigenvalues again, its Jacobi or LU sets up
      again (KSPSetOperators() marks the new matrix, as a rebuild would) */
   for (PetscInt l = 0; l < nlevels; ++l) {
@@ -395,7 +395,7 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
     PetscCall(KSPSetOperators(smoother, A, A));
   }
   /* except the finest level's Chebyshev interval, which a bound keeps (smoother_bound.c) */
-  if (!user->opt.solver.pc_update_esteig) PetscCall(SmootherBoundFinest(pc, nlevels, user, r->built_vals, user->opt.solver.pc_update_check));
+  if (!user->opt->solver.pc_update_esteig) PetscCall(SmootherBoundFinest(pc, nlevels, user, r->built_vals, user->opt->solver.pc_update_check));
   r->updates++;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -437,7 +437,7 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
     PetscCall(KSPGetConvergedReason(ksp, &reason));
     /* rebuild after a failed solve, or when the last solve needed twice the iterations of the first after the build */
     rebuild =
-        (PetscBool)(changes > user->opt.solver.pc_reuse_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
+        (PetscBool)(changes > user->opt->solver.pc_reuse_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
   }
   if (rebuild) {
     PetscCall(CountChanges(user, dim, x, PETSC_TRUE, &changes));
@@ -465,7 +465,7 @@ PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user)
   PetscInt nlevels;
 
   PetscFunctionBeginUser;
-  if (!r->enabled || !user->opt.solver.pc_update || r->no_update || !br->jacobian_in_K) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!r->enabled || !user->opt->solver.pc_update || r->no_update || !br->jacobian_in_K) PetscFunctionReturn(PETSC_SUCCESS);
   if (r->update) {
     PetscCall(HierarchyLevels(snes, user, &pc, &nlevels));
     PetscCall(UpdateHierarchy(pc, nlevels, user));

@@ -32,11 +32,11 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
 
     cp.bcs            = &user->scene.bcs;
     cp.obstacle       = &user->scene.obstacle;
-    cp.material       = &user->opt.material;
-    cp.degree         = user->opt.degree;
+    cp.material       = &user->opt->material;
+    cp.degree         = user->opt->degree;
     cp.h              = user->prob.h;
     cp.assembly       = user->prob.assembly; /* resolved above */
-    cp.assembly_check = user->opt.assembly_check;
+    cp.assembly_check = user->opt->assembly_check;
     cp.loc_bc         = user->prob.loc_bc;
     cp.like           = user->prob.r0;
     PetscCall(ContactSetUp(user->contact, dm, &cp)); /* the contact set, eps, the penalty's faces or SNESVI's bounds */

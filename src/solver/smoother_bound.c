@@ -136,13 +136,13 @@ static PetscErrorCode PenaltyBound(AppCtx *user, const PetscScalar jvals[], Pets
 
 /* The build's estimate (made on K), and Chebyshev's transform of estimates into its interval: a, b, c, d of
    -ksp_chebyshev_esteig on the smoother's prefix, PETSc's default 0, 0.1, 0, 1.1 if unset. */
-static PetscErrorCode ReadBuildEstimate(KSP smoother, PcReuse *r)
+static PetscErrorCode ReadBuildEstimate(KSP smoother, const SolverGiven *given, PcReuse *r)
 {
   KSP         est;
   const char *prefix;
   PetscReal   t[4];
   PetscInt    nt = 4;
-  PetscBool   set, found;
+  PetscBool   found;
 
   PetscFunctionBeginUser;
   r->bound_read = PETSC_TRUE;
@@ -156,11 +156,11 @@ static PetscErrorCode ReadBuildEstimate(KSP smoother, PcReuse *r)
   r->tform[2] = 0.0;
   r->tform[3] = 1.1;
   PetscCall(KSPGetOptionsPrefix(smoother, &prefix));
-  PetscCall(PetscOptionsGetRealArray(NULL, prefix, "-ksp_chebyshev_esteig", t, &nt, &set));
-  if (set && nt == 2) { /* PETSc's short form: b and d */
+  PetscCall(SolverGivenEsteig(given, prefix, &nt, t)); /* -ksp_chebyshev_esteig under the smoother's prefix */
+  if (nt == 2) { /* PETSc's short form: b and d */
     r->tform[1] = t[0];
     r->tform[3] = t[1];
-  } else if (set && nt == 4)
+  } else if (nt == 4)
     PetscCall(PetscArraycpy(r->tform, t, 4));
   r->bound_set = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -175,7 +175,7 @@ PetscErrorCode SmootherBoundFinest(PC pc, PetscInt nlevels, AppCtx *user, const 
   PetscFunctionBeginUser;
   PetscCall(FinestChebyshevJacobi(pc, nlevels, &smoother));
   if (!smoother) PetscFunctionReturn(PETSC_SUCCESS);
-  if (!r->bound_read) PetscCall(ReadBuildEstimate(smoother, r));
+  if (!r->bound_read) PetscCall(ReadBuildEstimate(smoother, &user->opt->solver.given, r));
   if (!r->bound_set) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PenaltyBound(user, jvals, &beta));
   if (beta < PETSC_MAX_REAL)

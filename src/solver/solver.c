@@ -20,7 +20,7 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   PetscCall(VecCopy(user->prob.loc_bc, locX)); /* u = 0 with the Dirichlet values, inserted once by ProblemSetUp() */
   PetscCall(VecZeroEntries(locF));
   if (user->prob.assembly == ASSEMBLY_FE) PetscCall(DMPlexSNESComputeJacobianFEM(dm, locX, user->prob.K, user->prob.K, user));
-  if (user->opt.assembly_check) PetscCall(AssemblyP1Check(dm, user, locX));
+  if (user->opt->assembly_check) PetscCall(AssemblyP1Check(dm, user, locX));
   PetscCall(MatAssemblyBegin(user->prob.K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(user->prob.K, MAT_FINAL_ASSEMBLY));
   if (user->prob.assembly == ASSEMBLY_P1)
@@ -33,7 +33,7 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   PetscCall(VecCopy(locF, user->prob.loc_r0));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscCall(DMRestoreLocalVector(dm, &locF));
-  if (user->opt.degree == 1)
+  if (user->opt->degree == 1)
     PetscCall(ElasticityRigidBodyModesP1(dm, user->prob.r0, &rigid)); /* unknowns at the vertices only */
   else
     PetscCall(DMPlexCreateRigidBody(dm, 0, &rigid));
@@ -179,7 +179,7 @@ static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, P
     PetscCall(SolverStopReference(user, &ref));
     *reason = f <= rtol * ref ? SNES_CONVERGED_FNORM_RELATIVE : SNES_CONVERGED_ITERATING;
   }
-  if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->opt.solver.load_rtol * user->prob.load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
+  if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->opt->solver.load_rtol * user->prob.load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
   /* A tolerance below what double precision can reach: Newton stalls at the round-off of the terms the residual sums
      (with eps far below h/E, (1/eps) times the displacement times the machine epsilon). Where a step did not halve |F|
      and |F| is within 100 times the estimated round-off (SolverRoundoffFloor()), it stops, converged at round-off,
@@ -243,7 +243,7 @@ static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
   PC pc;
 
   PetscFunctionBeginUser;
-  PetscCall(KSPSetType(ksp, ContactHasPenalty(user->contact) && user->opt.solver.pc_reuse ? KSPCG : KSPPREONLY));
+  PetscCall(KSPSetType(ksp, ContactHasPenalty(user->contact) && user->opt->solver.pc_reuse ? KSPCG : KSPPREONLY));
   PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCSetType(pc, PCLU));
@@ -263,9 +263,10 @@ static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
      0.01 converges there (tests/test_performance.py). -snes_ksp_ew 0 restores the fixed -ksp_rtol. */
 static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
 {
-  KSP       ksp;
-  PC        pc;
-  PetscBool is_cg, is_factor, set;
+  const SolverGiven *given = &user->opt->solver.given;
+  KSP                ksp;
+  PC                 pc;
+  PetscBool          is_cg, is_factor;
 
   PetscFunctionBeginUser;
   PetscCall(SNESGetKSP(snes, &ksp));
@@ -273,13 +274,17 @@ static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
   PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPCG, &is_cg));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &is_factor, PCLU, PCCHOLESKY, ""));
   if (is_factor) PetscFunctionReturn(PETSC_SUCCESS); /* a factorization: CG converges in one or a few iterations anyway */
-  PetscCall(PetscOptionsHasName(NULL, NULL, "-ksp_norm_type", &set));
-  if (is_cg && !set && ContactIsNone(user->contact)) PetscCall(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED));
-  PetscCall(PetscOptionsHasName(NULL, NULL, "-snes_ksp_ew", &set));
-  if (!set && ContactHasPenalty(user->contact)) {
+  {
+    const char *prefix;
+    PetscInt    k;
+
+    PetscCall(KSPGetOptionsPrefix(ksp, &prefix));
+    PetscCall(SolverGivenIndex(prefix, &k));
+    if (is_cg && !given->ksp_norm_type[k] && ContactIsNone(user->contact)) PetscCall(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED));
+  }
+  if (!given->snes_ksp_ew && ContactHasPenalty(user->contact)) {
     PetscCall(SNESKSPSetUseEW(snes, PETSC_TRUE));
-    PetscCall(PetscOptionsHasName(NULL, NULL, "-snes_ksp_ew_rtolmax", &set));
-    if (!set)
+    if (!given->snes_ksp_ew_rtolmax)
       PetscCall(
           SNESKSPSetParametersEW(snes, PETSC_DEFAULT, PETSC_DEFAULT, SOLVER_EW_RTOL_MAX, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
   }
@@ -293,7 +298,7 @@ static PetscErrorCode SolverPreSolve(KSP ksp, Vec b, Vec x, void *ctx)
   AppCtx *user = (AppCtx *)ctx;
 
   PetscFunctionBeginUser;
-  PetscCall(FineSmootherSetUp(ksp));
+  PetscCall(FineSmootherSetUp(ksp, &user->opt->solver.given));
   PetscCall(SolverStepGuessPreSolve(ksp, x, user));
   PetscCall(SolverForcingPreSolve(ksp, user));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -376,7 +381,7 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscBool is_preonly;
 
     PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &is_preonly));
-    user->prob.pc_reuse.enabled = (PetscBool)(ContactHasPenalty(user->contact) && user->opt.solver.pc_reuse && !is_preonly);
+    user->prob.pc_reuse.enabled = (PetscBool)(ContactHasPenalty(user->contact) && user->opt->solver.pc_reuse && !is_preonly);
   }
   PetscCall(SolverSetIterativeDefaults(*snes, user));
   {
@@ -385,7 +390,7 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscCall(SolverForcingSetUp(*snes, user, &petsc_presolve)); /* Eisenstat-Walker's terms with the oversolving guard */
     PetscCall(SolverStepGuessSetUp(ksp, user));
     if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, user));
-    PetscCall(FineSmootherGiven(ksp, &fine));
+    PetscCall(FineSmootherGiven(ksp, &user->opt->solver.given, &fine));
     PetscCheck(!fine || is_multigrid, comm, PETSC_ERR_USER_INPUT,
                "-mg_fine_ksp_type and -mg_fine_pc_type need a multigrid preconditioner (-pc_type gamg or mg), not %s", pc_type);
     PetscCheck(
@@ -424,7 +429,7 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   PetscCall(SolverStopReference(user, &ref));
   user->rec.stats.residual_reduced =
       (PetscBool)(user->rec.stats.residual_norm <= rtol * ref ||
-                  user->rec.stats.residual_norm <= user->opt.solver.load_rtol * user->prob.load_norm || fnorm <= atol || user->prob.roundoff_stop);
+                  user->rec.stats.residual_norm <= user->opt->solver.load_rtol * user->prob.load_norm || fnorm <= atol || user->prob.roundoff_stop);
   user->rec.stats.roundoff_stop = user->prob.roundoff_stop;
   user->rec.stats.converged     = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
   PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
@@ -565,7 +570,7 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
 
   PetscFunctionBeginUser;
   user->rec.stats.condition_1norm = PETSC_NAN;
-  if (!user->opt.solver.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt->solver.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
   if (ContactHasBounds(user->contact)) {

@@ -3,9 +3,77 @@
 #include "app.h"
 #include "solver.h"
 
+static const char *const solver_ksp_prefixes[SOLVER_KSP_PREFIXES] = {"", "contact_coarse_"};
+
+/* PETSc's options that change the project's defaults when given (SolverGiven), under each prefix the solver's objects
+   can have. Only their presence (and a few values) is read here; PETSc reads them itself when it sets its objects up. */
+static PetscErrorCode SolverReadGiven(SolverGiven *g)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-mat_type", &g->mat_type));
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-snes_ksp_ew", &g->snes_ksp_ew));
+  PetscCall(PetscOptionsHasName(NULL, NULL, "-snes_ksp_ew_rtolmax", &g->snes_ksp_ew_rtolmax));
+  PetscCall(PetscOptionsGetString(NULL, NULL, "-pc_type", g->pc_type, sizeof(g->pc_type), &g->pc_type_given));
+  for (PetscInt k = 0; k < SOLVER_KSP_PREFIXES; ++k) {
+    const char *pre = k ? solver_ksp_prefixes[k] : NULL;
+
+    PetscCall(PetscOptionsHasName(NULL, pre, "-ksp_norm_type", &g->ksp_norm_type[k]));
+    PetscCall(PetscOptionsHasName(NULL, pre, "-ksp_converged_use_initial_residual_norm", &g->use_initial_rnorm[k]));
+    PetscCall(PetscOptionsHasName(NULL, pre, "-pc_mg_levels", &g->pc_mg_levels[k]));
+    PetscCall(PetscOptionsHasName(NULL, pre, "-pc_mg_galerkin", &g->pc_mg_galerkin[k]));
+    PetscCall(PetscOptionsHasName(NULL, pre, "-mg_fine_ksp_type", &g->fine_ksp_type[k]));
+    PetscCall(PetscOptionsHasName(NULL, pre, "-mg_fine_pc_type", &g->fine_pc_type[k]));
+    for (PetscInt l = 0; l <= MULTIGRID_MAX_LEVELS; ++l) {
+      const PetscInt e = k * (MULTIGRID_MAX_LEVELS + 1) + l;
+      char           name[96];
+      PetscBool      set;
+
+      if (l == MULTIGRID_MAX_LEVELS) PetscCall(PetscSNPrintf(g->esteig_prefix[e], sizeof(g->esteig_prefix[e]), "%smg_fine_", solver_ksp_prefixes[k]));
+      else PetscCall(PetscSNPrintf(g->esteig_prefix[e], sizeof(g->esteig_prefix[e]), "%smg_levels_%d_", solver_ksp_prefixes[k], (int)l));
+      PetscCall(PetscSNPrintf(name, sizeof(name), "-%sksp_chebyshev_esteig", g->esteig_prefix[e]));
+      g->esteig_n[e] = 4;
+      PetscCall(PetscOptionsGetRealArray(NULL, NULL, name, g->esteig[e], &g->esteig_n[e], &set));
+      if (!set) g->esteig_n[e] = 0;
+    }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The index in SolverGiven of an object's options prefix (NULL or "": the solve's; "contact_coarse_": the coarser boxes'). */
+PetscErrorCode SolverGivenIndex(const char prefix[], PetscInt *k)
+{
+  PetscBool same;
+
+  PetscFunctionBeginUser;
+  for (*k = 0; *k < SOLVER_KSP_PREFIXES; ++*k) {
+    PetscCall(PetscStrcmp(prefix ? prefix : "", solver_ksp_prefixes[*k], &same));
+    if (same) PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  SETERRQ(PETSC_COMM_SELF, PETSC_ERR_PLIB, "options prefix %s is none of the solver's", prefix);
+}
+
+/* The -ksp_chebyshev_esteig given for a multigrid smoother with options prefix prefix (the solve's or the coarser boxes'
+   mg_levels_N_ or mg_fine_): *n values in t (0: not given). */
+PetscErrorCode SolverGivenEsteig(const SolverGiven *g, const char prefix[], PetscInt *n, PetscReal t[])
+{
+  PetscFunctionBeginUser;
+  *n = 0;
+  for (PetscInt e = 0; e < SOLVER_KSP_PREFIXES * (MULTIGRID_MAX_LEVELS + 1); ++e) {
+    PetscBool same;
+
+    PetscCall(PetscStrcmp(prefix ? prefix : "", g->esteig_prefix[e], &same));
+    if (!same) continue;
+    *n = g->esteig_n[e];
+    PetscCall(PetscArraycpy(t, g->esteig[e], *n));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  SETERRQ(PETSC_COMM_SELF, PETSC_ERR_PLIB, "smoother options prefix %s is none of the solver's", prefix);
+}
+
 PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts)
 {
   PetscFunctionBeginUser;
+  PetscCall(SolverReadGiven(&opts->given));
   PetscOptionsBegin(comm, NULL, "Nonlinear solve", "Signorini");
   opts->monitor = PETSC_FALSE;
   PetscCall(

@@ -20,7 +20,12 @@ PetscErrorCode SolverStepGuessSetUp(KSP ksp, AppCtx *user)
   PetscCall(VecDestroy(&sg->du));
   PetscCall(KSPGetInitialGuessNonzero(ksp, &sg->nonzero));
   PetscCall(KSPGetOptionsPrefix(ksp, &prefix));
-  PetscCall(PetscOptionsHasName(NULL, prefix, "-ksp_converged_use_initial_residual_norm", &sg->user_rnorm0));
+  {
+    PetscInt k;
+
+    PetscCall(SolverGivenIndex(prefix, &k));
+    sg->user_rnorm0 = user->opt->solver.given.use_initial_rnorm[k]; /* -ksp_converged_use_initial_residual_norm */
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -72,7 +72,7 @@ static PetscErrorCode IntegrateBulk(DM dm, AppCtx *user, CellQuadrature *cq, Vec
         g[k] = gt[k] - g[k];
         s1 += PetscSqr(g[k]);
       }
-      ElasticStress(dim, &user->opt.material, g, sigma);
+      ElasticStress(dim, &user->opt->material, g, sigma);
       for (PetscInt k = 0; k < dim * dim; ++k) s2 += sigma[k] * g[k];
       sums[0] += cq->w[q] * s0;
       sums[1] += cq->w[q] * s1;
@@ -201,7 +201,7 @@ PetscErrorCode ErrorNormsEvaluate(DM dm, AppCtx *user, Mat K, Vec loc_uh, Vec lo
 
   PetscFunctionBeginUser;
   PetscCall(ErrorNormsReset(e));
-  PetscCall(CellQuadratureCreate(dm, &user->scene, &user->opt.verify, &cq));
+  PetscCall(CellQuadratureCreate(dm, &user->scene, &user->opt->verify, &cq));
   if (target) {
     PetscCall(DMGetLocalVector(dm, &loc_b));
     PetscCall(VecZeroEntries(loc_b));

@@ -196,7 +196,7 @@ static PetscBool ReferenceHasCell(const Reference *ref, const PetscInt v[])
    message names the first item that differs. */
 static PetscErrorCode ReferenceCheckProblem(MPI_Comm comm, const AppCtx *user, PetscInt dim, PetscViewer v)
 {
-  const char *file = user->opt.verify.reference;
+  const char *file = user->opt->verify.reference;
   char        mine[SCENE_FINGERPRINT_LEN], *theirs = NULL;
   PetscBool   has, same;
 
@@ -206,7 +206,7 @@ static PetscErrorCode ReferenceCheckProblem(MPI_Comm comm, const AppCtx *user, P
              "Reference file %s has no /run attribute problem (written by an older version of the solver): the problem it solved cannot be "
              "compared with this run's; run the reference again",
              file);
-  PetscCall(SceneFingerprint(&user->scene, &user->opt.material, dim, mine, sizeof(mine)));
+  PetscCall(SceneFingerprint(&user->scene, &user->opt->material, dim, mine, sizeof(mine)));
   PetscCall(PetscViewerHDF5ReadAttribute(v, "/run", "problem", PETSC_STRING, NULL, &theirs));
   PetscCall(PetscStrcmp(mine, theirs, &same));
   if (!same) {
@@ -234,7 +234,7 @@ static PetscErrorCode ReferenceCheckProblem(MPI_Comm comm, const AppCtx *user, P
 
 static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, PetscInt dim, PetscViewer v, PetscInt *ref_dim, PetscInt *ncells)
 {
-  const char *file       = user->opt.verify.reference;
+  const char *file       = user->opt->verify.reference;
   const char *datasets[] = {"/geometry/vertices", "/vertex_fields/displacement", "/vertex_fields/contact_pressure", "/viz/topology/cells"};
   PetscInt    converged, degree;
   char       *scene = NULL;
@@ -256,10 +256,10 @@ static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, Pe
   PetscCall(ReferenceCheckProblem(comm, user, dim, v));
   PetscCheck(*ref_dim == dim, comm, PETSC_ERR_USER_INPUT, "Reference %s is %" PetscInt_FMT "D, this run is %" PetscInt_FMT "D", file, *ref_dim, dim);
   PetscCheck(converged == 1, comm, PETSC_ERR_USER_INPUT, "Reference %s did not converge (/run converged = 0)", file);
-  PetscCheck(degree == 1 && user->opt.degree == 1, comm, PETSC_ERR_USER_INPUT,
+  PetscCheck(degree == 1 && user->opt->degree == 1, comm, PETSC_ERR_USER_INPUT,
              "-reference needs degree 1 in the run and the reference (they are compared through vertex values); got %" PetscInt_FMT
              " and %" PetscInt_FMT,
-             user->opt.degree, degree);
+             user->opt->degree, degree);
   for (size_t i = 0; i < sizeof(datasets) / sizeof(datasets[0]); ++i) {
     PetscCall(PetscViewerHDF5HasDataset(v, datasets[i], &has));
     PetscCheck(has, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "Reference file %s has no dataset %s: not an output of this solver", file, datasets[i]);
@@ -270,7 +270,7 @@ static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, Pe
 /* Before the solve: the -reference file (if any) opens as HDF5 and fits this run (ReferenceCheckHeader()). */
 PetscErrorCode ReferenceCheckFile(DM dm, const AppCtx *user)
 {
-  const char    *file = user->opt.verify.reference;
+  const char    *file = user->opt->verify.reference;
   PetscViewer    v;
   PetscInt       dim, ref_dim, ncells;
   PetscErrorCode ierr;
@@ -303,7 +303,7 @@ PetscErrorCode ReferenceCheckFile(DM dm, const AppCtx *user)
 
 static PetscErrorCode ReferenceRead(MPI_Comm comm, const AppCtx *user, PetscInt dim, Reference *ref)
 {
-  const char *file = user->opt.verify.reference;
+  const char *file = user->opt->verify.reference;
   PetscViewer v;
   PetscInt    n;
   PetscReal  *cells;
@@ -428,11 +428,11 @@ static PetscErrorCode MatchReference(DM fine, const AppCtx *user, const Referenc
   PetscCheck(!nbad[0], comm, PETSC_ERR_USER_INPUT,
              "Reference %s does not match: a vertex of this mesh refined is not one of its vertices. Run the reference on the same coarse mesh "
              "with a larger -dm_refine",
-             user->opt.verify.reference);
+             user->opt->verify.reference);
   PetscCheck(!nbad[1], comm, PETSC_ERR_USER_INPUT,
              "Reference %s does not match: its vertices are those of this mesh refined, but not its cells. Run the reference on the same coarse "
              "mesh with a larger -dm_refine",
-             user->opt.verify.reference);
+             user->opt->verify.reference);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -448,7 +448,7 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
 
   PetscFunctionBeginUser;
   PetscCall(ErrorNormsReset(&user->rec.ref_errors));
-  if (!user->opt.verify.reference[0]) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt->verify.reference[0]) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(ReferenceRead(comm, user, dim, &ref));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
@@ -456,7 +456,7 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   while ((PetscInt64)ncells << (dim * levels) < (PetscInt64)ref.ncells && levels < 8) ++levels;
   PetscCheck((PetscInt64)ncells << (dim * levels) == (PetscInt64)ref.ncells, comm, PETSC_ERR_USER_INPUT,
              "Reference %s has %" PetscInt_FMT " cells, which is not this mesh (%" PetscInt_FMT " cells) uniformly refined",
-             user->opt.verify.reference, ref.ncells, ncells);
+             user->opt->verify.reference, ref.ncells, ncells);
 
   /* the run's displacement and, without the penalty law, its nodal pressure, on the refined mesh */
   nvec = ContactHasPenalty(user->contact) ? 1 : 2;
@@ -491,7 +491,7 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   target.loc_u        = loc_uref;
   target.loc_pressure = loc_pref;
   PetscCall(ErrorNormsEvaluate(fine, user, K, fine_loc[0], nvec == 2 ? fine_loc[1] : NULL, &target, &user->rec.ref_errors));
-  PetscCall(PetscInfo(dm, "Reference %s: %" PetscInt_FMT " refinement(s)\n", user->opt.verify.reference, levels));
+  PetscCall(PetscInfo(dm, "Reference %s: %" PetscInt_FMT " refinement(s)\n", user->opt->verify.reference, levels));
 
   PetscCall(MatDestroy(&K));
   for (PetscInt k = 0; k < nvec; ++k) PetscCall(VecDestroy(&fine_loc[k]));

@@ -16,7 +16,7 @@ PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const
   ObstacleGapNormalAt(&user->scene.obstacle, dim, x, n, &gap);
   PetscCall((*user->scene.exact_gradient)(dim, 0.0, x, dim * dim, g, (void *)user->scene.constants));
   for (PetscInt k = 0; k < dim * dim; ++k) grad[k] = PetscRealPart(g[k]);
-  ElasticStress(dim, &user->opt.material, grad, sigma);
+  ElasticStress(dim, &user->opt->material, grad, sigma);
   *sn = 0.0;
   for (PetscInt i = 0; i < dim; ++i)
     for (PetscInt j = 0; j < dim; ++j) *sn += n[i] * sigma[i * dim + j] * n[j];
@@ -36,7 +36,7 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0)
   PetscCheck(user->scene.exact && user->scene.exact_gradient, PetscObjectComm((PetscObject)dm), PETSC_ERR_PLIB,
              "Scene %s asks for weak data but has no exact solution and gradient", user->scene.name);
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(CellQuadratureCreate(dm, &user->scene, &user->opt.verify, &cq));
+  PetscCall(CellQuadratureCreate(dm, &user->scene, &user->opt->verify, &cq));
   PetscCall(PetscMalloc1(PetscMax(cq.Nb, 1), &elem));
   PetscCall(DMGetLocalVector(dm, &locL));
   PetscCall(VecZeroEntries(locL));
@@ -50,7 +50,7 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0)
 
       PetscCall((*user->scene.exact_gradient)(dim, 0.0, &cq.x[q * dim], dim * dim, g, (void *)user->scene.constants));
       for (PetscInt k = 0; k < dim * dim; ++k) grad[k] = PetscRealPart(g[k]);
-      ElasticStress(dim, &user->opt.material, grad, sigma);
+      ElasticStress(dim, &user->opt->material, grad, sigma);
       for (PetscInt b = 0; b < cq.Nb; ++b) {
         PetscReal s = 0.0;
 
