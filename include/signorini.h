@@ -154,57 +154,6 @@ typedef struct {
   PetscReal load_rtol;          /* Newton also stops when |F| <= load_rtol ||F(0)||: the residual is at round-off for the load */
 } SolverOptions;
 
-/* State of the preconditioner reuse (pc_reuse.c). */
-typedef struct {
-  PetscBool enabled;         /* penalty method with a Krylov method around the preconditioner */
-  PetscBool built;           /* a build exists */
-  PetscReal eps;             /* eps of the build */
-  PetscInt  its_after_build; /* Krylov iterations of the first solve after the build (-1: not yet known) */
-  PetscInt  builds;          /* builds so far */
-  /* -contact_pc_update: after the first build of a GAMG hierarchy, each new Jacobian changes the coarse operators by
-     the Galerkin products of its change, which lives in the contact rows only (the bulk matrix is constant) */
-  PetscBool    update;     /* the hierarchy exists and follows the Jacobian */
-  PetscBool    no_update;  /* updates given up after a preconditioner breakdown (pc_recovery.c): builds only */
-  PetscBool    record;     /* the Jacobian being assembled is the one of a build: record its contact rows */
-  PetscBool    recorded;   /* they are (on every rank alike) */
-  PetscInt     updates;    /* updates so far */
-  PetscScalar *built_vals; /* the Jacobian's values in the contact rows (K's pattern, bulk_ptr) at the last build or update */
-  PetscScalar *dvals;      /* their change since then, the values of dlocal */
-  Mat          rlocal;     /* the finest prolongator's rows at the columns S of the contact rows (from any rank) */
-  Mat          dlocal;     /* the change of the Jacobian since then, on S x S (nonzero in the contact rows only) */
-  Mat          clocal;     /* this rank's part of its product on the first coarse level */
-  PetscInt     nlevels;
-  Mat         *dcoarse; /* [nlevels - 1]: the change on the coarser levels, coarsest first */
-  /* -contact_pc_update_truncate: the finest prolongator R has zero rows at the penalty-dominated contact dofs Z, so the
-     coarse operators are R^T J' R, J' the Jacobian with the rows and columns Z set to zero (R the build's), and dlocal also holds the
-     columns Z of the rows that are not contact rows: the mirrors of the contact rows' entries there */
-  PetscInt     nmirror;              /* those entries */
-  PetscInt    *mirror_k;             /* [nmirror]: the contact-row entry (bulk_ptr numbering) each one mirrors, */
-  PetscInt    *mirror_at;            /*   and that row's place among the columns (bulk_x) */
-  PetscScalar *eff_vals;             /* [nnz + nmirror]: J' at dlocal's entries, as the coarse operators hold it */
-  PetscScalar *eff_dvals;            /* [nnz + nmirror]: its change, the values of dlocal */
-  PetscInt     nz;                   /* owned rows in Z */
-  PetscInt    *zrows;                /* [nbulk_rows]: their global numbers */
-  Mat          rfine;                /* the finest prolongator, whose rows Z are set to zero, */
-  PetscInt    *rrow_ptr, *rrow_cols; /*   its rows at the owned contact rows (CSR, global columns), */
-  PetscScalar *rrow_vals;            /*   with their values as GAMG made them */
-  Vec          zmark, zcols;         /* 0 outside the contact rows, 1 in them, 2 in Z; and those marks at the contact rows' columns */
-  /* the finest level's Chebyshev interval, bounded instead of estimated again at each update (SmootherBoundFinest(), smoother_bound.c) */
-  PetscBool built_on_K;       /* the build's Jacobian was K itself in the contact rows (no penalty term yet) */
-  PetscBool bound_set;        /* the build's estimate has been read, and the bound applies */
-  PetscBool bound_read;       /* ... has been looked for */
-  PetscReal est_min, est_max; /* the build's Chebyshev estimate of the extreme eigenvalues of diag(K)^-1 K */
-  PetscInt  est_steps;        /* the steps of its estimator */
-  PetscBool *built_active;    /* the contact nodes' penetration when the preconditioner was last built */
-  PetscReal tform[4];         /* Chebyshev's transform of estimates into its interval (-ksp_chebyshev_esteig) */
-  Vec       pdiag, pcols;     /* the penalty term's diagonal, and its values at the contact rows' columns */
-} PcReuse;
-
-/* State of the recovery from preconditioner breakdowns (pc_recovery.c). */
-typedef struct {
-  PetscInt stage; /* recovery steps taken: 0 none, 1 rebuilt, 2 GMRES, 3 direct */
-} PcRecovery;
-
 /* The nodes of Gamma_C owned by this rank with at least one free component: the unknowns the contact acts on. */
 typedef struct {
   PetscInt   n;
@@ -286,6 +235,7 @@ typedef struct {
   PetscBool           roundoff_stop;                   /* or Newton stalled at the round-off of the terms the residual sums */
   SNESConvergedReason reason;
   PetscReal           residual_norm;
+  PetscReal           residual_start;                  /* |F| at the start of the last Newton solve */
   PetscInt            continuation_stages; /* solves of the eps sequence before the target eps (0: none) */
   PetscInt            active_set_cycles;   /* active-set cycles detected (and damped) in the Newton iterations */
   PetscInt            pc_builds;           /* preconditioner (factorization) builds of the Newton steps */
@@ -330,19 +280,7 @@ typedef struct {
   PetscBool      output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
 } RunOptions;
 
-/* The forcing terms of the inexact Newton (ew_forcing.c): Eisenstat-Walker's, with the guard against oversolving. */
-typedef struct {
-  SNES      snes;                 /* the problem's SNES (not referenced) */
-  PetscReal guard;                /* -contact_ew_guard: no linear solve below guard * Newton's target / |F| (0: none) */
-  PetscReal norm_last, rtol_last; /* |F| and the linear tolerance of the last step */
-} SolverForcing;
-
-/* A predicted Newton step for the first linear solve of the next solve (step_guess.c). */
-typedef struct {
-  Vec       du;          /* the predicted change of the solution, in the user's units; NULL if none */
-  PetscBool nonzero;     /* the options' -ksp_initial_guess_nonzero, kept by every other linear solve */
-  PetscBool user_rnorm0; /* -ksp_converged_use_initial_residual_norm given: the options' test stays */
-} SolverStepGuess;
+typedef struct _n_SolverCtx *SolverCtx; /* private to src/solver/ */
 
 /* The discrete problem on one mesh: created by ProblemSetUp(), destroyed by ProblemDestroy(), one per grid level. */
 typedef struct {
@@ -357,18 +295,7 @@ typedef struct {
   Vec             loc_r0;             /* the same, local, with the rows of the fixed components (for the supports' reactions) */
   PetscReal       load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
   PetscReal       displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */
-  PetscReal       snes_scale;         /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
-  Vec             work;               /* U x~: the displacement of the SNES iterate x~ */
-  PcReuse         pc_reuse;
-  PcRecovery      pc_recovery;
-  SolverForcing   forcing;
-  SolverStepGuess step_guess;
-  PetscReal    fnorm0;                          /* |F| at the start of the last SNESSolve, in the user's units */
-  PetscReal    fnorm_last;                      /* |F| at the last Newton step, in the user's units */
-  PetscBool    roundoff_stop;                   /* the last SNESSolve stopped at the round-off of its terms (SolverConverged()) */
-  PetscBool    warm;                            /* the last SolverSolve() started from a given guess, not from zero */
-  PetscInt64   active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
-  PetscReal    fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */
+  SolverCtx       sctx;               /* the SNES's callbacks' context and the solver's own state (src/solver/solver_impl.h) */
 } Problem;
 
 /* What the run produced: statistics, one row per solve, error norms; the summary and the writer only read it. */

@@ -9,22 +9,13 @@
 PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user);
 PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
 PetscErrorCode SolverComputeScales(DM dm, AppCtx *user);
-PetscErrorCode SolverIterateDisplacement(AppCtx *user, Vec X, Vec *u);
 /* Where a solve starts: from zero, from the solution for a nearby eps (the sweep), or from a coarser mesh's (nested
    iteration); the last two are warm starts, and the first and last reach a small eps by continuation. */
 typedef enum { SOLVER_START_ZERO, SOLVER_START_NEARBY_EPS, SOLVER_START_COARSER_MESH } SolverStart;
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start);
 /* |F| (user's units) that -snes_rtol is relative to in the current solve: its first, or for a warm start the load
    ||F(0)||, so that a warm start ends as tight as a start from zero */
-PetscErrorCode SolverResidualNorm(SNES snes, AppCtx *user, Vec u, PetscReal *norm);
-/* The residual that -snes_rtol reduces (SolverConverged() in solver.c, and the forcing terms of ew_forcing.c): the
-   load ||F(0)|| for a warm start (eps sweep, nested iteration), else the first residual of the solve; user's units. */
-static inline PetscErrorCode SolverStopReference(const AppCtx *user, PetscReal *ref)
-{
-  *ref = user->prob.warm ? user->prob.load_norm : user->prob.fnorm0;
-  return PETSC_SUCCESS;
-}
-PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R);
+PetscErrorCode SolverResidualNorm(SNES snes, SolverCtx sc, Vec u, PetscReal *norm);
 PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
 
 /* problem.c, grid_sequence.c, eps_sweep.c */
@@ -49,29 +40,9 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user);
 PetscErrorCode MultigridSetCoarseBoxSolver(KSP ksp, const AppCtx *user);
 PetscErrorCode MultigridDestroy(Multigrid *mg);
 
-/* ew_forcing.c */
-PetscErrorCode SolverForcingSetUp(SNES snes, AppCtx *user, PetscBool *petsc_presolve);
-PetscErrorCode SolverForcingPreSolve(KSP ksp, AppCtx *user);
-
-/* step_guess.c */
-PetscErrorCode SolverStepGuessSetUp(KSP ksp, AppCtx *user);
-PetscErrorCode SolverSetStepGuess(AppCtx *user, Vec du);
-PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, AppCtx *user);
-PetscErrorCode SolverStepGuessDrop(AppCtx *user);
-
 /* fine_smoother.c: -mg_fine_ksp_*, -mg_fine_pc_* */
 PetscErrorCode FineSmootherGiven(KSP ksp, const SolverGiven *g, PetscBool *given);
 PetscErrorCode FineSmootherSetUp(KSP ksp, const SolverGiven *g);
-
-/* pc_reuse.c */
-PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X);
-PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user);
-PetscErrorCode PcReuseDestroy(AppCtx *user);
-PetscErrorCode PcReuseReset(AppCtx *user);
-
-/* pc_recovery.c */
-PetscErrorCode PcRecoveryTry(SNES snes, AppCtx *user, PetscBool *retry);
-PetscErrorCode SmootherBoundFinest(PC pc, PetscInt nlevels, AppCtx *user, const PetscScalar jvals[], PetscBool check);
 
 /* assembly_p1.c */
 PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscBool *check);
@@ -97,5 +68,3 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
 PetscErrorCode BandwidthGetOptions(MPI_Comm comm, PetscBool *measure);
 PetscErrorCode BandwidthMeasure(SNES snes, AppCtx *user);
 
-/* contact_monitor.c */
-PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx);

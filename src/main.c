@@ -176,7 +176,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
                           " Newton steps at residual %g, which fell neither by -snes_rtol from %g nor to round-off for the load %g; written with "
                           "converged = 0\n",
                           SNESConvergedReasons[user.rec.stats.reason], user.rec.stats.newton_its, (double)user.rec.stats.residual_norm,
-                          (double)user.prob.fnorm0, (double)user.prob.load_norm));
+                          (double)user.rec.stats.residual_start, (double)user.prob.load_norm));
   else if (!user.rec.stats.converged)
     PetscCall(PetscPrintf(comm,
                           "ERROR: the nonlinear solve failed: %s after %" PetscInt_FMT " Newton steps, residual %g; written with converged = 0\n",

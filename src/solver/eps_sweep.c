@@ -8,7 +8,7 @@
    over (256 x 256, eps down by 10 per value: first residuals of 2e-5 to 2e-8 instead of 0.16). The second value starts
    on the tangent of the solution path at the first (TangentDirection()). */
 #include "contact.h"
-#include "solver.h"
+#include "solver_impl.h"
 
 /* u <- u + factor dir if the penalty is active there at the same points as at u (the last solution) and the residual
    at the current eps is lower, or, whatever the points, if that residual is below relaxed times the last one (the
@@ -28,13 +28,13 @@ static PetscErrorCode ExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, V
   PetscCall(VecDuplicate(u, &guess));
   PetscCall(VecWAXPY(guess, factor, dir, u));
   PetscCall(ContactSameActivity(user->contact, dm, u, guess, &same));
-  PetscCall(SolverResidualNorm(snes, user, u, &f_last)); /* every start needs both: the tangent's and the secant's rules */
-  PetscCall(SolverResidualNorm(snes, user, guess, &f_guess));
+  PetscCall(SolverResidualNorm(snes, user->prob.sctx, u, &f_last)); /* every start needs both: the tangent's and the secant's rules */
+  PetscCall(SolverResidualNorm(snes, user->prob.sctx, guess, &f_guess));
   if ((same && f_guess < f_last) || f_guess < relaxed * f_last)
     PetscCall(VecCopy(guess, u));
   else if (step_guess && f_guess < f_last) {
     PetscCall(VecScale(dir, factor));
-    PetscCall(SolverSetStepGuess(user, dir));
+    PetscCall(SolverSetStepGuess(user->prob.sctx, dir));
   }
   PetscCall(VecDestroy(&guess));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -6,12 +6,12 @@
    term, never beyond -snes_ksp_ew_rtolmax.
    This pre-solve (part of SolverPreSolve() in solver.c) replaces PETSc's (KSPPreSolve_SNESEW(), installed with the
    SNES's KSP); without the guard its terms are PETSc's exactly. Other versions (-snes_ksp_ew_version) keep PETSc's. */
-#include "solver.h"
+#include "solver_impl.h"
 
 /* Before a linear solve (SolverPreSolve()): its tolerance, if the forcing is on. */
-PetscErrorCode SolverForcingPreSolve(KSP ksp, AppCtx *user)
+PetscErrorCode SolverForcingPreSolve(KSP ksp, SolverCtx sc)
 {
-  SolverForcing *fc   = &user->prob.forcing;
+  SolverForcing *fc   = &sc->forcing;
   SNES           snes = fc->snes;
   PetscInt       it;
   PetscReal      norm, rtol, rtol_0, rtol_max, gamma, alpha, threshold, srtol, atol, stol;
@@ -37,8 +37,8 @@ PetscErrorCode SolverForcingPreSolve(KSP ksp, AppCtx *user)
     PetscReal ref;
 
     PetscCall(SNESGetTolerances(snes, &atol, &srtol, &stol, &maxit, &maxf));
-    PetscCall(SolverStopReference(user, &ref)); /* SolverConverged()'s, in the user's units; the SNES sees F/U */
-    rtol = PetscMax(rtol, fc->guard * srtol * (ref / user->prob.snes_scale) / norm);
+    ref = SolverStopReference(sc); /* SolverConverged()'s, in the user's units; the SNES sees F/U */
+    rtol = PetscMax(rtol, fc->guard * srtol * (ref / sc->snes_scale) / norm);
   }
   rtol = PetscMin(rtol, rtol_max);
   PetscCall(KSPSetTolerances(ksp, rtol, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
@@ -51,20 +51,20 @@ PetscErrorCode SolverForcingPreSolve(KSP ksp, AppCtx *user)
 
 /* Records the forcing's parameters if Eisenstat-Walker's version 2 is on (SolverForcingPreSolve() then computes the
    terms); *petsc_presolve: another version is on, whose pre-solve is PETSc's own and must stay. */
-PetscErrorCode SolverForcingSetUp(SNES snes, AppCtx *user, PetscBool *petsc_presolve)
+PetscErrorCode SolverForcingSetUp(SNES snes, SolverCtx sc, PetscBool *petsc_presolve)
 {
   PetscBool ew;
   PetscInt  version;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMemzero(&user->prob.forcing, sizeof(user->prob.forcing)));
+  PetscCall(PetscMemzero(&sc->forcing, sizeof(sc->forcing)));
   *petsc_presolve = PETSC_FALSE;
   PetscCall(SNESKSPGetUseEW(snes, &ew));
   if (!ew) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESKSPGetParametersEW(snes, &version, NULL, NULL, NULL, NULL, NULL, NULL));
   *petsc_presolve = (PetscBool)(version != 2);
   if (version != 2) PetscFunctionReturn(PETSC_SUCCESS);
-  user->prob.forcing.snes  = snes;
-  user->prob.forcing.guard = user->opt->solver.ew_guard;
+  sc->forcing.snes  = snes;
+  sc->forcing.guard = sc->opt->ew_guard;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

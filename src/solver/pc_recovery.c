@@ -16,7 +16,7 @@
    Each step is taken once per run, counted in /run pc_breakdowns and described in pc_recovery; -contact_pc_recovery 0
    leaves the breakdown a failed solve. A breakdown is never turned into a converged result without the Newton
    convergence test it would have had to pass anyway. */
-#include "solver.h"
+#include "solver_impl.h"
 
 #define SAFER_EMAX 1.5
 
@@ -69,9 +69,9 @@ static PetscErrorCode IsBreakdown(SNES snes, KSPConvergedReason *kreason, PetscB
 }
 
 /* Appends one action to the run's record (/run pc_recovery, "; "-separated). */
-static PetscErrorCode Record(AppCtx *user, const char action[], KSPConvergedReason kreason)
+static PetscErrorCode Record(SolverCtx sc, const char action[], KSPConvergedReason kreason)
 {
-  RunStats *s = &user->rec.stats;
+  RunStats *s = sc->stats;
   char      item[160];
 
   PetscFunctionBeginUser;
@@ -97,10 +97,10 @@ static PetscErrorCode UseDirectSolve(SNES snes, PC pc)
 
 /* After a failed SNESSolve: if it ended on a breakdown and a recovery step is left, takes the next one and sets
  *retry (solve again from the last iterate); else leaves the failure as it is. */
-PetscErrorCode PcRecoveryTry(SNES snes, AppCtx *user, PetscBool *retry)
+PetscErrorCode PcRecoveryTry(SNES snes, SolverCtx sc, PetscBool *retry)
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)snes);
-  PcRecovery        *rec  = &user->prob.pc_recovery;
+  PcRecovery        *rec  = &sc->pc_recovery;
   KSPConvergedReason kreason;
   PetscBool          breakdown, is_gamg, is_mg;
   KSP                ksp;
@@ -108,18 +108,18 @@ PetscErrorCode PcRecoveryTry(SNES snes, AppCtx *user, PetscBool *retry)
 
   PetscFunctionBeginUser;
   *retry = PETSC_FALSE;
-  if (!user->opt->solver.pc_recovery || rec->stage >= 3) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!sc->opt->pc_recovery || rec->stage >= 3) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(IsBreakdown(snes, &kreason, &breakdown));
   if (!breakdown) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &is_gamg));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
-  PetscCall(PcReuseReset(user));                /* the next Newton step builds afresh, and builds only from then on */
+  PetscCall(PcReuseReset(sc));                /* the next Newton step builds afresh, and builds only from then on */
   PetscCall(SNESSetLagPreconditioner(snes, 1)); /* (PcReuseDecide() sets the lag again where it takes over) */
   if (rec->stage == 0) {                        /* 1. a fresh build */
     rec->stage = 1;
-    PetscCall(Record(user, "preconditioner rebuilt", kreason));
+    PetscCall(Record(sc, "preconditioner rebuilt", kreason));
     PetscCall(PetscPrintf(comm, "  preconditioner breakdown (%s): rebuilt on the current Jacobian, Newton goes on from its last iterate\n",
                           KSPConvergedReasons[kreason]));
   } else if (rec->stage == 1 && (is_gamg || is_mg)) { /* 2. safer smoother bounds */
@@ -131,14 +131,14 @@ PetscErrorCode PcRecoveryTry(SNES snes, AppCtx *user, PetscBool *retry)
       PetscCall(PCGAMGSetUseSAEstEig(pc, PETSC_FALSE));
     } else
       PetscCall(SaferChebyshev(pc)); /* the levels of the nested meshes stay */
-    PetscCall(Record(user, is_gamg ? "GAMG rebuilt with each level's own eigenvalue estimate" : "Chebyshev intervals widened", kreason));
+    PetscCall(Record(sc, is_gamg ? "GAMG rebuilt with each level's own eigenvalue estimate" : "Chebyshev intervals widened", kreason));
     PetscCall(PetscPrintf(
         comm, "  preconditioner breakdown (%s) again: %s, from the last iterate\n", KSPConvergedReasons[kreason],
         is_gamg ? "GAMG rebuilt, each level's smoother bounded by its own eigenvalue estimate" : "the smoothers' Chebyshev intervals widened"));
   } else { /* 3. a direct solve */
     rec->stage = 3;
     PetscCall(UseDirectSolve(snes, pc));
-    PetscCall(Record(user, "direct solve (MUMPS)", kreason));
+    PetscCall(Record(sc, "direct solve (MUMPS)", kreason));
     PetscCall(
         PetscPrintf(comm, "  preconditioner breakdown (%s) again: a direct solve (MUMPS) from the last iterate\n", KSPConvergedReasons[kreason]));
   }

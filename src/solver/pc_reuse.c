@@ -9,17 +9,17 @@
    Galerkin product of a matrix with a few hundred nonzero rows. The hierarchy then equals a rebuild's (GAMG reuses its
    prolongators on a rebuild) at the cost of a few sparse products instead of the products of the whole matrix. */
 #include "physics.h"
-#include "solver.h"
+#include "solver_impl.h"
 
 /* Number of contact nodes (over all ranks) whose state differs from the state at the last build. */
-static PetscErrorCode CountChanges(AppCtx *user, PetscInt dim, const PetscScalar x[], PetscBool record, PetscInt *changes)
+static PetscErrorCode CountChanges(SolverCtx sc, PetscInt dim, const PetscScalar x[], PetscBool record, PetscInt *changes)
 {
-  PcReuse          *r     = &user->prob.pc_reuse;
+  PcReuse          *r     = &sc->pc_reuse;
   PetscInt          local = 0;
   const ContactSet *cs;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(ContactGetSet(sc->contact, &cs));
   if (!r->built_active) PetscCall(PetscCalloc1(cs->n + 1, &r->built_active)); /* no node penetrated before the first build */
   for (PetscInt i = 0; i < cs->n; ++i) {
     const PetscBool on = (PetscBool)(ContactNodePenetration(cs, dim, i, x) > 0.0);
@@ -27,13 +27,13 @@ static PetscErrorCode CountChanges(AppCtx *user, PetscInt dim, const PetscScalar
     local += on != r->built_active[i];
     if (record) r->built_active[i] = on;
   }
-  PetscCall(MPIU_Allreduce(&local, changes, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)user->prob.K)));
+  PetscCall(MPIU_Allreduce(&local, changes, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)sc->K)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The levels of a GAMG hierarchy whose coarse operators can follow the Jacobian (0 if there is none yet, or if the
    Jacobian is not K itself with its kept contact rows). */
-static PetscErrorCode HierarchyLevels(SNES snes, AppCtx *user, PC *pc, PetscInt *nlevels)
+static PetscErrorCode HierarchyLevels(SNES snes, SolverCtx sc, PC *pc, PetscInt *nlevels)
 {
   KSP       ksp;
   PetscBool is_gamg;
@@ -43,7 +43,7 @@ static PetscErrorCode HierarchyLevels(SNES snes, AppCtx *user, PC *pc, PetscInt 
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(KSPGetPC(ksp, pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)*pc, PCGAMG, &is_gamg));
-  if (!is_gamg || !user->opt->solver.pc_update || user->prob.pc_reuse.no_update || !ContactBulkRowsOf(user->contact) || !ContactBulkRowsOf(user->contact)->ptr) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!is_gamg || !sc->opt->pc_update || sc->pc_reuse.no_update || !ContactBulkRowsOf(sc->contact) || !ContactBulkRowsOf(sc->contact)->ptr) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PCMGGetLevels(*pc, nlevels));
   for (PetscInt l = 0; l < *nlevels; ++l) {
     KSP smoother;
@@ -57,21 +57,21 @@ static PetscErrorCode HierarchyLevels(SNES snes, AppCtx *user, PC *pc, PetscInt 
 }
 
 /* The Jacobian's values in the contact rows into vals (collective only through the caller). */
-static PetscErrorCode ContactRowValues(AppCtx *user, PetscScalar vals[])
+static PetscErrorCode ContactRowValues(SolverCtx sc, PetscScalar vals[])
 {
-  Problem *pb = &user->prob;
-  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
+  
+  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
 
   PetscFunctionBeginUser;
   for (PetscInt r = 0; r < br->n; ++r) {
     const PetscScalar *v;
     PetscInt           ncols;
 
-    PetscCall(MatGetRow(pb->K, br->rows[r], &ncols, NULL, &v));
+    PetscCall(MatGetRow(sc->K, br->rows[r], &ncols, NULL, &v));
     PetscCheck(ncols == br->ptr[r + 1] - br->ptr[r], PETSC_COMM_SELF, PETSC_ERR_PLIB,
                "the Jacobian's row %" PetscInt_FMT " left K's pattern", br->rows[r]);
     PetscCall(PetscArraycpy(&vals[br->ptr[r]], v, ncols));
-    PetscCall(MatRestoreRow(pb->K, br->rows[r], &ncols, NULL, &v));
+    PetscCall(MatRestoreRow(sc->K, br->rows[r], &ncols, NULL, &v));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -98,9 +98,9 @@ static PetscErrorCode DestroyProducts(PcReuse *r)
 }
 
 /* The marks of the contact rows (1, or 2 in Z) at their columns, from any rank. */
-static PetscErrorCode ScatterMarks(Problem *pb, const ContactBulkRows *br)
+static PetscErrorCode ScatterMarks(SolverCtx sc, const ContactBulkRows *br)
 {
-  PcReuse *r = &pb->pc_reuse;
+  PcReuse *r = &sc->pc_reuse;
 
   PetscFunctionBeginUser;
   PetscCall(VecScatterBegin(br->scatter, r->zmark, r->zcols, INSERT_VALUES, SCATTER_FORWARD));
@@ -110,21 +110,21 @@ static PetscErrorCode ScatterMarks(Problem *pb, const ContactBulkRows *br)
 
 /* The mirrors: the entries (s, c) of J whose column c is a contact row of this rank and whose row s is no contact row
    of any rank, J(s, c) = K(c, s) by symmetry. */
-static PetscErrorCode MirrorsSetUp(AppCtx *user)
+static PetscErrorCode MirrorsSetUp(SolverCtx sc)
 {
-  Problem           *pb = &user->prob;
-  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
-  PcReuse           *r  = &pb->pc_reuse;
+  
+  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
+  PcReuse           *r  = &sc->pc_reuse;
   PetscInt           n  = 0;
   const PetscScalar *mark;
 
   PetscFunctionBeginUser;
-  PetscCall(MatCreateVecs(pb->K, &r->zmark, NULL));
+  PetscCall(MatCreateVecs(sc->K, &r->zmark, NULL));
   PetscCall(VecDuplicate(br->x, &r->zcols));
   for (PetscInt row = 0; row < br->n; ++row) PetscCall(VecSetValue(r->zmark, br->rows[row], 1.0, INSERT_VALUES));
   PetscCall(VecAssemblyBegin(r->zmark));
   PetscCall(VecAssemblyEnd(r->zmark));
-  PetscCall(ScatterMarks(pb, br));
+  PetscCall(ScatterMarks(sc, br));
   PetscCall(VecGetArrayRead(r->zcols, &mark));
   for (PetscInt k = 0; k < br->ptr[br->n]; ++k) n += PetscRealPart(mark[br->lcols[k]]) == 0.0;
   PetscCall(PetscMalloc2(n, &r->mirror_k, n, &r->mirror_at));
@@ -148,13 +148,12 @@ static PetscErrorCode MirrorsSetUp(AppCtx *user)
    diagonal. Such a row is nearly diagonal, so the finest level's smoother (Jacobi, SOR) solves it alone, while in the coarse
    operators its 1/eps would pin every coarse function touching it (GAMG's aggregates mix the contact dofs with the
    bulk); a rebuild at that eps would leave the same dofs out of its aggregates. Also sets zrows. */
-static PetscErrorCode EffectiveValues(AppCtx *user, const PetscScalar jvals[], PetscScalar eff[])
+static PetscErrorCode EffectiveValues(SolverCtx sc, const PetscScalar jvals[], PetscScalar eff[])
 {
-  Problem           *pb    = &user->prob;
-  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
-  PcReuse           *r     = &pb->pc_reuse;
+  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
+  PcReuse           *r     = &sc->pc_reuse;
   const PetscInt     nnz   = br->ptr[br->n];
-  const PetscReal    ratio = user->opt->solver.pc_update_truncate;
+  const PetscReal    ratio = sc->opt->pc_update_truncate;
   const PetscScalar *mark;
 
   PetscFunctionBeginUser;
@@ -171,7 +170,7 @@ static PetscErrorCode EffectiveValues(AppCtx *user, const PetscScalar jvals[], P
   }
   PetscCall(VecAssemblyBegin(r->zmark));
   PetscCall(VecAssemblyEnd(r->zmark));
-  PetscCall(ScatterMarks(pb, br));
+  PetscCall(ScatterMarks(sc, br));
   PetscCall(VecGetArrayRead(r->zcols, &mark));
   for (PetscInt row = 0; row < br->n; ++row) {
     const PetscInt kd = br->diag[row];
@@ -185,11 +184,11 @@ static PetscErrorCode EffectiveValues(AppCtx *user, const PetscScalar jvals[], P
 }
 
 /* The finest prolongator's rows at the owned contact rows, as GAMG made them. */
-static PetscErrorCode ProlongatorRowsSave(PC pc, AppCtx *user)
+static PetscErrorCode ProlongatorRowsSave(PC pc, SolverCtx sc)
 {
-  Problem *pb = &user->prob;
-  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
-  PcReuse *r  = &pb->pc_reuse;
+  
+  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
+  PcReuse *r  = &sc->pc_reuse;
 
   PetscFunctionBeginUser;
   PetscCall(PCMGGetInterpolation(pc, r->nlevels - 1, &r->rfine));
@@ -199,11 +198,10 @@ static PetscErrorCode ProlongatorRowsSave(PC pc, AppCtx *user)
 }
 
 /* The finest prolongator's contact rows: zero in Z (all = PETSC_FALSE), GAMG's values elsewhere (all rows with all). */
-static PetscErrorCode ProlongatorRowsSet(AppCtx *user, PetscBool all)
+static PetscErrorCode ProlongatorRowsSet(SolverCtx sc, PetscBool all)
 {
-  Problem     *pb = &user->prob;
-  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
-  PcReuse     *r  = &pb->pc_reuse;
+  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
+  PcReuse     *r  = &sc->pc_reuse;
   PetscScalar *zero;
   PetscInt     iz = 0, nmax = 0;
 
@@ -228,10 +226,10 @@ static PetscErrorCode ProlongatorRowsSet(AppCtx *user, PetscBool all)
 /* The product on the finest level without matrices of its size: D is nonzero in the contact rows only, at the columns
    S of those rows, so R^T D R = R_S^T D_S R_S with R_S the rows S of the prolongator (fetched from any rank) and D_S
    the change restricted to S x S. Each rank computes its own part, and a COO matrix sums the parts. */
-static PetscErrorCode FinestProductSetUp(PC pc, AppCtx *user)
+static PetscErrorCode FinestProductSetUp(PC pc, SolverCtx sc)
 {
-  PcReuse        *r   = &user->prob.pc_reuse;
-  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
+  PcReuse        *r   = &sc->pc_reuse;
+  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
   const PetscInt  nnz = br->ptr[br->n];
   PetscInt        nS  = nnz, N1, n1, *S, *coo_i, *coo_j, nrows;
   const PetscInt *ia, *ja;
@@ -253,9 +251,9 @@ static PetscErrorCode FinestProductSetUp(PC pc, AppCtx *user)
   r->rlocal = sub[0];
   PetscCall(PetscFree(sub));
   /* with the truncation, the columns S that are no contact row (on any rank) get the mirrors of their entries */
-  if (user->opt->solver.pc_update_truncate > 0.0) {
-    PetscCall(MirrorsSetUp(user));
-    PetscCall(ProlongatorRowsSave(pc, user));
+  if (sc->opt->pc_update_truncate > 0.0) {
+    PetscCall(MirrorsSetUp(sc));
+    PetscCall(ProlongatorRowsSave(pc, sc));
   }
   /* D_S in COO form: the contact rows' places in S, their columns' places (bulk_lcols); then the mirrors */
   PetscCall(PetscMalloc2(nnz + r->nmirror, &coo_i, nnz + r->nmirror, &coo_j));
@@ -334,10 +332,10 @@ static PetscErrorCode CheckHierarchy(PC pc, PetscInt nlevels, PcReuse *r)
 
 /* The change of the Jacobian since the last build or update, carried down the hierarchy: each coarse operator gets
    R^T D R, D the change on the level above (the first product makes the patterns, the later ones reuse them). */
-static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
+static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
 {
-  PcReuse  *r    = &user->prob.pc_reuse;
-  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
+  PcReuse  *r    = &sc->pc_reuse;
+  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
   PetscInt  nnz  = br->ptr[br->n];
   PetscReal dmax = 0.0;
 
@@ -345,13 +343,13 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
   if (!r->dcoarse) {
     r->nlevels = nlevels;
     PetscCall(PetscCalloc1(nlevels, &r->dcoarse));
-    PetscCall(FinestProductSetUp(pc, user));
+    PetscCall(FinestProductSetUp(pc, sc));
   }
   PetscCheck(r->nlevels == nlevels, PetscObjectComm((PetscObject)pc), PETSC_ERR_PLIB, "the multigrid hierarchy changed its levels");
-  PetscCall(ContactRowValues(user, r->dvals));
+  PetscCall(ContactRowValues(sc, r->dvals));
   PetscCall(PetscArraycpy(r->built_vals, r->dvals, nnz)); /* J now, for the finest smoother's bound */
-  PetscCall(EffectiveValues(user, r->dvals, r->eff_dvals));
-  PetscCall(ProlongatorRowsSet(user, PETSC_FALSE));
+  PetscCall(EffectiveValues(sc, r->dvals, r->eff_dvals));
+  PetscCall(ProlongatorRowsSet(sc, PETSC_FALSE));
   for (PetscInt k = 0; k < nnz + r->nmirror; ++k) {
     const PetscScalar now = r->eff_dvals[k];
 
@@ -383,7 +381,7 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
     PetscCall(KSPGetOperators(smoother, &A, NULL));
     PetscCall(MatAXPY(A, 1.0, r->dcoarse[l - 1], SUBSET_NONZERO_PATTERN));
   }
-  if (user->opt->solver.pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r));
+  if (sc->opt->pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r));
   /* every level's operator is new: its Chebyshev smoother estimates its eigenvalues again, its Jacobi or LU sets up
      again (KSPSetOperators() marks the new matrix, as a rebuild would) */
   for (PetscInt l = 0; l < nlevels; ++l) {
@@ -395,16 +393,16 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, AppCtx *user)
     PetscCall(KSPSetOperators(smoother, A, A));
   }
   /* except the finest level's Chebyshev interval, which a bound keeps (smoother_bound.c) */
-  if (!user->opt->solver.pc_update_esteig) PetscCall(SmootherBoundFinest(pc, nlevels, user, r->built_vals, user->opt->solver.pc_update_check));
+  if (!sc->opt->pc_update_esteig) PetscCall(SmootherBoundFinest(pc, nlevels, sc, r->built_vals, sc->opt->pc_update_check));
   r->updates++;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Called by the Jacobian evaluation at X, before SNES sets up the preconditioner: sets the SNES preconditioner lag to
    rebuild (-2) or reuse (-1), and records the state of the build. */
-PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
+PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
 {
-  PcReuse           *r = &user->prob.pc_reuse;
+  PcReuse           *r = &sc->pc_reuse;
   KSP                ksp;
   PetscInt           dim, changes = 0, its = 0;
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
@@ -421,7 +419,7 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
     PC       pc;
     PetscInt nlevels;
 
-    PetscCall(HierarchyLevels(snes, user, &pc, &nlevels));
+    PetscCall(HierarchyLevels(snes, sc, &pc, &nlevels));
     if (nlevels > 1 && r->recorded) { /* the hierarchy follows the Jacobian (PcReuseAfterJacobian()): no rebuild */
       r->update = PETSC_TRUE;
       PetscCall(SNESSetLagPreconditioner(snes, -1));
@@ -429,18 +427,18 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
     }
   }
   PetscCall(VecGetArrayRead(X, &x));
-  PetscCall(ContactGetEps(user->contact, &eps));
+  PetscCall(ContactGetEps(sc->contact, &eps));
   rebuild = (PetscBool)(!r->built || r->eps != eps);
   if (!rebuild) {
-    PetscCall(CountChanges(user, dim, x, PETSC_FALSE, &changes));
+    PetscCall(CountChanges(sc, dim, x, PETSC_FALSE, &changes));
     PetscCall(KSPGetIterationNumber(ksp, &its));
     PetscCall(KSPGetConvergedReason(ksp, &reason));
     /* rebuild after a failed solve, or when the last solve needed twice the iterations of the first after the build */
     rebuild =
-        (PetscBool)(changes > user->opt->solver.pc_reuse_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
+        (PetscBool)(changes > sc->opt->pc_reuse_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
   }
   if (rebuild) {
-    PetscCall(CountChanges(user, dim, x, PETSC_TRUE, &changes));
+    PetscCall(CountChanges(sc, dim, x, PETSC_TRUE, &changes));
     r->built           = PETSC_TRUE;
     r->eps             = eps;
     r->its_after_build = -1; /* set by the next call */
@@ -457,18 +455,18 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, AppCtx *user, Vec X)
 
 /* Called by the Jacobian evaluation once the Jacobian is assembled: records its contact rows for a build, or carries
    their change down the hierarchy. */
-PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user)
+PetscErrorCode PcReuseAfterJacobian(SNES snes, SolverCtx sc)
 {
-  PcReuse *r  = &user->prob.pc_reuse;
-  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
+  PcReuse *r  = &sc->pc_reuse;
+  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
   PC       pc;
   PetscInt nlevels;
 
   PetscFunctionBeginUser;
-  if (!r->enabled || !user->opt->solver.pc_update || r->no_update || !br->jacobian_in_K) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!r->enabled || !sc->opt->pc_update || r->no_update || !br->jacobian_in_K) PetscFunctionReturn(PETSC_SUCCESS);
   if (r->update) {
-    PetscCall(HierarchyLevels(snes, user, &pc, &nlevels));
-    PetscCall(UpdateHierarchy(pc, nlevels, user));
+    PetscCall(HierarchyLevels(snes, sc, &pc, &nlevels));
+    PetscCall(UpdateHierarchy(pc, nlevels, sc));
   } else if (r->record) {
     KSP       ksp;
     PetscBool is_gamg;
@@ -480,7 +478,7 @@ PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user)
     if (!is_gamg) PetscFunctionReturn(PETSC_SUCCESS);
     if (!r->recorded) PetscCall(PetscMalloc2(br->ptr[br->n], &r->built_vals, br->ptr[br->n], &r->dvals));
     r->recorded = PETSC_TRUE;
-    PetscCall(ContactRowValues(user, r->built_vals));
+    PetscCall(ContactRowValues(sc, r->built_vals));
     {
       const PetscInt nnz  = br->ptr[br->n];
       PetscBool      on_K = PETSC_TRUE;
@@ -489,16 +487,16 @@ PetscErrorCode PcReuseAfterJacobian(SNES snes, AppCtx *user)
       for (PetscInt k = 0; k < nnz && on_K; ++k) on_K = (PetscBool)(r->built_vals[k] == br->vals[k]);
       PetscCall(MPIU_Allreduce(&on_K, &r->built_on_K, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)pc)));
     }
-    PetscCall(ProlongatorRowsSet(user, PETSC_TRUE)); /* GAMG may reuse its prolongators: give them back whole */
+    PetscCall(ProlongatorRowsSet(sc, PETSC_TRUE)); /* GAMG may reuse its prolongators: give them back whole */
     PetscCall(DestroyProducts(r));                   /* a rebuild may make new prolongators: new patterns */
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Frees the state of the updates (with the problem: the next mesh has its own rows and hierarchy). */
-PetscErrorCode PcReuseDestroy(AppCtx *user)
+PetscErrorCode PcReuseDestroy(SolverCtx sc)
 {
-  PcReuse *r = &user->prob.pc_reuse;
+  PcReuse *r = &sc->pc_reuse;
 
   PetscFunctionBeginUser;
   PetscCall(DestroyProducts(r));
@@ -513,14 +511,14 @@ PetscErrorCode PcReuseDestroy(AppCtx *user)
 /* Forgets the build, so that the next Newton step builds the preconditioner afresh, and gives up the coarse-level
    updates for the rest of the run (pc_recovery.c): every later preconditioner is a build, with its own smoother
    estimates. enabled and the counts stay. */
-PetscErrorCode PcReuseReset(AppCtx *user)
+PetscErrorCode PcReuseReset(SolverCtx sc)
 {
-  PcReuse        *r       = &user->prob.pc_reuse;
+  PcReuse        *r       = &sc->pc_reuse;
   const PetscBool enabled = r->enabled;
   const PetscInt  builds = r->builds, updates = r->updates;
 
   PetscFunctionBeginUser;
-  PetscCall(PcReuseDestroy(user));
+  PetscCall(PcReuseDestroy(sc));
   r->enabled   = enabled;
   r->builds    = builds;
   r->updates   = updates;

@@ -3,7 +3,7 @@
 #include "contact.h"
 #include "mesh.h"
 #include "physics.h"
-#include "solver.h"
+#include "solver_impl.h"
 #include "verify.h"
 
 PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
@@ -44,8 +44,8 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(SolverAssembleBulk(dm, user));
   PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
   PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0));
+  PetscCall(SolverCtxCreate(user->prob.K, user->prob.r0, user->contact, &user->opt->solver, &user->rec.stats, &user->prob.sctx));
   PetscCall(SolverComputeScales(dm, user));
-  PetscCall(PcReuseDestroy(user));
   PetscCall(SolverCreateSNES(dm, user, snes));
   PetscCall(PetscTime(&t1));
   user->prob.setup_time = t1 - t0;
@@ -60,9 +60,7 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes)
   PetscCall(VecDestroy(&user->prob.r0));
   PetscCall(VecDestroy(&user->prob.loc_r0));
   PetscCall(VecDestroy(&user->prob.loc_bc));
-  PetscCall(VecDestroy(&user->prob.work));
   PetscCall(ContactReset(user->contact));
-  PetscCall(PcReuseDestroy(user));
-  PetscCall(SolverStepGuessDrop(user));
+  PetscCall(SolverCtxDestroy(&user->prob.sctx));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -9,7 +9,7 @@
    not. An estimate costs ten products with the finest matrix at each update; the bound, a pass
    over the contact rows. The coarse levels still estimate again: their estimates cost little. */
 #include "contact.h"
-#include "solver.h"
+#include "solver_impl.h"
 
 /* The finest level's smoother if it is Chebyshev with point Jacobi (the case the bound covers), else NULL. */
 static PetscErrorCode FinestChebyshevJacobi(PC pc, PetscInt nlevels, KSP *smoother)
@@ -89,11 +89,11 @@ static PetscErrorCode FreshEstimate(Mat A, PetscInt steps, PetscReal *emin, Pets
 /* beta above: Gershgorin's bound of the top eigenvalue of D_P^-1/2 P D_P^-1/2, P = J - K in the contact rows (jvals
    holds J's values there, K's pattern); PETSC_MAX_REAL if P's diagonal cannot bound it (a negative diagonal entry, or
    an entry in a row or column with a zero diagonal). */
-static PetscErrorCode PenaltyBound(AppCtx *user, const PetscScalar jvals[], PetscReal *beta)
+static PetscErrorCode PenaltyBound(SolverCtx sc, const PetscScalar jvals[], PetscReal *beta)
 {
-  Problem           *pb = &user->prob;
-  const ContactBulkRows *br = ContactBulkRowsOf(user->contact);
-  PcReuse           *r  = &pb->pc_reuse;
+  
+  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
+  PcReuse           *r  = &sc->pc_reuse;
   PetscInt           rstart;
   PetscScalar       *d;
   const PetscScalar *dcol;
@@ -101,10 +101,10 @@ static PetscErrorCode PenaltyBound(AppCtx *user, const PetscScalar jvals[], Pets
 
   PetscFunctionBeginUser;
   if (!r->pdiag) {
-    PetscCall(MatCreateVecs(pb->K, &r->pdiag, NULL));
+    PetscCall(MatCreateVecs(sc->K, &r->pdiag, NULL));
     PetscCall(VecDuplicate(br->x, &r->pcols));
   }
-  PetscCall(MatGetOwnershipRange(pb->K, &rstart, NULL));
+  PetscCall(MatGetOwnershipRange(sc->K, &rstart, NULL));
   PetscCall(VecSet(r->pdiag, 0.0));
   PetscCall(VecGetArray(r->pdiag, &d));
   for (PetscInt row = 0; row < br->n; ++row) d[br->rows[row] - rstart] = jvals[br->diag[row]] - br->vals[br->diag[row]];
@@ -130,7 +130,7 @@ static PetscErrorCode PenaltyBound(AppCtx *user, const PetscScalar jvals[], Pets
     local = PetscMax(local, sum);
   }
   PetscCall(VecRestoreArrayRead(r->pcols, &dcol));
-  PetscCall(MPIU_Allreduce(&local, beta, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)pb->K)));
+  PetscCall(MPIU_Allreduce(&local, beta, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)sc->K)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -166,18 +166,18 @@ static PetscErrorCode ReadBuildEstimate(KSP smoother, const SolverGiven *given, 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SmootherBoundFinest(PC pc, PetscInt nlevels, AppCtx *user, const PetscScalar jvals[], PetscBool check)
+PetscErrorCode SmootherBoundFinest(PC pc, PetscInt nlevels, SolverCtx sc, const PetscScalar jvals[], PetscBool check)
 {
-  PcReuse  *r = &user->prob.pc_reuse;
+  PcReuse  *r = &sc->pc_reuse;
   KSP       smoother;
   PetscReal beta, top, emin, emax;
 
   PetscFunctionBeginUser;
   PetscCall(FinestChebyshevJacobi(pc, nlevels, &smoother));
   if (!smoother) PetscFunctionReturn(PETSC_SUCCESS);
-  if (!r->bound_read) PetscCall(ReadBuildEstimate(smoother, &user->opt->solver.given, r));
+  if (!r->bound_read) PetscCall(ReadBuildEstimate(smoother, &sc->opt->given, r));
   if (!r->bound_set) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PenaltyBound(user, jvals, &beta));
+  PetscCall(PenaltyBound(sc, jvals, &beta));
   if (beta < PETSC_MAX_REAL)
     top = PetscMax(r->est_max, beta);
   else { /* no bound: estimate, as Chebyshev would */

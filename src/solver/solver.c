@@ -3,7 +3,7 @@
 #include <math.h>
 #include "contact.h"
 #include "physics.h"
-#include "solver.h"
+#include "solver_impl.h"
 
 PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
 {
@@ -42,163 +42,6 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* R = K X + r0: the residual of the elastic problem without the contact terms. */
-PetscErrorCode SolverBulkResidual(AppCtx *user, Vec X, Vec R)
-{
-  PetscFunctionBeginUser;
-  PetscCall(ContactBulkMult(user->contact, user->prob.K, X, R)); /* K X, also while K holds the penalty Jacobian (which it leaves alone) */
-  PetscCall(VecAXPY(R, 1.0, user->prob.r0));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The SNES works on x~ = u/U with the residual F~(x~) = F(U x~)/U, U = user->prob.snes_scale a power of 2 (exact in floating
-   point): F~ has the Jacobian of F, so Newton's iterates are U times smaller and the same, while the absolute tolerances
-   inside PETSc (SNESVI's bound tolerance, the line searches' maximal step) see a displacement of size one in any units.
-   The displacement of the iterate, U x~, goes to user->prob.work. */
-PetscErrorCode SolverIterateDisplacement(AppCtx *user, Vec X, Vec *u)
-{
-  PetscFunctionBeginUser;
-  *u = X;
-  if (user->prob.snes_scale == 1.0) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(VecCopy(X, user->prob.work));
-  PetscCall(VecScale(user->prob.work, user->prob.snes_scale));
-  *u = user->prob.work;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The residual K u + r0 + (penalty term) at the displacement u, in the user's units. */
-static PetscErrorCode SolverResidual(DM dm, AppCtx *user, Vec u, Vec F)
-{
-  PetscFunctionBeginUser;
-  PetscCall(SolverBulkResidual(user, u, F));
-  PetscCall(ContactAddResidual(user->contact, dm, u, F));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* ||F(u)||_2 at the displacement u, in the user's units (outside SolverSolve()). */
-PetscErrorCode SolverResidualNorm(SNES snes, AppCtx *user, Vec u, PetscReal *norm)
-{
-  DM  dm;
-  Vec F;
-
-  PetscFunctionBeginUser;
-  PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(VecDuplicate(u, &F));
-  PetscCall(SolverResidual(dm, user, u, F));
-  PetscCall(VecNorm(F, NORM_2, norm));
-  PetscCall(VecDestroy(&F));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode FormFunction(SNES snes, Vec X, Vec F, void *ctx)
-{
-  AppCtx *user = (AppCtx *)ctx;
-  DM      dm;
-  Vec     u;
-
-  PetscFunctionBeginUser;
-  PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(SolverIterateDisplacement(user, X, &u));
-  PetscCall(SolverResidual(dm, user, u, F));
-  if (user->prob.snes_scale != 1.0) PetscCall(VecScale(F, 1.0 / user->prob.snes_scale));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode FormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
-{
-  AppCtx *user = (AppCtx *)ctx;
-  DM      dm;
-  Vec     u;
-
-  PetscFunctionBeginUser;
-  PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(SolverIterateDisplacement(user, X, &u));
-  if (ContactHasPenalty(user->contact)) {
-    PetscCall(PcReuseDecide(snes, dm, user, u));
-    PetscCall(ContactComputeJacobian(user->contact, dm, u, user->prob.K, P)); /* P is K itself, or a copy (SBAIJ: no row access) */
-    PetscCall(PcReuseAfterJacobian(snes, user)); /* records the build's contact rows, or updates the GAMG hierarchy */
-  }
-  if (J != P) {
-    PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
-    PetscCall(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* Newton stops, converged, when PETSc's tests say so (|F| fell by -snes_rtol, ...) or when |F| <= -contact_load_rtol
-   ||F(0)||: at round-off for the load, which a warm start (eps sweep, grid sequence) may reach before any reduction
-   by -snes_rtol. A warm start stops when |F| <= -snes_rtol ||F(0)||, whatever its first residual: its final residual
-   is as tight as a start from zero would give. One whose first residual exceeds the load (an interpolated guess, whose
-   error is of the order of h) is not stopped by a reduction of that residual alone; one far below it (an extrapolated
-   start of the eps sweep) is not held to a reduction that round-off cannot reach.
-   Every norm here is relative, so the test is the same in any units. The reference of -snes_rtol is
-   SolverStopReference() (include/solver.h), which the forcing terms (ew_forcing.c) share. */
-
-/* The size of the round-off in the residual at u: F = K u + r0 + (1/eps)[u_n - g]_+ n w sums terms much larger than F
-   itself near the solution, and double precision knows each to about PETSC_MACHINE_EPSILON of its size. The terms:
-   |diag(J)| |u| (the bulk's rows, and the penalty's (1/eps) u_n, since J holds the penalty Jacobian in its contact
-   rows), r0, and the penalty's (1/eps) g w at the penetrating nodes (its gap term, large where the obstacle is
-   far from the origin or the indentation deep). This is an estimate of the floor, not a bound: it is used only where
-   Newton has stopped making progress (SolverConverged()). */
-static PetscErrorCode SolverRoundoffFloor(SNES snes, AppCtx *user, PetscReal *floor)
-{
-  Vec       X, u, D;
-  Mat       J;
-  PetscReal bulk, r0, gap = 0.0;
-
-  PetscFunctionBeginUser;
-  PetscCall(SNESGetSolution(snes, &X));
-  PetscCall(SolverIterateDisplacement(user, X, &u));
-  PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
-  PetscCall(VecDuplicate(u, &D));
-  PetscCall(MatGetDiagonal(J, D));
-  PetscCall(VecPointwiseMult(D, D, u));
-  PetscCall(VecNorm(D, NORM_2, &bulk));
-  PetscCall(VecDestroy(&D));
-  /* J is the Jacobian of F/U in u/U, that is of F in u: diag(J) u is in the user's units, as u (U x~) is */
-  PetscCall(VecNorm(user->prob.r0, NORM_2, &r0));
-  PetscCall(ContactRoundoffTerm(user->contact, u, &gap));
-  *floor = PETSC_MACHINE_EPSILON * PetscSqrtReal(bulk * bulk + r0 * r0 + gap);
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm, SNESConvergedReason *reason,
-                                      void *ctx)
-{
-  AppCtx         *user = (AppCtx *)ctx;
-  const PetscReal f    = fnorm * user->prob.snes_scale; /* |F| in the user's units */
-
-  PetscFunctionBeginUser;
-  PetscCall(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, NULL));
-  if (it == 0) user->prob.fnorm0 = f;
-  if (user->prob.warm && (*reason == SNES_CONVERGED_FNORM_RELATIVE || *reason == SNES_CONVERGED_ITERATING)) {
-    PetscReal atol, rtol, stol, ref;
-    PetscInt  maxit, maxf;
-
-    PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
-    PetscCall(SolverStopReference(user, &ref));
-    *reason = f <= rtol * ref ? SNES_CONVERGED_FNORM_RELATIVE : SNES_CONVERGED_ITERATING;
-  }
-  if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= user->opt->solver.load_rtol * user->prob.load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
-  /* A tolerance below what double precision can reach: Newton stalls at the round-off of the terms the residual sums
-     (with eps far below h/E, (1/eps) times the displacement times the machine epsilon). Where a step did not halve |F|
-     and |F| is within 100 times the estimated round-off (SolverRoundoffFloor()), it stops, converged at round-off,
-     instead of running to the iteration limit; /run says so (stopped_at_roundoff). A step that still makes progress is
-     never stopped here. */
-  if (it == 0) user->prob.roundoff_stop = PETSC_FALSE;
-  if (*reason <= 0 && it > 0 && !PetscIsInfOrNanReal(f) && f > 0.5 * user->prob.fnorm_last) {
-    PetscReal floor = 0.0;
-
-    PetscCall(SolverRoundoffFloor(snes, user, &floor));
-    if (f <= 100.0 * floor) {
-      *reason                  = SNES_CONVERGED_FNORM_ABS;
-      user->prob.roundoff_stop = PETSC_TRUE;
-    }
-  }
-  user->prob.fnorm_last = f;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* The scales of the problem on this mesh: the load ||F(0)||_2, and the displacement scale U, the largest entry of
    the best displacement along F(0) (one steepest-descent step of the energy from u = 0: alpha F(0) with
    alpha = |F(0)|^2 / F(0).K F(0)), rounded to a power of 2. Only U's order of magnitude matters. */
@@ -210,12 +53,11 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
   PetscReal   finf, U = 1.0;
 
   PetscFunctionBeginUser;
-  PetscCall(VecDuplicate(user->prob.r0, &user->prob.work)); /* DMCreateGlobalVector() would scan every mesh point again */
   PetscCall(VecDuplicate(user->prob.r0, &zero));
   PetscCall(VecDuplicate(user->prob.r0, &F));
   PetscCall(VecDuplicate(user->prob.r0, &KF));
   PetscCall(VecZeroEntries(zero));
-  PetscCall(SolverResidual(dm, user, zero, F));
+  PetscCall(SolverResidual(user->prob.sctx, dm, zero, F));
   PetscCall(VecNorm(F, NORM_2, &user->prob.load_norm));
   PetscCheck(!PetscIsInfOrNanReal(user->prob.load_norm), comm, PETSC_ERR_USER_INPUT,
              "The load of the problem is not finite (||F(0)|| = %g): check the loads, the material and the mesh coordinates",
@@ -227,8 +69,9 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
     if (PetscRealPart(fkf) > 0.0) U = PetscSqr(user->prob.load_norm) / PetscRealPart(fkf) * finf;
     if (!(U > 0.0) || PetscIsInfOrNanReal(U)) U = 1.0;
   }
-  user->prob.displacement_scale = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
-  user->prob.snes_scale         = 1.0;
+  user->prob.displacement_scale          = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
+  user->prob.sctx->load_norm             = user->prob.load_norm; /* the solver's copies of the problem's scales */
+  user->prob.sctx->displacement_scale    = user->prob.displacement_scale;
   PetscCall(VecDestroy(&zero));
   PetscCall(VecDestroy(&F));
   PetscCall(VecDestroy(&KF));
@@ -291,19 +134,6 @@ static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Before each linear solve: the finest multigrid smoother's -mg_fine_ options (fine_smoother.c), the initial guess
-   (step_guess.c), then the linear tolerance of the inexact Newton (ew_forcing.c). */
-static PetscErrorCode SolverPreSolve(KSP ksp, Vec b, Vec x, void *ctx)
-{
-  AppCtx *user = (AppCtx *)ctx;
-
-  PetscFunctionBeginUser;
-  PetscCall(FineSmootherSetUp(ksp, &user->opt->solver.given));
-  PetscCall(SolverStepGuessPreSolve(ksp, x, user));
-  PetscCall(SolverForcingPreSolve(ksp, user));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
 {
   MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
@@ -345,8 +175,8 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
       PetscCall(ContactPrepareOperator(user->contact, dm, J)); /* the penalty keeps K's own contact rows */
     }
   }
-  PetscCall(SNESSetFunction(*snes, NULL, FormFunction, user));
-  PetscCall(SNESSetJacobian(*snes, J, J, FormJacobian, user));
+  PetscCall(SNESSetFunction(*snes, NULL, SolverFormFunction, user->prob.sctx));
+  PetscCall(SNESSetJacobian(*snes, J, J, SolverFormJacobian, user->prob.sctx));
   PetscCall(MatDestroy(&J));
   PetscCall(ContactSetUpSNES(user->contact, dm, *snes)); /* SNESVI with its bounds, or semismooth Newton */
   {
@@ -357,12 +187,12 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscCall(SNESGetLineSearch(*snes, &ls));
     PetscCall(SNESLineSearchSetTolerances(ls, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, 0.0, PETSC_DEFAULT, PETSC_DEFAULT));
   }
-  PetscCall(SNESSetConvergenceTest(*snes, SolverConverged, user, NULL));
+  PetscCall(SNESSetConvergenceTest(*snes, SolverConverged, user->prob.sctx, NULL));
   PetscCall(SNESGetKSP(*snes, &ksp));
   PetscCall(SolverSetDefaultLinearSolver(ksp, user));
   PetscCall(MultigridSetCoarseBoxSolver(ksp, user)); /* -contact_coarse_mg on a coarser box */
   PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(SNESMonitorSet(*snes, ContactMonitor, user, NULL));
+  PetscCall(SNESMonitorSet(*snes, ContactMonitor, user->prob.sctx, NULL));
   PetscCall(SNESSetFromOptions(*snes));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)*snes, &is_vi, SNESVINEWTONRSLS, SNESVINEWTONSSLS, ""));
   PetscCall(SNESGetType(*snes, &type));
@@ -381,15 +211,15 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscBool is_preonly;
 
     PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &is_preonly));
-    user->prob.pc_reuse.enabled = (PetscBool)(ContactHasPenalty(user->contact) && user->opt->solver.pc_reuse && !is_preonly);
+    user->prob.sctx->pc_reuse.enabled = (PetscBool)(ContactHasPenalty(user->contact) && user->opt->solver.pc_reuse && !is_preonly);
   }
   PetscCall(SolverSetIterativeDefaults(*snes, user));
   {
     PetscBool petsc_presolve, fine;
 
-    PetscCall(SolverForcingSetUp(*snes, user, &petsc_presolve)); /* Eisenstat-Walker's terms with the oversolving guard */
-    PetscCall(SolverStepGuessSetUp(ksp, user));
-    if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, user));
+    PetscCall(SolverForcingSetUp(*snes, user->prob.sctx, &petsc_presolve)); /* Eisenstat-Walker's terms with the oversolving guard */
+    PetscCall(SolverStepGuessSetUp(ksp, user->prob.sctx));
+    if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, user->prob.sctx));
     PetscCall(FineSmootherGiven(ksp, &user->opt->solver.given, &fine));
     PetscCheck(!fine || is_multigrid, comm, PETSC_ERR_USER_INPUT,
                "-mg_fine_ksp_type and -mg_fine_pc_type need a multigrid preconditioner (-pc_type gamg or mg), not %s", pc_type);
@@ -425,16 +255,17 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   *ksp += lits;
   user->rec.stats.newton_its    = *newton;
   user->rec.stats.ksp_its       = *ksp;
-  user->rec.stats.residual_norm = fnorm * user->prob.displacement_scale; /* the SNES saw F/U */
-  PetscCall(SolverStopReference(user, &ref));
+  user->rec.stats.residual_norm  = fnorm * user->prob.displacement_scale; /* the SNES saw F/U */
+  user->rec.stats.residual_start = user->prob.sctx->fnorm0;
+  ref = SolverStopReference(user->prob.sctx);
   user->rec.stats.residual_reduced =
       (PetscBool)(user->rec.stats.residual_norm <= rtol * ref ||
-                  user->rec.stats.residual_norm <= user->opt->solver.load_rtol * user->prob.load_norm || fnorm <= atol || user->prob.roundoff_stop);
-  user->rec.stats.roundoff_stop = user->prob.roundoff_stop;
+                  user->rec.stats.residual_norm <= user->opt->solver.load_rtol * user->prob.load_norm || fnorm <= atol || user->prob.sctx->roundoff_stop);
+  user->rec.stats.roundoff_stop = user->prob.sctx->roundoff_stop;
   user->rec.stats.converged     = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
   PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
-  user->rec.stats.pc_builds  = user->prob.pc_reuse.enabled ? user->prob.pc_reuse.builds : *newton; /* without reuse: one per Newton step */
-  user->rec.stats.pc_updates = user->prob.pc_reuse.updates;
+  user->rec.stats.pc_builds  = user->prob.sctx->pc_reuse.enabled ? user->prob.sctx->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
+  user->rec.stats.pc_updates = user->prob.sctx->pc_reuse.updates;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -478,14 +309,14 @@ static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
   const PetscReal U = user->prob.displacement_scale;
 
   PetscFunctionBeginUser;
-  user->prob.snes_scale = U;
+  user->prob.sctx->snes_scale = U;
   PetscCall(VecScale(u, 1.0 / U));
   PetscCall(ContactScaleBounds(user->contact, 1.0 / U));
   PetscCall(SNESSolve(snes, NULL, u));
-  PetscCall(SolverStepGuessDrop(user)); /* unused if no linear solve came */
+  PetscCall(SolverStepGuessDrop(user->prob.sctx)); /* unused if no linear solve came */
   PetscCall(VecScale(u, U));
   PetscCall(ContactScaleBounds(user->contact, U));
-  user->prob.snes_scale = 1.0;
+  user->prob.sctx->snes_scale = 1.0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -499,7 +330,7 @@ static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *
   PetscCall(SolverSNESSolve(snes, user, u));
   PetscCall(RecordSolve(snes, user, newton, ksp));
   while (!user->rec.stats.converged && retry) {
-    PetscCall(PcRecoveryTry(snes, user, &retry));
+    PetscCall(PcRecoveryTry(snes, user->prob.sctx, &retry));
     if (!retry) break;
     PetscCall(SolverSNESSolve(snes, user, u));
     PetscCall(RecordSolve(snes, user, newton, ksp));
@@ -530,10 +361,10 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
   PetscCall(ContactGetPenaltyScale(user->contact, &eps_start));
   if (!warm) PetscCall(VecZeroEntries(u));
   PetscCall(MultigridSetUpPC(snes, user)); /* -pc_type mg: the levels of the meshes solved so far */
-  user->prob.warm = warm;
+  user->prob.sctx->warm = warm;
   PetscCall(PetscTime(&t0));
-  user->prob.pc_reuse.builds          = 0; /* counted per solve */
-  user->prob.pc_reuse.updates         = 0;
+  user->prob.sctx->pc_reuse.builds          = 0; /* counted per solve */
+  user->prob.sctx->pc_reuse.updates         = 0;
   user->rec.stats.continuation_stages = 0;
   if (start != SOLVER_START_NEARBY_EPS && ContactHasPenalty(user->contact) && copt->continuation && eps_target < eps_start) {
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= copt->continuation_factor) {

@@ -8,12 +8,12 @@
    a close guess meets the forcing term almost at once, and Newton, left with the guess as its step, needs more steps.
    The test stays so set for later solves, where it changes nothing unless the options ask for a nonzero initial guess,
    which it then measures the same way. */
-#include "solver.h"
+#include "solver_impl.h"
 
 /* At the SNES's set-up: what the options asked of its KSP. */
-PetscErrorCode SolverStepGuessSetUp(KSP ksp, AppCtx *user)
+PetscErrorCode SolverStepGuessSetUp(KSP ksp, SolverCtx sc)
 {
-  SolverStepGuess *sg = &user->prob.step_guess;
+  SolverStepGuess *sg = &sc->step_guess;
   const char      *prefix;
 
   PetscFunctionBeginUser;
@@ -24,26 +24,26 @@ PetscErrorCode SolverStepGuessSetUp(KSP ksp, AppCtx *user)
     PetscInt k;
 
     PetscCall(SolverGivenIndex(prefix, &k));
-    sg->user_rnorm0 = user->opt->solver.given.use_initial_rnorm[k]; /* -ksp_converged_use_initial_residual_norm */
+    sg->user_rnorm0 = sc->opt->given.use_initial_rnorm[k]; /* -ksp_converged_use_initial_residual_norm */
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The next solve's first linear solve starts from the Newton step that the change du of the solution (the user's
    units) predicts. du is referenced until that linear solve, or the end of that solve (SolverStepGuessDrop()). */
-PetscErrorCode SolverSetStepGuess(AppCtx *user, Vec du)
+PetscErrorCode SolverSetStepGuess(SolverCtx sc, Vec du)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscObjectReference((PetscObject)du));
-  PetscCall(VecDestroy(&user->prob.step_guess.du));
-  user->prob.step_guess.du = du;
+  PetscCall(VecDestroy(&sc->step_guess.du));
+  sc->step_guess.du = du;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Before each linear solve (SolverPreSolve()): the guess, if one is pending, else the options' initial guess. */
-PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, AppCtx *user)
+PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, SolverCtx sc)
 {
-  SolverStepGuess *sg = &user->prob.step_guess;
+  SolverStepGuess *sg = &sc->step_guess;
   PetscBool        preonly;
 
   PetscFunctionBeginUser;
@@ -52,7 +52,7 @@ PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, AppCtx *user)
   PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &preonly)); /* a factorization alone takes no guess */
   if (!preonly) {
     PetscCall(VecCopy(sg->du, x)); /* Newton's step y of the SNES, x~_next = x~ - y with x~ = u / U: y = -du / U */
-    PetscCall(VecScale(x, -1.0 / user->prob.snes_scale));
+    PetscCall(VecScale(x, -1.0 / sc->snes_scale));
     PetscCall(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE));
     if (!sg->user_rnorm0) PetscCall(KSPConvergedDefaultSetUMIRNorm(ksp));
   }
@@ -60,9 +60,9 @@ PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SolverStepGuessDrop(AppCtx *user)
+PetscErrorCode SolverStepGuessDrop(SolverCtx sc)
 {
   PetscFunctionBeginUser;
-  PetscCall(VecDestroy(&user->prob.step_guess.du));
+  PetscCall(VecDestroy(&sc->step_guess.du));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
