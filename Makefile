@@ -113,7 +113,7 @@ study-%: deps
 	$(PYTHON) scripts/study.py options/studies/$*.yaml --check
 
 format:
-	clang-format -i src/*.c src/*/*.c include/*.h
+	clang-format -i src/*.c src/*/*.c src/*/*.h include/*.h
 
 clean:
 	rm -rf build build-asan bin output tests/out .pytest_cache

@@ -14,10 +14,10 @@
 #pragma once
 #include "signorini.h"
 
-typedef const char        *ContactType;
+typedef const char *ContactType;
 #define CONTACTPENALTY "penalty"
-#define CONTACTVI      "vi"
-#define CONTACTNONE    "none"
+#define CONTACTVI "vi"
+#define CONTACTNONE "none"
 
 /* What the contact needs of the problem on one mesh, given to ContactSetUp() (read during the call; loc_bc is kept
    with a reference). */
@@ -100,7 +100,7 @@ typedef struct {
   PetscBool    jacobian_in_K; /* K holds K + the penalty Jacobian in those rows */
 } ContactBulkRows;
 const ContactBulkRows *ContactBulkRowsOf(Contact ct); /* NULL without a penalty term; rows->ptr NULL before they are saved */
-PetscErrorCode ContactCopyRows(Mat A, PetscInt n, const PetscInt rows[], PetscInt **ptr, PetscInt **cols, PetscScalar **vals);
+PetscErrorCode         ContactCopyRows(Mat A, PetscInt n, const PetscInt rows[], PetscInt **ptr, PetscInt **cols, PetscScalar **vals);
 
 /* Penetration u . n - g of contact node i, from the owned part x[] of a global vector (fixed components: their values). */
 static inline PetscReal ContactNodePenetration(const ContactSet *cs, PetscInt dim, PetscInt i, const PetscScalar x[])

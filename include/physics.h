@@ -4,10 +4,6 @@
 #include "contact.h"
 #include "mesh.h" /* MeshClosure */
 
-/* section.c */
-PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user);
-PetscErrorCode SectionSetUpGlobalP1(DM dm, PetscBool check);
-
 /* elasticity.c */
 PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degree, PetscBool *section_check);
 PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user);

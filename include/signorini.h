@@ -116,16 +116,16 @@ typedef struct {
 #define SOLVER_KSP_PREFIXES 2
 #define MULTIGRID_MAX_LEVELS 16 /* levels of a multigrid preconditioner the solver follows */
 typedef struct {
-  PetscBool mat_type;                                /* -mat_type */
-  PetscBool snes_ksp_ew, snes_ksp_ew_rtolmax;        /* -snes_ksp_ew, -snes_ksp_ew_rtolmax */
-  PetscBool pc_type_given;                           /* -pc_type, */
-  char      pc_type[64];                             /*   its value */
-  PetscBool ksp_norm_type[SOLVER_KSP_PREFIXES];      /* -ksp_norm_type */
-  PetscBool use_initial_rnorm[SOLVER_KSP_PREFIXES];  /* -ksp_converged_use_initial_residual_norm */
-  PetscBool pc_mg_levels[SOLVER_KSP_PREFIXES];       /* -pc_mg_levels */
-  PetscBool pc_mg_galerkin[SOLVER_KSP_PREFIXES];     /* -pc_mg_galerkin */
-  PetscBool fine_ksp_type[SOLVER_KSP_PREFIXES];      /* -mg_fine_ksp_type */
-  PetscBool fine_pc_type[SOLVER_KSP_PREFIXES];       /* -mg_fine_pc_type */
+  PetscBool mat_type;                               /* -mat_type */
+  PetscBool snes_ksp_ew, snes_ksp_ew_rtolmax;       /* -snes_ksp_ew, -snes_ksp_ew_rtolmax */
+  PetscBool pc_type_given;                          /* -pc_type, */
+  char      pc_type[64];                            /*   its value */
+  PetscBool ksp_norm_type[SOLVER_KSP_PREFIXES];     /* -ksp_norm_type */
+  PetscBool use_initial_rnorm[SOLVER_KSP_PREFIXES]; /* -ksp_converged_use_initial_residual_norm */
+  PetscBool pc_mg_levels[SOLVER_KSP_PREFIXES];      /* -pc_mg_levels */
+  PetscBool pc_mg_galerkin[SOLVER_KSP_PREFIXES];    /* -pc_mg_galerkin */
+  PetscBool fine_ksp_type[SOLVER_KSP_PREFIXES];     /* -mg_fine_ksp_type */
+  PetscBool fine_pc_type[SOLVER_KSP_PREFIXES];      /* -mg_fine_pc_type */
   /* -ksp_chebyshev_esteig of each multigrid smoother's prefix: mg_fine_, and mg_levels_N_ (PETSc's name of level N, which
      also finds -mg_levels_ksp_chebyshev_esteig), under each KSP prefix */
   char      esteig_prefix[SOLVER_KSP_PREFIXES * (MULTIGRID_MAX_LEVELS + 1)][48];
@@ -136,22 +136,22 @@ typedef struct {
 /* Options of the nonlinear solve around the contact (SolverGetOptions(), src/solver/solver_options.c). */
 typedef struct {
   SolverGiven given;
-  PetscBool monitor;
-  PetscBool condition_estimate; /* estimate the 1-norm condition number of the final Jacobian */
-  PetscBool cycle_damping;      /* damp the Newton step when the active set cycles */
-  PetscBool pc_reuse;           /* reuse the preconditioner/factorization while few contact nodes change */
-  PetscInt  pc_reuse_changes;   /*   at most this many changed nodes since the build */
-  PetscBool pc_recovery;        /* go on after a preconditioner breakdown (pc_recovery.c) */
-  PetscBool pc_update;          /* multigrid (GAMG): the coarse operators follow the Jacobian instead of rebuilds */
-  PetscBool pc_update_check;    /*   and each update is compared with the full Galerkin products */
-  PetscBool pc_update_esteig;   /*   and the finest smoother estimates its eigenvalues again at each update */
-  PetscReal pc_update_truncate; /*   and the coarse spaces leave out the contact dofs whose penalty exceeds this times K's diagonal (0: none) */
-  PetscInt  grid_sequence;      /* solve on the mesh and on this many uniform refinements of it, each from the last */
-  PetscInt  coarse_levels;      /* nested iteration to the mesh: this many coarser boxes solved first (-1: automatic) */
-  PetscReal coarse_rtol;        /*   Newton's relative tolerance there */
-  PetscBool coarse_mg;          /*   -contact_coarse_mg as given; whether it applies is GridSequenceCoarseRequest()'s answer */
-  PetscReal ew_guard;           /* Eisenstat-Walker's terms no smaller than this times Newton's target / |F| */
-  PetscReal load_rtol;          /* Newton also stops when |F| <= load_rtol ||F(0)||: the residual is at round-off for the load */
+  PetscBool   monitor;
+  PetscBool   condition_estimate; /* estimate the 1-norm condition number of the final Jacobian */
+  PetscBool   cycle_damping;      /* damp the Newton step when the active set cycles */
+  PetscBool   pc_reuse;           /* reuse the preconditioner/factorization while few contact nodes change */
+  PetscInt    pc_reuse_changes;   /*   at most this many changed nodes since the build */
+  PetscBool   pc_recovery;        /* go on after a preconditioner breakdown (pc_recovery.c) */
+  PetscBool   pc_update;          /* multigrid (GAMG): the coarse operators follow the Jacobian instead of rebuilds */
+  PetscBool   pc_update_check;    /*   and each update is compared with the full Galerkin products */
+  PetscBool   pc_update_esteig;   /*   and the finest smoother estimates its eigenvalues again at each update */
+  PetscReal   pc_update_truncate; /*   and the coarse spaces leave out the contact dofs whose penalty exceeds this times K's diagonal (0: none) */
+  PetscInt    grid_sequence;      /* solve on the mesh and on this many uniform refinements of it, each from the last */
+  PetscInt    coarse_levels;      /* nested iteration to the mesh: this many coarser boxes solved first (-1: automatic) */
+  PetscReal   coarse_rtol;        /*   Newton's relative tolerance there */
+  PetscBool   coarse_mg;          /*   -contact_coarse_mg as given; whether it applies is GridSequenceCoarseRequest()'s answer */
+  PetscReal   ew_guard;           /* Eisenstat-Walker's terms no smaller than this times Newton's target / |F| */
+  PetscReal   load_rtol;          /* Newton also stops when |F| <= load_rtol ||F(0)||: the residual is at round-off for the load */
 } SolverOptions;
 
 /* The nodes of Gamma_C owned by this rank with at least one free component: the unknowns the contact acts on. */
@@ -163,12 +163,12 @@ typedef struct {
   PetscReal *fixed;      /* [n][dim]: the prescribed value of each fixed component (0 for the free ones) */
   PetscReal *normal;     /* [n][dim]: unit normal from the body into the obstacle at the node's undeformed position */
   PetscBool *is_vertex;
-  PetscReal *gap;          /* g: distance from the node to the obstacle along the normal (negative: initial penetration) */
-  PetscReal *eps_factor;   /* the node's eps over the run's eps: (h_node / h)^power, h_node the largest cell at its contact faces */
-  PetscReal *weight;       /* lumped boundary mass, the integral of the node's basis function over Gamma_C */
-  PetscBool *active;       /* active set at the last monitor call */
-  PetscReal *pressure;     /* contact pressure -sigma_n at the node, after the solve */
-  PetscReal *reaction;     /* normal reaction force of the obstacle on the node, -R . n with R = K u + r0, after the solve */
+  PetscReal *gap;        /* g: distance from the node to the obstacle along the normal (negative: initial penetration) */
+  PetscReal *eps_factor; /* the node's eps over the run's eps: (h_node / h)^power, h_node the largest cell at its contact faces */
+  PetscReal *weight;     /* lumped boundary mass, the integral of the node's basis function over Gamma_C */
+  PetscBool *active;     /* active set at the last monitor call */
+  PetscReal *pressure;   /* contact pressure -sigma_n at the node, after the solve */
+  PetscReal *reaction;   /* normal reaction force of the obstacle on the node, -R . n with R = K u + r0, after the solve */
 } ContactSet;
 
 /* Accurate integration for the verification: Gauss points per direction, and how many times the reference
@@ -235,7 +235,7 @@ typedef struct {
   PetscBool           roundoff_stop;                   /* or Newton stalled at the round-off of the terms the residual sums */
   SNESConvergedReason reason;
   PetscReal           residual_norm;
-  PetscReal           residual_start;                  /* |F| at the start of the last Newton solve */
+  PetscReal           residual_start;      /* |F| at the start of the last Newton solve */
   PetscInt            continuation_stages; /* solves of the eps sequence before the target eps (0: none) */
   PetscInt            active_set_cycles;   /* active-set cycles detected (and damped) in the Newton iterations */
   PetscInt            pc_builds;           /* preconditioner (factorization) builds of the Newton steps */
@@ -267,35 +267,35 @@ typedef struct {
 
 /* The options of the run, read once before any set-up (each module's *GetOptions fills its part), read-only after. */
 typedef struct {
-  char           scene_name[64];
-  Material       material;
-  PetscInt       degree;        /* of the displacement, -displacement_petscspace_degree */
-  PetscBool      section_check; /* -section_check: the P1 section compared with PETSc's */
-  SolverOptions  solver;
-  VerifyOptions  verify;
-  AssemblyType   assembly;       /* -assembly as given (auto, fe, p1) */
-  PetscBool      assembly_check; /* -assembly_check: assemble K both ways and compare */
-  PetscBool      perf_bandwidth; /* -perf_bandwidth: measure the memory bandwidths after the solve */
-  char           output[PETSC_MAX_PATH_LEN];
-  PetscBool      output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
+  char          scene_name[64];
+  Material      material;
+  PetscInt      degree;        /* of the displacement, -displacement_petscspace_degree */
+  PetscBool     section_check; /* -section_check: the P1 section compared with PETSc's */
+  SolverOptions solver;
+  VerifyOptions verify;
+  AssemblyType  assembly;       /* -assembly as given (auto, fe, p1) */
+  PetscBool     assembly_check; /* -assembly_check: assemble K both ways and compare */
+  PetscBool     perf_bandwidth; /* -perf_bandwidth: measure the memory bandwidths after the solve */
+  char          output[PETSC_MAX_PATH_LEN];
+  PetscBool     output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
 } RunOptions;
 
 typedef struct _n_SolverCtx *SolverCtx; /* private to src/solver/ */
 
 /* The discrete problem on one mesh: created by ProblemSetUp(), destroyed by ProblemDestroy(), one per grid level. */
 typedef struct {
-  PetscInt        level;                          /* grid sequence level of the mesh (0: the mesh built first) */
-  PetscReal       setup_time;                     /* set-up time of this problem, counted with its first solve */
-  PetscReal       h;                              /* the largest cell diameter */
-  DMLabel         face_sets;
-  Vec             loc_bc;             /* local vector holding the Dirichlet values, zero elsewhere */
-  AssemblyType    assembly;           /* how K is assembled: fe or p1 (-assembly auto resolved) */
-  Mat             K;                  /* bulk elastic operator, assembled once */
-  Vec             r0;                 /* bulk residual at u = 0 (loads and Dirichlet lifting) */
-  Vec             loc_r0;             /* the same, local, with the rows of the fixed components (for the supports' reactions) */
-  PetscReal       load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
-  PetscReal       displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */
-  SolverCtx       sctx;               /* the SNES's callbacks' context and the solver's own state (src/solver/solver_impl.h) */
+  PetscInt     level;      /* grid sequence level of the mesh (0: the mesh built first) */
+  PetscReal    setup_time; /* set-up time of this problem, counted with its first solve */
+  PetscReal    h;          /* the largest cell diameter */
+  DMLabel      face_sets;
+  Vec          loc_bc;             /* local vector holding the Dirichlet values, zero elsewhere */
+  AssemblyType assembly;           /* how K is assembled: fe or p1 (-assembly auto resolved) */
+  Mat          K;                  /* bulk elastic operator, assembled once */
+  Vec          r0;                 /* bulk residual at u = 0 (loads and Dirichlet lifting) */
+  Vec          loc_r0;             /* the same, local, with the rows of the fixed components (for the supports' reactions) */
+  PetscReal    load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
+  PetscReal    displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */
+  SolverCtx    sctx;               /* the SNES's callbacks' context and the solver's own state (src/solver/solver_impl.h) */
 } Problem;
 
 /* What the run produced: statistics, one row per solve, error norms; the summary and the writer only read it. */
@@ -311,7 +311,7 @@ typedef struct {
 /* The interpolations between the nested meshes solved so far (src/solver/multigrid.c): the levels of a geometric
    multigrid (-pc_type mg) on the mesh of the current problem, which has n + 1 of them. */
 typedef struct {
-  PetscInt n;
+  PetscInt  n;
   Mat       interp[MULTIGRID_MAX_LEVELS]; /* [l]: from the global vector of mesh l to that of mesh l + 1 */
   PetscBool coarse_mg; /* the coarser boxes are solved with the geometric multigrid of the boxes below (GridSequenceCoarseRequest()) */
 } Multigrid;
@@ -323,8 +323,8 @@ typedef struct {
   const RunOptions *opt;     /* read once before any set-up, then read only */
   Contact           contact; /* created and read from the options once, set up on the mesh of each problem */
   MeshBox           box;     /* the simplex box of the mesh options, if the mesh is one (MeshCreate()) */
-  Scene      scene;
-  Problem    prob;
-  Multigrid  mg;
-  RunRecord  rec;
+  Scene             scene;
+  Problem           prob;
+  Multigrid         mg;
+  RunRecord         rec;
 } AppCtx;

@@ -27,7 +27,8 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
    -contact_coarse_mg) a coarser box costs little and is one more level of the hierarchy (a smaller coarse factorization). */
 #define GRID_SEQUENCE_MIN_FACES 64
 #define GRID_SEQUENCE_MIN_FACES_MG 16
-PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt *min_faces, PetscBool *coarse_mg);
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt *min_faces,
+                                         PetscBool *coarse_mg);
 PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts);
 PetscErrorCode SolverGivenIndex(const char prefix[], PetscInt *k);
 PetscErrorCode SolverGivenEsteig(const SolverGiven *g, const char prefix[], PetscInt *n, PetscReal t[]);
@@ -44,27 +45,6 @@ PetscErrorCode MultigridDestroy(Multigrid *mg);
 PetscErrorCode FineSmootherGiven(KSP ksp, const SolverGiven *g, PetscBool *given);
 PetscErrorCode FineSmootherSetUp(KSP ksp, const SolverGiven *g);
 
-/* assembly_p1.c */
-PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscBool *check);
-PetscErrorCode AssemblyResolve(DM dm, AppCtx *user);
-PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K);
-PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX);
-PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF);
-
-/* assembly_p1_csr.c */
-PetscErrorCode AssemblyP1BlockPattern(DM dm, PetscInt bs, PetscInt nb, const PetscInt vidx[], PetscInt **bptr, PetscInt **bcol);
-PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
-                                      PetscBool *done);
-PetscErrorCode AssemblyP1CSRAllocated(Mat K, PetscLogDouble *nz);
-PetscErrorCode AssemblyP1CSRApplies(DM dm, PetscInt bs, PetscBool mat_type_given, PetscBool *applies);
-PetscErrorCode AssemblyP1CellCoordinates(PetscSection csection, const PetscScalar xa[], PetscInt dim, const PetscInt verts[], PetscReal x[]);
-PetscErrorCode AssemblyP1CSRCompose(Mat K, PetscInt *i, PetscInt *j, PetscScalar *a, PetscInt *oi, PetscInt *oj, PetscScalar *oa);
-
-/* assembly_p1_mpiaij.c */
-PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
-                                      PetscBool *done);
-
 /* bandwidth.c */
 PetscErrorCode BandwidthGetOptions(MPI_Comm comm, PetscBool *measure);
 PetscErrorCode BandwidthMeasure(SNES snes, AppCtx *user);
-

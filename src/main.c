@@ -5,6 +5,7 @@ static const char help[] =
 #include <sys/resource.h>
 #include "app.h"
 #include "contact.h"
+#include "discretization.h"
 #include "scenes.h"
 #include "mesh.h"
 #include "physics.h"
@@ -128,7 +129,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
     PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, &coarse_request, &coarse_min_faces, &user.mg.coarse_mg));
     PetscCall(MeshCreate(comm, opt.solver.grid_sequence, coarse_request, coarse_min_faces, &user.box, &dm));
   }
-  PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition)); /* the partitioner; the final mesh's cut is taken after the solve */
+  PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));        /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(ReferenceCheckFile(dm, &user));    /* before the solve, not after it */

@@ -111,7 +111,7 @@ def test_assembly_p1_solution_equals_fe(name, args, np_):
     """The solution with -assembly p1 is the -assembly fe one to solver tolerance (direct solves): 2D square on 1 rank,
     3D mms on 2 ranks (inhomogeneous Dirichlet data), 3D square with its body force and a constant one on 2 ranks; same
     Newton steps and active set. The P1 path also assembles r0 itself (AssemblyP1Residual), with PetscFE's rule, and the
-    penalty term's Gauss rule in closed form (src/physics/penalty_faces.c)."""
+    penalty term's Gauss rule in closed form (src/contact/penalty_faces.c)."""
     sol, attrs = {}, {}
     for asm in ("fe", "p1"):
         _, h5 = run(args + ["-contact_monitor", 0, "-assembly", asm], f"assembly_solution_{name}_{asm}", np_=np_)

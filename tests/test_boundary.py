@@ -181,10 +181,10 @@ def test_cylinder_options_file(outdir, quarter_disk):
 @pytest.mark.parametrize("np_", [1, 2])
 @pytest.mark.parametrize("case", ["slips_2d", "slips_3d", "clamp_quads", "clamp_hexes", "mms", "disk_names"])
 def test_p1_section_is_petscs(outdir, quarter_disk, case, np_):
-    """src/physics/section.c builds the P1/Q1 section itself (the Dirichlet components constrained face set by face set,
+    """src/discretization/section.c builds the P1/Q1 section itself (the Dirichlet components constrained face set by face set,
     several on one vertex at the corners); -section_check also has DMCreateLocalSection() build it and compares the two
     with PetscSectionCompare() (dofs, offsets, constraint counts and indices, the field's too); the global section and the
-    section SF built over the vertices (src/physics/section_global.c) are compared with PETSc's, the SF graph entry by entry."""
+    section SF built over the vertices (src/discretization/section_global.c) are compared with PETSc's, the SF graph entry by entry."""
     args = {"slips_2d": patch_args(2, "traction", 0.05, 0.01), "slips_3d": patch_args(3, "pressure", 0.05, 0.01),
             "clamp_quads": ["-dm_plex_simplex", 0, "-dm_plex_box_faces", "5,4"],
             "clamp_hexes": ["-dm_plex_dim", 3, "-dm_plex_simplex", 0, "-dm_plex_box_faces", "2,3,2"],

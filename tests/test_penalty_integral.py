@@ -1,7 +1,7 @@
 """The penalty term of the Gauss rule against face integrals computed by hand in Python (issue 29, item 5).
 
 tests/test_assembly.py compares the closed-form Gauss assembly with PETSc's boundary integration, but both call the same
-pointwise kernels (include/penalty_kernels.h), so a wrong kernel passes it. Here the observable is the solver's nodal
+pointwise kernels (src/contact/penalty_kernels.h), so a wrong kernel passes it. Here the observable is the solver's nodal
 reaction of the foundation, the field contact_reaction = -R_i . n with R = K u + r0 the bulk residual: at a converged
 solve R = -(penalty term), so on a flat obstacle with every component of the Gamma_C nodes free
 

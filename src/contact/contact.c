@@ -48,8 +48,8 @@ PetscErrorCode ContactCreate(MPI_Comm comm, Contact *ct)
 /* -contact_method and the penalty parameter, read once before any set-up; the type's create function runs here. */
 PetscErrorCode ContactSetFromOptions(Contact ct)
 {
-  MPI_Comm        comm = ct->comm;
-  ContactOptions *opts = &ct->opt;
+  MPI_Comm        comm              = ct->comm;
+  ContactOptions *opts              = &ct->opt;
   PetscErrorCode (*create)(Contact) = NULL;
   PetscBool eps_set, sweep_set;
 
@@ -97,7 +97,8 @@ PetscErrorCode ContactSetFromOptions(Contact ct)
     PetscCall(OptionsCheckFiniteArray(comm, "-penalty_eps0_sweep", opts->n_sweep, opts->eps0_sweep));
   }
   PetscCall(PetscFunctionListFind(contact_list, opts->method, &create));
-  PetscCheck(create, comm, PETSC_ERR_USER_INPUT, "Unknown option %s for -contact_method: the registered types are penalty, vi and none", opts->method);
+  PetscCheck(create, comm, PETSC_ERR_USER_INPUT, "Unknown option %s for -contact_method: the registered types are penalty, vi and none",
+             opts->method);
   PetscCall(PetscStrncpy(ct->type, opts->method, sizeof(ct->type)));
   PetscCall((*create)(ct));
   PetscCheck(!sweep_set || opts->n_sweep > 0, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep needs a comma-separated list of values");
@@ -301,8 +302,10 @@ PetscErrorCode ContactPrepareOperator(Contact ct, DM dm, Mat K)
 PetscErrorCode ContactBulkMult(Contact ct, Mat K, Vec X, Vec R)
 {
   PetscFunctionBeginUser;
-  if (ct->ops.bulk_mult) PetscCall((*ct->ops.bulk_mult)(ct, K, X, R));
-  else PetscCall(MatMult(K, X, R));
+  if (ct->ops.bulk_mult)
+    PetscCall((*ct->ops.bulk_mult)(ct, K, X, R));
+  else
+    PetscCall(MatMult(K, X, R));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -311,7 +314,8 @@ PetscErrorCode ContactBulkMult(Contact ct, Mat K, Vec X, Vec R)
 PetscErrorCode ContactBulkOperator(Contact ct, Mat K, Mat *Kb)
 {
   PetscFunctionBeginUser;
-  if (ct->ops.bulk_operator) PetscCall((*ct->ops.bulk_operator)(ct, K, Kb));
+  if (ct->ops.bulk_operator)
+    PetscCall((*ct->ops.bulk_operator)(ct, K, Kb));
   else {
     PetscCall(PetscObjectReference((PetscObject)K));
     *Kb = K;
@@ -420,8 +424,10 @@ PetscErrorCode ContactPostProcess(Contact ct, DM dm, Mat K, Vec r0, Vec u, Petsc
   for (PetscInt c = 0; c < 3; ++c) res->force_vector[c] = global[2 + c];
   res->force           = global[1];
   res->max_penetration = PetscMax(global[0], drule);
-  if (ct->ops.acts) PetscCall(MPIU_Allreduce(&nacts, &res->active_vertices, 1, MPIU_INT, MPI_SUM, ct->comm));
-  else PetscCall(ContactCountActive(ct, u, tol_scale, PETSC_FALSE, &res->active_vertices, NULL, NULL));
+  if (ct->ops.acts)
+    PetscCall(MPIU_Allreduce(&nacts, &res->active_vertices, 1, MPIU_INT, MPI_SUM, ct->comm));
+  else
+    PetscCall(ContactCountActive(ct, u, tol_scale, PETSC_FALSE, &res->active_vertices, NULL, NULL));
   PetscCall(PetscFree(acts));
   PetscCall(ContactEnergy(ct, dm, u, &res->energy));
   if (ct->ops.check) PetscCall((*ct->ops.check)(ct, dm, u));

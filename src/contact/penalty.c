@@ -72,7 +72,8 @@ static PetscErrorCode PenaltySetUpLocalEps(Contact ct, DM dm)
   }
   PetscCall(VecRestoreArray(loc_a, &a));
   for (PetscInt s = 0; s < ct->nids; ++s)
-    for (PetscInt part = PENALTY_PART_TERM; part <= PENALTY_PART_ENERGY; ++part) PetscCall(DMSetAuxiliaryVec(dm, ct->face_sets, ct->ids[s], part, loc_a));
+    for (PetscInt part = PENALTY_PART_TERM; part <= PENALTY_PART_ENERGY; ++part)
+      PetscCall(DMSetAuxiliaryVec(dm, ct->face_sets, ct->ids[s], part, loc_a));
   PetscCall(VecDestroy(&loc_a));
   PetscCall(DMDestroy(&dm_aux));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -144,7 +145,8 @@ static PetscErrorCode GaussTermLocal(Contact ct, DM dm, PetscBool use_fe, Vec X,
       PetscCall(VecSum(locF, &e)); /* the entries of a face's energy residual sum to its integral (partition of unity) */
       *energy = PetscRealPart(e);
     }
-  } else if (energy) PetscCall(PenaltyFacesEnergy(&pen->faces, dm, locX, energy));
+  } else if (energy)
+    PetscCall(PenaltyFacesEnergy(&pen->faces, dm, locX, energy));
   else {
     PetscCall(VecZeroEntries(locF));
     PetscCall(PenaltyFacesResidual(&pen->faces, dm, locX, locF));
@@ -161,8 +163,10 @@ static PetscErrorCode GaussJacobian(Contact ct, DM dm, PetscBool use_fe, Vec X, 
 
   PetscFunctionBeginUser;
   PetscCall(ContactGetLocalSolution(ct, dm, X, &locX));
-  if (use_fe) PetscCall(CompatComputeBdJacobianSingle(dm, pen->wf, ct->face_sets, ct->nids, ct->ids, locX, J));
-  else PetscCall(PenaltyFacesJacobian(&pen->faces, dm, locX, J));
+  if (use_fe)
+    PetscCall(CompatComputeBdJacobianSingle(dm, pen->wf, ct->face_sets, ct->nids, ct->ids, locX, J));
+  else
+    PetscCall(PenaltyFacesJacobian(&pen->faces, dm, locX, J));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -211,7 +215,8 @@ static PetscErrorCode ContactSameActivity_Penalty(Contact ct, DM dm, Vec X, Vec 
   if (ct->opt.quadrature == PENALTY_QUADRATURE_GAUSS) {
     Vec locX, locY;
 
-    if (UseFE(ct)) *same = PETSC_FALSE;
+    if (UseFE(ct))
+      *same = PETSC_FALSE;
     else {
       PetscCall(ContactGetLocalSolution(ct, dm, X, &locX));
       PetscCall(ContactGetLocalSolution(ct, dm, Y, &locY));
@@ -488,20 +493,20 @@ PetscErrorCode ContactCreate_Penalty(Contact ct)
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&pen));
-  ct->data                  = pen;
-  ct->has_penalty           = PETSC_TRUE;
-  ct->ops.setup             = ContactSetUp_Penalty;
-  ct->ops.reset             = ContactReset_Penalty;
-  ct->ops.destroy           = ContactDestroy_Penalty;
-  ct->ops.residual          = ContactResidual_Penalty;
-  ct->ops.jacobian          = ContactJacobian_Penalty;
-  ct->ops.prepare_operator  = ContactPrepareOperator_Penalty;
-  ct->ops.bulk_mult         = ContactBulkMult_Penalty;
-  ct->ops.bulk_operator     = ContactBulkOperator_Penalty;
-  ct->ops.energy            = ContactEnergy_Penalty;
-  ct->ops.acts              = ContactActs_Penalty;
-  ct->ops.same_activity     = ContactSameActivity_Penalty;
-  ct->ops.check             = ContactCheck_Penalty;
-  ct->ops.view              = ContactView_Penalty;
+  ct->data                 = pen;
+  ct->has_penalty          = PETSC_TRUE;
+  ct->ops.setup            = ContactSetUp_Penalty;
+  ct->ops.reset            = ContactReset_Penalty;
+  ct->ops.destroy          = ContactDestroy_Penalty;
+  ct->ops.residual         = ContactResidual_Penalty;
+  ct->ops.jacobian         = ContactJacobian_Penalty;
+  ct->ops.prepare_operator = ContactPrepareOperator_Penalty;
+  ct->ops.bulk_mult        = ContactBulkMult_Penalty;
+  ct->ops.bulk_operator    = ContactBulkOperator_Penalty;
+  ct->ops.energy           = ContactEnergy_Penalty;
+  ct->ops.acts             = ContactActs_Penalty;
+  ct->ops.same_activity    = ContactSameActivity_Penalty;
+  ct->ops.check            = ContactCheck_Penalty;
+  ct->ops.view             = ContactView_Penalty;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -160,12 +160,12 @@ static PetscErrorCode FaceKernelData(DM dm, PetscInt *dim, PetscInt *ncst, const
    rank's integral of the energy density (f0_bd_penalty_energy), and locF is not touched. */
 static PetscErrorCode PenaltyFacesIntegrate(const PenaltyFaces *pf, DM dm, Vec locX, Vec locF, PetscReal *energy)
 {
-  const PetscInt      zero[1]  = {0};
-  const PetscReal     nzero[3] = {0.0, 0.0, 0.0};
-  const PetscScalar  *x, *cst;
-  PetscScalar        *f = NULL;
-  PetscInt            dim, ncst;
-  PetscReal           esum = 0.0;
+  const PetscInt     zero[1]  = {0};
+  const PetscReal    nzero[3] = {0.0, 0.0, 0.0};
+  const PetscScalar *x, *cst;
+  PetscScalar       *f = NULL;
+  PetscInt           dim, ncst;
+  PetscReal          esum = 0.0;
 
   PetscFunctionBeginUser;
   PetscCall(FaceKernelData(dm, &dim, &ncst, &cst));
@@ -218,8 +218,8 @@ PetscErrorCode PenaltyFacesEnergy(const PenaltyFaces *pf, DM dm, Vec locX, Petsc
 /* The largest u_n - g at the Gauss points of this rank's contact faces (-PETSC_MAX_REAL if it has none). */
 PetscErrorCode PenaltyFacesMaxPenetration(const PenaltyFaces *pf, DM dm, Vec locX, PetscReal *dmax)
 {
-  const PetscScalar  *x, *cst;
-  PetscInt            dim, ncst;
+  const PetscScalar *x, *cst;
+  PetscInt           dim, ncst;
 
   PetscFunctionBeginUser;
   PetscCall(FaceKernelData(dm, &dim, &ncst, &cst));
@@ -259,8 +259,8 @@ static inline PetscBool FacePointKernel(const PenaltyFaces *pf, PetscInt dim, Pe
    without a penetrating point adds nothing and is skipped. */
 PetscErrorCode PenaltyFacesJacobian(const PenaltyFaces *pf, DM dm, Vec locX, Mat J)
 {
-  const PetscScalar  *x, *cst;
-  PetscInt            dim, ncst;
+  const PetscScalar *x, *cst;
+  PetscInt           dim, ncst;
 
   PetscFunctionBeginUser;
   PetscCall(FaceKernelData(dm, &dim, &ncst, &cst));
@@ -294,8 +294,8 @@ PetscErrorCode PenaltyFacesJacobian(const PenaltyFaces *pf, DM dm, Vec locX, Mat
    kernel is nonzero at one and not at the other, Newton's model at one misses a kink that the other crosses. */
 PetscErrorCode PenaltyFacesSameActivity(const PenaltyFaces *pf, DM dm, Vec locA, Vec locB, PetscBool *same)
 {
-  const PetscScalar  *xa, *xb, *cst;
-  PetscInt            dim, ncst;
+  const PetscScalar *xa, *xb, *cst;
+  PetscInt           dim, ncst;
 
   PetscFunctionBeginUser;
   PetscCall(FaceKernelData(dm, &dim, &ncst, &cst));

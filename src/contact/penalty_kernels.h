@@ -1,6 +1,6 @@
 /* The pointwise kernels of the penalty term on Gamma_C (the Gauss rule): pure functions of the displacement, the
    quadrature point and constants[] (include/physics.h's index map), shared by PETSc's boundary integration
-   (src/physics/penalty.c) and the closed-form one on P1 simplices (src/physics/penalty_faces.c). */
+   (src/contact/penalty.c) and the closed-form one on P1 simplices (src/contact/penalty_faces.c). */
 #pragma once
 #include "obstacle.h"
 

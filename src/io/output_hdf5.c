@@ -208,9 +208,9 @@ static PetscErrorCode WriteErrorNorms(PetscViewer v, const char prefix[], const 
 
 static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscViewer v, PetscInt ncells, PetscInt nverts)
 {
-  const RunStats *s = &user->rec.stats;
-  PetscMPIInt     size;
-  PetscInt        dim, ndofs;
+  const RunStats       *s = &user->rec.stats;
+  PetscMPIInt           size;
+  PetscInt              dim, ndofs;
   ContactType           method;
   const ContactOptions *copt;
   PetscReal             eps = 0.0, eps_min = 0.0, eps_max = 0.0;

@@ -3,6 +3,7 @@
 #include "app.h"
 #include "obstacle.h"
 #include "physics.h"
+#include "discretization.h"
 
 /* sigma(u) = 2 mu eps(u) + lambda tr(eps(u)) I */
 static void f1_u(PetscInt dim, PetscInt Nf, PetscInt NfAux, const PetscInt uOff[], const PetscInt uOff_x[], const PetscScalar u[],

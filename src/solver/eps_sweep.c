@@ -82,7 +82,7 @@ static PetscErrorCode TangentDirection(SNES snes, DM dm, AppCtx *user, Vec u, Ve
 
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 {
-  Vec       prev = NULL, last = NULL, dir = NULL; /* the solutions for the values before the last, and for the last */
+  Vec                   prev = NULL, last = NULL, dir = NULL; /* the solutions for the values before the last, and for the last */
   PetscReal             eps_prev = 0.0, eps;
   const ContactOptions *copt;
 
@@ -104,8 +104,7 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
       PetscBool ok = PETSC_FALSE;
 
       PetscCall(TangentDirection(snes, dm, user, u, dir, &ok));
-      if (ok)
-        PetscCall(ExtrapolatedStart(snes, dm, user, u, dir, (eps - eps_last) * eps / (eps_last * eps_last), 1e-2, PETSC_FALSE));
+      if (ok) PetscCall(ExtrapolatedStart(snes, dm, user, u, dir, (eps - eps_last) * eps / (eps_last * eps_last), 1e-2, PETSC_FALSE));
     }
     if (!prev) PetscCall(VecDuplicate(u, &prev));
     PetscCall(VecSwap(prev, last));

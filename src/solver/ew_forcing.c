@@ -37,7 +37,7 @@ PetscErrorCode SolverForcingPreSolve(KSP ksp, SolverCtx sc)
     PetscReal ref;
 
     PetscCall(SNESGetTolerances(snes, &atol, &srtol, &stol, &maxit, &maxf));
-    ref = SolverStopReference(sc); /* SolverConverged()'s, in the user's units; the SNES sees F/U */
+    ref  = SolverStopReference(sc); /* SolverConverged()'s, in the user's units; the SNES sees F/U */
     rtol = PetscMax(rtol, fc->guard * srtol * (ref / sc->snes_scale) / norm);
   }
   rtol = PetscMin(rtol, rtol_max);

@@ -61,12 +61,13 @@ static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt *min_faces, PetscBool *coarse_mg)
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt *min_faces,
+                                         PetscBool *coarse_mg)
 {
-  const PetscInt k           = opt->solver.coarse_levels;
-  const char    *pc_type     = opt->solver.given.pc_type;
-  const PetscBool given       = opt->solver.given.pc_type_given;
-  PetscBool      is_mg, is_factor;
+  const PetscInt  k       = opt->solver.coarse_levels;
+  const char     *pc_type = opt->solver.given.pc_type;
+  const PetscBool given   = opt->solver.given.pc_type_given;
+  PetscBool       is_mg, is_factor;
 
   PetscFunctionBeginUser;
   PetscCheck(k <= 0 || opt->degree == 1, comm, PETSC_ERR_USER_INPUT,
@@ -77,8 +78,8 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOpt
      default is MUMPS's factorization, which a coarser box's small matrix does not make expensive); not with SNESVI, whose
      reduced system (vinewtonrsls) no PCMG can follow and whose vinewtonssls Jacobian CG cannot take */
   *coarse_mg = (PetscBool)(opt->solver.coarse_mg && given && !is_mg && !is_factor && !ContactHasBounds(ct));
-  *request               = k;
-  *min_faces             = (is_mg || *coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
+  *request   = k;
+  *min_faces = (is_mg || *coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
   /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels) */
   if (k < 0 && (!(ContactHasPenalty(ct) || (ContactIsNone(ct) && is_mg)) || opt->degree != 1)) *request = 0;
   PetscFunctionReturn(PETSC_SUCCESS);

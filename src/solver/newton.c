@@ -81,8 +81,8 @@ PetscErrorCode SolverResidualNorm(SNES snes, SolverCtx sc, Vec u, PetscReal *nor
 PetscErrorCode SolverFormFunction(SNES snes, Vec X, Vec F, void *ctx)
 {
   SolverCtx sc = (SolverCtx)ctx;
-  DM      dm;
-  Vec     u;
+  DM        dm;
+  Vec       u;
 
   PetscFunctionBeginUser;
   PetscCall(SNESGetDM(snes, &dm));
@@ -95,8 +95,8 @@ PetscErrorCode SolverFormFunction(SNES snes, Vec X, Vec F, void *ctx)
 PetscErrorCode SolverFormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
 {
   SolverCtx sc = (SolverCtx)ctx;
-  DM      dm;
-  Vec     u;
+  DM        dm;
+  Vec       u;
 
   PetscFunctionBeginUser;
   PetscCall(SNESGetDM(snes, &dm));
@@ -104,7 +104,7 @@ PetscErrorCode SolverFormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
   if (ContactHasPenalty(sc->contact)) {
     PetscCall(PcReuseDecide(snes, dm, sc, u));
     PetscCall(ContactComputeJacobian(sc->contact, dm, u, sc->K, P)); /* P is K itself, or a copy (SBAIJ: no row access) */
-    PetscCall(PcReuseAfterJacobian(snes, sc)); /* records the build's contact rows, or updates the GAMG hierarchy */
+    PetscCall(PcReuseAfterJacobian(snes, sc));                       /* records the build's contact rows, or updates the GAMG hierarchy */
   }
   if (J != P) {
     PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
@@ -150,11 +150,10 @@ static PetscErrorCode SolverRoundoffFloor(SNES snes, SolverCtx sc, PetscReal *fl
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm, SNESConvergedReason *reason,
-                                      void *ctx)
+PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm, SNESConvergedReason *reason, void *ctx)
 {
   SolverCtx       sc = (SolverCtx)ctx;
-  const PetscReal f    = fnorm * sc->snes_scale; /* |F| in the user's units */
+  const PetscReal f  = fnorm * sc->snes_scale; /* |F| in the user's units */
 
   PetscFunctionBeginUser;
   PetscCall(SNESConvergedDefault(snes, it, xnorm, snorm, fnorm, reason, NULL));
@@ -164,7 +163,7 @@ PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscRea
     PetscInt  maxit, maxf;
 
     PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
-    ref = SolverStopReference(sc);
+    ref     = SolverStopReference(sc);
     *reason = f <= rtol * ref ? SNES_CONVERGED_FNORM_RELATIVE : SNES_CONVERGED_ITERATING;
   }
   if (*reason <= 0 && !PetscIsInfOrNanReal(f) && f <= sc->opt->load_rtol * sc->load_norm) *reason = SNES_CONVERGED_FNORM_ABS;
@@ -179,14 +178,13 @@ PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscRea
 
     PetscCall(SolverRoundoffFloor(snes, sc, &floor));
     if (f <= 100.0 * floor) {
-      *reason                  = SNES_CONVERGED_FNORM_ABS;
+      *reason           = SNES_CONVERGED_FNORM_ABS;
       sc->roundoff_stop = PETSC_TRUE;
     }
   }
   sc->fnorm_last = f;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
-
 
 /* Before each linear solve: the finest multigrid smoother's -mg_fine_ options (fine_smoother.c), the initial guess
    (step_guess.c), then the linear tolerance of the inexact Newton (ew_forcing.c). */
@@ -200,4 +198,3 @@ PetscErrorCode SolverPreSolve(KSP ksp, Vec b, Vec x, void *ctx)
   PetscCall(SolverForcingPreSolve(ksp, sc));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
-

@@ -115,7 +115,7 @@ PetscErrorCode PcRecoveryTry(SNES snes, SolverCtx sc, PetscBool *retry)
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &is_gamg));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
-  PetscCall(PcReuseReset(sc));                /* the next Newton step builds afresh, and builds only from then on */
+  PetscCall(PcReuseReset(sc));                  /* the next Newton step builds afresh, and builds only from then on */
   PetscCall(SNESSetLagPreconditioner(snes, 1)); /* (PcReuseDecide() sets the lag again where it takes over) */
   if (rec->stage == 0) {                        /* 1. a fresh build */
     rec->stage = 1;

@@ -43,7 +43,8 @@ static PetscErrorCode HierarchyLevels(SNES snes, SolverCtx sc, PC *pc, PetscInt 
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(KSPGetPC(ksp, pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)*pc, PCGAMG, &is_gamg));
-  if (!is_gamg || !sc->opt->pc_update || sc->pc_reuse.no_update || !ContactBulkRowsOf(sc->contact) || !ContactBulkRowsOf(sc->contact)->ptr) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!is_gamg || !sc->opt->pc_update || sc->pc_reuse.no_update || !ContactBulkRowsOf(sc->contact) || !ContactBulkRowsOf(sc->contact)->ptr)
+    PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PCMGGetLevels(*pc, nlevels));
   for (PetscInt l = 0; l < *nlevels; ++l) {
     KSP smoother;
@@ -59,7 +60,6 @@ static PetscErrorCode HierarchyLevels(SNES snes, SolverCtx sc, PC *pc, PetscInt 
 /* The Jacobian's values in the contact rows into vals (collective only through the caller). */
 static PetscErrorCode ContactRowValues(SolverCtx sc, PetscScalar vals[])
 {
-  
   const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
 
   PetscFunctionBeginUser;
@@ -68,8 +68,8 @@ static PetscErrorCode ContactRowValues(SolverCtx sc, PetscScalar vals[])
     PetscInt           ncols;
 
     PetscCall(MatGetRow(sc->K, br->rows[r], &ncols, NULL, &v));
-    PetscCheck(ncols == br->ptr[r + 1] - br->ptr[r], PETSC_COMM_SELF, PETSC_ERR_PLIB,
-               "the Jacobian's row %" PetscInt_FMT " left K's pattern", br->rows[r]);
+    PetscCheck(ncols == br->ptr[r + 1] - br->ptr[r], PETSC_COMM_SELF, PETSC_ERR_PLIB, "the Jacobian's row %" PetscInt_FMT " left K's pattern",
+               br->rows[r]);
     PetscCall(PetscArraycpy(&vals[br->ptr[r]], v, ncols));
     PetscCall(MatRestoreRow(sc->K, br->rows[r], &ncols, NULL, &v));
   }
@@ -112,11 +112,10 @@ static PetscErrorCode ScatterMarks(SolverCtx sc, const ContactBulkRows *br)
    of any rank, J(s, c) = K(c, s) by symmetry. */
 static PetscErrorCode MirrorsSetUp(SolverCtx sc)
 {
-  
   const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
-  PcReuse           *r  = &sc->pc_reuse;
-  PetscInt           n  = 0;
-  const PetscScalar *mark;
+  PcReuse               *r  = &sc->pc_reuse;
+  PetscInt               n  = 0;
+  const PetscScalar     *mark;
 
   PetscFunctionBeginUser;
   PetscCall(MatCreateVecs(sc->K, &r->zmark, NULL));
@@ -150,11 +149,11 @@ static PetscErrorCode MirrorsSetUp(SolverCtx sc)
    bulk); a rebuild at that eps would leave the same dofs out of its aggregates. Also sets zrows. */
 static PetscErrorCode EffectiveValues(SolverCtx sc, const PetscScalar jvals[], PetscScalar eff[])
 {
-  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
-  PcReuse           *r     = &sc->pc_reuse;
-  const PetscInt     nnz   = br->ptr[br->n];
-  const PetscReal    ratio = sc->opt->pc_update_truncate;
-  const PetscScalar *mark;
+  const ContactBulkRows *br    = ContactBulkRowsOf(sc->contact);
+  PcReuse               *r     = &sc->pc_reuse;
+  const PetscInt         nnz   = br->ptr[br->n];
+  const PetscReal        ratio = sc->opt->pc_update_truncate;
+  const PetscScalar     *mark;
 
   PetscFunctionBeginUser;
   if (ratio <= 0.0) {
@@ -186,9 +185,8 @@ static PetscErrorCode EffectiveValues(SolverCtx sc, const PetscScalar jvals[], P
 /* The finest prolongator's rows at the owned contact rows, as GAMG made them. */
 static PetscErrorCode ProlongatorRowsSave(PC pc, SolverCtx sc)
 {
-  
   const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
-  PcReuse *r  = &sc->pc_reuse;
+  PcReuse               *r  = &sc->pc_reuse;
 
   PetscFunctionBeginUser;
   PetscCall(PCMGGetInterpolation(pc, r->nlevels - 1, &r->rfine));
@@ -201,9 +199,9 @@ static PetscErrorCode ProlongatorRowsSave(PC pc, SolverCtx sc)
 static PetscErrorCode ProlongatorRowsSet(SolverCtx sc, PetscBool all)
 {
   const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
-  PcReuse     *r  = &sc->pc_reuse;
-  PetscScalar *zero;
-  PetscInt     iz = 0, nmax = 0;
+  PcReuse               *r  = &sc->pc_reuse;
+  PetscScalar           *zero;
+  PetscInt               iz = 0, nmax = 0;
 
   PetscFunctionBeginUser;
   if (!r->rfine) PetscFunctionReturn(PETSC_SUCCESS);
@@ -214,8 +212,8 @@ static PetscErrorCode ProlongatorRowsSet(SolverCtx sc, PetscBool all)
     const PetscBool in_z = (PetscBool)(!all && iz < r->nz && r->zrows[iz] == br->rows[row]); /* zrows follow the rows' order */
 
     iz += in_z;
-    PetscCall(MatSetValues(r->rfine, 1, &br->rows[row], n, &r->rrow_cols[r->rrow_ptr[row]], in_z ? zero : &r->rrow_vals[r->rrow_ptr[row]],
-                           INSERT_VALUES));
+    PetscCall(
+        MatSetValues(r->rfine, 1, &br->rows[row], n, &r->rrow_cols[r->rrow_ptr[row]], in_z ? zero : &r->rrow_vals[r->rrow_ptr[row]], INSERT_VALUES));
   }
   PetscCall(PetscFree(zero));
   PetscCall(MatAssemblyBegin(r->rfine, MAT_FINAL_ASSEMBLY));
@@ -228,15 +226,15 @@ static PetscErrorCode ProlongatorRowsSet(SolverCtx sc, PetscBool all)
    the change restricted to S x S. Each rank computes its own part, and a COO matrix sums the parts. */
 static PetscErrorCode FinestProductSetUp(PC pc, SolverCtx sc)
 {
-  PcReuse        *r   = &sc->pc_reuse;
-  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
-  const PetscInt  nnz = br->ptr[br->n];
-  PetscInt        nS  = nnz, N1, n1, *S, *coo_i, *coo_j, nrows;
-  const PetscInt *ia, *ja;
-  PetscBool       done;
-  PetscCount      ncoo;
-  IS              is_rows, is_cols;
-  Mat             R, *sub;
+  PcReuse               *r   = &sc->pc_reuse;
+  const ContactBulkRows *br  = ContactBulkRowsOf(sc->contact);
+  const PetscInt         nnz = br->ptr[br->n];
+  PetscInt               nS  = nnz, N1, n1, *S, *coo_i, *coo_j, nrows;
+  const PetscInt        *ia, *ja;
+  PetscBool              done;
+  PetscCount             ncoo;
+  IS                     is_rows, is_cols;
+  Mat                    R, *sub;
 
   PetscFunctionBeginUser;
   PetscCall(PCMGGetInterpolation(pc, r->nlevels - 1, &R));
@@ -334,10 +332,10 @@ static PetscErrorCode CheckHierarchy(PC pc, PetscInt nlevels, PcReuse *r)
    R^T D R, D the change on the level above (the first product makes the patterns, the later ones reuse them). */
 static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
 {
-  PcReuse  *r    = &sc->pc_reuse;
-  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
-  PetscInt  nnz  = br->ptr[br->n];
-  PetscReal dmax = 0.0;
+  PcReuse               *r    = &sc->pc_reuse;
+  const ContactBulkRows *br   = ContactBulkRowsOf(sc->contact);
+  PetscInt               nnz  = br->ptr[br->n];
+  PetscReal              dmax = 0.0;
 
   PetscFunctionBeginUser;
   if (!r->dcoarse) {
@@ -434,8 +432,7 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
     PetscCall(KSPGetIterationNumber(ksp, &its));
     PetscCall(KSPGetConvergedReason(ksp, &reason));
     /* rebuild after a failed solve, or when the last solve needed twice the iterations of the first after the build */
-    rebuild =
-        (PetscBool)(changes > sc->opt->pc_reuse_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
+    rebuild = (PetscBool)(changes > sc->opt->pc_reuse_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
   }
   if (rebuild) {
     PetscCall(CountChanges(sc, dim, x, PETSC_TRUE, &changes));
@@ -457,10 +454,10 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
    their change down the hierarchy. */
 PetscErrorCode PcReuseAfterJacobian(SNES snes, SolverCtx sc)
 {
-  PcReuse *r  = &sc->pc_reuse;
+  PcReuse               *r  = &sc->pc_reuse;
   const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
-  PC       pc;
-  PetscInt nlevels;
+  PC                     pc;
+  PetscInt               nlevels;
 
   PetscFunctionBeginUser;
   if (!r->enabled || !sc->opt->pc_update || r->no_update || !br->jacobian_in_K) PetscFunctionReturn(PETSC_SUCCESS);
@@ -488,7 +485,7 @@ PetscErrorCode PcReuseAfterJacobian(SNES snes, SolverCtx sc)
       PetscCall(MPIU_Allreduce(&on_K, &r->built_on_K, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)pc)));
     }
     PetscCall(ProlongatorRowsSet(sc, PETSC_TRUE)); /* GAMG may reuse its prolongators: give them back whole */
-    PetscCall(DestroyProducts(r));                   /* a rebuild may make new prolongators: new patterns */
+    PetscCall(DestroyProducts(r));                 /* a rebuild may make new prolongators: new patterns */
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

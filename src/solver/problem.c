@@ -1,6 +1,7 @@
 /* The discrete problem on one mesh: everything that depends on the mesh, set up and destroyed as a unit
    (the grid sequencing sets up one per level). */
 #include "contact.h"
+#include "discretization.h"
 #include "mesh.h"
 #include "physics.h"
 #include "solver_impl.h"

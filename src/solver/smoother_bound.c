@@ -91,13 +91,12 @@ static PetscErrorCode FreshEstimate(Mat A, PetscInt steps, PetscReal *emin, Pets
    an entry in a row or column with a zero diagonal). */
 static PetscErrorCode PenaltyBound(SolverCtx sc, const PetscScalar jvals[], PetscReal *beta)
 {
-  
   const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
-  PcReuse           *r  = &sc->pc_reuse;
-  PetscInt           rstart;
-  PetscScalar       *d;
-  const PetscScalar *dcol;
-  PetscReal          local = 0.0;
+  PcReuse               *r  = &sc->pc_reuse;
+  PetscInt               rstart;
+  PetscScalar           *d;
+  const PetscScalar     *dcol;
+  PetscReal              local = 0.0;
 
   PetscFunctionBeginUser;
   if (!r->pdiag) {
@@ -157,7 +156,7 @@ static PetscErrorCode ReadBuildEstimate(KSP smoother, const SolverGiven *given, 
   r->tform[3] = 1.1;
   PetscCall(KSPGetOptionsPrefix(smoother, &prefix));
   PetscCall(SolverGivenEsteig(given, prefix, &nt, t)); /* -ksp_chebyshev_esteig under the smoother's prefix */
-  if (nt == 2) { /* PETSc's short form: b and d */
+  if (nt == 2) {                                       /* PETSc's short form: b and d */
     r->tform[1] = t[0];
     r->tform[3] = t[1];
   } else if (nt == 4)

@@ -2,6 +2,7 @@
    the residual is K u + r0 + (contact terms) and the Jacobian K + (contact Jacobian). */
 #include <math.h>
 #include "contact.h"
+#include "discretization.h"
 #include "physics.h"
 #include "solver_impl.h"
 
@@ -69,9 +70,9 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
     if (PetscRealPart(fkf) > 0.0) U = PetscSqr(user->prob.load_norm) / PetscRealPart(fkf) * finf;
     if (!(U > 0.0) || PetscIsInfOrNanReal(U)) U = 1.0;
   }
-  user->prob.displacement_scale          = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
-  user->prob.sctx->load_norm             = user->prob.load_norm; /* the solver's copies of the problem's scales */
-  user->prob.sctx->displacement_scale    = user->prob.displacement_scale;
+  user->prob.displacement_scale       = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
+  user->prob.sctx->load_norm          = user->prob.load_norm; /* the solver's copies of the problem's scales */
+  user->prob.sctx->displacement_scale = user->prob.displacement_scale;
   PetscCall(VecDestroy(&zero));
   PetscCall(VecDestroy(&F));
   PetscCall(VecDestroy(&KF));
@@ -253,18 +254,18 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
   *newton += its;
   *ksp += lits;
-  user->rec.stats.newton_its    = *newton;
-  user->rec.stats.ksp_its       = *ksp;
-  user->rec.stats.residual_norm  = fnorm * user->prob.displacement_scale; /* the SNES saw F/U */
-  user->rec.stats.residual_start = user->prob.sctx->fnorm0;
-  ref = SolverStopReference(user->prob.sctx);
-  user->rec.stats.residual_reduced =
-      (PetscBool)(user->rec.stats.residual_norm <= rtol * ref ||
-                  user->rec.stats.residual_norm <= user->opt->solver.load_rtol * user->prob.load_norm || fnorm <= atol || user->prob.sctx->roundoff_stop);
-  user->rec.stats.roundoff_stop = user->prob.sctx->roundoff_stop;
-  user->rec.stats.converged     = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
+  user->rec.stats.newton_its       = *newton;
+  user->rec.stats.ksp_its          = *ksp;
+  user->rec.stats.residual_norm    = fnorm * user->prob.displacement_scale; /* the SNES saw F/U */
+  user->rec.stats.residual_start   = user->prob.sctx->fnorm0;
+  ref                              = SolverStopReference(user->prob.sctx);
+  user->rec.stats.residual_reduced = (PetscBool)(user->rec.stats.residual_norm <= rtol * ref ||
+                                                 user->rec.stats.residual_norm <= user->opt->solver.load_rtol * user->prob.load_norm ||
+                                                 fnorm <= atol || user->prob.sctx->roundoff_stop);
+  user->rec.stats.roundoff_stop    = user->prob.sctx->roundoff_stop;
+  user->rec.stats.converged        = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
   PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
-  user->rec.stats.pc_builds  = user->prob.sctx->pc_reuse.enabled ? user->prob.sctx->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
+  user->rec.stats.pc_builds = user->prob.sctx->pc_reuse.enabled ? user->prob.sctx->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
   user->rec.stats.pc_updates = user->prob.sctx->pc_reuse.updates;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -272,8 +273,8 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
 /* Appends the outcome of the last SolverSolve() to the table of solves (/solves in the output). */
 static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal time_solve)
 {
-  SolveRecord       *r;
-  DM                 dm;
+  SolveRecord *r;
+  DM           dm;
 
   PetscFunctionBeginUser;
   if (user->rec.nrecords == user->rec.maxrecords) { /* grow */
@@ -289,9 +290,9 @@ static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal 
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(ContactMaxNodePenetration(user->contact, u, &r->max_penetration));
   PetscCall(VecGetSize(u, &r->n_dofs));
-  r->level              = user->prob.level;
-  r->h                  = user->prob.h;
-  r->eps                = 0.0;
+  r->level = user->prob.level;
+  r->h     = user->prob.h;
+  r->eps   = 0.0;
   if (ContactHasPenalty(user->contact)) PetscCall(ContactGetEps(user->contact, &r->eps));
   r->newton_its         = user->rec.stats.newton_its;
   r->ksp_its            = user->rec.stats.ksp_its;
@@ -347,11 +348,11 @@ static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *
    and a free coarse one, start far off on the 1/eps scale, and Newton stalled (128 x 128, eps = 1e-6 h). */
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
 {
-  const PetscBool warm       = (PetscBool)(start != SOLVER_START_ZERO);
-  PetscReal       eps_target, eps_start;
-  PetscLogDouble  t0, t1;
-  PetscInt        newton = 0, ksp = 0;
-  DM              dm;
+  const PetscBool       warm = (PetscBool)(start != SOLVER_START_ZERO);
+  PetscReal             eps_target, eps_start;
+  PetscLogDouble        t0, t1;
+  PetscInt              newton = 0, ksp = 0;
+  DM                    dm;
   const ContactOptions *copt;
 
   PetscFunctionBeginUser;
@@ -363,8 +364,8 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
   PetscCall(MultigridSetUpPC(snes, user)); /* -pc_type mg: the levels of the meshes solved so far */
   user->prob.sctx->warm = warm;
   PetscCall(PetscTime(&t0));
-  user->prob.sctx->pc_reuse.builds          = 0; /* counted per solve */
-  user->prob.sctx->pc_reuse.updates         = 0;
+  user->prob.sctx->pc_reuse.builds    = 0; /* counted per solve */
+  user->prob.sctx->pc_reuse.updates   = 0;
   user->rec.stats.continuation_stages = 0;
   if (start != SOLVER_START_NEARBY_EPS && ContactHasPenalty(user->contact) && copt->continuation && eps_target < eps_start) {
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= copt->continuation_factor) {

@@ -43,14 +43,14 @@ typedef struct {
   PetscScalar *rrow_vals;            /*   with their values as GAMG made them */
   Vec          zmark, zcols;         /* 0 outside the contact rows, 1 in them, 2 in Z; and those marks at the contact rows' columns */
   /* the finest level's Chebyshev interval, bounded instead of estimated again at each update (SmootherBoundFinest(), smoother_bound.c) */
-  PetscBool built_on_K;       /* the build's Jacobian was K itself in the contact rows (no penalty term yet) */
-  PetscBool bound_set;        /* the build's estimate has been read, and the bound applies */
-  PetscBool bound_read;       /* ... has been looked for */
-  PetscReal est_min, est_max; /* the build's Chebyshev estimate of the extreme eigenvalues of diag(K)^-1 K */
-  PetscInt  est_steps;        /* the steps of its estimator */
-  PetscBool *built_active;    /* the contact nodes' penetration when the preconditioner was last built */
-  PetscReal tform[4];         /* Chebyshev's transform of estimates into its interval (-ksp_chebyshev_esteig) */
-  Vec       pdiag, pcols;     /* the penalty term's diagonal, and its values at the contact rows' columns */
+  PetscBool  built_on_K;       /* the build's Jacobian was K itself in the contact rows (no penalty term yet) */
+  PetscBool  bound_set;        /* the build's estimate has been read, and the bound applies */
+  PetscBool  bound_read;       /* ... has been looked for */
+  PetscReal  est_min, est_max; /* the build's Chebyshev estimate of the extreme eigenvalues of diag(K)^-1 K */
+  PetscInt   est_steps;        /* the steps of its estimator */
+  PetscBool *built_active;     /* the contact nodes' penetration when the preconditioner was last built */
+  PetscReal  tform[4];         /* Chebyshev's transform of estimates into its interval (-ksp_chebyshev_esteig) */
+  Vec        pdiag, pcols;     /* the penalty term's diagonal, and its values at the contact rows' columns */
 } PcReuse;
 
 /* State of the recovery from preconditioner breakdowns (pc_recovery.c). */

@@ -28,8 +28,10 @@ static PetscErrorCode SolverReadGiven(SolverGiven *g)
       char           name[96];
       PetscBool      set;
 
-      if (l == MULTIGRID_MAX_LEVELS) PetscCall(PetscSNPrintf(g->esteig_prefix[e], sizeof(g->esteig_prefix[e]), "%smg_fine_", solver_ksp_prefixes[k]));
-      else PetscCall(PetscSNPrintf(g->esteig_prefix[e], sizeof(g->esteig_prefix[e]), "%smg_levels_%d_", solver_ksp_prefixes[k], (int)l));
+      if (l == MULTIGRID_MAX_LEVELS)
+        PetscCall(PetscSNPrintf(g->esteig_prefix[e], sizeof(g->esteig_prefix[e]), "%smg_fine_", solver_ksp_prefixes[k]));
+      else
+        PetscCall(PetscSNPrintf(g->esteig_prefix[e], sizeof(g->esteig_prefix[e]), "%smg_levels_%d_", solver_ksp_prefixes[k], (int)l));
       PetscCall(PetscSNPrintf(name, sizeof(name), "-%sksp_chebyshev_esteig", g->esteig_prefix[e]));
       g->esteig_n[e] = 4;
       PetscCall(PetscOptionsGetRealArray(NULL, NULL, name, g->esteig[e], &g->esteig_n[e], &set));

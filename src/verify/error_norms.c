@@ -253,7 +253,8 @@ PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
     PetscCall(ContactBulkOperator(user->contact, user->prob.K, &K)); /* K, or a copy without the penalty Jacobian: K is read only */
     PetscCall(ErrorNormsEvaluate(dm, user, K, loc_uh, loc_ph, &exact, &user->rec.errors));
     PetscCall(MatDestroy(&K));
-  } else PetscCall(ErrorNormsEvaluate(dm, user, NULL, loc_uh, loc_ph, NULL, &user->rec.errors));
+  } else
+    PetscCall(ErrorNormsEvaluate(dm, user, NULL, loc_uh, loc_ph, NULL, &user->rec.errors));
   if (loc_ph) PetscCall(DMRestoreLocalVector(dm, &loc_ph));
   PetscCall(DMRestoreLocalVector(dm, &loc_uh));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -475,7 +475,8 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(MatchReference(fine, user, &ref, loc_uref, loc_pref));
   PetscCall(ReferenceDestroy(&ref));
 
-  if (levels == 0) PetscCall(ContactBulkOperator(user->contact, user->prob.K, &K)); /* the run's bulk operator, K read only */
+  if (levels == 0)
+    PetscCall(ContactBulkOperator(user->contact, user->prob.K, &K)); /* the run's bulk operator, K read only */
   else {
     Vec locX;
 

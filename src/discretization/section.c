@@ -3,6 +3,7 @@
    point: PETSc 3.18 makes that label's strata hash sets just before (DMPlexGetGhostCellStratum()), so each lookup is a
    hash-set query. Other discretizations (higher degrees, several fields, anchors) are left to PETSc. -section_check
    builds both and compares them (PetscSectionCompare()). */
+#include "discretization.h"
 #include "physics.h"
 
 /* The points of the essential condition bd (its label's strata, cells left out) and its components (NULL: all). */
@@ -227,6 +228,6 @@ PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user)
   }
   PetscCall(DMSetLocalSection(dm, section));
   PetscCall(PetscSectionDestroy(&section));
-  PetscCall(SectionSetUpGlobalP1(dm, user->opt->section_check)); /* src/physics/section_global.c */
+  PetscCall(SectionSetUpGlobalP1(dm, user->opt->section_check)); /* src/discretization/section_global.c */
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -5,8 +5,8 @@
    MatSeqAIJSetPreallocationCSR() inserts a given pattern row by row through it. The arrays belong to a container
    composed with K and are freed with it. Applies where every vertex is free or fully constrained (a block per vertex). */
 #include <petscdmplex.h>
+#include "discretization.h"
 #include "physics.h"
-#include "solver.h"
 
 typedef struct {
   PetscInt    *i, *j, *oi, *oj; /* the off-diagonal part of an MPIAIJ K (assembly_p1_mpiaij.c), NULL on one rank */

@@ -7,8 +7,8 @@
    is free or fully constrained (a block per vertex). */
 #include <petscdmplex.h>
 #include <petscsf.h>
+#include "discretization.h"
 #include "physics.h"
-#include "solver.h"
 
 /* Block rows of global block columns: rows [ptr[r], ptr[r + 1]) of col, sorted and unique after BlockRowsFinish(). */
 typedef struct {

@@ -1,9 +1,10 @@
-/* The global section and the section SF of the P1/Q1 section (src/physics/section.c), built over the vertices, the only
+/* The global section and the section SF of the P1/Q1 section (src/discretization/section.c), built over the vertices, the only
    points with dofs. PETSc 3.18 builds both with several calls per mesh point (PetscSectionCreateGlobalSection(),
    PetscSFSetGraphSection()), of which a 2D mesh has 6 per vertex (a 3D one 26). These are PETSc's results, entry for
    entry, in the same order; -section_check builds PETSc's too and compares them (PetscSectionCompare(), and the SF's
    graph). */
 #include <petscsf.h>
+#include "discretization.h"
 #include "physics.h"
 
 /* PetscSectionCreateGlobalSection(lsec, point SF, PETSC_FALSE, PETSC_FALSE): the vertices' dofs and constraints, every

@@ -4,8 +4,8 @@
    The result is the matrix of DMCreateMatrix() + DMPlexSNESComputeJacobianFEM(): same type, sizes, block size,
    local-to-global mapping, nonzero pattern and values; the rows and columns of constrained dofs are absent. */
 #include "mesh.h"
+#include "discretization.h"
 #include "physics.h"
-#include "solver.h"
 
 const char *const AssemblyTypes[] = {"auto", "fe", "p1", "AssemblyType", "ASSEMBLY_", NULL};
 

@@ -1,0 +1,29 @@
+/* The discretization of the displacement beside PetscFE's (src/discretization/): the local and global sections of
+   P1/Q1 displacements built as PETSc builds them, without its lookups per mesh point, and the assembly of the bulk
+   operator K and of r0 for P1 simplices in closed form, into K's own CSR arrays on one rank or many. */
+#pragma once
+#include "signorini.h"
+
+/* section.c */
+PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user);
+PetscErrorCode SectionSetUpGlobalP1(DM dm, PetscBool check);
+
+/* assembly_p1.c */
+PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscBool *check);
+PetscErrorCode AssemblyResolve(DM dm, AppCtx *user);
+PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K);
+PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX);
+PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF);
+
+/* assembly_p1_csr.c */
+PetscErrorCode AssemblyP1BlockPattern(DM dm, PetscInt bs, PetscInt nb, const PetscInt vidx[], PetscInt **bptr, PetscInt **bcol);
+PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
+                                      PetscBool *done);
+PetscErrorCode AssemblyP1CSRAllocated(Mat K, PetscLogDouble *nz);
+PetscErrorCode AssemblyP1CSRApplies(DM dm, PetscInt bs, PetscBool mat_type_given, PetscBool *applies);
+PetscErrorCode AssemblyP1CellCoordinates(PetscSection csection, const PetscScalar xa[], PetscInt dim, const PetscInt verts[], PetscReal x[]);
+PetscErrorCode AssemblyP1CSRCompose(Mat K, PetscInt *i, PetscInt *j, PetscScalar *a, PetscInt *oi, PetscInt *oj, PetscScalar *oa);
+
+/* assembly_p1_mpiaij.c */
+PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
+                                      PetscBool *done);
