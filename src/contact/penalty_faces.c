@@ -1,7 +1,7 @@
 /* The Gauss rule of the penalty term on P1 simplices in closed form: PETSc's face quadrature and the same pointwise
-   kernels (src/contact/penalty_kernels.h), each face's points and weights computed once. PETSc's boundary integration
-   (DMPlexComputeBdJacobianSingle()) spends about 100 us per face and call in 3D in its generic element loops: with
-   eps = h on 34^3 tetrahedra, 2.4 s of a 7.6 s solve. The numbers are PETSc 3.18's to round-off (-assembly_check):
+   kernels (src/contact/penalty_kernels.h), each face's points and weights computed once, instead of PETSc's boundary
+   integration (DMPlexComputeBdJacobianSingle()) with its generic element loops at every call. The numbers are PETSc
+   3.18's to round-off (-assembly_check):
    the kernel sees the point x of the face's own map, the displacement and the test functions are the support cell's
    basis at its reference face's points, as PETSc evaluates them. On a face whose orientation in its cell is not the
    identity (3D refinement makes such faces) those are other points of the same face; PETSc's choice is kept. */

@@ -54,9 +54,8 @@ static PetscErrorCode CreateRigidBodyModes(DM dm, PetscInt origField, PetscInt f
 }
 
 /* The rigid-body modes (the near-null space of GAMG) of a field whose unknowns all sit at the vertices (P1, Q1),
-   directly from the vertex coordinates: DMPlexCreateRigidBody projects them through PetscFE, which took 2 of the
-   5.5 s of set-up at 250k unknowns. Constrained (Dirichlet) unknowns drop out in the local-to-global map, as there.
-   like: a global vector of dm. */
+   directly from the vertex coordinates, without DMPlexCreateRigidBody's projection through PetscFE. Constrained (Dirichlet) unknowns drop out in the
+   local-to-global map, as there. like: a global vector of dm. */
 PetscErrorCode ElasticityRigidBodyModesP1(DM dm, Vec like, MatNullSpace *nullspace)
 {
   const PetscInt nmodes[4] = {0, 1, 3, 6};

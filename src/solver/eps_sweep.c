@@ -5,7 +5,7 @@
    From the third value on, the start is extrapolated linearly in eps from the last two solutions: while the active
    set stays, u(eps) = (K + P/eps)^-1 f is u(0) + eps u'(0) + O(eps^2) once the penalty dominates, so the
    penetration, whose 1/eps multiple is most of the residual after a step of eps, is predicted instead of carried
-   over (256 x 256, eps down by 10 per value: first residuals of 2e-5 to 2e-8 instead of 0.16). The second value starts
+   over. The second value starts
    on the tangent of the solution path at the first (TangentDirection()). */
 #include "contact.h"
 #include "solver_impl.h"
@@ -13,9 +13,8 @@
 /* u <- u + factor dir if the penalty is active there at the same points as at u (the last solution) and the residual
    at the current eps is lower, or, whatever the points, if that residual is below relaxed times the last one (the
    tangent's guess, below; 0 for the secant's). A secant guess active elsewhere is not taken: a Gauss point it lifts off that the new eps keeps
-   in contact (near the edge of the contact zone) made the line search cut every Newton step at that kink, and Newton
-   stalled (16 x 16 and 32 x 32, GAMG, 1e-5 h to 1e-7 h: 40 and 50 steps). Halving the step when the full one changes
-   the active points was tried: 116 CG iterations instead of 119 at 256 x 256, not kept. Such a guess that still lowers
+   in contact (near the edge of the contact zone) makes the line search cut every Newton step at that kink, and Newton
+   stalls. Such a guess that still lowers
    the residual gives, with step_guess, the first linear solve's initial guess instead (step_guess.c): Newton starts
    from u, with its active points, and CG from the step factor dir; dir is then scaled. */
 static PetscErrorCode ExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscReal factor, PetscReal relaxed, PetscBool step_guess)
@@ -45,10 +44,9 @@ static PetscErrorCode ExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, V
    du/deps = J^-1 P(u; eps) / eps, J the Jacobian, which K and the SNES's preconditioner still hold from the last Newton
    step. dir = J^-1 P(u; eps_new), solved loosely (CG to 1e-2, the preconditioner shared); the step to eps_new is
    (eps_new - eps) du/deps = dir (eps_new - eps) eps_new / eps^2. Its CG iterations count in ksp_its_total. *ok is false
-   if CG did not converge. At 256 x 256 (h to h/10) the guess's residual was 140 times lower than the last solution's (a temporary print),
-   though a few Gauss points at the edge of the contact zone flip: it is taken where its residual is 100 times lower
-   (4 Newton steps and 26 CG iterations instead of 5 and 40, and 3 for the tangent); the secant's rule (the same
-   active points) would refuse it. */
+   if CG did not converge. A few Gauss points at the edge of the contact zone may flip on the tangent, so its guess is
+   taken where its residual is 100 times lower than the last solution's, whatever its active points; the secant's rule
+   (the same active points) would refuse it. */
 static PetscErrorCode TangentDirection(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscBool *ok)
 {
   KSP                ksp, tangent;

@@ -98,13 +98,13 @@ static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
 /* Defaults for an iterative linear solver (a multigrid PC such as GAMG or hypre, not a factorization), where the options
    say nothing:
    - the linear elastic solve (-contact_method none): CG measures the true residual (-ksp_norm_type unpreconditioned),
-     so that -ksp_rtol means what -snes_rtol means, and the solve takes one Newton step (two with the preconditioned
-     norm, whose 1e-10 left the true residual above -snes_rtol: 31 CG iterations instead of 47 at 512 x 512);
+     so that -ksp_rtol means what -snes_rtol means, and the solve takes one Newton step (the preconditioned norm's 1e-10
+     can leave the true residual above -snes_rtol, and a second step);
    - the penalty method: an inexact Newton, Eisenstat-Walker's forcing terms (-snes_ksp_ew) bounded by
      -snes_ksp_ew_rtolmax 0.01. Newton's final residual is as tight as before (-snes_rtol decides), the linear solves
-     are as loose as Newton allows: 512 x 512 square with GAMG, 72 CG iterations instead of 199. PETSc's bound, 0.9,
-     made the semismooth Newton cycle to DIVERGED_MAX_IT (GAMG at eps = 1e-6 h, hypre in 3D with the nodal rule);
-     0.01 converges there (tests/test_performance.py). -snes_ksp_ew 0 restores the fixed -ksp_rtol. */
+     are as loose as Newton allows. PETSc's bound, 0.9, lets the semismooth Newton cycle between active sets on
+     steps too inexact to settle them; 0.01 does not (tests/test_performance.py). -snes_ksp_ew 0 restores the fixed
+     -ksp_rtol. */
 static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
 {
   const SolverGiven *given = &user->opt->solver.given;
