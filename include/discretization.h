@@ -22,6 +22,9 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
 PetscErrorCode AssemblyP1CSRAllocated(Mat K, PetscLogDouble *nz);
 PetscErrorCode AssemblyP1CSRApplies(DM dm, PetscInt bs, PetscBool mat_type_given, PetscBool *applies);
 PetscErrorCode AssemblyP1CellCoordinates(PetscSection csection, const PetscScalar xa[], PetscInt dim, const PetscInt verts[], PetscReal x[]);
+/* the cell loop for one rank and many: adds the block Kab (row stride ld) of local vertices va (row) and vb (column) */
+typedef void (*AssemblyP1AddBlock)(void *ctx, PetscInt va, PetscInt vb, const PetscScalar *Kab, PetscInt ld);
+PetscErrorCode AssemblyP1CellLoop(DM dm, const Material *mat, const PetscInt cverts[], AssemblyP1AddBlock add, void *ctx);
 PetscErrorCode AssemblyP1CSRCompose(Mat K, PetscInt *i, PetscInt *j, PetscScalar *a, PetscInt *oi, PetscInt *oj, PetscScalar *oa);
 
 /* assembly_p1_mpiaij.c */

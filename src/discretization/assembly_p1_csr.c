@@ -60,6 +60,39 @@ PetscErrorCode AssemblyP1CellCoordinates(PetscSection csection, const PetscScala
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The cell loop of the P1 assembly, for one rank and many: the element stiffness of every cell of dm (cverts: each
+   cell's dim + 1 vertices, in the cell's closure order), handed block by block to add(ctx, va, vb, Kab, ld) for each pair
+   of its vertices, row vertex va first, in the cell's order (local vertex numbers from the first vertex; Kab the
+   dim x dim block of the element matrix, row stride ld). The order is MatSetValues()'s, so sums come out the same to the
+   bit whoever adds them. */
+PetscErrorCode AssemblyP1CellLoop(DM dm, const Material *mat, const PetscInt cverts[], AssemblyP1AddBlock add, void *ctx)
+{
+  PetscInt           dim, cStart, cEnd, vStart;
+  PetscSection       csection;
+  Vec                coords;
+  const PetscScalar *xa;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, NULL));
+  PetscCall(DMGetCoordinateSection(dm, &csection));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(VecGetArrayRead(coords, &xa));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    const PetscInt *cv = &cverts[(c - cStart) * (dim + 1)], n = (dim + 1) * dim;
+    PetscReal       x[12];
+    PetscScalar     Ke[144];
+
+    PetscCall(AssemblyP1CellCoordinates(csection, xa, dim, cv, x));
+    PetscCall(ElasticityP1ElementStiffness(dim, mat->lambda, mat->mu, x, Ke));
+    for (PetscInt a = 0; a <= dim; ++a)
+      for (PetscInt b = 0; b <= dim; ++b) add(ctx, cv[a] - vStart, cv[b] - vStart, &Ke[(a * dim) * n + b * dim], n);
+  }
+  PetscCall(VecRestoreArrayRead(coords, &xa));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Gives K's own CSR arrays to a container composed with K, which frees them with K. */
 PetscErrorCode AssemblyP1CSRCompose(Mat K, PetscInt *i, PetscInt *j, PetscScalar *a, PetscInt *oi, PetscInt *oj, PetscScalar *oa)
 {
@@ -141,18 +174,37 @@ PetscErrorCode AssemblyP1BlockPattern(DM dm, PetscInt bs, PetscInt nb, const Pet
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* One rank: the block (va, vb) added in place into the CSR arrays (block row r of n blocks starts at bs^2 bptr[r], its
+   row ci at ci bs n, block k of it at k bs). A vertex whose components are all fixed has no row and no column. */
+typedef struct {
+  PetscInt        bs;
+  const PetscInt *vidx, *bptr, *bcol;
+  PetscScalar    *ca;
+} SeqAdd;
+
+static void SeqAddBlock(void *ctx, PetscInt va, PetscInt vb, const PetscScalar *v, PetscInt ld)
+{
+  const SeqAdd  *s  = (const SeqAdd *)ctx;
+  const PetscInt bs = s->bs, ga = s->vidx[va * bs], gb = s->vidx[vb * bs];
+  PetscInt       r, nr, k                              = 0;
+
+  if (ga < 0 || gb < 0) return;
+  r  = ga / bs;
+  nr = s->bptr[r + 1] - s->bptr[r];
+  while (s->bcol[s->bptr[r] + k] != gb / bs) ++k; /* present: an edge or the vertex itself */
+  for (PetscInt ci = 0; ci < bs; ++ci)
+    for (PetscInt d = 0; d < bs; ++d) s->ca[bs * bs * s->bptr[r] + ci * bs * nr + k * bs + d] += v[ci * ld + d];
+}
+
 PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
                                       PetscBool *done)
 {
-  MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
-  PetscMPIInt        size;
-  PetscInt           dim, cStart, cEnd, vStart, vEnd, nb, *bptr, *bcol;
-  PetscBool          applies;
-  PetscInt          *ci_, *cj;
-  PetscScalar       *ca;
-  PetscSection       csection;
-  Vec                coords;
-  const PetscScalar *xa;
+  MPI_Comm     comm = PetscObjectComm((PetscObject)dm);
+  PetscMPIInt  size;
+  PetscInt     dim, nb, *bptr, *bcol;
+  PetscBool    applies;
+  PetscInt    *ci_, *cj;
+  PetscScalar *ca;
 
   PetscFunctionBeginUser;
   *done = PETSC_FALSE;
@@ -178,39 +230,11 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   }
   ci_[nlocal] = bs * bs * bptr[nb];
 
-  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
-  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  PetscCall(DMGetCoordinateSection(dm, &csection));
-  PetscCall(DMGetCoordinatesLocal(dm, &coords));
-  PetscCall(VecGetArrayRead(coords, &xa));
-  for (PetscInt c = cStart; c < cEnd; ++c) {
-    const PetscInt n = (dim + 1) * dim;
-    PetscInt       blk[4];
-    PetscReal      x[12];
-    PetscScalar    Ke[144];
+  {
+    SeqAdd add = {bs, vidx, bptr, bcol, ca};
 
-    PetscCall(AssemblyP1CellCoordinates(csection, xa, dim, &cverts[(c - cStart) * (dim + 1)], x));
-    for (PetscInt a = 0; a <= dim; ++a) {
-      const PetscInt g = vidx[(cverts[(c - cStart) * (dim + 1) + a] - vStart) * dim];
-
-      blk[a] = g < 0 ? -1 : g / bs;
-    }
-    PetscCall(ElasticityP1ElementStiffness(dim, user->opt->material.lambda, user->opt->material.mu, x, Ke));
-    for (PetscInt a = 0; a <= dim; ++a) {
-      const PetscInt r = blk[a], nr = r < 0 ? 0 : bptr[r + 1] - bptr[r];
-
-      if (r < 0) continue;
-      for (PetscInt b = 0; b <= dim; ++b) {
-        PetscInt k = 0;
-
-        if (blk[b] < 0) continue;
-        while (bcol[bptr[r] + k] != blk[b]) ++k; /* present: an edge or the vertex itself */
-        for (PetscInt ci = 0; ci < bs; ++ci)
-          for (PetscInt d = 0; d < bs; ++d) ca[bs * bs * bptr[r] + ci * bs * nr + k * bs + d] += Ke[(a * dim + ci) * n + b * dim + d];
-      }
-    }
+    PetscCall(AssemblyP1CellLoop(dm, &user->opt->material, cverts, SeqAddBlock, &add));
   }
-  PetscCall(VecRestoreArrayRead(coords, &xa));
   PetscCall(PetscFree(bptr));
   PetscCall(PetscFree(bcol));
 

@@ -155,6 +155,31 @@ static inline void SplitRowsAdd(SplitRows *s, PetscInt r, PetscInt b, const Pets
   }
 }
 
+/* Several ranks: the block (va, vb) added in place into an owned block row, or kept for the owner of a ghost row (gval,
+   block row by block row as sent). A vertex whose components are all fixed has no row and no column. */
+typedef struct {
+  SplitRows       *s;
+  const BlockRows *grows;
+  const PetscInt  *blk, *ghost;
+  PetscScalar     *gval;
+} MPIAdd;
+
+static void MPIAddBlock(void *ctx, PetscInt va, PetscInt vb, const PetscScalar *v, PetscInt ld)
+{
+  const MPIAdd  *m  = (const MPIAdd *)ctx;
+  const PetscInt bs = m->s->bs;
+
+  if (m->blk[va] < 0 || m->blk[vb] < 0) return;
+  if (m->ghost[va] < 0)
+    SplitRowsAdd(m->s, m->blk[va] - m->s->b0, m->blk[vb], v, ld);
+  else {
+    PetscScalar *g = &m->gval[bs * bs * (m->grows->ptr[m->ghost[va]] + BlockRowsFind(m->grows, m->ghost[va], m->blk[vb]))];
+
+    for (PetscInt ci = 0; ci < bs; ++ci)
+      for (PetscInt d = 0; d < bs; ++d) g[ci * bs + d] += v[ci * ld + d];
+  }
+}
+
 /* The entry (r, c) of local vertices r and c: counted (fill false) or filled into r's block row. */
 static inline void LocalPatternAdd(const PetscInt blk[], const PetscInt ghost[], PetscInt b0, BlockRows *own, BlockRows *ghosts, PetscBool fill,
                                    PetscInt r, PetscInt c)
@@ -234,16 +259,13 @@ static PetscErrorCode Exchange(MPI_Comm comm, MPI_Datatype type, const PetscMPII
 PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
                                       PetscBool *done)
 {
-  MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
-  PetscMPIInt        size, *icounts, *scounts, *ircounts, *irdispls, *srcounts, *srdispls;
-  PetscInt           dim, cStart, cEnd, vStart, vEnd, rstart, ng = 0, *blk, *ghost, *owner, *ibuf, *irecv, *at, total;
-  PetscScalar       *sbuf, *srecv, *gval;
-  PetscBool          applies;
-  SplitRows          s;
-  BlockRows          grows;
-  PetscSection       csection;
-  Vec                coords;
-  const PetscScalar *xa;
+  MPI_Comm     comm = PetscObjectComm((PetscObject)dm);
+  PetscMPIInt  size, *icounts, *scounts, *ircounts, *irdispls, *srcounts, *srdispls;
+  PetscInt     dim, cStart, cEnd, vStart, vEnd, rstart, ng = 0, *blk, *ghost, *owner, *ibuf, *irecv, *at, total;
+  PetscScalar *sbuf, *srecv, *gval;
+  PetscBool    applies;
+  SplitRows    s;
+  BlockRows    grows;
 
   PetscFunctionBeginUser;
   *done = PETSC_FALSE;
@@ -342,38 +364,11 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
 
   /* the cells' element matrices: owned rows in place, ghost rows into gval (block row by block row, as sent) */
   PetscCall(PetscCalloc1(bs * bs * grows.ptr[ng] + 1, &gval));
-  PetscCall(DMGetCoordinateSection(dm, &csection));
-  PetscCall(DMGetCoordinatesLocal(dm, &coords));
-  PetscCall(VecGetArrayRead(coords, &xa));
-  for (PetscInt c = cStart; c < cEnd; ++c) {
-    const PetscInt n = (dim + 1) * dim;
-    PetscInt       vl[4];
-    PetscReal      x[12];
-    PetscScalar    Ke[144];
+  {
+    MPIAdd add = {&s, &grows, blk, ghost, gval};
 
-    PetscCall(AssemblyP1CellCoordinates(csection, xa, dim, &cverts[(c - cStart) * (dim + 1)], x));
-    for (PetscInt a = 0; a <= dim; ++a) vl[a] = cverts[(c - cStart) * (dim + 1) + a] - vStart;
-    PetscCall(ElasticityP1ElementStiffness(dim, user->opt->material.lambda, user->opt->material.mu, x, Ke));
-    for (PetscInt a = 0; a <= dim; ++a) {
-      const PetscInt ra = vl[a];
-
-      if (blk[ra] < 0) continue;
-      for (PetscInt b = 0; b <= dim; ++b) {
-        const PetscScalar *v = &Ke[(a * dim) * n + b * dim];
-
-        if (blk[vl[b]] < 0) continue;
-        if (ghost[ra] < 0)
-          SplitRowsAdd(&s, blk[ra] - s.b0, blk[vl[b]], v, n);
-        else {
-          PetscScalar *g = &gval[bs * bs * (grows.ptr[ghost[ra]] + BlockRowsFind(&grows, ghost[ra], blk[vl[b]]))];
-
-          for (PetscInt ci = 0; ci < bs; ++ci)
-            for (PetscInt d = 0; d < bs; ++d) g[ci * bs + d] += v[ci * n + d];
-        }
-      }
-    }
+    PetscCall(AssemblyP1CellLoop(dm, &user->opt->material, cverts, MPIAddBlock, &add));
   }
-  PetscCall(VecRestoreArrayRead(coords, &xa));
 
   /* the ghost rows' values to their owners, in the order of their patterns */
   PetscCall(RankOffsets(size, scounts, at, &total));
