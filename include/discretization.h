@@ -1,6 +1,7 @@
 /* The discretization of the displacement beside PetscFE's (src/discretization/): the local and global sections of
    P1/Q1 displacements built as PETSc builds them, without its lookups per mesh point, and the assembly of the bulk
-   operator K and of r0 for P1 simplices in closed form, into K's own CSR arrays on one rank or many. */
+   operator K and of r0 for P1 simplices in closed form, into K's own CSR arrays on one rank or many; and the accurate
+   (composite) quadrature that the weak data of manufactured solutions and the error norms integrate with. */
 #pragma once
 #include "signorini.h"
 
@@ -30,3 +31,26 @@ PetscErrorCode AssemblyP1CSRCompose(Mat K, PetscInt *i, PetscInt *j, PetscScalar
 /* assembly_p1_mpiaij.c */
 PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
                                       PetscBool *done);
+
+/* cell_quadrature.c: basis functions at the points of an accurate rule, cell by cell or on faces */
+typedef struct {
+  PetscInt         dim, Nb, Nc; /* space dimension, basis functions, components */
+  PetscInt         Nq;          /* points of the current cell or face */
+  const PetscReal *x;           /* [Nq][dim] physical points */
+  const PetscReal *w;           /* [Nq] weights times the Jacobian determinant */
+  const PetscReal *B;           /* [Nq][Nb][Nc] basis values */
+  const PetscReal *D;           /* [Nq][Nb][Nc][dim] physical basis gradients (cells only) */
+  PetscInt         cell;        /* the cell whose basis is tabulated (the support cell of a face) */
+  /* private */
+  DM              dm;
+  PetscFE         fe;
+  const Scene    *scene;
+  PetscQuadrature cell_rule[2], face_rule[2]; /* plain and refined */
+  PetscTabulation cell_tab[2], face_tab;
+  PetscReal      *xbuf, *wbuf, *dbuf, *J, *invJ, *detJ, *refbuf;
+} CellQuadrature;
+PetscErrorCode CellQuadratureCreate(DM dm, const Scene *scene, const VerifyOptions *opts, CellQuadrature *cq);
+PetscErrorCode CellQuadratureSetCell(CellQuadrature *cq, PetscInt cell);
+PetscErrorCode CellQuadratureSetFace(CellQuadrature *cq, PetscInt face);
+PetscErrorCode CellQuadratureDestroy(CellQuadrature *cq);
+PetscErrorCode CellQuadratureInterpolate(const CellQuadrature *cq, const PetscScalar closure[], PetscInt q, PetscReal u[], PetscReal grad[]);

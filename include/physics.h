@@ -14,6 +14,10 @@ PetscErrorCode ElasticityP1CellVertices(MeshClosure *mc, PetscSection csec, Pets
                                         PetscInt off[], PetscInt *nv);
 PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Vec locU, Vec locF);
 
+/* weak_data.c: the load of a scene with an exact solution, L(v) = a(u_exact, v) - int_Gamma_C sigma_n(u_exact) v_n */
+PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0);
+PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal *sn);
+
 /* postprocess.c */
 PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u);
 PetscErrorCode PostprocessPenetration(AppCtx *user);

@@ -45,3 +45,47 @@ def test_the_check_finds_a_cycle():
              "src/b.c": "PetscErrorCode BetaRun(void)\n{\n  return AlphaRun();\n}\n"}
     _, calls = call_graph(texts)
     assert calls["src/a.c"] == {"src/b.c"} and calls["src/b.c"] == {"src/a.c"}
+
+
+OPTION_READ = re.compile(r"\bPetscOptions(?:Begin|Get[A-Za-z]*|HasName)\s*\(")
+FUNCTION = re.compile(r"^(?:static\s+)?(?:inline\s+)?(?:PetscErrorCode|void|PetscBool|PetscReal|PetscInt|int)\s+\**([A-Za-z_][A-Za-z0-9_]*)\s*\(", re.M)
+# The options phase (docs/design.md, "The steps of a run", step 2): each module's options block, the scenes' own
+# options (read when the scene is made, before any set-up), the mesh options (MeshCreate) and the checks of src/app/.
+OPTIONS_PHASE = re.compile(r"(GetOptions|SetFromOptions|ReadGiven|^SceneCreate_[A-Za-z]+|^MeshCreate|^OptionsCheck[A-Za-z]+|^AppErrorPushHandler|"
+                           r"^NameOptionsWithValue)$")
+
+
+def option_reads(texts):
+    """(file, function) of every read of the options database."""
+    found = []
+    for path, text in texts.items():
+        starts = [(m.start(), m.group(1)) for m in FUNCTION.finditer(text)]
+        for m in OPTION_READ.finditer(text):
+            inside = [name for pos, name in starts if pos < m.start()]
+            found.append((path, inside[-1] if inside else "(file scope)"))
+    return found
+
+
+def test_options_are_read_in_the_options_phase_only():
+    """No option is read during set-up or solve (issue 30): every PetscOptionsBegin/Get*/HasName of src/ is in a
+    function of the options phase."""
+    reads = option_reads(sources())
+    assert len(reads) > 20, reads  # the scan found them
+    outside = sorted({(p, f) for p, f in reads if not OPTIONS_PHASE.search(f)})
+    assert not outside, f"options read outside the options phase: {outside}"
+
+
+def test_the_options_check_finds_a_read_during_the_solve():
+    texts = {"src/solver/x.c": "PetscErrorCode SolverStep(SNES snes)\n{\n  PetscCall(PetscOptionsHasName(NULL, NULL, \"-a\", &set));\n}\n",
+             "src/solver/y.c": "PetscErrorCode SolverGetOptions(MPI_Comm comm)\n{\n  PetscOptionsBegin(comm, NULL, \"t\", \"\");\n}\n"}
+    assert option_reads(texts) == [("src/solver/x.c", "SolverStep"), ("src/solver/y.c", "SolverGetOptions")]
+
+
+def test_no_code_tests_the_contact_type_by_name():
+    """The contact treatment is an object with registered types (include/contact.h): what a type does is asked through
+    its operations and flags, never by comparing its name or a method flag outside src/contact/contact.c's registry."""
+    texts = sources()
+    flag = [p for p, t in texts.items() if re.search(r"method\s*(==|!=)\s*CONTACT_", t)]
+    by_name = [p for p, t in texts.items() if p != os.path.join("src", "contact", "contact.c")
+               and re.search(r"Str(n)?cmp\([^;]*(CONTACTPENALTY|CONTACTVI|CONTACTNONE|\"penalty\"|\"vi\"|\"none\")", t)]
+    assert not flag and not by_name, (flag, by_name)

@@ -4,7 +4,7 @@
      phi = A s_+^p (separation side), psi = -B (-s)_+^q (contact side),
      u_1 = -x_d phi'(x_1),  u_d = phi(x_1) + x_d psi(x_1),  the other components 0,
    so that on Gamma_C u_n = -phi <= 0, sigma_n = (lambda + 2 mu) psi <= 0, sigma_t = 0 and sigma_n u_n = 0,
-   and u is in H^{3/2 + nu - delta} for every delta > 0. The data enter through the weak form (weak_data.c). */
+   and u is in H^{3/2 + nu - delta} for every delta > 0. The data enter through the weak form (src/physics/weak_data.c). */
 #include "app.h"
 #include "scenes.h"
 

@@ -5,7 +5,6 @@
 #include "mesh.h"
 #include "physics.h"
 #include "solver_impl.h"
-#include "verify.h"
 
 PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
 {

@@ -1,9 +1,10 @@
-/* Error norms of the verification (verification.md section 1), integrated with the accurate rule of cell_quadrature.c:
+/* Error norms of the verification (verification.md section 1), integrated with the accurate rule of src/discretization/cell_quadrature.c:
    ||u - u_h|| in L2, H1 (semi and full) and energy; on Gamma_C the contact-pressure residual R = sigma_n(u) + p_h in L2,
    weighted by eps^1/2, and in the H^-1/2 dual norm; and the penetration [u_h,n - g]_+ in L2 and max.
    p_h is the penalty law (1/eps)[u_h,n - g]_+ for the penalty method and the nodal multiplier, interpolated, otherwise. */
 #include "mesh.h"
 #include "obstacle.h"
+#include "discretization.h"
 #include "physics.h"
 #include "verify.h"
 

@@ -1,10 +1,10 @@
 /* Data of a manufactured solution through the weak form (verification.md section 2): for v = 0 on Gamma_D,
      L(v) = int_Omega sigma(u_exact) : eps(v) dx - int_Gamma_C sigma_n(u_exact) v_n ds,
-   so no singular source term is ever evaluated pointwise. Integrated with the accurate rule of cell_quadrature.c. */
+   so no singular source term is ever evaluated pointwise. Integrated with the accurate rule of src/discretization/cell_quadrature.c. */
 #include "mesh.h"
 #include "obstacle.h"
 #include "physics.h"
-#include "verify.h"
+#include "discretization.h"
 
 /* sigma_n(u_exact) = (sigma n) . n at x, with n the obstacle normal at x */
 PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal *sn)

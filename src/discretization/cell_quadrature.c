@@ -3,8 +3,7 @@
    The cells and faces cut by a scene's kink get a composite rule: the same rule on every subcell of the reference
    cell refined -verify_quadrature_refine times, so the non-smooth exact solution does not spoil the integrals. */
 #include "mesh.h"
-#include "physics.h"
-#include "verify.h"
+#include "discretization.h"
 
 /* Gauss rule with npoints per direction (Stroud conical on simplices), repeated on the subcells of the reference cell refined `refine` times. */
 static PetscErrorCode RuleCreate(DMPolytopeType ct, PetscInt npoints, PetscInt refine, PetscQuadrature *q)
