@@ -56,8 +56,8 @@ PetscErrorCode ContactSetFromOptions(Contact ct)
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, NULL, "Contact on Gamma_C", "Signorini");
   PetscCall(PetscStrncpy(opts->method, CONTACTPENALTY, sizeof(opts->method)));
-  PetscCall(PetscOptionsFList("-contact_method", "Contact treatment: penalty, vi (SNESVI reference), none (no contact)", NULL, contact_list,
-                              opts->method, opts->method, sizeof(opts->method), NULL));
+  PetscCall(PetscOptionsFList("-contact_method", "Contact treatment: penalty, vi (SNESVI reference), none (no contact)", "ContactRegister",
+                              contact_list, opts->method, opts->method, sizeof(opts->method), NULL));
   opts->quadrature = PENALTY_QUADRATURE_GAUSS;
   PetscCall(PetscOptionsEnum("-penalty_quadrature", "Quadrature of the penalty term: gauss (L2 product) or nodal (lumped, vertex rule)", NULL,
                              PenaltyQuadratures, (PetscEnum)opts->quadrature, (PetscEnum *)&opts->quadrature, NULL));

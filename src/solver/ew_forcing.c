@@ -4,7 +4,7 @@
    (-snes_rtol times |F| at the start, or times the load for a warm start). Near the solution version 2's terms fall
    superlinearly, so the last linear solve can go orders of magnitude below what Newton needs. The guard only loosens a
    term, never beyond -snes_ksp_ew_rtolmax.
-   This pre-solve (part of SolverPreSolve() in solver.c) replaces PETSc's (KSPPreSolve_SNESEW(), installed with the
+   This pre-solve (part of SolverPreSolve() in newton.c) replaces PETSc's (KSPPreSolve_SNESEW(), installed with the
    SNES's KSP); without the guard its terms are PETSc's exactly. Other versions (-snes_ksp_ew_version) keep PETSc's. */
 #include "solver_impl.h"
 

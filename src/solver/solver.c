@@ -342,10 +342,10 @@ static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *
 /* Solves from a zero initial guess (or from u, start) and records the outcome; a failed solve is recorded, not raised.
    An eps below h/M is reached by continuation: the penalty problems for eps = h/M, h/M f, h/M f^2, ... are solved in turn,
    each from the solution of the previous one, so that Newton starts near the active set and the 1/eps scale of the
-   residual never meets a far-off initial guess (the direct solve at eps = 1e-12 h diverges on the square scene).
-   A warm start from the solution for a nearby eps (the sweep) needs no continuation; one from a coarser mesh's
-   (nested iteration) runs it from that guess: below h/100 its new contact nodes, between an active
-   and a free coarse one, start far off on the 1/eps scale, and Newton stalled (128 x 128, eps = 1e-6 h). */
+   residual never meets a far-off initial guess, where semismooth Newton's steps are driven by the penetration's 1/eps
+   multiple and may not converge. A warm start from the solution for a nearby eps (the sweep) needs no continuation;
+   one from a coarser mesh's (nested iteration) runs it from that guess: below h/100 its new contact nodes, between an
+   active and a free coarse one, start far off on the 1/eps scale. */
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
 {
   const PetscBool       warm = (PetscBool)(start != SOLVER_START_ZERO);
