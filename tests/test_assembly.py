@@ -103,6 +103,23 @@ def test_assembly_p1_honours_the_matrix_type(mat_type, scene, dim, np_):
     assert load(h5)[0]["converged"] == 1
 
 
+@pytest.mark.parametrize("scene,np_", (("square", 1), ("square", 2), ("mms", 1)), ids=("square", "square_np2", "mms"))
+def test_sbaij_with_the_default_solver_gives_the_aij_answer(scene, np_):
+    """-dm_mat_type sbaij with the default direct solver: MUMPS factors K's upper triangle by Cholesky (its LU refuses a
+    symmetric block matrix), in the solve and in the dual norm of the error norms; the answer is aij's to 1e-10."""
+    res = {}
+    for m in ("aij", "sbaij"):
+        _, h5 = run(["-options_file", f"options/{scene}.yaml", "-contact_monitor", 0, "-dm_plex_box_faces", "16,16", "-dm_mat_type", m],
+                    f"sbaij_default_{scene}_{np_}_{m}", np_=np_)
+        res[m] = load(h5)
+    (a, fa), (b, fb) = res["aij"], res["sbaij"]
+    assert a["converged"] == 1 and b["converged"] == 1
+    u, v = fa["displacement"], fb["displacement"]
+    assert np.abs(u - v).max() <= 1e-10 * np.abs(u).max(), np.abs(u - v).max()
+    for key in ("contact_force", "energy") + (("error_h1", "error_pressure_dual") if scene == "mms" else ()):
+        assert abs(a[key] - b[key]) <= 1e-10 * abs(a[key]), (key, a[key], b[key])
+
+
 @pytest.mark.parametrize("name,args,np_", (("square_2d", ["-options_file", "options/square.yaml", "-dm_plex_box_faces", "32,32"], 1),
                                           ("mms_3d", ["-options_file", "options/mms.yaml"] + MESH[3], 2),
                                           ("square_3d_body_force", ["-options_file", "options/square.yaml", "-body_force", "0.1,0.2,-0.3"] + MESH[3], 2)),

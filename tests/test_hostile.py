@@ -148,6 +148,8 @@ OPTION_CASES = [
     ("typo_cycle_damping", ["-penalty_eps0", 1, "-contact_cycle_dampng", 0],
      "never used (misspelled? see -help): -contact_cycle_dampng (did you mean -contact_cycle_damping?)"),
     ("vi_with_newtonls", ["-contact_method", "vi", "-snes_type", "newtonls"], "-snes_type newtonls does not fit -contact_method vi"),
+    ("vi_with_sbaij", ["-contact_method", "vi", "-dm_mat_type", "sbaij"], "-contact_method vi cannot use the block matrix seqsbaij (-dm_mat_type)"),
+    ("vi_with_baij", ["-contact_method", "vi", "-dm_mat_type", "baij"], "-contact_method vi cannot use the block matrix seqbaij (-dm_mat_type)"),
     ("vi_with_gamg", ["-contact_method", "vi", "-pc_type", "gamg"], "-pc_type gamg cannot follow the reduced system"),
     ("vi_with_mg", ["-contact_method", "vi", "-pc_type", "mg"], "-pc_type mg cannot follow the reduced system"),
     ("p1_assembly_on_p2", ["-displacement_petscspace_degree", 2, "-assembly", "p1"], "-assembly p1 needs P1 displacements"),

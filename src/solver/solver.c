@@ -84,13 +84,17 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
    The Newton steps are as accurate as with a fresh factorization, also when it is reused. */
 static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
 {
-  PC pc;
+  PC        pc;
+  PetscBool sbaij;
 
   PetscFunctionBeginUser;
   PetscCall(KSPSetType(ksp, ContactHasPenalty(user->contact) && user->opt->solver.pc_reuse ? KSPCG : KSPPREONLY));
   PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
   PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, PCLU));
+  /* K is symmetric positive definite: a symmetric block matrix (-dm_mat_type sbaij) holds its upper triangle only,
+     which MUMPS factors by Cholesky and not by LU */
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)user->prob.K, &sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
+  PetscCall(PCSetType(pc, sbaij ? PCCHOLESKY : PCLU));
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -234,6 +238,17 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscCall(ContactGetType(user->contact, &ctype));
     PetscCheck(is_vi == ContactHasBounds(user->contact), comm, PETSC_ERR_USER_INPUT,
                "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type, ctype);
+  }
+  { /* SNESVI takes the rows and columns of single components out of the Jacobian, which a block matrix refuses */
+    PetscBool block;
+    MatType   mtype;
+
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)user->prob.K, &block, MATSEQBAIJ, MATMPIBAIJ, MATSEQSBAIJ, MATMPISBAIJ, ""));
+    PetscCall(MatGetType(user->prob.K, &mtype));
+    PetscCheck(!(block && ContactHasBounds(user->contact)), comm, PETSC_ERR_USER_INPUT,
+               "-contact_method vi cannot use the block matrix %s (-dm_mat_type): SNESVI's reduced system takes single components out of "
+               "it; use aij",
+               mtype);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -172,7 +172,12 @@ static PetscErrorCode DualNorm(DM dm, Mat K, Vec loc_b, PetscReal *norm)
   PetscCall(KSPSetOperators(ksp, K, K));
   PetscCall(KSPSetType(ksp, KSPPREONLY));
   PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(PCSetType(pc, PCLU));
+  {
+    PetscBool sbaij; /* K's upper triangle only: MUMPS factors it by Cholesky */
+
+    PetscCall(PetscObjectTypeCompareAny((PetscObject)K, &sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
+    PetscCall(PCSetType(pc, sbaij ? PCCHOLESKY : PCLU));
+  }
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   PetscCall(KSPSetFromOptions(ksp));
   PetscCall(KSPSolve(ksp, b, w));
