@@ -240,6 +240,7 @@ typedef struct {
   PetscInt            active_set_cycles;   /* active-set cycles detected (and damped) in the Newton iterations */
   PetscInt            pc_builds;           /* preconditioner (factorization) builds of the Newton steps */
   PetscInt            pc_updates;          /* updates of a GAMG hierarchy's coarse operators instead of builds (-contact_pc_update) */
+  PetscBool           coarse_mg;           /* the coarser boxes solved with the geometric multigrid of the boxes below, if any */
   PetscInt            pc_breakdowns;       /* preconditioner breakdowns recovered from (pc_recovery.c), */
   char                pc_recovery[512];    /*   and what was done, "; "-separated */
   PetscBool           ksp_ew;              /* Eisenstat-Walker linear tolerances (-snes_ksp_ew) */
@@ -308,23 +309,16 @@ typedef struct {
   char         diagnostics_failed[1024]; /* the diagnostics that failed after the solve, with their messages ("" if none) */
 } RunRecord;
 
-/* The interpolations between the nested meshes solved so far (src/solver/multigrid.c): the levels of a geometric
-   multigrid (-pc_type mg) on the mesh of the current problem, which has n + 1 of them. */
-typedef struct {
-  PetscInt  n;
-  Mat       interp[MULTIGRID_MAX_LEVELS]; /* [l]: from the global vector of mesh l to that of mesh l + 1 */
-  PetscBool coarse_mg; /* the coarser boxes are solved with the geometric multigrid of the boxes below (GridSequenceCoarseRequest()) */
-} Multigrid;
-
 /* The state of a run, by concern: its options, its scene, the problem on the current mesh, the hierarchy of the meshes
    solved before it, and its record. */
-typedef struct _p_Contact *Contact; /* include/contact.h */
+typedef struct _p_Contact   *Contact;   /* include/contact.h */
+typedef struct _n_Multigrid *Multigrid; /* the nested meshes' interpolations, private to src/solver/ (solver_impl.h) */
 typedef struct {
   const RunOptions *opt;     /* read once before any set-up, then read only */
   Contact           contact; /* created and read from the options once, set up on the mesh of each problem */
   MeshBox           box;     /* the simplex box of the mesh options, if the mesh is one (MeshCreate()) */
   Scene             scene;
   Problem           prob;
-  Multigrid         mg;
+  Multigrid         mg; /* the interpolations between the nested meshes solved so far */
   RunRecord         rec;
 } AppCtx;

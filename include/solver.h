@@ -39,6 +39,7 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt vertex_source[], AppCtx *user);
 PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user);
 PetscErrorCode MultigridSetCoarseBoxSolver(KSP ksp, const AppCtx *user);
+PetscErrorCode MultigridCreate(PetscBool coarse_mg, Multigrid *mg);
 PetscErrorCode MultigridDestroy(Multigrid *mg);
 
 /* fine_smoother.c: -mg_fine_ksp_*, -mg_fine_pc_* */

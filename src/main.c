@@ -126,7 +126,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   {
     PetscInt coarse_request, coarse_min_faces;
 
-    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, &coarse_request, &coarse_min_faces, &user.mg.coarse_mg));
+    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, &coarse_request, &coarse_min_faces, &user.rec.stats.coarse_mg));
+    PetscCall(MultigridCreate(user.rec.stats.coarse_mg, &user.mg));
     PetscCall(MeshCreate(comm, opt.solver.grid_sequence, coarse_request, coarse_min_faces, &user.box, &dm));
   }
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));        /* the partitioner; the final mesh's cut is taken after the solve */

@@ -7,12 +7,39 @@
    -contact_coarse_mg: with another iterative preconditioner, the coarser boxes of nested iteration are solved by this
    geometric multigrid under the options prefix contact_coarse_, and the final mesh by the options' preconditioner. */
 #include "mesh.h"
-#include "solver.h"
+#include "solver_impl.h"
+
+/* coarse_mg: GridSequenceCoarseRequest()'s answer, whether the coarser boxes are solved by their geometric multigrid. */
+PetscErrorCode MultigridCreate(PetscBool coarse_mg, Multigrid *mg)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(mg));
+  (*mg)->coarse_mg = coarse_mg;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Forgets the levels (the meshes no longer nest with the current one). */
+static PetscErrorCode MultigridClear(Multigrid mg)
+{
+  PetscFunctionBeginUser;
+  for (PetscInt l = 0; l < mg->n; ++l) PetscCall(MatDestroy(&mg->interp[l]));
+  mg->n = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode MultigridDestroy(Multigrid *mg)
+{
+  PetscFunctionBeginUser;
+  if (!*mg) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(MultigridClear(*mg));
+  PetscCall(PetscFree(*mg));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
 /* Whether the problem's mesh is a coarser box of nested iteration solved under -contact_coarse_mg. */
 static inline PetscBool MultigridOnCoarseBox(const AppCtx *user)
 {
-  return (PetscBool)(user->mg.coarse_mg && user->prob.level < user->box.coarse_levels);
+  return (PetscBool)(user->mg->coarse_mg && user->prob.level < user->box.coarse_levels);
 }
 
 /* With -pc_type mg (the PC of snes, the fine mesh's problem) and P1/Q1, adds the interpolation from coarse to fine,
@@ -22,7 +49,7 @@ static inline PetscBool MultigridOnCoarseBox(const AppCtx *user)
 PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt vertex_source[], AppCtx *user)
 {
   MPI_Comm     comm = PetscObjectComm((PetscObject)fine);
-  Multigrid   *mg   = &user->mg;
+  Multigrid    mg   = user->mg;
   PetscSection cl, cg, fl, fg;
   PetscInt     dim, vStart, vEnd, cvb[2], ceb[2], m, n, rstart, cstart, cend, *dnz, *onz;
   Mat          P;
@@ -35,7 +62,7 @@ PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt v
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
   if (!is_mg || user->opt->degree != 1) { /* the coarser meshes' interpolations, if any (-contact_coarse_mg), serve no longer */
-    PetscCall(MultigridDestroy(mg));
+    PetscCall(MultigridClear(mg));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCheck(mg->n < MULTIGRID_MAX_LEVELS, comm, PETSC_ERR_USER_INPUT, "-pc_type mg: at most %d nested meshes", MULTIGRID_MAX_LEVELS + 1);
@@ -96,12 +123,12 @@ PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt v
    options must have coarser meshes: a PCMG of one level would be its coarse solver alone. */
 PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
 {
-  const Multigrid *mg = &user->mg;
-  KSP              ksp;
-  PC               pc;
-  PetscBool        is_mg;
-  PetscInt         nlevels, k;
-  const char      *prefix;
+  const Multigrid mg = user->mg;
+  KSP             ksp;
+  PC              pc;
+  PetscBool       is_mg;
+  PetscInt        nlevels, k;
+  const char     *prefix;
 
   PetscFunctionBeginUser;
   PetscCall(SNESGetKSP(snes, &ksp));
@@ -176,13 +203,5 @@ PetscErrorCode MultigridSetCoarseBoxSolver(KSP ksp, const AppCtx *user)
   PetscCall(KSPSetType(ksp, KSPCG));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PCSetType(pc, PCMG));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-PetscErrorCode MultigridDestroy(Multigrid *mg)
-{
-  PetscFunctionBeginUser;
-  for (PetscInt l = 0; l < mg->n; ++l) PetscCall(MatDestroy(&mg->interp[l]));
-  mg->n = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -72,6 +72,14 @@ typedef struct {
   PetscBool user_rnorm0; /* -ksp_converged_use_initial_residual_norm given: the options' test stays */
 } SolverStepGuess;
 
+/* The interpolations between the nested meshes solved so far (multigrid.c): the levels of a geometric multigrid
+   (-pc_type mg) on the mesh of the current problem, which has n + 1 of them. */
+struct _n_Multigrid {
+  PetscInt  n;
+  Mat       interp[MULTIGRID_MAX_LEVELS]; /* [l]: from the global vector of mesh l to that of mesh l + 1 */
+  PetscBool coarse_mg;                    /* the coarser boxes are solved with the geometric multigrid of the boxes below */
+};
+
 struct _n_SolverCtx {
   /* the problem the callbacks solve: F(u) = K u + r0 + (contact term) */
   Mat                  K;       /* the bulk operator (the Jacobian is made in it: ContactComputeJacobian()) */
