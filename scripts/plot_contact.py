@@ -11,8 +11,12 @@ are scattered and the mean per distinct abscissa is overlaid as a line.
 contact curve from its lowest vertex; r: the distance from the lowest vertex in
 the coordinates other than the last (a body touching a plane x_d = const).
 
+--zoom auto|on|off: the abscissa range shown. auto (the default) zooms on the contact zone (the vertices with a
+positive pressure, and the free vertices next to them) when it spans less than a third of Gamma_C: a Hertz contact
+of width 0.03 on a unit arc is then the whole plot, not its first 4%; the title says so. off shows Gamma_C whole.
+
 Usage:
-    plot_contact.py FILE.h5 [-o OUT.png] [--along x|y|z|arc|r]
+    plot_contact.py FILE.h5 [-o OUT.png] [--along x|y|z|arc|r] [--zoom auto|on|off]
 
 The default output is FILE with .h5 replaced by _contact.png. Exit code 2 if
 the file cannot be read or has no contact-boundary vertices.
@@ -51,12 +55,31 @@ def make_title(run):
             f" | eps={fmt('eps')} | converged={fmt('converged')}")
 
 
+def contact_window(t, p, neighbours=2, fraction=1.0 / 3.0):
+    """The abscissa window (lo, hi) of the contact zone: the vertices with p > 0 and, on each side, the next
+    `neighbours` distinct abscissae (the zone's edge and the gap opening beyond it). None when nothing is in contact, or
+    when the zone spans more than `fraction` of the whole range (zooming would hide little)."""
+    keys = np.unique(np.round(t, 12))
+    if not (p > 0.0).any() or len(keys) < 2:
+        return None
+    lo, hi = t[p > 0.0].min(), t[p > 0.0].max()
+    i, j = np.searchsorted(keys, np.round(lo, 12)), np.searchsorted(keys, np.round(hi, 12))
+    lo, hi = keys[max(i - neighbours, 0)], keys[min(j + neighbours, len(keys) - 1)]
+    if hi - lo > fraction * (keys[-1] - keys[0]):
+        return None
+    return lo, hi
+
+
 XLABELS = {"x": "$x_1$", "y": "$x_2$", "z": "$x_3$", "arc": "arc length from the lowest contact vertex", "r": "distance from the lowest contact vertex"}
 
 
-def plot_contact(h5path, pngpath, along="x"):
+def plot_contact(h5path, pngpath, along="x", zoom="auto"):
     """Plot pressure and gap along Gamma_C of `h5path` into `pngpath`; return it."""
     x1, p, g, run = read_contact(h5path, along)
+    window = contact_window(x1, p, fraction=1.0 if zoom == "on" else 1.0 / 3.0) if zoom != "off" else None
+    if window:  # the values inside the window only, so that the axes fit them
+        inside = (x1 >= window[0]) & (x1 <= window[1])
+        x1, p, g = x1[inside], p[inside], g[inside]
     keys = np.unique(np.round(x1, 10))
     many = len(keys) < len(x1)  # several vertices per x_1 (3D faces)
     fig, (ax_p, ax_g) = plt.subplots(2, 1, sharex=True, figsize=(8, 6.5))
@@ -73,7 +96,10 @@ def plot_contact(h5path, pngpath, along="x"):
         ax.grid(True, alpha=0.3)
     ax_g.axhline(0.0, color="gray", lw=1, ls="--")
     ax_g.set_xlabel(XLABELS[along])
-    fig.suptitle(make_title(run), fontsize=10)
+    title = make_title(run)
+    if window:
+        title += f"\nzoomed on the contact zone: {window[0]:.4g} to {window[1]:.4g} (--zoom off: the whole of Gamma_C)"
+    fig.suptitle(title, fontsize=10)
     save_png(fig, pngpath, 120)
     return pngpath
 
@@ -85,10 +111,12 @@ def main(argv=None):
     ap.add_argument("-o", "--output", metavar="OUT.png", default=None,
                     help="output PNG (default: FILE_contact.png)")
     ap.add_argument("--along", choices=ABSCISSAE, default="x", help="abscissa: a coordinate, the arc length (2D) or r (default x)")
+    ap.add_argument("--zoom", choices=("auto", "on", "off"), default="auto",
+                    help="auto: the contact zone when it spans less than a third of Gamma_C (default); on: always; off: never")
     args = ap.parse_args(argv)
     out = args.output or default_output(args.h5file)
     try:
-        plot_contact(args.h5file, out, args.along)
+        plot_contact(args.h5file, out, args.along, args.zoom)
     except ValueError as exc:
         print(f"plot_contact.py: error: {exc}", file=sys.stderr)
         return 2

@@ -111,3 +111,28 @@ def test_obstacle_facing_away_and_deep_overlap_are_warned():
     out, h5 = run(["-dm_plex_box_faces", "16,16"], "warn_none")
     a, _ = load(h5)
     assert a["warnings"] == 0 and "WARNING" not in out and a["obstacle_away_fraction"] == 0.0
+
+
+def test_plot_zooms_on_a_narrow_contact_zone(outdir):
+    """scripts/plot_contact.py zooms on the contact zone when it spans less than a third of Gamma_C (issue 31's plots):
+    the window holds every vertex with a positive pressure and the free vertices next to it, and no zoom is made where
+    nothing or everything is in contact."""
+    import subprocess
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    from plot_contact import contact_window
+    from signorini.runs import read_contact
+    _, h5 = run(CYL + ["-dm_plex_box_faces", "64,64"], "outputs_zoom")
+    t, p, _, _ = read_contact(h5, "x")
+    window = contact_window(t, p)
+    assert window is not None
+    lo, hi = window
+    assert lo <= t[p > 0].min() and t[p > 0].max() <= hi and hi - lo <= (t.max() - t.min()) / 3, (window, t[p > 0].min(), t[p > 0].max())
+    inside = (t >= lo) & (t <= hi)
+    assert (p[inside] == 0).sum() >= 2 and inside.sum() < len(t) / 2, (inside.sum(), len(t))  # the gap opening on each side
+    assert contact_window(t, np.zeros_like(p)) is None and contact_window(t, np.ones_like(p)) is None
+    for zoom in ("auto", "off"):
+        png = os.path.join(outdir, f"zoom_{zoom}.png")
+        q = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "plot_contact.py"), h5, "-o", png, "--zoom", zoom], cwd=ROOT,
+                           stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        assert q.returncode == 0 and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n", q.stdout
