@@ -133,7 +133,10 @@ PetscErrorCode ContactDestroy(Contact *ct)
   PetscFunctionBeginUser;
   if (!*ct) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactReset(*ct));
-  if ((*ct)->ops.destroy) PetscCall((*(*ct)->ops.destroy)(*ct));
+  if ((*ct)->ops.destroy)
+    PetscCall((*(*ct)->ops.destroy)(*ct));
+  else
+    PetscCall(PetscFree((*ct)->data)); /* data with nothing to free inside */
   PetscCall(PetscFree((*ct)->opt.eps0_sweep));
   PetscCall(PetscFree(*ct));
   PetscFunctionReturn(PETSC_SUCCESS);

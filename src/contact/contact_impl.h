@@ -7,7 +7,7 @@
 typedef struct {
   PetscErrorCode (*setup)(Contact, DM);                                 /* after the contact set is built: the type's own state */
   PetscErrorCode (*reset)(Contact);                                     /* frees the state of the mesh */
-  PetscErrorCode (*destroy)(Contact);                                   /* frees data */
+  PetscErrorCode (*destroy)(Contact);                                   /* frees data (NULL: PetscFree(data)) */
   PetscErrorCode (*residual)(Contact, DM, Vec u, Vec F);                /* F += the contact term at u (NULL: none) */
   PetscErrorCode (*jacobian)(Contact, DM, Vec u, Mat K, Mat P);         /* P = K + the contact Jacobian at u (NULL: P = K) */
   PetscErrorCode (*prepare_operator)(Contact, DM, Mat K);               /* once K is assembled, before the first Jacobian */

@@ -121,13 +121,6 @@ static PetscErrorCode ContactReset_Penalty(Contact ct)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode ContactDestroy_Penalty(Contact ct)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscFree(ct->data));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* The Gauss rule's term (locF) or energy (this rank's part): by PETSc (use_fe) or in closed form. */
 static PetscErrorCode GaussTermLocal(Contact ct, DM dm, PetscBool use_fe, Vec X, Vec locF, PetscReal *energy)
 {
@@ -497,7 +490,6 @@ PetscErrorCode ContactCreate_Penalty(Contact ct)
   ct->has_penalty          = PETSC_TRUE;
   ct->ops.setup            = ContactSetUp_Penalty;
   ct->ops.reset            = ContactReset_Penalty;
-  ct->ops.destroy          = ContactDestroy_Penalty;
   ct->ops.residual         = ContactResidual_Penalty;
   ct->ops.jacobian         = ContactJacobian_Penalty;
   ct->ops.prepare_operator = ContactPrepareOperator_Penalty;

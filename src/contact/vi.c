@@ -92,13 +92,6 @@ static PetscErrorCode ContactReset_VI(Contact ct)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode ContactDestroy_VI(Contact ct)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscFree(ct->data));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* SNESVI's reduced-space method with the bounds; the options may choose vinewtonssls instead. */
 static PetscErrorCode ContactSetUpSNES_VI(Contact ct, DM dm, SNES snes)
 {
@@ -131,7 +124,6 @@ PetscErrorCode ContactCreate_VI(Contact ct)
   ct->has_bounds       = PETSC_TRUE;
   ct->ops.setup        = ContactSetUp_VI;
   ct->ops.reset        = ContactReset_VI;
-  ct->ops.destroy      = ContactDestroy_VI;
   ct->ops.setup_snes   = ContactSetUpSNES_VI;
   ct->ops.scale_bounds = ContactScaleBounds_VI;
   PetscFunctionReturn(PETSC_SUCCESS);
