@@ -114,7 +114,7 @@ static PetscErrorCode MeshCheckDuplicateCells(DM dm, const char filename[])
     PetscCall(DMPlexRestoreTransitiveClosure(dm, c, PETSC_TRUE, &npoints, &points));
     PetscCall(PetscSortInt(k->n, k->v));
   }
-  qsort(keys, (size_t)(cEnd - cStart), sizeof(CellKey), CompareCellKeys);
+  if (cEnd > cStart) qsort(keys, (size_t)(cEnd - cStart), sizeof(CellKey), CompareCellKeys); /* a rank without cells has no array */
   for (PetscInt i = 1; i < cEnd - cStart; ++i)
     if (!CompareCellKeys(&keys[i - 1], &keys[i])) {
       if (!ndup) {
