@@ -65,6 +65,7 @@ PetscErrorCode ContactEpsFromFactor(Contact ct, PetscReal eps0, PetscReal *eps);
 PetscErrorCode ContactSetEps(Contact ct, DM dm, PetscReal eps);
 PetscErrorCode ContactGetEps(Contact ct, PetscReal *eps);
 PetscErrorCode ContactGetEpsRange(Contact ct, PetscReal *eps_min, PetscReal *eps_max, PetscBool *local);
+PetscErrorCode ContactFaceEps(Contact ct, PetscReal cell_diameter, PetscReal *eps);
 PetscErrorCode ContactGetPenaltyScale(Contact ct, PetscReal *eps_start);
 PetscErrorCode ContactGetSet(Contact ct, const ContactSet **cs);
 

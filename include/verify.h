@@ -12,7 +12,8 @@ typedef struct {
 } ErrorTarget;
 PetscErrorCode ErrorNormsReset(ErrorNorms *e);
 PetscErrorCode ErrorNormsPressureVector(DM dm, AppCtx *user, Vec loc_p);
-PetscErrorCode ErrorNormsEvaluate(DM dm, AppCtx *user, Mat K, Vec loc_uh, Vec loc_ph, const ErrorTarget *target, ErrorNorms *e);
+PetscErrorCode ErrorNormsEvaluate(DM dm, const PetscReal run_cell_h[], AppCtx *user, Mat K, Vec loc_uh, Vec loc_ph, const ErrorTarget *target,
+                                  ErrorNorms *e);
 PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u);
 PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u);
 PetscErrorCode ReferenceCheckFile(DM dm, const AppCtx *user);

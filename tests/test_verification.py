@@ -235,3 +235,47 @@ def test_study_eps_refinement_is_monotone_until_the_floor():
     discretization floor, and the distance to the SNESVI solution falls like eps (rate >= 0.9)."""
     out = run_study("quick_epsrefine2d")
     assert out.count("PASS") == 3, out
+
+
+def write_graded_unit_square(path):
+    """The unit square with Gmsh's face sets 1 (y = 0), 2 (x = 1), 3 (y = 1), 4 (x = 0), as the built-in box numbers
+    them, and cells of size 0.015 + 0.1 y: finer toward Gamma_C, so that eps is local."""
+    import gmsh
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.model.add("graded_square")
+    p = [gmsh.model.geo.addPoint(x, y, 0) for x, y in ((0, 0), (1, 0), (1, 1), (0, 1))]
+    lines = [gmsh.model.geo.addLine(p[i], p[(i + 1) % 4]) for i in range(4)]
+    surface = gmsh.model.geo.addPlaneSurface([gmsh.model.geo.addCurveLoop(lines)])
+    gmsh.model.geo.synchronize()
+    for tag, line in zip((1, 2, 3, 4), lines):
+        gmsh.model.addPhysicalGroup(1, [line], tag)
+    gmsh.model.addPhysicalGroup(2, [surface], 10)
+    field = gmsh.model.mesh.field.add("MathEval")
+    gmsh.model.mesh.field.setString(field, "F", "0.015 + 0.1*y")
+    gmsh.model.mesh.field.setAsBackgroundMesh(field)
+    gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+    gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+    gmsh.model.mesh.generate(2)
+    gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+    gmsh.write(path)
+    gmsh.finalize()
+
+
+def test_penalty_pressure_error_takes_the_local_eps(outdir):
+    """The error norms evaluate the penalty's pressure by its law, p = [u_n - g]_+ / eps, with the eps of each contact
+    face, as the solve does: on a mesh graded toward Gamma_C the local eps (0.015 to 0.020, against 0.128 for the largest
+    cell) gives smaller errors than one eps for the whole mesh, the pressure's too. The law with the largest cell's eps
+    reported a pressure error 31 times too large (1.19e-1 against 3.79e-3) and 5 times that of the uniform eps."""
+    mesh = os.path.join(outdir, "graded_square.msh")
+    write_graded_unit_square(mesh)
+    res = {}
+    for local in (1, 0):
+        _, h5 = run(["-options_file", "options/mms.yaml", "-dm_plex_filename", mesh, "-penalty_eps_local", local], f"local_eps_norms_{local}")
+        res[local] = load(h5)[0]
+    loc, uni = res[1], res[0]
+    assert loc["converged"] == 1 and uni["converged"] == 1
+    assert loc["eps_max"] < 0.25 * loc["eps"], (loc["eps_max"], loc["eps"])  # eps is local: the contact cells are small
+    for key in ("error_h1", "error_pressure_l2", "error_pressure_dual"):
+        assert loc[key] < uni[key], (key, loc[key], uni[key])
+    assert loc["error_pressure_l2"] < 0.5 * uni["error_pressure_l2"], (loc["error_pressure_l2"], uni["error_pressure_l2"])

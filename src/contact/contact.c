@@ -235,6 +235,15 @@ PetscErrorCode ContactGetEpsRange(Contact ct, PetscReal *eps_min, PetscReal *eps
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* eps of the Gauss rule at a contact face whose cell has the given diameter: the run's eps, scaled to the cell where eps
+   is local (a graded mesh); the penalty law there is p = [u_n - g]_+ / eps. */
+PetscErrorCode ContactFaceEps(Contact ct, PetscReal cell_diameter, PetscReal *eps)
+{
+  PetscFunctionBeginUser;
+  *eps = ct->eps_local ? ct->eps * ContactEpsFactor(ct, cell_diameter) : ct->eps;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode ContactGetSet(Contact ct, const ContactSet **cs)
 {
   PetscFunctionBeginUser;

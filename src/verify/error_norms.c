@@ -87,16 +87,17 @@ static PetscErrorCode IntegrateBulk(DM dm, AppCtx *user, CellQuadrature *cq, Vec
 
 /* Integrals over Gamma_C: R^2 and [d]_+^2, the max of [d]_+, and the load b_i = int R phi_i . n of the dual problem.
    Without a target (t == NULL) only the penetration is integrated. */
-static PetscErrorCode IntegrateContact(DM dm, AppCtx *user, CellQuadrature *cq, Vec loc_uh, Vec loc_ph, const ErrorTarget *t, Vec loc_b,
-                                       PetscReal sums[2], PetscReal *dmax)
+static PetscErrorCode IntegrateContact(DM dm, const PetscReal run_cell_h[], AppCtx *user, CellQuadrature *cq, Vec loc_uh, Vec loc_ph,
+                                       const ErrorTarget *t, Vec loc_b, PetscReal sums[2], PetscReal *dmax)
 {
   const PetscInt dim = cq->dim;
   PetscInt      *faces, nf;
   PetscScalar   *elem;
-  PetscReal      eps; /* of the run, for the penalty law p = [u_n - g]_+ / eps */
+  PetscReal      eps = 0.0; /* of the face, for the penalty law p = [u_n - g]_+ / eps */
+  PetscInt       cStart;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetEps(user->contact, &eps));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, NULL));
   PetscCall(PetscMalloc1(PetscMax(cq->Nb, 1), &elem));
   for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
     PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces)); /* of this mesh, maybe a refinement of the run's */
@@ -104,6 +105,15 @@ static PetscErrorCode IntegrateContact(DM dm, AppCtx *user, CellQuadrature *cq, 
       PetscScalar *uh = NULL, *ph = NULL, *pr = NULL;
 
       PetscCall(CellQuadratureSetFace(cq, faces[i]));
+      if (!loc_ph && t) { /* the penalty's eps at this face: that of the run's cell holding it (local eps on a graded mesh) */
+        PetscReal diam;
+
+        if (run_cell_h)
+          diam = run_cell_h[cq->cell - cStart];
+        else
+          PetscCall(MeshCellDiameter(dm, cq->cell, &diam));
+        PetscCall(ContactFaceEps(user->contact, diam, &eps));
+      }
       PetscCall(DMPlexVecGetClosure(dm, NULL, loc_uh, cq->cell, NULL, &uh));
       if (loc_ph) PetscCall(DMPlexVecGetClosure(dm, NULL, loc_ph, cq->cell, NULL, &ph));
       if (t && !t->scene) PetscCall(DMPlexVecGetClosure(dm, NULL, t->loc_pressure, cq->cell, NULL, &pr));
@@ -197,8 +207,11 @@ static PetscErrorCode DualNorm(DM dm, Mat K, Vec loc_b, PetscReal *norm)
 }
 
 /* All norms of u_h (loc_uh, with its pressure loc_ph or the penalty law if NULL) against the target, on the mesh of dm;
-   K is the elastic operator of dm for the dual norm. Without a target (NULL) only the penetration norms. */
-PetscErrorCode ErrorNormsEvaluate(DM dm, AppCtx *user, Mat K, Vec loc_uh, Vec loc_ph, const ErrorTarget *target, ErrorNorms *e)
+   K is the elastic operator of dm for the dual norm. Without a target (NULL) only the penetration norms. run_cell_h:
+   for each cell of dm, the diameter of the run's cell that holds it, whose local eps the penalty law takes (NULL: dm
+   is the run's mesh). */
+PetscErrorCode ErrorNormsEvaluate(DM dm, const PetscReal run_cell_h[], AppCtx *user, Mat K, Vec loc_uh, Vec loc_ph, const ErrorTarget *target,
+                                  ErrorNorms *e)
 {
   MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
   CellQuadrature cq;
@@ -213,7 +226,7 @@ PetscErrorCode ErrorNormsEvaluate(DM dm, AppCtx *user, Mat K, Vec loc_uh, Vec lo
     PetscCall(VecZeroEntries(loc_b));
     PetscCall(IntegrateBulk(dm, user, &cq, loc_uh, target, bulk));
   }
-  PetscCall(IntegrateContact(dm, user, &cq, loc_uh, loc_ph, target, loc_b, contact, &dmax));
+  PetscCall(IntegrateContact(dm, run_cell_h, user, &cq, loc_uh, loc_ph, target, loc_b, contact, &dmax));
   PetscCall(CellQuadratureDestroy(&cq));
   PetscCall(MPIU_Allreduce(bulk, gbulk, 3, MPIU_REAL, MPIU_SUM, comm));
   PetscCall(MPIU_Allreduce(contact, gcontact, 2, MPIU_REAL, MPIU_SUM, comm));
@@ -257,10 +270,10 @@ PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
     Mat K;
 
     PetscCall(ContactBulkOperator(user->contact, user->prob.K, &K)); /* K, or a copy without the penalty Jacobian: K is read only */
-    PetscCall(ErrorNormsEvaluate(dm, user, K, loc_uh, loc_ph, &exact, &user->rec.errors));
+    PetscCall(ErrorNormsEvaluate(dm, NULL, user, K, loc_uh, loc_ph, &exact, &user->rec.errors));
     PetscCall(MatDestroy(&K));
   } else
-    PetscCall(ErrorNormsEvaluate(dm, user, NULL, loc_uh, loc_ph, NULL, &user->rec.errors));
+    PetscCall(ErrorNormsEvaluate(dm, NULL, user, NULL, loc_uh, loc_ph, NULL, &user->rec.errors));
   if (loc_ph) PetscCall(DMRestoreLocalVector(dm, &loc_ph));
   PetscCall(DMRestoreLocalVector(dm, &loc_uh));
   PetscFunctionReturn(PETSC_SUCCESS);

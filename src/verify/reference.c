@@ -350,14 +350,17 @@ static PetscErrorCode ReferenceDestroy(Reference *ref)
 
 /* Refines dm `levels` times (regular refinement) into fine, with the run's discretization and boundary conditions, and
    interpolates the local vectors loc[] (boundary values included) to fine_loc[]. */
-static PetscErrorCode RefineAndInterpolate(DM dm, PetscInt levels, PetscInt nvec, Vec loc[], DM *fine, Vec fine_loc[])
+static PetscErrorCode RefineAndInterpolate(DM dm, PetscInt levels, PetscInt nvec, Vec loc[], DM *fine, Vec fine_loc[], PetscReal **run_cell_h)
 {
-  PetscInt *parent;
+  PetscInt *parent, cStart, cEnd;
 
   PetscFunctionBeginUser;
   PetscCall(MeshRefineRegular(dm, levels, fine, &parent, NULL));
   PetscCall(DMCopyDisc(dm, *fine)); /* the run's field, weak form and boundary conditions */
   PetscCall(MeshInterpolateFromParents(dm, *fine, parent, nvec, loc, fine_loc));
+  PetscCall(DMPlexGetHeightStratum(*fine, 0, &cStart, &cEnd));
+  PetscCall(PetscMalloc1(cEnd - cStart + 1, run_cell_h)); /* each fine cell: the diameter of the run's cell holding it */
+  for (PetscInt c = cStart; c < cEnd; ++c) PetscCall(MeshCellDiameter(dm, parent[c - cStart], &(*run_cell_h)[c - cStart]));
   PetscCall(PetscFree(parent));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -445,6 +448,7 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   Vec         loc[2], fine_loc[2], loc_uref, loc_pref;
   Mat         K;
   ErrorTarget target;
+  PetscReal  *run_cell_h;
 
   PetscFunctionBeginUser;
   PetscCall(ErrorNormsReset(&user->rec.ref_errors));
@@ -467,7 +471,7 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
     PetscCall(DMCreateLocalVector(dm, &loc[1]));
     PetscCall(ErrorNormsPressureVector(dm, user, loc[1]));
   }
-  PetscCall(RefineAndInterpolate(dm, levels, nvec, loc, &fine, fine_loc));
+  PetscCall(RefineAndInterpolate(dm, levels, nvec, loc, &fine, fine_loc, &run_cell_h));
   for (PetscInt k = 0; k < nvec; ++k) PetscCall(VecDestroy(&loc[k]));
 
   PetscCall(DMCreateLocalVector(fine, &loc_uref));
@@ -491,7 +495,8 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   target.scene        = NULL;
   target.loc_u        = loc_uref;
   target.loc_pressure = loc_pref;
-  PetscCall(ErrorNormsEvaluate(fine, user, K, fine_loc[0], nvec == 2 ? fine_loc[1] : NULL, &target, &user->rec.ref_errors));
+  PetscCall(ErrorNormsEvaluate(fine, run_cell_h, user, K, fine_loc[0], nvec == 2 ? fine_loc[1] : NULL, &target, &user->rec.ref_errors));
+  PetscCall(PetscFree(run_cell_h));
   PetscCall(PetscInfo(dm, "Reference %s: %" PetscInt_FMT " refinement(s)\n", user->opt->verify.reference, levels));
 
   PetscCall(MatDestroy(&K));
