@@ -87,7 +87,7 @@ PetscErrorCode ContactPenetrationHash(Contact ct, Vec X, PetscInt64 *hash);
 PetscErrorCode ContactMaxNodePenetration(Contact ct, Vec u, PetscReal *dmax);
 
 /* After the solve: the pressure and the reaction at each node (kept in the contact set), the force, the active set, the energy */
-PetscErrorCode ContactPostProcess(Contact ct, DM dm, Mat K, Vec r0, Vec u, PetscReal tol_scale, ContactResult *res);
+PetscErrorCode ContactPostProcess(Contact ct, DM dm, Vec R, Vec u, PetscReal tol_scale, ContactResult *res);
 
 /* The rows of K that the penalty Jacobian changes (penalty.c, bulk_rows.c): read by the GAMG updates (src/solver/pc_reuse.c) */
 typedef struct {

@@ -381,7 +381,8 @@ PetscErrorCode ContactEnergy(Contact ct, DM dm, Vec u, PetscReal *energy)
 }
 
 /* The contact outputs, every one from the force the rule exerts, for every type, rule and obstacle:
-   - the reaction of the obstacle at node i is -R_i . n with R = K u + r0 the bulk residual: the nodal contact force
+   - the reaction of the obstacle at node i is -R_i . n with R = K u + r0 the bulk residual (the caller's, K the bulk
+     operator, not the penalty Jacobian): the nodal contact force
      (the penalty term's at a converged penalty solve, the multiplier of SNESVI's bound);
    - the pressure is that reaction over the lumped boundary mass (the area the node stands for), where the contact acts
      (penalty: where the rule's force is positive, exactly zero elsewhere; SNESVI: everywhere), so that the sum of
@@ -394,11 +395,10 @@ PetscErrorCode ContactEnergy(Contact ct, DM dm, Vec u, PetscReal *energy)
    - the penetration is the largest of the nodes' and the rule's points';
    - SNESVI's active vertices are those within 1e-10 tol_scale of their bound (tol_scale: the size of the displacement).
    The pressure and the reaction of each node are kept in the contact set, for the output. */
-PetscErrorCode ContactPostProcess(Contact ct, DM dm, Mat K, Vec r0, Vec u, PetscReal tol_scale, ContactResult *res)
+PetscErrorCode ContactPostProcess(Contact ct, DM dm, Vec R, Vec u, PetscReal tol_scale, ContactResult *res)
 {
   ContactSet        *cs  = &ct->set;
   const PetscInt     dim = ct->dim;
-  Vec                R;
   const PetscScalar *x, *r;
   PetscReal          local[5] = {0.0, 0.0, 0.0, 0.0, 0.0}, global[5], drule = -PETSC_MAX_REAL;
   PetscBool         *acts;
@@ -408,9 +408,6 @@ PetscErrorCode ContactPostProcess(Contact ct, DM dm, Mat K, Vec r0, Vec u, Petsc
   PetscCall(PetscMalloc1(cs->n + 1, &acts));
   for (PetscInt i = 0; i < cs->n; ++i) acts[i] = PETSC_TRUE;
   if (ct->ops.acts) PetscCall((*ct->ops.acts)(ct, dm, u, acts, &drule));
-  PetscCall(VecDuplicate(u, &R));
-  PetscCall(ContactBulkMult(ct, K, u, R)); /* K u, not the penalty Jacobian times u */
-  PetscCall(VecAXPY(R, 1.0, r0));
   PetscCall(VecGetArrayRead(u, &x));
   PetscCall(VecGetArrayRead(R, &r));
   for (PetscInt i = 0; i < cs->n; ++i) {
@@ -430,7 +427,6 @@ PetscErrorCode ContactPostProcess(Contact ct, DM dm, Mat K, Vec r0, Vec u, Petsc
   }
   PetscCall(VecRestoreArrayRead(R, &r));
   PetscCall(VecRestoreArrayRead(u, &x));
-  PetscCall(VecDestroy(&R));
   PetscCall(MPIU_Allreduce(&local[0], &global[0], 1, MPIU_REAL, MPIU_MAX, ct->comm));
   PetscCall(MPIU_Allreduce(&local[1], &global[1], 4, MPIU_REAL, MPIU_SUM, ct->comm));
   for (PetscInt c = 0; c < 3; ++c) res->force_vector[c] = global[2 + c];

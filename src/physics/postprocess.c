@@ -8,16 +8,17 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
 {
   RunStats     *st = &user->rec.stats;
   ContactResult res;
-  Vec           Ku;
+  Vec           R;
   PetscScalar   uKu, r0u;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactPostProcess(user->contact, dm, user->prob.K, user->prob.r0, u, user->prob.displacement_scale, &res));
-  PetscCall(VecDuplicate(u, &Ku));
-  PetscCall(ContactBulkMult(user->contact, user->prob.K, u, Ku)); /* K u, not the penalty Jacobian times u */
-  PetscCall(VecDot(u, Ku, &uKu));
+  PetscCall(VecDuplicate(u, &R));
+  PetscCall(ContactBulkMult(user->contact, user->prob.K, u, R)); /* K u, not the penalty Jacobian times u */
+  PetscCall(VecDot(u, R, &uKu));
   PetscCall(VecDot(u, user->prob.r0, &r0u));
-  PetscCall(VecDestroy(&Ku));
+  PetscCall(VecAXPY(R, 1.0, user->prob.r0)); /* the bulk residual K u + r0, whose contact rows are the reactions */
+  PetscCall(ContactPostProcess(user->contact, dm, R, u, user->prob.displacement_scale, &res));
+  PetscCall(VecDestroy(&R));
   for (PetscInt c = 0; c < 3; ++c) st->contact_force_vector[c] = res.force_vector[c];
   PetscCall(BoundaryComputeReactions(dm, user, u, st->reaction));
   st->max_penetration = res.max_penetration;

@@ -360,7 +360,16 @@ static PetscErrorCode RefineAndInterpolate(DM dm, PetscInt levels, PetscInt nvec
   PetscCall(MeshInterpolateFromParents(dm, *fine, parent, nvec, loc, fine_loc));
   PetscCall(DMPlexGetHeightStratum(*fine, 0, &cStart, &cEnd));
   PetscCall(PetscMalloc1(cEnd - cStart + 1, run_cell_h)); /* each fine cell: the diameter of the run's cell holding it */
-  for (PetscInt c = cStart; c < cEnd; ++c) PetscCall(MeshCellDiameter(dm, parent[c - cStart], &(*run_cell_h)[c - cStart]));
+  {
+    PetscInt   rStart, rEnd;
+    PetscReal *diam;
+
+    PetscCall(DMPlexGetHeightStratum(dm, 0, &rStart, &rEnd));
+    PetscCall(PetscMalloc1(rEnd - rStart + 1, &diam));
+    for (PetscInt c = rStart; c < rEnd; ++c) PetscCall(MeshCellDiameter(dm, c, &diam[c - rStart]));
+    for (PetscInt c = cStart; c < cEnd; ++c) (*run_cell_h)[c - cStart] = diam[parent[c - cStart] - rStart];
+    PetscCall(PetscFree(diam));
+  }
   PetscCall(PetscFree(parent));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
