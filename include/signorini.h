@@ -87,6 +87,7 @@ typedef struct {
   PetscPointFunc f0_body;        /* volume residual term, -f, if not constant; it adds the -body_force of constants[] */
   ScenePointFn   exact;          /* exact solution, NULL if none; called with ctx = constants */
   ScenePointFn   exact_gradient; /* its gradient, G[i*dim+j] = du_i/dx_j (Nc = dim*dim); needed for the error norms */
+  ScenePointFn   exact_source;   /* with weak data: f = -div sigma(u_exact) (Nc = dim), for the error estimate; ctx = the kernels' constants[] */
   PetscBool      weak_data;      /* load from the exact solution: L(v) = a(u_exact, v) - int_Gamma_C sigma_n(u_exact) v_n */
   PetscBool      has_kink;       /* the exact solution is not smooth across the plane {x . kink_normal = kink_offset}: */
   PetscReal      kink_normal[3]; /*   the cells it cuts get the refined quadrature rule */
@@ -187,6 +188,27 @@ typedef struct {
   PetscReal penetration_l2, penetration_max; /* of [u_h,n - g]_+ on Gamma_C */
 } ErrorNorms;
 
+/* The a posteriori estimate of the energy-norm error of a run (src/estimate/), by part: each part is the square root
+   of the sum over the cells of its squared indicators, and the total that of the sum of the parts' squares. */
+typedef enum {
+  ESTIMATE_BULK,               /* h_T ||f + div sigma(u_h)||_T: the body force left unbalanced inside the cells */
+  ESTIMATE_JUMP,               /* h_F^1/2 ||[sigma(u_h) n]||_F: the stress jumps across the interior faces */
+  ESTIMATE_NEUMANN,            /* h_F^1/2 ||t - sigma(u_h) n||_F on the loaded and free faces (the free components of a slip) */
+  ESTIMATE_CONTACT_NORMAL,     /* h_F^1/2 ||sigma_n(u_h) + p_h||_F on Gamma_C, p_h the contact pressure of the method */
+  ESTIMATE_CONTACT_TANGENTIAL, /* h_F^1/2 ||sigma_t(u_h)||_F on Gamma_C (frictionless) */
+  ESTIMATE_PENALTY,            /* the penalty's consistency error, from the penetration [u_h,n - g]_+ = eps p_h */
+  ESTIMATE_NUM_PARTS
+} EstimatePart;
+extern const char *const EstimateParts[];
+typedef struct {
+  PetscBool  computed;
+  char       unavailable[160]; /* why there is no estimate ("" if computed or not asked for) */
+  PetscReal  total, part[ESTIMATE_NUM_PARTS];
+  PetscInt   ncells; /* the local cells, */
+  PetscReal *cell;   /*   the indicator eta_T of each: the square root of the sum of its parts' squares */
+  PetscReal  time;
+} ErrorEstimate;
+
 /* The simplex box of the options, when the mesh is one (MeshCreate()): the grid sequence builds its finer levels directly. */
 typedef struct {
   PetscBool is_box;        /* a 2D simplex box not refined by -dm_refine, on one rank or in slabs of rows that nest */
@@ -277,6 +299,7 @@ typedef struct {
   AssemblyType  assembly;       /* -assembly as given (auto, fe, p1) */
   PetscBool     assembly_check; /* -assembly_check: assemble K both ways and compare */
   PetscBool     perf_bandwidth; /* -perf_bandwidth: measure the memory bandwidths after the solve */
+  PetscBool     estimate, estimate_given; /* -estimate: the a posteriori error estimate after the solve (and whether it was given) */
   char          output[PETSC_MAX_PATH_LEN];
   PetscBool     output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
 } RunOptions;
@@ -306,6 +329,7 @@ typedef struct {
   PetscInt     nrecords, maxrecords;
   ErrorNorms   errors;                   /* against the scene's exact solution */
   ErrorNorms   ref_errors;               /* against the -reference solution */
+  ErrorEstimate estimate;                /* the a posteriori estimate of the error */
   char         diagnostics_failed[1024]; /* the diagnostics that failed after the solve, with their messages ("" if none) */
 } RunRecord;
 

@@ -6,6 +6,7 @@ static const char help[] =
 #include "app.h"
 #include "contact.h"
 #include "discretization.h"
+#include "estimate.h"
 #include "scenes.h"
 #include "mesh.h"
 #include "physics.h"
@@ -56,6 +57,7 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
                             (double)r->time_solve, r->converged ? "" : "  FAILED"));
     }
   }
+  PetscCall(EstimateView(comm, &user->rec.estimate, &user->rec.errors));
   PetscCall(ContactChecksWarnings(comm, &s->checks, PETSC_TRUE, NULL));
   if (user->rec.diagnostics_failed[0])
     PetscCall(
@@ -118,6 +120,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(ContactSetFromOptions(user.contact)); /* -contact_method, -penalty_* */
   PetscCall(SolverGetOptions(comm, &opt.solver));
   PetscCall(VerifyGetOptions(comm, &opt.verify));
+  PetscCall(EstimateGetOptions(comm, &opt));
   PetscCall(AssemblyGetOptions(comm, &opt.assembly, &opt.assembly_check));
   PetscCall(OutputGetOptions(comm, &opt));
   PetscCall(BandwidthGetOptions(comm, &opt.perf_bandwidth));
@@ -134,6 +137,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(ReferenceCheckFile(dm, &user));    /* before the solve, not after it */
+  PetscCall(EstimateCheckSupported(dm, &user)); /* -estimate on a discretization it does not cover */
+  PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(ContactChecksGeometry(dm, &user)); /* initial overlap, an obstacle facing away: warnings */
   PetscCall(VecDuplicate(user.prob.r0, &u));   /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
@@ -158,6 +163,12 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
     PetscCall(AppDiagnosticRun("-reference comparison", ReferenceCompute, dm, &user, u, failed, sizeof(failed)));
     if (failed[0]) {
       PetscCall(ErrorNormsReset(&user.rec.ref_errors));
+      if (user.rec.diagnostics_failed[0]) PetscCall(PetscStrlcat(user.rec.diagnostics_failed, "; ", sizeof(user.rec.diagnostics_failed)));
+      PetscCall(PetscStrlcat(user.rec.diagnostics_failed, failed, sizeof(user.rec.diagnostics_failed)));
+    }
+    PetscCall(AppDiagnosticRun("error estimate", EstimateCompute, dm, &user, u, failed, sizeof(failed)));
+    if (failed[0]) {
+      PetscCall(EstimateReset(&user.rec.estimate));
       if (user.rec.diagnostics_failed[0]) PetscCall(PetscStrlcat(user.rec.diagnostics_failed, "; ", sizeof(user.rec.diagnostics_failed)));
       PetscCall(PetscStrlcat(user.rec.diagnostics_failed, failed, sizeof(user.rec.diagnostics_failed)));
     }
@@ -191,6 +202,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(ContactDestroy(&user.contact));
   PetscCall(ContactFinalizePackage());
   PetscCall(PetscFree(user.rec.records));
+  PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(SceneFinalize());
   *converged      = user.rec.stats.converged;
   *diagnostics_ok = (PetscBool)!user.rec.diagnostics_failed[0];

@@ -176,6 +176,34 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* /cell_fields/error_indicator: the estimate's indicator eta_T of each owned cell, in the cell order of /viz/topology/cells. */
+static PetscErrorCode WriteCellFields(DM dm, const AppCtx *user, PetscViewer viewer)
+{
+  const ErrorEstimate *est = &user->rec.estimate;
+  PetscInt             cStart, cEnd, *index, nowned;
+  Vec                  eta;
+  PetscScalar         *a;
+
+  PetscFunctionBeginUser;
+  if (!est->computed) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCheck(est->ncells == cEnd - cStart, PETSC_COMM_SELF, PETSC_ERR_PLIB, "The estimate's cells are not the mesh's");
+  PetscCall(MeshOwnedIndex(dm, cStart, cEnd, &index, &nowned));
+  PetscCall(VecCreateMPI(PetscObjectComm((PetscObject)dm), nowned, PETSC_DETERMINE, &eta));
+  PetscCall(PetscObjectSetName((PetscObject)eta, "error_indicator"));
+  PetscCall(VecGetArray(eta, &a));
+  for (PetscInt c = cStart; c < cEnd; ++c)
+    if (index[c - cStart] >= 0) a[index[c - cStart]] = est->cell[c - cStart];
+  PetscCall(VecRestoreArray(eta, &a));
+  PetscCall(PetscViewerHDF5PushGroup(viewer, "/cell_fields"));
+  PetscCall(VecView(eta, viewer));
+  PetscCall(PetscViewerHDF5WriteObjectAttribute(viewer, (PetscObject)eta, "vector_field_type", PETSC_STRING, "scalar"));
+  PetscCall(PetscViewerHDF5PopGroup(viewer));
+  PetscCall(VecDestroy(&eta));
+  PetscCall(PetscFree(index));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode WriteRealAttr(PetscViewer v, const char name[], PetscReal value)
 {
   PetscFunctionBeginUser;
@@ -339,6 +367,17 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteRealAttr(v, "penetration_max", user->rec.errors.penetration_max));
   PetscCall(WriteErrorNorms(v, "error", &user->rec.errors));
   PetscCall(WriteErrorNorms(v, "reference_error", &user->rec.ref_errors));
+  if (user->rec.estimate.computed) { /* estimate_total and estimate_PART (the parts of include/signorini.h) */
+    PetscCall(WriteRealAttr(v, "estimate_total", user->rec.estimate.total));
+    for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k) {
+      char name[64];
+
+      PetscCall(PetscSNPrintf(name, sizeof(name), "estimate_%s", EstimateParts[k]));
+      PetscCall(WriteRealAttr(v, name, user->rec.estimate.part[k]));
+    }
+    PetscCall(WriteRealAttr(v, "time_estimate", user->rec.estimate.time));
+  } else if (user->rec.estimate.unavailable[0])
+    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "estimate_unavailable", PETSC_STRING, user->rec.estimate.unavailable));
   if (user->opt->verify.reference[0]) {
     PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "reference", PETSC_STRING, user->opt->verify.reference));
   }
@@ -416,6 +455,10 @@ static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const cha
       fprintf(fp, "    <DataItem Dimensions=\"%d\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n", (int)nverts, h5name, fields[f]);
     fprintf(fp, "   </Attribute>\n");
   }
+  if (user->rec.estimate.computed) {
+    fprintf(fp, "   <Attribute Name=\"error_indicator\" AttributeType=\"Scalar\" Center=\"Cell\">\n");
+    fprintf(fp, "    <DataItem Dimensions=\"%d\" Format=\"HDF\">%s:/cell_fields/error_indicator</DataItem>\n   </Attribute>\n", (int)ncells, h5name);
+  }
   fprintf(fp, "  </Grid>\n </Domain>\n</Xdmf>\n");
   bad = fflush(fp) != 0 || ferror(fp);
   bad = (fclose(fp) != 0) || bad;
@@ -449,6 +492,7 @@ static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, const char h5
   else
     PetscCall(OutputViewMesh(dm, viewer)); /* DMView() without its closures per cell */
   PetscCall(WriteVertexFields(dm, user, u, viewer));
+  PetscCall(WriteCellFields(dm, user, viewer));
   PetscCall(PetscViewerPopFormat(viewer));
   PetscCall(WriteRunMetadata(dm, user, u, viewer, ncells, nverts));
   PetscCall(WriteSolves(comm, user, viewer));

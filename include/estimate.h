@@ -1,0 +1,12 @@
+/* The a posteriori estimate of the error of a run (src/estimate/): a residual-type estimator of the energy-norm error
+   ||u - u_h||_a, with one indicator per cell, split into the parts of EstimatePart (include/signorini.h). Read only:
+   it reads the solution and the contact after the solve and writes RunRecord.estimate. */
+#pragma once
+#include "signorini.h"
+
+/* estimate.c */
+PetscErrorCode EstimateGetOptions(MPI_Comm comm, RunOptions *opt);
+PetscErrorCode EstimateCheckSupported(DM dm, const AppCtx *user);
+PetscErrorCode EstimateReset(ErrorEstimate *est);
+PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u);
+PetscErrorCode EstimateView(MPI_Comm comm, const ErrorEstimate *est, const ErrorNorms *exact);

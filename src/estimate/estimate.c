@@ -1,0 +1,371 @@
+/* The a posteriori error estimate of a run: its option, the geometry of the P1 simplices it walks, and the sum of the
+   parts (estimate_residual.c: the residual of the equilibrium, estimate_penalty.c: the penalty's consistency error).
+
+   For P1 elements sigma(u_h) is constant in each cell, and the residual of the discrete problem is carried by the body
+   force inside the cells and by the tractions on the faces: the jumps [sigma(u_h) n] across interior faces, the misfit
+   t - sigma(u_h) n on the loaded and free faces, and on Gamma_C the misfit of sigma(u_h) n with the traction -p_h n the
+   obstacle exerts. The classical residual estimator of linear elasticity (Verfurth, "A posteriori error estimation
+   techniques", 2013, section 1.4 and 4.2) bounds the energy-norm error by the h-weighted norms of these, divided by 2 mu
+   to have the energy's units; for contact the same face terms with the contact traction (Hild and Nicaise, M2AN 41
+   (2007); Chouly, Fabre, Hild, Pousin, Renard, hal-01143168, for Nitsche's method), plus the error of the contact law
+   itself, which for the penalty method is its penetration (estimate_penalty.c). */
+#include "app.h"
+#include "contact.h"
+#include "estimate_impl.h"
+#include "physics.h"
+#include "verify.h"
+
+const char *const EstimateParts[] = {"bulk", "jump", "neumann", "contact_normal", "contact_tangential", "penalty", "EstimatePart", "ESTIMATE_", NULL};
+
+PetscErrorCode EstimateGetOptions(MPI_Comm comm, RunOptions *opt)
+{
+  PetscFunctionBeginUser;
+  PetscOptionsBegin(comm, NULL, "A posteriori error estimate", "Signorini");
+  opt->estimate = PETSC_TRUE;
+  PetscCall(PetscOptionsBool("-estimate", "Estimate the energy-norm error of the solution, cell by cell (P1 simplices)", "EstimateCompute",
+                             opt->estimate, &opt->estimate, &opt->estimate_given));
+  PetscOptionsEnd();
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Whether the estimator applies: P1 on simplices; *why says what else the discretization is. */
+static PetscErrorCode Supported(DM dm, const AppCtx *user, PetscBool *ok, char why[], size_t len)
+{
+  PetscInt       dim, cStart, cEnd, simplex = 1, all;
+  DMPolytopeType ct;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  if (cEnd > cStart) {
+    PetscCall(DMPlexGetCellType(dm, cStart, &ct));
+    simplex = DMPolytopeTypeGetNumVertices(ct) == dim + 1;
+  }
+  PetscCall(MPIU_Allreduce(&simplex, &all, 1, MPIU_INT, MPI_MIN, PetscObjectComm((PetscObject)dm)));
+  *ok = (PetscBool)(all && user->opt->degree == 1);
+  if (user->opt->degree != 1)
+    PetscCall(PetscSNPrintf(why, len, "implemented for P1, not P%" PetscInt_FMT, user->opt->degree));
+  else if (!all)
+    PetscCall(PetscSNPrintf(why, len, "implemented for simplices (triangles, tetrahedra), not %s", dim == 2 ? "quadrilaterals" : "hexahedra"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -estimate given on a discretization the estimator does not cover is refused before the solve; by default such a run
+   goes without the estimate, and the summary says why. */
+PetscErrorCode EstimateCheckSupported(DM dm, const AppCtx *user)
+{
+  PetscBool ok;
+  char      why[128] = "";
+
+  PetscFunctionBeginUser;
+  if (!user->opt->estimate || !user->opt->estimate_given) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(Supported(dm, user, &ok, why, sizeof(why)));
+  PetscCheck(ok, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT,
+             "-estimate: the error estimate is %s; run without -estimate (or with -estimate false)", why);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode EstimateReset(ErrorEstimate *est)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(est->cell));
+  est->computed       = PETSC_FALSE;
+  est->unavailable[0] = '\0';
+  est->total          = PETSC_NAN;
+  for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k) est->part[k] = PETSC_NAN;
+  est->ncells = 0;
+  est->time   = 0.0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The cell c: vertices, coordinates, displacement, the gradients of the barycentric coordinates (the rows of the
+   inverse of J = [x_1 - x_0, ..., x_d - x_0], and minus their sum for lambda_0), grad u_h and sigma(u_h). */
+PetscErrorCode EstimateCellLoad(EstimateWork *w, PetscInt c, EstimateCell *cell)
+{
+  const PetscInt dim = w->dim;
+  PetscReal      J[9], Ji[9], det;
+
+  PetscFunctionBeginUser;
+  PetscCall(MeshClosureVertices(&w->mc, c, 4, &cell->nv, cell->vert));
+  PetscCheck(cell->nv == dim + 1, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Cell %" PetscInt_FMT " is not a simplex", c);
+  for (PetscInt k = 0; k < cell->nv; ++k) {
+    PetscInt coff;
+
+    PetscCall(PetscSectionGetOffset(w->csec, cell->vert[k], &coff));
+    PetscCall(PetscSectionGetOffset(w->lsec, cell->vert[k], &cell->off[k]));
+    for (PetscInt d = 0; d < dim; ++d) {
+      cell->x[k * dim + d] = PetscRealPart(w->xc[coff + d]);
+      cell->u[k * dim + d] = PetscRealPart(w->lu[cell->off[k] + d]);
+    }
+  }
+  for (PetscInt i = 0; i < dim; ++i)
+    for (PetscInt k = 0; k < dim; ++k) J[i * dim + k] = cell->x[(k + 1) * dim + i] - cell->x[i];
+  if (dim == 2) {
+    det   = J[0] * J[3] - J[1] * J[2];
+    Ji[0] = J[3] / det;
+    Ji[1] = -J[1] / det;
+    Ji[2] = -J[2] / det;
+    Ji[3] = J[0] / det;
+  } else {
+    det = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
+    Ji[0] = (J[4] * J[8] - J[5] * J[7]) / det;
+    Ji[1] = (J[2] * J[7] - J[1] * J[8]) / det;
+    Ji[2] = (J[1] * J[5] - J[2] * J[4]) / det;
+    Ji[3] = (J[5] * J[6] - J[3] * J[8]) / det;
+    Ji[4] = (J[0] * J[8] - J[2] * J[6]) / det;
+    Ji[5] = (J[2] * J[3] - J[0] * J[5]) / det;
+    Ji[6] = (J[3] * J[7] - J[4] * J[6]) / det;
+    Ji[7] = (J[1] * J[6] - J[0] * J[7]) / det;
+    Ji[8] = (J[0] * J[4] - J[1] * J[3]) / det;
+  }
+  cell->volume = PetscAbsReal(det) / (dim == 2 ? 2.0 : 6.0);
+  for (PetscInt d = 0; d < dim; ++d) cell->dl[d] = 0.0;
+  for (PetscInt k = 1; k <= dim; ++k) /* d lambda_k / dx_j = (J^-1)_{k-1, j} */
+    for (PetscInt j = 0; j < dim; ++j) {
+      cell->dl[k * dim + j] = Ji[(k - 1) * dim + j];
+      cell->dl[j] -= Ji[(k - 1) * dim + j];
+    }
+  cell->diameter = 0.0;
+  for (PetscInt a = 0; a < cell->nv; ++a)
+    for (PetscInt b = a + 1; b < cell->nv; ++b) {
+      PetscReal d2 = 0.0;
+
+      for (PetscInt d = 0; d < dim; ++d) d2 += PetscSqr(cell->x[a * dim + d] - cell->x[b * dim + d]);
+      cell->diameter = PetscMax(cell->diameter, PetscSqrtReal(d2));
+    }
+  for (PetscInt i = 0; i < dim; ++i)
+    for (PetscInt j = 0; j < dim; ++j) {
+      cell->grad[i * dim + j] = 0.0;
+      for (PetscInt k = 0; k < cell->nv; ++k) cell->grad[i * dim + j] += cell->u[k * dim + i] * cell->dl[k * dim + j];
+    }
+  ElasticStress(dim, &w->user->opt->material, cell->grad, cell->sigma);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The face f of the cell: its vertices among the cell's, and its outward normal -grad lambda_opp / |grad lambda_opp|
+   (lambda_opp the barycentric coordinate of the vertex opposite f, which vanishes on f and grows into the cell). */
+PetscErrorCode EstimateFaceOfCell(EstimateWork *w, const EstimateCell *cell, PetscInt f, EstimateFace *face)
+{
+  const PetscInt dim = w->dim;
+  PetscInt       fv[3], nfv, opp = -1;
+  PetscReal      len = 0.0;
+
+  PetscFunctionBeginUser;
+  PetscCall(MeshClosureVertices(&w->mc, f, 3, &nfv, fv));
+  PetscCheck(nfv == dim, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Face %" PetscInt_FMT " has %" PetscInt_FMT " vertices", f, nfv);
+  face->nv = nfv;
+  for (PetscInt k = 0; k < cell->nv; ++k) {
+    PetscInt j;
+
+    for (j = 0; j < nfv; ++j)
+      if (fv[j] == cell->vert[k]) break;
+    if (j < nfv)
+      face->local[j] = k;
+    else
+      opp = k;
+  }
+  PetscCheck(opp >= 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Face %" PetscInt_FMT " is not a face of its cell", f);
+  for (PetscInt d = 0; d < dim; ++d) len += PetscSqr(cell->dl[opp * dim + d]);
+  len = PetscSqrtReal(len);
+  for (PetscInt d = 0; d < dim; ++d) face->normal[d] = -cell->dl[opp * dim + d] / len;
+  face->measure  = dim * cell->volume * len; /* |T| = |F| dist(x_opp, F) / dim and |grad lambda_opp| = 1 / dist */
+  face->diameter = 0.0;
+  for (PetscInt a = 0; a < nfv; ++a)
+    for (PetscInt b = a + 1; b < nfv; ++b) {
+      PetscReal d2 = 0.0;
+
+      for (PetscInt d = 0; d < dim; ++d) d2 += PetscSqr(cell->x[face->local[a] * dim + d] - cell->x[face->local[b] * dim + d]);
+      face->diameter = PetscMax(face->diameter, PetscSqrtReal(d2));
+    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Point q of the face rule on the face: its position, u_h there, and its weight times the face's measure. */
+void EstimateFacePoint(const EstimateWork *w, const EstimateCell *cell, const EstimateFace *face, PetscInt q, PetscReal x[], PetscReal u[],
+                       PetscReal *weight)
+{
+  const PetscInt   dim = w->dim;
+  const PetscReal *b   = &w->face_rule.bary[q * w->face_rule.nb];
+
+  for (PetscInt d = 0; d < dim; ++d) {
+    x[d] = 0.0;
+    u[d] = 0.0;
+    for (PetscInt k = 0; k < face->nv; ++k) {
+      x[d] += b[k] * cell->x[face->local[k] * dim + d];
+      u[d] += b[k] * cell->u[face->local[k] * dim + d];
+    }
+  }
+  *weight = w->face_rule.w[q] * face->measure;
+}
+
+/* A Gauss rule with npts points per direction on the reference simplex of dimension sdim (Stroud's conical product),
+   in barycentric coordinates. */
+static PetscErrorCode RuleCreate(PetscInt sdim, PetscInt npts, EstimateRule *rule)
+{
+  PetscQuadrature  q;
+  const PetscReal *pts, *wts;
+  PetscInt         n;
+  PetscReal        sum = 0.0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscDTStroudConicalQuadrature(sdim, 1, npts, -1.0, 1.0, &q));
+  PetscCall(PetscQuadratureGetData(q, NULL, NULL, &n, &pts, &wts));
+  rule->n  = n;
+  rule->nb = sdim + 1;
+  PetscCall(PetscMalloc2(n * rule->nb, &rule->bary, n, &rule->w));
+  for (PetscInt i = 0; i < n; ++i) sum += wts[i];
+  for (PetscInt i = 0; i < n; ++i) { /* the reference simplex has vertices -1 and e_k: lambda_k = (xi_k + 1) / 2 */
+    PetscReal *b = &rule->bary[i * rule->nb];
+
+    b[0] = 1.0;
+    for (PetscInt k = 1; k <= sdim; ++k) {
+      b[k] = 0.5 * (pts[i * sdim + k - 1] + 1.0);
+      b[0] -= b[k];
+    }
+    rule->w[i] = wts[i] / sum;
+  }
+  PetscCall(PetscQuadratureDestroy(&q));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The faces of the scene's boundary conditions: ESTIMATE_FACE_CONTACT on Gamma_C, the index of the face set's
+   condition, or ESTIMATE_FACE_FREE (traction-free, or loaded by the exact solution of a scene with weak data). */
+static PetscErrorCode ClassifyFaces(EstimateWork *w)
+{
+  const BoundarySet *bcs = &w->user->scene.bcs;
+  DMLabel            label;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(w->fEnd - w->fStart, &w->face_kind));
+  for (PetscInt f = w->fStart; f < w->fEnd; ++f) w->face_kind[f - w->fStart] = ESTIMATE_FACE_FREE;
+  PetscCall(DMGetLabel(w->dm, "Face Sets", &label));
+  if (!label) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt i = 0; i < bcs->n + bcs->ncontact; ++i) {
+    const PetscInt  id   = i < bcs->n ? bcs->bc[i].id : bcs->contact_ids[i - bcs->n];
+    const PetscInt  kind = i < bcs->n ? i : ESTIMATE_FACE_CONTACT;
+    IS              is;
+    PetscInt        n;
+    const PetscInt *pts;
+
+    PetscCall(DMLabelGetStratumIS(label, id, &is));
+    if (!is) continue;
+    PetscCall(ISGetLocalSize(is, &n));
+    PetscCall(ISGetIndices(is, &pts));
+    for (PetscInt k = 0; k < n; ++k)
+      if (pts[k] >= w->fStart && pts[k] < w->fEnd) w->face_kind[pts[k] - w->fStart] = kind;
+    PetscCall(ISRestoreIndices(is, &pts));
+    PetscCall(ISDestroy(&is));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
+{
+  ErrorEstimate *est = &user->rec.estimate;
+  MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
+  EstimateWork   w;
+  PetscBool      ok;
+  PetscDS        ds;
+  DM             cdm;
+  Vec            loc_u, loc_p = NULL, coords;
+  PetscReal      sums[ESTIMATE_NUM_PARTS], gsums[ESTIMATE_NUM_PARTS], total = 0.0;
+  PetscLogDouble t0, t1;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscTime(&t0));
+  PetscCall(EstimateReset(est));
+  if (!user->opt->estimate) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(Supported(dm, user, &ok, est->unavailable, sizeof(est->unavailable)));
+  if (!ok) PetscFunctionReturn(PETSC_SUCCESS);
+
+  PetscCall(PetscMemzero(&w, sizeof(w)));
+  w.dm   = dm;
+  w.user = user;
+  PetscCall(DMGetDimension(dm, &w.dim));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &w.cStart, &w.cEnd));
+  PetscCall(DMPlexGetHeightStratum(dm, 1, &w.fStart, &w.fEnd));
+  PetscCall(MeshClosureCreate(dm, &w.mc));
+  PetscCall(DMGetLocalSection(dm, &w.lsec));
+  PetscCall(DMGetCoordinateDM(dm, &cdm));
+  PetscCall(DMGetLocalSection(cdm, &w.csec));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(VecGetArrayRead(coords, &w.xc));
+  PetscCall(DMGetLocalVector(dm, &loc_u));
+  PetscCall(VecCopy(user->prob.loc_bc, loc_u)); /* the Dirichlet values, inserted once by ProblemSetUp() */
+  PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc_u));
+  PetscCall(VecGetArrayRead(loc_u, &w.lu));
+  if (!ContactIsNone(user->contact)) {
+    const ContactOptions *copt;
+
+    PetscCall(ContactGetOptions(user->contact, &copt));
+    if (!ContactHasPenalty(user->contact) || copt->quadrature == PENALTY_QUADRATURE_NODAL) { /* the nodal force over the lumped area */
+      PetscCall(DMGetLocalVector(dm, &loc_p));
+      PetscCall(ErrorNormsPressureVector(dm, user, loc_p));
+      PetscCall(VecGetArrayRead(loc_p, &w.lp));
+    }
+  }
+  PetscCall(DMGetDS(dm, &ds));
+  PetscCall(PetscDSGetConstants(ds, &w.nconstants, &w.constants));
+  w.m_normal = user->opt->material.lambda + 2.0 * user->opt->material.mu;
+  w.m_shear  = 2.0 * user->opt->material.mu;
+  PetscCall(RuleCreate(w.dim, user->scene.exact_source ? 3 : 2, &w.cell_rule));
+  PetscCall(RuleCreate(w.dim - 1, 3, &w.face_rule));
+  PetscCall(PetscCalloc1((w.cEnd - w.cStart) * ESTIMATE_NUM_PARTS, &w.eta2));
+  PetscCall(ClassifyFaces(&w));
+
+  PetscCall(EstimateResidualTerms(&w));
+  PetscCall(EstimatePenaltyTerm(&w));
+
+  for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k) sums[k] = 0.0;
+  est->ncells = w.cEnd - w.cStart;
+  PetscCall(PetscMalloc1(est->ncells, &est->cell));
+  for (PetscInt c = 0; c < est->ncells; ++c) {
+    PetscReal s = 0.0;
+
+    for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k) {
+      sums[k] += w.eta2[c * ESTIMATE_NUM_PARTS + k];
+      s += w.eta2[c * ESTIMATE_NUM_PARTS + k];
+    }
+    est->cell[c] = PetscSqrtReal(s);
+  }
+  PetscCall(MPIU_Allreduce(sums, gsums, ESTIMATE_NUM_PARTS, MPIU_REAL, MPIU_SUM, comm));
+  for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k) {
+    est->part[k] = PetscSqrtReal(gsums[k]);
+    total += gsums[k];
+  }
+  est->total    = PetscSqrtReal(total);
+  est->computed = PETSC_TRUE;
+
+  PetscCall(PetscFree(w.face_kind));
+  PetscCall(PetscFree(w.eta2));
+  PetscCall(PetscFree2(w.cell_rule.bary, w.cell_rule.w));
+  PetscCall(PetscFree2(w.face_rule.bary, w.face_rule.w));
+  if (loc_p) {
+    PetscCall(VecRestoreArrayRead(loc_p, &w.lp));
+    PetscCall(DMRestoreLocalVector(dm, &loc_p));
+  }
+  PetscCall(VecRestoreArrayRead(loc_u, &w.lu));
+  PetscCall(DMRestoreLocalVector(dm, &loc_u));
+  PetscCall(VecRestoreArrayRead(coords, &w.xc));
+  PetscCall(MeshClosureDestroy(&w.mc));
+  PetscCall(PetscTime(&t1));
+  est->time = t1 - t0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The summary's line: the total and its parts, and the effectivity where the exact error is known. */
+PetscErrorCode EstimateView(MPI_Comm comm, const ErrorEstimate *est, const ErrorNorms *exact)
+{
+  PetscFunctionBeginUser;
+  if (!est->computed) {
+    if (est->unavailable[0]) PetscCall(PetscPrintf(comm, "  error estimate: none (%s)\n", est->unavailable));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(PetscPrintf(comm, "  error estimate (energy norm): %.4e =", (double)est->total));
+  for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k)
+    PetscCall(PetscPrintf(comm, "%s %s %.2e", k ? "," : "", EstimateParts[k], (double)est->part[k]));
+  if (!PetscIsNanReal(exact->energy) && exact->energy > 0.0)
+    PetscCall(PetscPrintf(comm, "; effectivity %.3f against the exact error %.4e", (double)(est->total / exact->energy), (double)exact->energy));
+  PetscCall(PetscPrintf(comm, "\n"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

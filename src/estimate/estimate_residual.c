@@ -1,0 +1,264 @@
+/* The residual parts of the estimate (estimate.c says where they come from), for P1 simplices, each squared term divided
+   by 2 mu:
+     bulk      eta_T^2 = h_T^2 ||f||_T^2                       (div sigma(u_h) = 0 in a P1 cell)
+     jump      eta_F^2 = h_F ||[sigma(u_h) n]||_F^2            interior faces, half to each of the two cells
+     neumann   eta_F^2 = h_F ||t - sigma(u_h) n||_F^2          loaded and free faces; on a slip face the free components
+     contact   eta_F^2 = h_F ||sigma(u_h) n + p_h n_o||_F^2    on Gamma_C, split along the obstacle's normal n_o (normal)
+                                                               and across it (tangential: frictionless, the traction has none)
+   with h_T, h_F the diameters, f the body force, t the traction of the face, p_h the contact pressure of the method:
+   the penalty law (1/eps)[u_h . n_o - g]_+ at each point for the Gauss rule (the traction the discrete problem applies),
+   and the nodal force over the lumped area, interpolated, for the nodal rule and SNESVI. A scene with weak data (mms)
+   loads its faces by sigma(u_exact) n and its cells by f = -div sigma(u_exact) (Scene.exact_source).
+   The jumps need the stress of both cells of a face, which may sit on two ranks: each cell adds sigma n_out to its
+   faces, and the point SF sums them, so that an interior face holds sigma_1 n_1 + sigma_2 n_2 = [sigma n]. */
+#include <petscsf.h>
+#include "contact.h"
+#include "estimate_impl.h"
+#include "obstacle.h"
+#include "physics.h"
+
+/* The body force at x: -f0_body (which includes -body_force), or the constant body force; plus the exact source. */
+static PetscErrorCode BodyForce(const EstimateWork *w, const PetscReal x[], PetscReal f[])
+{
+  const Scene   *scene = &w->user->scene;
+  const PetscInt dim   = w->dim;
+
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < dim; ++d) f[d] = 0.0;
+  if (scene->f0_body) {
+    const PetscScalar zero[9] = {0.0};
+    PetscScalar       f0[3];
+
+    scene->f0_body(dim, 1, 0, NULL, NULL, zero, NULL, zero, NULL, NULL, NULL, NULL, NULL, 0.0, x, w->nconstants, w->constants, f0);
+    for (PetscInt d = 0; d < dim; ++d) f[d] -= PetscRealPart(f0[d]);
+  } else
+    for (PetscInt d = 0; d < dim; ++d) f[d] += PetscRealPart(w->constants[CONST_BODY_FORCE + d]);
+  if (scene->exact_source) {
+    PetscScalar s[3];
+
+    PetscCall((*scene->exact_source)(dim, 0.0, x, dim, s, (void *)w->constants));
+    for (PetscInt d = 0; d < dim; ++d) f[d] += PetscRealPart(s[d]);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* sigma(u_exact) n at x, the traction of a scene with weak data */
+static PetscErrorCode ExactTraction(const EstimateWork *w, const PetscReal x[], const PetscReal n[], PetscReal t[])
+{
+  const Scene   *scene = &w->user->scene;
+  const PetscInt dim   = w->dim;
+  PetscScalar    g[9];
+  PetscReal      grad[9], sigma[9];
+
+  PetscFunctionBeginUser;
+  PetscCall((*scene->exact_gradient)(dim, 0.0, x, dim * dim, g, (void *)scene->constants));
+  for (PetscInt k = 0; k < dim * dim; ++k) grad[k] = PetscRealPart(g[k]);
+  ElasticStress(dim, &w->user->opt->material, grad, sigma);
+  for (PetscInt i = 0; i < dim; ++i) {
+    t[i] = 0.0;
+    for (PetscInt j = 0; j < dim; ++j) t[i] += sigma[i * dim + j] * n[j];
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* |R . n|^2 / (lambda + 2 mu) + |R - (R . n) n|^2 / (2 mu): a traction R in energy units, by the stiffness of the body
+   against it (a normal traction stretches, a tangential one shears). */
+static PetscReal WeightedSquare(const EstimateWork *w, const PetscReal R[], const PetscReal n[])
+{
+  PetscReal rn = 0.0, rt = 0.0;
+
+  for (PetscInt d = 0; d < w->dim; ++d) rn += R[d] * n[d];
+  for (PetscInt d = 0; d < w->dim; ++d) rt += PetscSqr(R[d] - rn * n[d]);
+  return rn * rn / w->m_normal + rt / w->m_shear;
+}
+
+/* Bulk terms, and each cell's sigma n_out added to its faces' sums (with a count of the cells). */
+static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
+{
+  const PetscInt dim      = w->dim;
+  PetscBool      has_load = (PetscBool)(w->user->scene.f0_body || w->user->scene.exact_source);
+
+  PetscFunctionBeginUser;
+  for (PetscInt d = 0; d < dim && !has_load; ++d) has_load = (PetscBool)(PetscRealPart(w->constants[CONST_BODY_FORCE + d]) != 0.0);
+  for (PetscInt c = w->cStart; c < w->cEnd; ++c) {
+    EstimateCell    cell;
+    const PetscInt *cone;
+    PetscInt        ncone;
+
+    PetscCall(EstimateCellLoad(w, c, &cell));
+    if (has_load) {
+      PetscReal ff = 0.0;
+
+      for (PetscInt q = 0; q < w->cell_rule.n; ++q) {
+        const PetscReal *b = &w->cell_rule.bary[q * w->cell_rule.nb];
+        PetscReal        x[3], f[3];
+
+        for (PetscInt d = 0; d < dim; ++d) {
+          x[d] = 0.0;
+          for (PetscInt k = 0; k < cell.nv; ++k) x[d] += b[k] * cell.x[k * dim + d];
+        }
+        PetscCall(BodyForce(w, x, f));
+        for (PetscInt d = 0; d < dim; ++d) ff += w->cell_rule.w[q] * cell.volume * f[d] * f[d];
+      }
+      w->eta2[(c - w->cStart) * ESTIMATE_NUM_PARTS + ESTIMATE_BULK] = PetscSqr(cell.diameter) * ff / w->m_normal;
+    }
+    PetscCall(DMPlexGetConeSize(w->dm, c, &ncone));
+    PetscCall(DMPlexGetCone(w->dm, c, &cone));
+    for (PetscInt k = 0; k < ncone; ++k) {
+      EstimateFace face;
+      PetscReal   *s = &w->face_sum[(cone[k] - pStart) * (dim + 1)];
+
+      PetscCall(EstimateFaceOfCell(w, &cell, cone[k], &face));
+      for (PetscInt i = 0; i < dim; ++i)
+        for (PetscInt j = 0; j < dim; ++j) s[i] += cell.sigma[i * dim + j] * face.normal[j];
+      s[dim] += 1.0;
+    }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The contact traction's misfit on a face of Gamma_C: into eta2[normal] and eta2[tangential] of its cell. */
+static PetscErrorCode ContactFace(EstimateWork *w, const EstimateCell *cell, const EstimateFace *face, PetscReal eta2[])
+{
+  const PetscInt dim  = w->dim;
+  const PetscInt none = ContactIsNone(w->user->contact);
+  PetscReal      sn[3], eps = 0.0, rn = 0.0, rt = 0.0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < dim; ++i) {
+    sn[i] = 0.0;
+    for (PetscInt j = 0; j < dim; ++j) sn[i] += cell->sigma[i * dim + j] * face->normal[j];
+  }
+  if (!none && !w->lp) PetscCall(ContactFaceEps(w->user->contact, cell->diameter, &eps));
+  for (PetscInt q = 0; q < w->face_rule.n; ++q) {
+    PetscReal x[3], u[3], wq, n[3], g, p = 0.0, R[3], Rn = 0.0, Rt = 0.0;
+
+    EstimateFacePoint(w, cell, face, q, x, u, &wq);
+    ObstacleGapNormalAt(&w->user->scene.obstacle, dim, x, n, &g);
+    if (w->lp) { /* the nodal pressure, stored as p n at the nodes */
+      const PetscReal *b = &w->face_rule.bary[q * w->face_rule.nb];
+
+      for (PetscInt k = 0; k < face->nv; ++k)
+        for (PetscInt d = 0; d < dim; ++d) p += b[k] * PetscRealPart(w->lp[cell->off[face->local[k]] + d]) * n[d];
+    } else if (!none) {
+      PetscReal d = -g;
+
+      for (PetscInt k = 0; k < dim; ++k) d += u[k] * n[k];
+      p = d > 0.0 ? d / eps : 0.0;
+    }
+    for (PetscInt i = 0; i < dim; ++i) R[i] = sn[i] + p * n[i];
+    if (w->user->scene.weak_data) { /* the exact solution's tangential traction is the face's datum */
+      PetscReal t[3], tn = 0.0;
+
+      PetscCall(ExactTraction(w, x, face->normal, t));
+      for (PetscInt i = 0; i < dim; ++i) tn += t[i] * n[i];
+      for (PetscInt i = 0; i < dim; ++i) R[i] -= t[i] - tn * n[i];
+    }
+    for (PetscInt i = 0; i < dim; ++i) Rn += R[i] * n[i];
+    for (PetscInt i = 0; i < dim; ++i) Rt += PetscSqr(R[i] - Rn * n[i]);
+    rn += wq * Rn * Rn;
+    rt += wq * Rt;
+  }
+  eta2[ESTIMATE_CONTACT_NORMAL] += face->diameter * rn / w->m_normal;
+  eta2[ESTIMATE_CONTACT_TANGENTIAL] += face->diameter * rt / w->m_shear;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* t - sigma(u_h) n on a loaded, free or slip face (the slip's fixed components carry the support's reaction). */
+static PetscErrorCode NeumannFace(EstimateWork *w, const EstimateCell *cell, const EstimateFace *face, PetscInt kind, PetscReal eta2[])
+{
+  const PetscInt           dim = w->dim;
+  const BoundaryCondition *bc  = kind >= 0 ? &w->user->scene.bcs.bc[kind] : NULL;
+  PetscBool                fixed[3] = {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE};
+  PetscReal                t0[3] = {0.0, 0.0, 0.0}, sn[3], r = 0.0;
+
+  PetscFunctionBeginUser;
+  if (bc && bc->kind == BC_CLAMP) PetscFunctionReturn(PETSC_SUCCESS);
+  if (bc && bc->kind == BC_SLIP)
+    for (PetscInt k = 0; k < bc->ncomp; ++k) fixed[bc->comps[k]] = PETSC_TRUE;
+  if (bc && bc->kind == BC_TRACTION)
+    for (PetscInt d = 0; d < dim; ++d) t0[d] = bc->value[d];
+  if (bc && bc->kind == BC_PRESSURE)
+    for (PetscInt d = 0; d < dim; ++d) t0[d] = -bc->value[0] * face->normal[d];
+  for (PetscInt i = 0; i < dim; ++i) {
+    sn[i] = 0.0;
+    for (PetscInt j = 0; j < dim; ++j) sn[i] += cell->sigma[i * dim + j] * face->normal[j];
+  }
+  if (!w->user->scene.weak_data) { /* constant on the face */
+    PetscReal R[3];
+
+    for (PetscInt d = 0; d < dim; ++d) R[d] = fixed[d] ? 0.0 : t0[d] - sn[d];
+    r = face->measure * WeightedSquare(w, R, face->normal);
+  } else
+    for (PetscInt q = 0; q < w->face_rule.n; ++q) {
+      PetscReal x[3], u[3], wq, t[3], R[3];
+
+      EstimateFacePoint(w, cell, face, q, x, u, &wq);
+      PetscCall(ExactTraction(w, x, face->normal, t));
+      for (PetscInt d = 0; d < dim; ++d) R[d] = fixed[d] ? 0.0 : t0[d] + t[d] - sn[d];
+      r += wq * WeightedSquare(w, R, face->normal);
+    }
+  eta2[ESTIMATE_NEUMANN] += face->diameter * r;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Faces: the jumps of the interior ones, the boundary terms of the others (from the cell holding them). */
+static PetscErrorCode FaceTerms(EstimateWork *w, PetscInt pStart)
+{
+  const PetscInt dim = w->dim;
+
+  PetscFunctionBeginUser;
+  for (PetscInt c = w->cStart; c < w->cEnd; ++c) {
+    EstimateCell    cell;
+    const PetscInt *cone;
+    PetscInt        ncone;
+    PetscReal      *eta2 = &w->eta2[(c - w->cStart) * ESTIMATE_NUM_PARTS];
+
+    PetscCall(EstimateCellLoad(w, c, &cell));
+    PetscCall(DMPlexGetConeSize(w->dm, c, &ncone));
+    PetscCall(DMPlexGetCone(w->dm, c, &cone));
+    for (PetscInt k = 0; k < ncone; ++k) {
+      const PetscReal *s    = &w->face_sum[(cone[k] - pStart) * (dim + 1)];
+      const PetscInt   kind = w->face_kind[cone[k] - w->fStart];
+      EstimateFace     face;
+
+      PetscCall(EstimateFaceOfCell(w, &cell, cone[k], &face));
+      if (s[dim] > 1.5) { /* interior: [sigma n] is constant on the face; half of the face's term to each cell */
+        eta2[ESTIMATE_JUMP] += 0.5 * face.diameter * face.measure * WeightedSquare(w, s, face.normal);
+      } else if (kind == ESTIMATE_FACE_CONTACT)
+        PetscCall(ContactFace(w, &cell, &face, eta2));
+      else
+        PetscCall(NeumannFace(w, &cell, &face, kind, eta2));
+    }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode EstimateResidualTerms(EstimateWork *w)
+{
+  const PetscInt dim = w->dim;
+  PetscInt       pStart, pEnd;
+  PetscSF        sf;
+  PetscInt       nroots;
+  MPI_Datatype   unit;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetChart(w->dm, &pStart, &pEnd));
+  PetscCall(PetscCalloc1((pEnd - pStart) * (dim + 1), &w->face_sum));
+  PetscCall(CellTerms(w, pStart));
+  /* the faces a rank shares: their owners sum the contributions, then send the sums back */
+  PetscCall(DMGetPointSF(w->dm, &sf));
+  PetscCall(PetscSFGetGraph(sf, &nroots, NULL, NULL, NULL));
+  if (nroots >= 0) { /* a graph: a distributed mesh */
+    PetscCallMPI(MPI_Type_contiguous((PetscMPIInt)(dim + 1), MPIU_REAL, &unit));
+    PetscCallMPI(MPI_Type_commit(&unit));
+    PetscCall(PetscSFReduceBegin(sf, unit, w->face_sum, w->face_sum, MPI_SUM));
+    PetscCall(PetscSFReduceEnd(sf, unit, w->face_sum, w->face_sum, MPI_SUM));
+    PetscCall(PetscSFBcastBegin(sf, unit, w->face_sum, w->face_sum, MPI_REPLACE));
+    PetscCall(PetscSFBcastEnd(sf, unit, w->face_sum, w->face_sum, MPI_REPLACE));
+    PetscCallMPI(MPI_Type_free(&unit));
+  }
+  PetscCall(FaceTerms(w, pStart));
+  PetscCall(PetscFree(w->face_sum));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
