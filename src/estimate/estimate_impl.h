@@ -42,6 +42,7 @@ typedef struct {
   PetscReal         *eta2;       /* [ncells][ESTIMATE_NUM_PARTS] the squared indicators */
   PetscInt          *face_kind;  /* [fEnd - fStart]: ESTIMATE_FACE_* or the index of the face's clamp/slip/load in the scene */
   PetscReal         *face_sum;   /* [chart][dim + 1]: sum over a face's cells of sigma n_out, and their number */
+  PetscReal         *face_geom;  /* [fEnd - fStart][dim + 2]: each face's measure, diameter and unit normal */
 } EstimateWork;
 
 enum { ESTIMATE_FACE_FREE = -1, ESTIMATE_FACE_CONTACT = -2 };

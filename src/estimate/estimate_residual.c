@@ -108,10 +108,15 @@ static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
       EstimateFace face;
       PetscReal   *s = &w->face_sum[(cone[k] - pStart) * (dim + 1)];
 
+      PetscReal   *geom = &w->face_geom[(cone[k] - w->fStart) * (dim + 2)];
+
       PetscCall(EstimateFaceOfCell(w, &cell, cone[k], &face));
       for (PetscInt i = 0; i < dim; ++i)
         for (PetscInt j = 0; j < dim; ++j) s[i] += cell.sigma[i * dim + j] * face.normal[j];
       s[dim] += 1.0;
+      geom[0] = face.measure; /* the normal's sign does not matter to the jump's weighted square */
+      geom[1] = face.diameter;
+      for (PetscInt d = 0; d < dim; ++d) geom[2 + d] = face.normal[d];
     }
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -202,30 +207,35 @@ static PetscErrorCode NeumannFace(EstimateWork *w, const EstimateCell *cell, con
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Faces: the jumps of the interior ones, the boundary terms of the others (from the cell holding them). */
+/* Faces: the jumps of the interior ones (their geometry from the cell pass), the boundary terms of the others (from
+   the cell holding them); a clamped face has none. */
 static PetscErrorCode FaceTerms(EstimateWork *w, PetscInt pStart)
 {
   const PetscInt dim = w->dim;
 
   PetscFunctionBeginUser;
-  for (PetscInt c = w->cStart; c < w->cEnd; ++c) {
-    EstimateCell    cell;
-    const PetscInt *cone;
-    PetscInt        ncone;
-    PetscReal      *eta2 = &w->eta2[(c - w->cStart) * ESTIMATE_NUM_PARTS];
+  for (PetscInt f = w->fStart; f < w->fEnd; ++f) {
+    const PetscReal *s    = &w->face_sum[(f - pStart) * (dim + 1)];
+    const PetscReal *geom = &w->face_geom[(f - w->fStart) * (dim + 2)];
+    const PetscInt   kind = w->face_kind[f - w->fStart];
+    const PetscInt  *support;
+    PetscInt         ns;
 
-    PetscCall(EstimateCellLoad(w, c, &cell));
-    PetscCall(DMPlexGetConeSize(w->dm, c, &ncone));
-    PetscCall(DMPlexGetCone(w->dm, c, &cone));
-    for (PetscInt k = 0; k < ncone; ++k) {
-      const PetscReal *s    = &w->face_sum[(cone[k] - pStart) * (dim + 1)];
-      const PetscInt   kind = w->face_kind[cone[k] - w->fStart];
-      EstimateFace     face;
+    PetscCall(DMPlexGetSupportSize(w->dm, f, &ns));
+    if (!ns) continue; /* a face of no local cell */
+    PetscCall(DMPlexGetSupport(w->dm, f, &support));
+    if (s[dim] > 1.5) { /* interior: [sigma n] is constant on the face; half of the face's term to each cell */
+      const PetscReal eta2 = 0.5 * geom[1] * geom[0] * WeightedSquare(w, s, &geom[2]);
 
-      PetscCall(EstimateFaceOfCell(w, &cell, cone[k], &face));
-      if (s[dim] > 1.5) { /* interior: [sigma n] is constant on the face; half of the face's term to each cell */
-        eta2[ESTIMATE_JUMP] += 0.5 * face.diameter * face.measure * WeightedSquare(w, s, face.normal);
-      } else if (kind == ESTIMATE_FACE_CONTACT)
+      for (PetscInt k = 0; k < ns; ++k) w->eta2[(support[k] - w->cStart) * ESTIMATE_NUM_PARTS + ESTIMATE_JUMP] += eta2;
+    } else if (kind == ESTIMATE_FACE_CONTACT || kind == ESTIMATE_FACE_FREE || w->user->scene.bcs.bc[kind].kind != BC_CLAMP) {
+      PetscReal   *eta2 = &w->eta2[(support[0] - w->cStart) * ESTIMATE_NUM_PARTS];
+      EstimateCell cell;
+      EstimateFace face;
+
+      PetscCall(EstimateCellLoad(w, support[0], &cell));
+      PetscCall(EstimateFaceOfCell(w, &cell, f, &face));
+      if (kind == ESTIMATE_FACE_CONTACT)
         PetscCall(ContactFace(w, &cell, &face, eta2));
       else
         PetscCall(NeumannFace(w, &cell, &face, kind, eta2));
@@ -245,6 +255,7 @@ PetscErrorCode EstimateResidualTerms(EstimateWork *w)
   PetscFunctionBeginUser;
   PetscCall(DMPlexGetChart(w->dm, &pStart, &pEnd));
   PetscCall(PetscCalloc1((pEnd - pStart) * (dim + 1), &w->face_sum));
+  PetscCall(PetscMalloc1((w->fEnd - w->fStart) * (dim + 2), &w->face_geom));
   PetscCall(CellTerms(w, pStart));
   /* the faces a rank shares: their owners sum the contributions, then send the sums back */
   PetscCall(DMGetPointSF(w->dm, &sf));
@@ -260,5 +271,6 @@ PetscErrorCode EstimateResidualTerms(EstimateWork *w)
   }
   PetscCall(FaceTerms(w, pStart));
   PetscCall(PetscFree(w->face_sum));
+  PetscCall(PetscFree(w->face_geom));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
