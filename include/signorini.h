@@ -204,8 +204,9 @@ typedef struct {
   PetscBool  computed;
   char       unavailable[160]; /* why there is no estimate ("" if computed or not asked for) */
   PetscReal  total, part[ESTIMATE_NUM_PARTS];
-  PetscInt   ncells; /* the local cells, */
-  PetscReal *cell;   /*   the indicator eta_T of each: the square root of the sum of its parts' squares */
+  PetscInt   ncells;  /* the local cells, */
+  PetscReal *cell;    /*   the indicator eta_T of each: the square root of the sum of its parts' squares */
+  PetscReal *density; /*   and eta_T / |T|^1/2, the error's level per unit volume, comparable across cells of any size */
   PetscReal  time;
 } ErrorEstimate;
 
@@ -296,9 +297,9 @@ typedef struct {
   PetscBool     section_check; /* -section_check: the P1 section compared with PETSc's */
   SolverOptions solver;
   VerifyOptions verify;
-  AssemblyType  assembly;       /* -assembly as given (auto, fe, p1) */
-  PetscBool     assembly_check; /* -assembly_check: assemble K both ways and compare */
-  PetscBool     perf_bandwidth; /* -perf_bandwidth: measure the memory bandwidths after the solve */
+  AssemblyType  assembly;                 /* -assembly as given (auto, fe, p1) */
+  PetscBool     assembly_check;           /* -assembly_check: assemble K both ways and compare */
+  PetscBool     perf_bandwidth;           /* -perf_bandwidth: measure the memory bandwidths after the solve */
   PetscBool     estimate, estimate_given; /* -estimate: the a posteriori error estimate after the solve (and whether it was given) */
   char          output[PETSC_MAX_PATH_LEN];
   PetscBool     output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
@@ -324,13 +325,13 @@ typedef struct {
 
 /* What the run produced: statistics, one row per solve, error norms; the summary and the writer only read it. */
 typedef struct {
-  RunStats     stats;
-  SolveRecord *records; /* one per solve, any number */
-  PetscInt     nrecords, maxrecords;
-  ErrorNorms   errors;                   /* against the scene's exact solution */
-  ErrorNorms   ref_errors;               /* against the -reference solution */
-  ErrorEstimate estimate;                /* the a posteriori estimate of the error */
-  char         diagnostics_failed[1024]; /* the diagnostics that failed after the solve, with their messages ("" if none) */
+  RunStats      stats;
+  SolveRecord  *records; /* one per solve, any number */
+  PetscInt      nrecords, maxrecords;
+  ErrorNorms    errors;                   /* against the scene's exact solution */
+  ErrorNorms    ref_errors;               /* against the -reference solution */
+  ErrorEstimate estimate;                 /* the a posteriori estimate of the error */
+  char          diagnostics_failed[1024]; /* the diagnostics that failed after the solve, with their messages ("" if none) */
 } RunRecord;
 
 /* The state of a run, by concern: its options, its scene, the problem on the current mesh, the hierarchy of the meshes

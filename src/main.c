@@ -136,7 +136,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));        /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(ProblemSetUp(dm, &user, &snes));
-  PetscCall(ReferenceCheckFile(dm, &user));    /* before the solve, not after it */
+  PetscCall(ReferenceCheckFile(dm, &user));     /* before the solve, not after it */
   PetscCall(EstimateCheckSupported(dm, &user)); /* -estimate on a discretization it does not cover */
   PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(ContactChecksGeometry(dm, &user)); /* initial overlap, an obstacle facing away: warnings */

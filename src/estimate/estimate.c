@@ -68,7 +68,7 @@ PetscErrorCode EstimateCheckSupported(DM dm, const AppCtx *user)
 PetscErrorCode EstimateReset(ErrorEstimate *est)
 {
   PetscFunctionBeginUser;
-  PetscCall(PetscFree(est->cell));
+  PetscCall(PetscFree2(est->cell, est->density));
   est->computed       = PETSC_FALSE;
   est->unavailable[0] = '\0';
   est->total          = PETSC_NAN;
@@ -107,7 +107,7 @@ PetscErrorCode EstimateCellLoad(EstimateWork *w, PetscInt c, EstimateCell *cell)
     Ji[2] = -J[2] / det;
     Ji[3] = J[0] / det;
   } else {
-    det = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
+    det   = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
     Ji[0] = (J[4] * J[8] - J[5] * J[7]) / det;
     Ji[1] = (J[2] * J[7] - J[1] * J[8]) / det;
     Ji[2] = (J[1] * J[5] - J[2] * J[4]) / det;
@@ -261,7 +261,7 @@ static PetscErrorCode ClassifyFaces(EstimateWork *w)
 
 PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
 {
-  ErrorEstimate *est = &user->rec.estimate;
+  ErrorEstimate *est  = &user->rec.estimate;
   MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
   EstimateWork   w;
   PetscBool      ok;
@@ -311,6 +311,7 @@ PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(RuleCreate(w.dim, user->scene.exact_source ? 3 : 2, &w.cell_rule));
   PetscCall(RuleCreate(w.dim - 1, 3, &w.face_rule));
   PetscCall(PetscCalloc1((w.cEnd - w.cStart) * ESTIMATE_NUM_PARTS, &w.eta2));
+  PetscCall(PetscMalloc1(w.cEnd - w.cStart, &w.volume));
   PetscCall(ClassifyFaces(&w));
 
   PetscCall(EstimateResidualTerms(&w));
@@ -318,7 +319,7 @@ PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
 
   for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k) sums[k] = 0.0;
   est->ncells = w.cEnd - w.cStart;
-  PetscCall(PetscMalloc1(est->ncells, &est->cell));
+  PetscCall(PetscMalloc2(est->ncells, &est->cell, est->ncells, &est->density));
   for (PetscInt c = 0; c < est->ncells; ++c) {
     PetscReal s = 0.0;
 
@@ -326,7 +327,8 @@ PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
       sums[k] += w.eta2[c * ESTIMATE_NUM_PARTS + k];
       s += w.eta2[c * ESTIMATE_NUM_PARTS + k];
     }
-    est->cell[c] = PetscSqrtReal(s);
+    est->cell[c]    = PetscSqrtReal(s);
+    est->density[c] = PetscSqrtReal(s / w.volume[c]);
   }
   PetscCall(MPIU_Allreduce(sums, gsums, ESTIMATE_NUM_PARTS, MPIU_REAL, MPIU_SUM, comm));
   for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k) {
@@ -338,6 +340,7 @@ PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
 
   PetscCall(PetscFree(w.face_kind));
   PetscCall(PetscFree(w.eta2));
+  PetscCall(PetscFree(w.volume));
   PetscCall(PetscFree2(w.cell_rule.bary, w.cell_rule.w));
   PetscCall(PetscFree2(w.face_rule.bary, w.face_rule.w));
   if (loc_p) {
@@ -362,8 +365,7 @@ PetscErrorCode EstimateView(MPI_Comm comm, const ErrorEstimate *est, const Error
     PetscFunctionReturn(PETSC_SUCCESS);
   }
   PetscCall(PetscPrintf(comm, "  error estimate (energy norm): %.4e =", (double)est->total));
-  for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k)
-    PetscCall(PetscPrintf(comm, "%s %s %.2e", k ? "," : "", EstimateParts[k], (double)est->part[k]));
+  for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k) PetscCall(PetscPrintf(comm, "%s %s %.2e", k ? "," : "", EstimateParts[k], (double)est->part[k]));
   if (!PetscIsNanReal(exact->energy) && exact->energy > 0.0)
     PetscCall(PetscPrintf(comm, "; effectivity %.3f against the exact error %.4e", (double)(est->total / exact->energy), (double)exact->energy));
   PetscCall(PetscPrintf(comm, "\n"));

@@ -35,14 +35,15 @@ typedef struct {
   const PetscScalar *lp;        /* the nodal contact pressure as p n (the nodal rule and SNESVI), NULL for the pointwise law */
   const PetscScalar *constants; /* the kernels' constants[] */
   PetscInt           nconstants;
-  PetscReal          m_normal;   /* lambda + 2 mu: the normal tractions' and the body force's squares are divided by it */
-  PetscReal          m_shear;    /* 2 mu: the tangential tractions' squares are divided by it */
-  EstimateRule       cell_rule;  /* for the body force */
-  EstimateRule       face_rule;  /* for the boundary terms */
-  PetscReal         *eta2;       /* [ncells][ESTIMATE_NUM_PARTS] the squared indicators */
-  PetscInt          *face_kind;  /* [fEnd - fStart]: ESTIMATE_FACE_* or the index of the face's clamp/slip/load in the scene */
-  PetscReal         *face_sum;   /* [chart][dim + 1]: sum over a face's cells of sigma n_out, and their number */
-  PetscReal         *face_geom;  /* [fEnd - fStart][dim + 2]: each face's measure, diameter and unit normal */
+  PetscReal          m_normal;  /* lambda + 2 mu: the normal tractions' and the body force's squares are divided by it */
+  PetscReal          m_shear;   /* 2 mu: the tangential tractions' squares are divided by it */
+  EstimateRule       cell_rule; /* for the body force */
+  EstimateRule       face_rule; /* for the boundary terms */
+  PetscReal         *eta2;      /* [ncells][ESTIMATE_NUM_PARTS] the squared indicators */
+  PetscReal         *volume;    /* [ncells] */
+  PetscInt          *face_kind; /* [fEnd - fStart]: ESTIMATE_FACE_* or the index of the face's clamp/slip/load in the scene */
+  PetscReal         *face_sum;  /* [chart][dim + 1]: sum over a face's cells of sigma n_out, and their number */
+  PetscReal         *face_geom; /* [fEnd - fStart][dim + 2]: each face's measure, diameter and unit normal */
 } EstimateWork;
 
 enum { ESTIMATE_FACE_FREE = -1, ESTIMATE_FACE_CONTACT = -2 };

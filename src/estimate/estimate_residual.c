@@ -86,6 +86,7 @@ static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
     PetscInt        ncone;
 
     PetscCall(EstimateCellLoad(w, c, &cell));
+    w->volume[c - w->cStart] = cell.volume;
     if (has_load) {
       PetscReal ff = 0.0;
 
@@ -108,7 +109,7 @@ static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
       EstimateFace face;
       PetscReal   *s = &w->face_sum[(cone[k] - pStart) * (dim + 1)];
 
-      PetscReal   *geom = &w->face_geom[(cone[k] - w->fStart) * (dim + 2)];
+      PetscReal *geom = &w->face_geom[(cone[k] - w->fStart) * (dim + 2)];
 
       PetscCall(EstimateFaceOfCell(w, &cell, cone[k], &face));
       for (PetscInt i = 0; i < dim; ++i)
@@ -172,8 +173,8 @@ static PetscErrorCode ContactFace(EstimateWork *w, const EstimateCell *cell, con
 /* t - sigma(u_h) n on a loaded, free or slip face (the slip's fixed components carry the support's reaction). */
 static PetscErrorCode NeumannFace(EstimateWork *w, const EstimateCell *cell, const EstimateFace *face, PetscInt kind, PetscReal eta2[])
 {
-  const PetscInt           dim = w->dim;
-  const BoundaryCondition *bc  = kind >= 0 ? &w->user->scene.bcs.bc[kind] : NULL;
+  const PetscInt           dim      = w->dim;
+  const BoundaryCondition *bc       = kind >= 0 ? &w->user->scene.bcs.bc[kind] : NULL;
   PetscBool                fixed[3] = {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE};
   PetscReal                t0[3] = {0.0, 0.0, 0.0}, sn[3], r = 0.0;
 

@@ -176,31 +176,43 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* /cell_fields/error_indicator: the estimate's indicator eta_T of each owned cell, in the cell order of /viz/topology/cells. */
+/* /cell_fields/<name>: a value of each owned cell (values[] over the local cells), in the cell order of /viz/topology/cells. */
+static PetscErrorCode ViewCellField(DM dm, const char name[], const PetscReal values[], PetscViewer viewer)
+{
+  PetscInt     cStart, cEnd, *index, nowned;
+  Vec          v;
+  PetscScalar *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(MeshOwnedIndex(dm, cStart, cEnd, &index, &nowned));
+  PetscCall(VecCreateMPI(PetscObjectComm((PetscObject)dm), nowned, PETSC_DETERMINE, &v));
+  PetscCall(PetscObjectSetName((PetscObject)v, name));
+  PetscCall(VecGetArray(v, &a));
+  for (PetscInt c = cStart; c < cEnd; ++c)
+    if (index[c - cStart] >= 0) a[index[c - cStart]] = values[c - cStart];
+  PetscCall(VecRestoreArray(v, &a));
+  PetscCall(PetscViewerHDF5PushGroup(viewer, "/cell_fields"));
+  PetscCall(VecView(v, viewer));
+  PetscCall(PetscViewerHDF5WriteObjectAttribute(viewer, (PetscObject)v, "vector_field_type", PETSC_STRING, "scalar"));
+  PetscCall(PetscViewerHDF5PopGroup(viewer));
+  PetscCall(VecDestroy(&v));
+  PetscCall(PetscFree(index));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The estimate's cell fields: error_indicator (eta_T) and error_density (eta_T / |T|^1/2). */
 static PetscErrorCode WriteCellFields(DM dm, const AppCtx *user, PetscViewer viewer)
 {
   const ErrorEstimate *est = &user->rec.estimate;
-  PetscInt             cStart, cEnd, *index, nowned;
-  Vec                  eta;
-  PetscScalar         *a;
+  PetscInt             cStart, cEnd;
 
   PetscFunctionBeginUser;
   if (!est->computed) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCheck(est->ncells == cEnd - cStart, PETSC_COMM_SELF, PETSC_ERR_PLIB, "The estimate's cells are not the mesh's");
-  PetscCall(MeshOwnedIndex(dm, cStart, cEnd, &index, &nowned));
-  PetscCall(VecCreateMPI(PetscObjectComm((PetscObject)dm), nowned, PETSC_DETERMINE, &eta));
-  PetscCall(PetscObjectSetName((PetscObject)eta, "error_indicator"));
-  PetscCall(VecGetArray(eta, &a));
-  for (PetscInt c = cStart; c < cEnd; ++c)
-    if (index[c - cStart] >= 0) a[index[c - cStart]] = est->cell[c - cStart];
-  PetscCall(VecRestoreArray(eta, &a));
-  PetscCall(PetscViewerHDF5PushGroup(viewer, "/cell_fields"));
-  PetscCall(VecView(eta, viewer));
-  PetscCall(PetscViewerHDF5WriteObjectAttribute(viewer, (PetscObject)eta, "vector_field_type", PETSC_STRING, "scalar"));
-  PetscCall(PetscViewerHDF5PopGroup(viewer));
-  PetscCall(VecDestroy(&eta));
-  PetscCall(PetscFree(index));
+  PetscCall(ViewCellField(dm, "error_indicator", est->cell, viewer));
+  PetscCall(ViewCellField(dm, "error_density", est->density, viewer));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -425,7 +437,8 @@ static PetscErrorCode WriteSolves(MPI_Comm comm, const AppCtx *user, PetscViewer
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* XDMF for ParaView into the file xdmf, pointing into h5name, the final .h5 beside it (rank 0 only). */
+/* XDMF for ParaView into the file xdmf, pointing into h5name, the final .h5 beside it (rank 0 only). The reals are
+   declared 8-byte (XDMF's default precision is 4: ParaView would read them as floats). */
 static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const char h5name[], PetscInt dim, PetscInt ncells, PetscInt ncorners,
                                 PetscInt nverts)
 {
@@ -445,19 +458,26 @@ static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const cha
   fprintf(fp, "    <DataItem Dimensions=\"%d %d\" NumberType=\"Int\" Format=\"HDF\">%s:/viz/topology/cells</DataItem>\n   </Topology>\n", (int)ncells,
           (int)ncorners, h5name);
   fprintf(fp, "   <Geometry GeometryType=\"%s\">\n", dim == 2 ? "XY" : "XYZ");
-  fprintf(fp, "    <DataItem Dimensions=\"%d %d\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n   </Geometry>\n", (int)nverts, (int)dim, h5name);
+  fprintf(fp,
+          "    <DataItem Dimensions=\"%d %d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n   </Geometry>\n",
+          (int)nverts, (int)dim, h5name);
   for (PetscInt f = 0; f < nfields; ++f) {
     fprintf(fp, "   <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", fields[f], ncomp[f] > 1 ? "Vector" : "Scalar");
     if (ncomp[f] > 1)
-      fprintf(fp, "    <DataItem Dimensions=\"%d %d\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n", (int)nverts, (int)ncomp[f], h5name,
-              fields[f]);
+      fprintf(fp, "    <DataItem Dimensions=\"%d %d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n",
+              (int)nverts, (int)ncomp[f], h5name, fields[f]);
     else
-      fprintf(fp, "    <DataItem Dimensions=\"%d\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n", (int)nverts, h5name, fields[f]);
+      fprintf(fp, "    <DataItem Dimensions=\"%d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n",
+              (int)nverts, h5name, fields[f]);
     fprintf(fp, "   </Attribute>\n");
   }
-  if (user->rec.estimate.computed) {
-    fprintf(fp, "   <Attribute Name=\"error_indicator\" AttributeType=\"Scalar\" Center=\"Cell\">\n");
-    fprintf(fp, "    <DataItem Dimensions=\"%d\" Format=\"HDF\">%s:/cell_fields/error_indicator</DataItem>\n   </Attribute>\n", (int)ncells, h5name);
+  for (PetscInt f = 0; f < 2 && user->rec.estimate.computed; ++f) {
+    const char *name = f ? "error_density" : "error_indicator";
+
+    fprintf(fp, "   <Attribute Name=\"%s\" AttributeType=\"Scalar\" Center=\"Cell\">\n", name);
+    fprintf(fp,
+            "    <DataItem Dimensions=\"%d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/cell_fields/%s</DataItem>\n   </Attribute>\n",
+            (int)ncells, h5name, name);
   }
   fprintf(fp, "  </Grid>\n </Domain>\n</Xdmf>\n");
   bad = fflush(fp) != 0 || ferror(fp);
