@@ -23,7 +23,7 @@ SRC = $(wildcard src/*.c src/*/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test test-long asan rates extremes tradeoff hertz bench format clean
+.PHONY: all deps run test test-long asan rates extremes tradeoff hertz estimates bench format clean
 STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
@@ -99,6 +99,12 @@ tradeoff: deps
 hertz: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/hertz.py --check 0.01
+
+# The a posteriori estimate (docs/estimate.md): effectivity on the manufactured solutions, its penalty part against SNESVI,
+# the error density on Hertz: output/estimates/estimates.{md,csv}, penalty.csv, hertz.csv, effectivity.png, hertz_density.png
+estimates: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) scripts/estimates.py --check
 
 # Performance (docs/solvers.md, "Performance"): bench/{bench,getfem,bandwidth,targets}.{md,csv}, runs under bench/runs/
 bench: deps

@@ -48,7 +48,7 @@ typedef struct {
 
 enum { ESTIMATE_FACE_FREE = -1, ESTIMATE_FACE_CONTACT = -2 };
 
-/* estimate.c */
+/* estimate_geometry.c */
 PetscErrorCode EstimateCellLoad(EstimateWork *w, PetscInt c, EstimateCell *cell);
 PetscErrorCode EstimateFaceOfCell(EstimateWork *w, const EstimateCell *cell, PetscInt f, EstimateFace *face);
 void           EstimateFacePoint(const EstimateWork *w, const EstimateCell *cell, const EstimateFace *face, PetscInt q, PetscReal x[], PetscReal u[],

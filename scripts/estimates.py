@@ -1,0 +1,200 @@
+#!/usr/bin/python3
+"""The study of the a posteriori error estimate (make estimates; docs/estimate.md).
+
+Usage: estimates.py [--outdir DIR] [--check]
+
+1. Effectivity (estimate / exact energy-norm error) on the manufactured solution, 2D and 3D, Poisson ratio 0.3 and 0.49,
+   eps = h and h/100, and SNESVI, each on a series of meshes (signorini.estimates.SERIES).
+2. The penalty part of the estimate against the energy-norm distance of the penalty solution to SNESVI's on the same
+   mesh, eps = h to h/1000, both rules, 2D and 3D.
+3. Hertz: how far from the contact zone's edge the largest error densities lie (the four cases of make hertz, on their
+   coarsest graded mesh, eps = h/10), and a figure of the 2D cylinder's error density.
+
+DIR (default output/estimates) receives the runs, estimates.csv, penalty.csv, hertz.csv, estimates.md, effectivity.png
+and hertz_density.png. --check: exit 1 unless, in every series, the effectivity varies by at most 1.5x over the four
+finest meshes and the estimate's rate is the error's within 0.1; the effectivity over all series varies by at most 3x;
+every penalty ratio lies in [1/3, 3]; and on every Hertz case the densest cell lies within 3 cells of the zone's edge.
+"""
+import argparse
+import csv
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from signorini import estimates as st  # noqa: E402
+from signorini import hertz  # noqa: E402
+from signorini.figures import plt, save_png  # noqa: E402
+from signorini.mpirun import error_line, run_mpi  # noqa: E402
+from signorini.paths import ROOT, display_path  # noqa: E402
+
+HERTZ_METHOD = "eps=h/10"
+
+
+def run(cmd, out):
+    res = run_mpi(cmd, log=out[:-3] + ".log", timeout=1800, header=" ".join(cmd) + "\n")
+    if res.returncode != 0 or not os.path.isfile(out):
+        sys.exit(f"failed: {' '.join(cmd)}: {error_line(res.output)}")
+    return st.read(out)
+
+
+def effectivity_series(outdir):
+    rows = []
+    for label, dim, args, sizes in st.SERIES:
+        for n in sizes:
+            out = os.path.join(outdir, f"{label.replace(' ', '_').replace('=', '').replace('/', '_')}_{n}.h5")
+            a = run(st.mms_command(dim, n, args, display_path(out)), out)
+            rows.append({"series": label, "dim": dim, "n": n, "h": a["h"], "n_dofs": a["n_dofs"], "estimate_total": a["estimate_total"],
+                         **{"estimate_" + p: a["estimate_" + p] for p in st.PARTS}, "error_energy": a["error_energy"],
+                         "effectivity": a["estimate_total"] / a["error_energy"], "time_total": a["time_total"],
+                         "time_estimate": a["time_estimate"]})
+            print(f"{label} n={n}: effectivity {rows[-1]['effectivity']:.3f}")
+    return rows
+
+
+def penalty_ladder(outdir):
+    rows = []
+    for dim, n in st.PENALTY_MESHES.items():
+        vi = os.path.join(outdir, f"penalty{dim}d_vi.h5")
+        run(st.mms_command(dim, n, ["-contact_method", "vi"], display_path(vi)), vi)
+        for rule in ("nodal", "gauss"):
+            for eps0 in st.EPS0_LADDER:
+                out = os.path.join(outdir, f"penalty{dim}d_{rule}_{eps0:g}.h5")
+                a = run(st.mms_command(dim, n, ["-penalty_quadrature", rule, "-penalty_eps0", str(eps0)], display_path(out),
+                                       reference=display_path(vi)), out)
+                rows.append({"dim": dim, "n": n, "rule": rule, "eps0": eps0, "estimate_penalty": a["estimate_penalty"],
+                             "distance_to_vi": a["reference_error_energy"], "ratio": a["estimate_penalty"] / a["reference_error_energy"]})
+                print(f"penalty {dim}D {rule} eps=h*{eps0:g}: ratio {rows[-1]['ratio']:.3f}")
+    return rows
+
+
+def hertz_cases(outdir):
+    rows, files = [], {}
+    for case, spec in hertz.CASES.items():
+        h_near = spec["h_near"][0]
+        mesh = os.path.join(outdir, hertz.mesh_name(case, h_near))
+        if not os.path.isfile(mesh):
+            hertz.write_mesh(case, h_near, mesh)
+        out = os.path.join(outdir, hertz.output_name(case, h_near, HERTZ_METHOD))
+        run(hertz.command(case, display_path(mesh), HERTZ_METHOD, display_path(out)), out)
+        m, dist = st.hertz_peak(case, out)
+        files[case] = (out, m)
+        rows.append({"case": case, "h_near": h_near, "a": m["a"], "a_h": m["a_h"], "densest_cells_from_edge": float(dist[0]),
+                     "median_of_10_densest": float(np.median(dist))})
+        print(f"hertz {case}: densest cell {dist[0]:.2f} cells from the zone's edge")
+    return rows, files
+
+
+def write_csv(rows, path):
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+
+
+def figures(rows, hertz_files, outdir):
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for ax, dim in zip(axes, (2, 3)):
+        for label, d, _, _ in st.SERIES:
+            if d != dim:
+                continue
+            sel = [r for r in rows if r["series"] == label]
+            ax.semilogx([r["n_dofs"] for r in sel], [r["effectivity"] for r in sel], "o-", label=label.split(" ", 1)[1])
+        ax.set_xlabel("dofs")
+        ax.set_ylabel("estimate / exact energy-norm error")
+        ax.set_title(f"mms {dim}D")
+        ax.set_ylim(0, None)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=8)
+    save_png(fig, os.path.join(outdir, "effectivity.png"), 120)
+
+    path, m = hertz_files["cylinder"]
+    import h5py
+    with h5py.File(path, "r") as f:
+        X, cells, dens = f["geometry/vertices"][:], f["viz/topology/cells"][:], f["cell_fields/error_density"][:]
+    a = m["a_h"]
+    cen = X[cells].mean(axis=1)
+    keep = (cen[:, 0] < 4 * a) & (cen[:, 1] < 2 * a)
+    fig, ax = plt.subplots(figsize=(8, 4))
+    tp = ax.tripcolor(X[:, 0], X[:, 1], cells[keep], facecolors=np.log10(dens[keep]), cmap="viridis", edgecolors="none")
+    ax.axvline(a, color="w", ls="--", lw=1)
+    ax.set_xlim(0, 4 * a)
+    ax.set_ylim(0, 2 * a)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x")
+    ax.set_ylabel("y")
+    ax.set_title(f"Hertz cylinder: log10 error_density near the contact (dashed: the zone's edge x = a = {a:.4f})")
+    fig.colorbar(tp, ax=ax, shrink=0.8)
+    save_png(fig, os.path.join(outdir, "hertz_density.png"), 120)
+
+
+def report(rows, pen, hz, outdir):
+    lines = ["# The a posteriori estimate: effectivity, penalty part, Hertz", "",
+             f"Made by `make estimates` (scripts/estimates.py). Effectivity = estimate_total / error_energy; spread and rates over "
+             f"the {st.ASYMPTOTIC} finest meshes of each series.", "",
+             "| series | effectivity (finest) | min | max | spread | rate of the estimate | rate of the error |", "|---|---|---|---|---|---|---|"]
+    summaries = {}
+    for label, _, _, _ in st.SERIES:
+        sel = [r for r in rows if r["series"] == label]
+        s = st.series_summary(sel)
+        summaries[label] = s
+        lines.append(f"| {label} | {sel[-1]['effectivity']:.3f} | {s['eff_min']:.3f} | {s['eff_max']:.3f} | {s['eff_spread']:.3f} | "
+                     f"{s['rate_estimate']:.3f} | {s['rate_error']:.3f} |")
+    allfine = [r["effectivity"] for label in summaries for r in [x for x in rows if x["series"] == label][-st.ASYMPTOTIC:]]
+    lines += ["", f"Over all series (their {st.ASYMPTOTIC} finest meshes): effectivity from {min(allfine):.3f} to {max(allfine):.3f}, "
+              f"a spread of {max(allfine) / min(allfine):.3f}.", "",
+              "## The penalty part against the distance to SNESVI (same mesh)", "",
+              "| dim | mesh | rule | eps | estimate_penalty | ‖u_eps − u_vi‖_a | ratio |", "|---|---|---|---|---|---|---|"]
+    for r in pen:
+        lines.append(f"| {r['dim']} | {r['n']}^{r['dim']} | {r['rule']} | h × {r['eps0']:g} | {r['estimate_penalty']:.3e} | "
+                     f"{r['distance_to_vi']:.3e} | {r['ratio']:.3f} |")
+    lines += ["", f"## Hertz: where the error density is largest ({HERTZ_METHOD}, the coarsest mesh of make hertz)", "",
+              "| case | a (closed form) | a (run) | densest cell from the edge (cells) | median of the 10 densest |", "|---|---|---|---|---|"]
+    for r in hz:
+        lines.append(f"| {r['case']} | {r['a']:.4f} | {r['a_h']:.4f} | {r['densest_cells_from_edge']:.2f} | {r['median_of_10_densest']:.2f} |")
+    with open(os.path.join(outdir, "estimates.md"), "w") as fh:
+        fh.write("\n".join(lines) + "\n")
+    return summaries, allfine
+
+
+def check(summaries, allfine, pen, hz):
+    bad = []
+    for label, s in summaries.items():
+        if s["eff_spread"] > 1.5:
+            bad.append(f"{label}: effectivity spread {s['eff_spread']:.3f} > 1.5")
+        if abs(s["rate_estimate"] - s["rate_error"]) > 0.1:
+            bad.append(f"{label}: rate {s['rate_estimate']:.3f} against the error's {s['rate_error']:.3f}")
+    if max(allfine) / min(allfine) > 3:
+        bad.append(f"effectivity over all series varies {max(allfine) / min(allfine):.3f}x > 3")
+    bad += [f"penalty {r['dim']}D {r['rule']} eps0={r['eps0']}: ratio {r['ratio']:.3f}" for r in pen if not 1 / 3 <= r["ratio"] <= 3]
+    bad += [f"hertz {r['case']}: densest cell {r['densest_cells_from_edge']:.2f} cells from the edge" for r in hz
+            if r["densest_cells_from_edge"] > 3]
+    return bad
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--outdir", default=os.path.join(ROOT, "output", "estimates"))
+    p.add_argument("--check", action="store_true")
+    args = p.parse_args()
+    os.makedirs(args.outdir, exist_ok=True)
+    rows = effectivity_series(args.outdir)
+    pen = penalty_ladder(args.outdir)
+    hz, hertz_files = hertz_cases(args.outdir)
+    write_csv(rows, os.path.join(args.outdir, "estimates.csv"))
+    write_csv(pen, os.path.join(args.outdir, "penalty.csv"))
+    write_csv(hz, os.path.join(args.outdir, "hertz.csv"))
+    figures(rows, hertz_files, args.outdir)
+    summaries, allfine = report(rows, pen, hz, args.outdir)
+    print(f"wrote {display_path(os.path.join(args.outdir, 'estimates.md'))}")
+    if args.check:
+        bad = check(summaries, allfine, pen, hz)
+        for b in bad:
+            print("CHECK FAILED:", b, file=sys.stderr)
+        return 1 if bad else 0
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
