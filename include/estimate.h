@@ -10,3 +10,8 @@ PetscErrorCode EstimateCheckSupported(DM dm, const AppCtx *user);
 PetscErrorCode EstimateReset(ErrorEstimate *est);
 PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u);
 PetscErrorCode EstimateView(MPI_Comm comm, const ErrorEstimate *est, const ErrorNorms *exact);
+
+/* bars.c: -bars, the error bars of the quantities users read */
+PetscErrorCode BarsCheck(MPI_Comm comm, const AppCtx *user);
+PetscErrorCode BarsCompute(DM dm, AppCtx *user);
+PetscErrorCode BarsView(MPI_Comm comm, const ErrorBars *b);

@@ -21,6 +21,9 @@ PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const
 /* postprocess.c */
 PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u);
 PetscErrorCode PostprocessPenetration(AppCtx *user);
+void           PostprocessGetQuantities(const AppCtx *user, Quantities *q);
+/* contact_zone.c */
+PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size);
 
 /* contact_checks.c */
 PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user);

@@ -250,6 +250,16 @@ typedef struct {
   PetscReal zone_limit;       /* fewer cells are warned of: CONTACT_CHECK_ZONE_CELLS_2D or _3D */
 } ContactChecks;
 
+/* The quantities users read of a solution (PostprocessContact()), whose error bars -bars estimates (src/estimate/bars.c). */
+typedef struct {
+  PetscReal force[3];                  /* the obstacle's force on the body */
+  PetscReal pressure_max;              /* the largest nodal contact pressure */
+  PetscReal contact_size;              /* the contact zone's measure on Gamma_C: its width in 2D, its area in 3D */
+  PetscReal penetration_max;           /* the largest penetration */
+  PetscReal energy;                    /* 1/2 a(u,u) - L(u) + the contact term's energy */
+  PetscReal reaction[BOUNDARY_MAX][3]; /* the force of each clamp or slip face set's support on the body */
+} Quantities;
+
 typedef struct {
   PetscInt            newton_its, ksp_its;             /* of the last solve (the finest mesh, the last eps) */
   PetscInt            newton_its_total, ksp_its_total; /* of all solves: grid sequence levels, continuation, eps sweep */
@@ -273,11 +283,34 @@ typedef struct {
   PetscReal           time_setup, time_solve, time_total;
   PetscInt            active_vertices;
   PetscReal           max_penetration, contact_force, energy;
+  PetscReal           pressure_max;              /* the largest nodal contact pressure */
+  PetscReal           contact_size;              /* the contact zone's width (2D) or area (3D), PostprocessContactSize() */
   PetscReal           contact_force_vector[3];   /* the obstacle's force on the body: the sum of R = K u + r0 over the contact nodes */
   PetscReal           reaction[BOUNDARY_MAX][3]; /* force the support of each clamp or slip face set exerts on the body */
   MeshPartitionStats  partition;                 /* from MeshPartitionGetStats() */
   ContactChecks       checks;                    /* the set-up's and the contact zone's warnings */
 } RunStats;
+
+/* Error bars of the quantities users read (-bars, src/estimate/bars.c): the mesh's part from the solutions on the three
+   finest nested meshes (Richardson extrapolation with the observed order, Roache's grid convergence index), the penalty's
+   from a second solve at eps / BARS_EPS_RATIO on the coarsest of them. */
+#define BARS_LEVELS 3
+#define BARS_EPS_RATIO 10.0
+#define BARS_MAX (8 + 3 * BOUNDARY_MAX)
+typedef struct {
+  PetscInt   nlevels;                /* levels recorded, coarsest first: the last is the final mesh */
+  Quantities level[BARS_LEVELS];
+  PetscReal  level_h[BARS_LEVELS];
+  PetscBool  eps_done;               /* the second eps was solved (the penalty method) */
+  PetscReal  eps, eps_second;        /* the run's eps on the coarsest level and the second one */
+  Quantities eps_level;              /* that level's quantities at eps_second */
+  PetscInt   n;                      /* the quantities, after BarsCompute(): */
+  char       name[BARS_MAX][64];     /*   contact_force_x, ..., pressure_max, contact_size, penetration_max, energy, reaction_* */
+  PetscReal  value[BARS_MAX];        /*   on the final mesh */
+  PetscReal  bar[BARS_MAX];          /*   bar_mesh + bar_eps, NaN where there is none */
+  PetscReal  bar_mesh[BARS_MAX], bar_eps[BARS_MAX], order[BARS_MAX];
+  char       note[BARS_MAX][128];    /*   why there is no bar ("" if there is one) */
+} ErrorBars;
 
 /* One solve of a run: a level of the grid sequence or an eps of the sweep (/solves in the output). */
 typedef struct {
@@ -301,6 +334,7 @@ typedef struct {
   PetscBool     assembly_check;           /* -assembly_check: assemble K both ways and compare */
   PetscBool     perf_bandwidth;           /* -perf_bandwidth: measure the memory bandwidths after the solve */
   PetscBool     estimate, estimate_given; /* -estimate: the a posteriori error estimate after the solve (and whether it was given) */
+  PetscBool     bars;                     /* -bars: error bars of the quantities from the nested meshes and a second eps */
   char          output[PETSC_MAX_PATH_LEN];
   PetscBool     output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
 } RunOptions;
@@ -331,6 +365,7 @@ typedef struct {
   ErrorNorms    errors;                   /* against the scene's exact solution */
   ErrorNorms    ref_errors;               /* against the -reference solution */
   ErrorEstimate estimate;                 /* the a posteriori estimate of the error */
+  ErrorBars     bars;                     /* the error bars of the quantities (-bars) */
   char          diagnostics_failed[1024]; /* the diagnostics that failed after the solve, with their messages ("" if none) */
 } RunRecord;
 

@@ -58,6 +58,7 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
     }
   }
   PetscCall(EstimateView(comm, &user->rec.estimate, &user->rec.errors));
+  PetscCall(BarsView(comm, &user->rec.bars));
   PetscCall(ContactChecksWarnings(comm, &s->checks, PETSC_TRUE, NULL));
   if (user->rec.diagnostics_failed[0])
     PetscCall(
@@ -138,6 +139,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(ReferenceCheckFile(dm, &user));     /* before the solve, not after it */
   PetscCall(EstimateCheckSupported(dm, &user)); /* -estimate on a discretization it does not cover */
+  PetscCall(BarsCheck(comm, &user));             /* -bars without three nested meshes */
   PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(ContactChecksGeometry(dm, &user)); /* initial overlap, an obstacle facing away: warnings */
   PetscCall(VecDuplicate(user.prob.r0, &u));   /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
@@ -151,6 +153,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(EpsSweepSolve(dm, &user, snes, u));
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
+  PetscCall(BarsCompute(dm, &user));             /* -bars: from the levels' quantities and this mesh's */
   PetscCall(ContactChecksResolution(dm, &user)); /* cells across the contact zone: a warning */
   { /* diagnostics: a failure there is reported and the output written without them, never the solve lost */
     char failed[512];

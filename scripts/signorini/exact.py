@@ -81,6 +81,19 @@ class MMS:
         return (lam + 2 * mu) * self.profiles(x1)[3]
 
 
+def mms_quantities(mms, E, poisson):
+    """The quantities of the error bars (/run qoi_*) of the exact solution: the obstacle's force on the body (the pressure
+    (lambda + 2 mu) B (a - x)^q integrated over [0, a], times the unit depth in 3D, along +x_d), the largest pressure
+    (at x = 0), the contact zone's size (a: a width in 2D, a x 1 area in 3D) and the penetration (none)."""
+    lam, mu = plane_strain_lame(E, poisson)
+    m = lam + 2 * mu
+    axis = "xyz"[mms.dim - 1]
+    q = {f"contact_force_{c}": 0.0 for c in "xyz"[: mms.dim]}
+    q[f"contact_force_{axis}"] = m * mms.B * mms.a ** (mms.q + 1) / (mms.q + 1)
+    q.update({"pressure_max": m * mms.B * mms.a ** mms.q, "contact_size": mms.a, "penetration_max": 0.0})
+    return q
+
+
 def mms_from_run(attrs):
     """The MMS of a run of scene mms, from its /run attributes (scene_0..3 = nu, a, A, B; dim)."""
     assert attrs["scene"] == "mms", attrs["scene"]

@@ -24,6 +24,9 @@ PetscErrorCode EstimateGetOptions(MPI_Comm comm, RunOptions *opt)
   opt->estimate = PETSC_TRUE;
   PetscCall(PetscOptionsBool("-estimate", "Estimate the energy-norm error of the solution, cell by cell (P1 simplices)", "EstimateCompute",
                              opt->estimate, &opt->estimate, &opt->estimate_given));
+  opt->bars = PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-bars", "Error bars of the force, pressure, contact size, penetration, energy and reactions (three nested meshes)",
+                             "BarsCompute", opt->bars, &opt->bars, NULL));
   PetscOptionsEnd();
   PetscFunctionReturn(PETSC_SUCCESS);
 }

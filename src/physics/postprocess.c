@@ -25,7 +25,30 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   st->contact_force   = res.force;
   st->active_vertices = res.active_vertices;
   st->energy          = 0.5 * PetscRealPart(uKu) + PetscRealPart(r0u) + res.energy;
+  {
+    const ContactSet *cs;
+    PetscReal         pmax = 0.0;
+
+    PetscCall(ContactGetSet(user->contact, &cs));
+    for (PetscInt i = 0; i < cs->n; ++i) pmax = PetscMax(pmax, cs->pressure[i]);
+    PetscCall(MPIU_Allreduce(&pmax, &st->pressure_max, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
+  }
+  PetscCall(PostprocessContactSize(dm, user, u, &st->contact_size));
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The quantities users read, as PostprocessContact() left them in the record. */
+void PostprocessGetQuantities(const AppCtx *user, Quantities *q)
+{
+  const RunStats *st = &user->rec.stats;
+
+  for (PetscInt c = 0; c < 3; ++c) q->force[c] = st->contact_force_vector[c];
+  q->pressure_max    = st->pressure_max;
+  q->contact_size    = st->contact_size;
+  q->penetration_max = st->max_penetration;
+  q->energy          = st->energy;
+  for (PetscInt i = 0; i < BOUNDARY_MAX; ++i)
+    for (PetscInt c = 0; c < 3; ++c) q->reaction[i][c] = st->reaction[i][c];
 }
 
 /* The largest penetration of the run: that of the nodes and the rule's points (PostprocessContact()) and that of the

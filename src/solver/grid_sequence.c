@@ -8,6 +8,7 @@
    reported and the next level starts from zero: the mesh of the options is always solved. */
 #include "contact.h"
 #include "mesh.h"
+#include "physics.h"
 #include "solver.h"
 
 /* Replaces the problem on *dm by the problem on its uniform refinement, with *u interpolated as the initial guess. */
@@ -51,11 +52,13 @@ static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *
    looser than -snes_rtol. Its solution is only the next level's initial guess, whose own error is of the order of h. */
 static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
 {
-  PetscReal atol, rtol, stol;
-  PetscInt  maxit, maxf;
+  const PetscInt nlevels = user->box.coarse_levels + user->opt->solver.grid_sequence;
+  PetscReal      atol, rtol, stol;
+  PetscInt       maxit, maxf;
 
   PetscFunctionBeginUser;
   if (user->prob.level >= user->box.coarse_levels) PetscFunctionReturn(PETSC_SUCCESS);
+  if (user->opt->bars && user->prob.level >= nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS); /* they serve the bars */
   PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
   if (user->opt->solver.coarse_rtol > rtol) PetscCall(SNESSetTolerances(snes, atol, user->opt->solver.coarse_rtol, stol, maxit, maxf));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -80,8 +83,72 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOpt
   *coarse_mg = (PetscBool)(opt->solver.coarse_mg && given && !is_mg && !is_factor && !ContactHasBounds(ct));
   *request   = k;
   *min_faces = (is_mg || *coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
+  if (opt->bars) *min_faces = PetscMin(*min_faces, GRID_SEQUENCE_MIN_FACES_BARS); /* -bars: boxes coarse enough for three levels */
   /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels) */
   if (k < 0 && (!(ContactHasPenalty(ct) || (ContactIsNone(ct) && is_mg)) || opt->degree != 1)) *request = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -bars: a coarser level solves at the final mesh's eps, so that the levels differ by their discretization alone: eps =
+   eps0 h^power / M with h halved at each level up to the final one (the local factors are the same on nested meshes). */
+static PetscErrorCode GridSequenceBarsEps(SNES snes, AppCtx *user, PetscInt nlevels)
+{
+  const ContactOptions *copt;
+  PetscReal             eps;
+  DM                    dm;
+
+  PetscFunctionBeginUser;
+  if (!user->opt->bars || !ContactHasPenalty(user->contact) || user->prob.level >= nlevels) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetOptions(user->contact, &copt));
+  if (copt->eps_fixed > 0.0) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(SNESGetDM(snes, &dm));
+  PetscCall(ContactGetEps(user->contact, &eps));
+  PetscCall(ContactSetEps(user->contact, dm, eps * PetscPowReal(2.0, -(PetscReal)(nlevels - user->prob.level) * copt->eps_power)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -bars: the quantities of each of the three finest levels, and on the coarsest of them those of a second solve at
+   eps / BARS_EPS_RATIO from its solution (the penalty's part of the bars, src/estimate/bars.c); that solve leaves the
+   level's solution, eps and record of the outcome as they were, and counts in the run's totals. */
+static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, PetscInt nlevels)
+{
+  ErrorBars     *b     = &user->rec.bars;
+  const PetscInt first = nlevels - (BARS_LEVELS - 1);
+  DM             dm;
+
+  PetscFunctionBeginUser;
+  if (!user->opt->bars || user->prob.level < first || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(SNESGetDM(snes, &dm));
+  PetscCall(PostprocessContact(dm, user, u));
+  PostprocessGetQuantities(user, &b->level[b->nlevels]);
+  b->level_h[b->nlevels++] = user->prob.h;
+  if (user->prob.level == first && ContactHasPenalty(user->contact)) {
+    const RunStats saved = user->rec.stats;
+    Vec            u0;
+
+    PetscCall(ContactGetEps(user->contact, &b->eps));
+    b->eps_second = b->eps / BARS_EPS_RATIO;
+    PetscCall(VecDuplicate(u, &u0));
+    PetscCall(VecCopy(u, u0));
+    PetscCall(ContactSetEps(user->contact, dm, b->eps_second));
+    PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
+    if (user->rec.stats.converged) {
+      PetscCall(PostprocessContact(dm, user, u));
+      PostprocessGetQuantities(user, &b->eps_level);
+      b->eps_done = PETSC_TRUE;
+    }
+    PetscCall(ContactSetEps(user->contact, dm, b->eps));
+    PetscCall(VecCopy(u0, u));
+    PetscCall(VecDestroy(&u0));
+    {
+      RunStats now = user->rec.stats;
+
+      user->rec.stats                  = saved;
+      user->rec.stats.newton_its_total = now.newton_its_total;
+      user->rec.stats.ksp_its_total    = now.ksp_its_total;
+      user->rec.stats.time_solve       = now.time_solve;
+    }
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -90,8 +157,12 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
   const PetscInt nlevels = user->box.coarse_levels + user->opt->solver.grid_sequence;
 
   PetscFunctionBeginUser;
+  user->rec.bars.nlevels  = 0;
+  user->rec.bars.eps_done = PETSC_FALSE;
   PetscCall(GridSequenceSetTolerance(*snes, user));
+  PetscCall(GridSequenceBarsEps(*snes, user, nlevels));
   PetscCall(SolverSolve(*snes, user, *u, SOLVER_START_ZERO));
+  PetscCall(GridSequenceBarsLevel(*snes, user, *u, nlevels));
   for (PetscInt l = 1; l <= nlevels; ++l) {
     const PetscBool failed = (PetscBool)!user->rec.stats.converged;
     PetscLogDouble  t0, t1;
@@ -106,7 +177,9 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     user->prob.setup_time = t1 - t0; /* refinement, set-up and interpolation */
     user->rec.stats.time_setup += t1 - t0;
     PetscCall(GridSequenceSetTolerance(*snes, user));
+    PetscCall(GridSequenceBarsEps(*snes, user, nlevels));
     PetscCall(SolverSolve(*snes, user, *u, failed ? SOLVER_START_ZERO : SOLVER_START_COARSER_MESH));
+    PetscCall(GridSequenceBarsLevel(*snes, user, *u, nlevels));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
