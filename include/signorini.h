@@ -298,18 +298,18 @@ typedef struct {
 #define BARS_EPS_RATIO 10.0
 #define BARS_MAX (8 + 3 * BOUNDARY_MAX)
 typedef struct {
-  PetscInt   nlevels;                /* levels recorded, coarsest first: the last is the final mesh */
+  PetscInt   nlevels; /* levels recorded, coarsest first: the last is the final mesh */
   Quantities level[BARS_LEVELS];
   PetscReal  level_h[BARS_LEVELS];
-  PetscBool  eps_done;               /* the second eps was solved (the penalty method) */
-  PetscReal  eps, eps_second;        /* the run's eps on the coarsest level and the second one */
-  Quantities eps_level;              /* that level's quantities at eps_second */
-  PetscInt   n;                      /* the quantities, after BarsCompute(): */
-  char       name[BARS_MAX][64];     /*   contact_force_x, ..., pressure_max, contact_size, penetration_max, energy, reaction_* */
-  PetscReal  value[BARS_MAX];        /*   on the final mesh */
-  PetscReal  bar[BARS_MAX];          /*   bar_mesh + bar_eps, NaN where there is none */
+  PetscBool  eps_done;           /* the second eps was solved (the penalty method) */
+  PetscReal  eps, eps_second;    /* the run's eps on the coarsest level and the second one */
+  Quantities eps_level;          /* that level's quantities at eps_second */
+  PetscInt   n;                  /* the quantities, after BarsCompute(): */
+  char       name[BARS_MAX][64]; /*   contact_force_x, ..., pressure_max, contact_size, penetration_max, energy, reaction_* */
+  PetscReal  value[BARS_MAX];    /*   on the final mesh */
+  PetscReal  bar[BARS_MAX];      /*   bar_mesh + bar_eps, NaN where there is none */
   PetscReal  bar_mesh[BARS_MAX], bar_eps[BARS_MAX], order[BARS_MAX];
-  char       note[BARS_MAX][128];    /*   why there is no bar ("" if there is one) */
+  char       note[BARS_MAX][128]; /*   why there is no bar ("" if there is one) */
 } ErrorBars;
 
 /* One solve of a run: a level of the grid sequence or an eps of the sweep (/solves in the output). */

@@ -27,9 +27,8 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
    -contact_coarse_mg) a coarser box costs little and is one more level of the hierarchy (a smaller coarse factorization). */
 #define GRID_SEQUENCE_MIN_FACES 64
 #define GRID_SEQUENCE_MIN_FACES_MG 16
-#define GRID_SEQUENCE_MIN_FACES_BARS 4 /* with -bars, which needs two boxes below the final one */
 PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt *min_faces,
-                                         PetscBool *coarse_mg);
+                                         PetscInt *min_levels, PetscBool *coarse_mg);
 PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts);
 PetscErrorCode SolverGivenIndex(const char prefix[], PetscInt *k);
 PetscErrorCode SolverGivenEsteig(const SolverGiven *g, const char prefix[], PetscInt *n, PetscReal t[]);

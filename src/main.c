@@ -128,18 +128,18 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   user.opt = &opt;
 
   {
-    PetscInt coarse_request, coarse_min_faces;
+    PetscInt coarse_request, coarse_min_faces, coarse_min_levels;
 
-    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, &coarse_request, &coarse_min_faces, &user.rec.stats.coarse_mg));
+    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, &coarse_request, &coarse_min_faces, &coarse_min_levels, &user.rec.stats.coarse_mg));
     PetscCall(MultigridCreate(user.rec.stats.coarse_mg, &user.mg));
-    PetscCall(MeshCreate(comm, opt.solver.grid_sequence, coarse_request, coarse_min_faces, &user.box, &dm));
+    PetscCall(MeshCreate(comm, opt.solver.grid_sequence, coarse_request, coarse_min_faces, coarse_min_levels, &user.box, &dm));
   }
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));        /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(ReferenceCheckFile(dm, &user));     /* before the solve, not after it */
   PetscCall(EstimateCheckSupported(dm, &user)); /* -estimate on a discretization it does not cover */
-  PetscCall(BarsCheck(comm, &user));             /* -bars without three nested meshes */
+  PetscCall(BarsCheck(comm, &user));            /* -bars without three nested meshes */
   PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(ContactChecksGeometry(dm, &user)); /* initial overlap, an obstacle facing away: warnings */
   PetscCall(VecDuplicate(user.prob.r0, &u));   /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */

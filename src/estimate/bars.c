@@ -45,7 +45,7 @@ PetscErrorCode BarsCheck(MPI_Comm comm, const AppCtx *user)
    components and the reactions, since a component may be zero): a difference below round-off of that size is none. */
 static PetscInt List(const AppCtx *user, PetscInt dim, const Quantities *q, char names[][64], PetscReal v[], PetscReal kind[])
 {
-  PetscInt  n = 0;
+  PetscInt  n     = 0;
   PetscReal force = 0.0, reactions = 0.0;
 
   for (PetscInt c = 0; c < dim; ++c) force += PetscSqr(q->force[c]);
@@ -90,8 +90,8 @@ static void MeshPart(const PetscReal f[3], PetscReal kind, PetscReal *bar, Petsc
   const PetscReal e21 = f[1] - f[2], e32 = f[0] - f[1];
   const PetscReal scale = PetscMax(PetscMax(PetscMax(PetscAbsReal(f[0]), PetscAbsReal(f[1])), PetscAbsReal(f[2])), kind);
 
-  *bar   = PETSC_NAN;
-  *order = PETSC_NAN;
+  *bar    = PETSC_NAN;
+  *order  = PETSC_NAN;
   note[0] = '\0';
   if (PetscAbsReal(e21) <= 1e-10 * scale && PetscAbsReal(e32) <= 1e-10 * scale) { /* the same on every mesh to round-off: exact, or zero */
     *bar = 0.0;
@@ -140,7 +140,7 @@ PetscErrorCode BarsCompute(DM dm, AppCtx *user)
     }
     b->bar_eps[k] = b->eps_done ? PetscAbsReal(lv[0][k] - ev[k]) * BARS_EPS_RATIO / (BARS_EPS_RATIO - 1.0) : 0.0;
     if (b->bar_eps[k] <= 1e-10 * PetscMax(kind[k], PetscAbsReal(lv[0][k]))) b->bar_eps[k] = 0.0; /* round-off */
-    b->bar[k]     = b->bar_mesh[k] + b->bar_eps[k]; /* NaN with the mesh's part */
+    b->bar[k] = b->bar_mesh[k] + b->bar_eps[k];                                                  /* NaN with the mesh's part */
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

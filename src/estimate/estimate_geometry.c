@@ -122,4 +122,3 @@ void EstimateFacePoint(const EstimateWork *w, const EstimateCell *cell, const Es
   }
   *weight = w->face_rule.w[q] * face->measure;
 }
-

@@ -312,7 +312,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteRealAttr(v, "energy", s->energy));
   PetscCall(WriteRealAttr(v, "pressure_max", s->pressure_max)); /* the largest nodal contact pressure */
   PetscCall(WriteRealAttr(v, "contact_size", s->contact_size)); /* the contact zone's width (2D) or area (3D) */
-  for (PetscInt c = 0; c < dim; ++c) { /* the total force of the obstacle, contact_force_x, _y, _z */
+  for (PetscInt c = 0; c < dim; ++c) {                          /* the total force of the obstacle, contact_force_x, _y, _z */
     char name[32];
 
     PetscCall(PetscSNPrintf(name, sizeof(name), "contact_force_%c", "xyz"[c]));
@@ -393,7 +393,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   } else if (user->rec.estimate.unavailable[0])
     PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "estimate_unavailable", PETSC_STRING, user->rec.estimate.unavailable));
   for (PetscInt k = 0; k < user->rec.bars.n; ++k) { /* -bars: qoi_NAME, its bar and parts and order, or why there is no bar */
-    const ErrorBars *b = &user->rec.bars;
+    const ErrorBars *b        = &user->rec.bars;
     const char      *suffix[] = {"", "_bar", "_bar_mesh", "_bar_eps", "_order"};
     const PetscReal  values[] = {b->value[k], b->bar[k], b->bar_mesh[k], b->bar_eps[k], b->order[k]};
     char             name[128];

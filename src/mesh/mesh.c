@@ -53,9 +53,11 @@ static PetscErrorCode MeshReadFile(MPI_Comm comm, const char filename[], DM *dm)
 /* Creates the mesh from PETSc's own options; simplex boxes, which PETSc 3.18 cannot generate
    without Triangle/CTetGen, come from MeshCreateSimplexBox(). later_refinements: uniform refinements the run will
    still make (grid sequencing), counted in the size check. coarse_request: nested iteration to the box of the options
-   (-1: as many levels as keep coarse_min_faces cells per side, where the box nests; 0: none; k: k levels, or an
-   error): the box built is then the coarsest, and box->coarse_levels says how many doublings lead to the one asked for. */
-PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt coarse_request, PetscInt coarse_min_faces, MeshBox *box, DM *dm)
+   (-1: as many levels as keep coarse_min_faces cells per side, and at least coarse_min_levels while the box has 2 cells per
+   side to halve, where the box nests; 0: none; k: k levels, or an error): the box built is then the coarsest, and
+   box->coarse_levels says how many doublings lead to the one asked for. */
+PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt coarse_request, PetscInt coarse_min_faces, PetscInt coarse_min_levels,
+                          MeshBox *box, DM *dm)
 {
   PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
   PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
@@ -147,7 +149,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
       for (PetscBool halves = PETSC_TRUE; halves && coarse < 8;) {
         halves = (PetscBool)((faces[1] >> (coarse + 1)) % size == 0);
         for (PetscInt d = 0; d < dim; ++d)
-          halves = (PetscBool)(halves && faces[d] % (2 << coarse) == 0 && faces[d] >> (coarse + 1) >= coarse_min_faces);
+          halves =
+              (PetscBool)(halves && faces[d] % (2 << coarse) == 0 && faces[d] >> (coarse + 1) >= (coarse < coarse_min_levels ? 2 : coarse_min_faces));
         if (halves) ++coarse;
       }
     }

@@ -2,12 +2,12 @@
 
    A count of the active nodes' areas would change by a whole face whenever a node enters, so the size would not
    converge smoothly with h and its error could not be extrapolated (src/estimate/bars.c). Instead each vertex of
-   Gamma_C gets the signed value
-     s = u_n - g + (h_v / E) p,     h_v = (lumped boundary mass)^(1/(dim-1)) the local mesh size,
-   negative where the body is open (-s is the gap) and positive where it is in contact, for every method: the penalty's
-   penetration and pressure, or SNESVI's pressure with u_n = g; and the zone is the part of Gamma_C where the linear
-   interpolant of s is positive, measured exactly face by face (the zero crossing on an edge, the clipped part of a
-   triangle; a quadrilateral as two triangles). */
+   Gamma_C gets a signed value s, negative where the body is open (-s is the gap) and positive where it is in contact,
+   and the zone is the part of Gamma_C where the linear interpolant of s is positive, measured exactly face by face (the
+   zero crossing on an edge, the clipped part of a triangle; a quadrilateral as two triangles):
+     the penalty method (and no contact): s = u_n - g, positive where the penalty force acts;
+     SNESVI, where u_n = g on the whole active set: s = u_n - g + (h_v / E) p, with h_v = (lumped boundary mass)^(1/(dim-1))
+     the local mesh size, so that the pressure marks the contact side. */
 #include <petscsf.h>
 #include "physics.h"
 
@@ -63,7 +63,8 @@ PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *siz
   PetscCall(VecGetArrayRead(u, &x));
   for (PetscInt i = 0; i < cs->n; ++i) {
     if (!cs->is_vertex[i]) continue;
-    s[cs->point[i] - pStart] = ContactNodePenetration(cs, dim, i, x) + PetscPowReal(cs->weight[i], 1.0 / (dim - 1)) / E * cs->pressure[i];
+    s[cs->point[i] - pStart] = ContactNodePenetration(cs, dim, i, x);
+    if (ContactHasBounds(user->contact)) s[cs->point[i] - pStart] += PetscPowReal(cs->weight[i], 1.0 / (dim - 1)) / E * cs->pressure[i];
   }
   PetscCall(VecRestoreArrayRead(u, &x));
   PetscCall(DMGetPointSF(dm, &sf)); /* the owners' values to the ranks that share the vertex */

@@ -65,7 +65,7 @@ static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
 }
 
 PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt *min_faces,
-                                         PetscBool *coarse_mg)
+                                         PetscInt *min_levels, PetscBool *coarse_mg)
 {
   const PetscInt  k       = opt->solver.coarse_levels;
   const char     *pc_type = opt->solver.given.pc_type;
@@ -80,17 +80,18 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOpt
   /* -contact_coarse_mg: with an iterative preconditioner that is not already the boxes' multigrid (without -pc_type, the
      default is MUMPS's factorization, which a coarser box's small matrix does not make expensive); not with SNESVI, whose
      reduced system (vinewtonrsls) no PCMG can follow and whose vinewtonssls Jacobian CG cannot take */
-  *coarse_mg = (PetscBool)(opt->solver.coarse_mg && given && !is_mg && !is_factor && !ContactHasBounds(ct));
-  *request   = k;
-  *min_faces = (is_mg || *coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
-  if (opt->bars) *min_faces = PetscMin(*min_faces, GRID_SEQUENCE_MIN_FACES_BARS); /* -bars: boxes coarse enough for three levels */
+  *coarse_mg  = (PetscBool)(opt->solver.coarse_mg && given && !is_mg && !is_factor && !ContactHasBounds(ct));
+  *request    = k;
+  *min_faces  = (is_mg || *coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
+  *min_levels = opt->bars ? BARS_LEVELS - 1 : 0; /* -bars: at least two boxes below the final one, whatever their size */
   /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels) */
   if (k < 0 && (!(ContactHasPenalty(ct) || (ContactIsNone(ct) && is_mg)) || opt->degree != 1)) *request = 0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* -bars: a coarser level solves at the final mesh's eps, so that the levels differ by their discretization alone: eps =
-   eps0 h^power / M with h halved at each level up to the final one (the local factors are the same on nested meshes). */
+/* -bars: the two levels below the final one solve at the final mesh's eps, so that the three differ by their
+   discretization alone: eps = eps0 h^power / M with h halved at each level up to the final one (the local factors are the
+   same on nested meshes). The levels below them only give the next its initial guess, at their own eps. */
 static PetscErrorCode GridSequenceBarsEps(SNES snes, AppCtx *user, PetscInt nlevels)
 {
   const ContactOptions *copt;
@@ -98,7 +99,8 @@ static PetscErrorCode GridSequenceBarsEps(SNES snes, AppCtx *user, PetscInt nlev
   DM                    dm;
 
   PetscFunctionBeginUser;
-  if (!user->opt->bars || !ContactHasPenalty(user->contact) || user->prob.level >= nlevels) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt->bars || !ContactHasPenalty(user->contact) || user->prob.level >= nlevels || user->prob.level < nlevels - (BARS_LEVELS - 1))
+    PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactGetOptions(user->contact, &copt));
   if (copt->eps_fixed > 0.0) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetDM(snes, &dm));
@@ -152,6 +154,24 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* How a level starts from the coarser one's solution: like the sweep's start from a nearby eps (no continuation) when
+   -bars has solved both at the same eps and the continuation would make one stage only (eps >= f h / M, f the
+   continuation factor: a stage at h / M and back, for nothing); otherwise as nested iteration does. */
+static PetscErrorCode GridSequenceStart(const AppCtx *user, PetscInt nlevels, SolverStart *start)
+{
+  const ContactOptions *copt;
+  PetscReal             eps, eps_start;
+
+  PetscFunctionBeginUser;
+  *start = SOLVER_START_COARSER_MESH;
+  if (!user->opt->bars || !ContactHasPenalty(user->contact) || user->prob.level <= nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetOptions(user->contact, &copt));
+  PetscCall(ContactGetEps(user->contact, &eps));
+  PetscCall(ContactGetPenaltyScale(user->contact, &eps_start));
+  if (eps >= copt->continuation_factor * eps_start) *start = SOLVER_START_NEARBY_EPS;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
 {
   const PetscInt nlevels = user->box.coarse_levels + user->opt->solver.grid_sequence;
@@ -166,6 +186,7 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
   for (PetscInt l = 1; l <= nlevels; ++l) {
     const PetscBool failed = (PetscBool)!user->rec.stats.converged;
     PetscLogDouble  t0, t1;
+    SolverStart     start;
 
     if (failed && user->prob.level >= user->box.coarse_levels) break; /* a failed level of -contact_grid_sequence ends it */
     if (failed)
@@ -178,7 +199,8 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     user->rec.stats.time_setup += t1 - t0;
     PetscCall(GridSequenceSetTolerance(*snes, user));
     PetscCall(GridSequenceBarsEps(*snes, user, nlevels));
-    PetscCall(SolverSolve(*snes, user, *u, failed ? SOLVER_START_ZERO : SOLVER_START_COARSER_MESH));
+    PetscCall(GridSequenceStart(user, nlevels, &start));
+    PetscCall(SolverSolve(*snes, user, *u, failed ? SOLVER_START_ZERO : start));
     PetscCall(GridSequenceBarsLevel(*snes, user, *u, nlevels));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
