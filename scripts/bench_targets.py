@@ -273,6 +273,27 @@ def measure_mg(out, s, pairs):
     return rows
 
 
+BASE_DEFAULT = ["-options_file", "options/square.yaml", "-contact_monitor", "0"]  # the default run: MUMPS
+
+
+def measure_estimate(out, s, pairs):
+    """The error estimate and the error bars (issue 31) against the default run without them, 512 x 512 with the default
+    solver (MUMPS), side by side: the estimate at most 5% of the run (also its own time_estimate over time_total), the
+    bars at most 25% more."""
+    n = 512 // s
+    box = ["-dm_plex_box_faces", f"{n},{n}"]
+    r = side_by_side({"no_estimate": (box + ["-estimate", "false"], 1, BASE_DEFAULT), "estimate": (box, 1, BASE_DEFAULT),
+                      "bars": (box + ["-bars"], 1, BASE_DEFAULT)}, pairs, out)
+    o, e, b = r["no_estimate"], r["estimate"], r["bars"]
+    own = statistics.median(float(a["time_estimate"]) / float(a["time_total"]) for a in e[4])
+    cmd = f"bin/signorini {' '.join(BASE_DEFAULT)} -dm_plex_box_faces {n},{n} [-estimate false | -bars]"
+    return [row(f"error estimate <= 5% of the default run ({n} x {n}, MUMPS, 1 rank, whole process)",
+                f"{e[0] / o[0]:.3f} ({e[0]:.3f} s / {o[0]:.3f} s without it; {pair_range(e, o)}); its own time_estimate {100 * own:.1f}% of time_total",
+                own <= 0.05, cmd),
+            row("error bars (-bars) <= 25% more than the run without them", f"{b[0] / e[0]:.3f} ({b[0]:.3f} s / {e[0]:.3f} s; {pair_range(b, e)})",
+                b[0] / e[0] <= 1.25, cmd)]
+
+
 def measure_getfem(out, s, pairs):
     """The ratio of bench/getfem.csv (scripts/bench_getfem.py)."""
     gcsv = os.path.join(os.path.dirname(os.path.dirname(out)), "getfem.csv")
@@ -284,7 +305,8 @@ def measure_getfem(out, s, pairs):
                 "scripts/bench_getfem.py (bench/getfem.md)")]
 
 
-SECTIONS = {"default": measure_default, "mg": measure_mg, "iterations": measure_iterations, "eps": measure_eps, "parallel": measure_parallel, "getfem": measure_getfem}
+SECTIONS = {"default": measure_default, "mg": measure_mg, "iterations": measure_iterations, "eps": measure_eps, "parallel": measure_parallel, "getfem": measure_getfem,
+            "estimate": measure_estimate}
 
 
 def rows_of_table(path):

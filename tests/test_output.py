@@ -49,7 +49,8 @@ def test_xdmf_points_at_existing_datasets():
             dims = tuple(int(d) for d in item.get("Dimensions").split())
             assert f[path].shape == dims, f"{path}: {f[path].shape} vs {dims}"
             n += 1
-        assert n == 8  # topology, geometry and the fields: displacement, pressure, gap, boundary, reaction, area
+        assert n == 10  # topology, geometry, the vertex fields (displacement, pressure, gap, boundary, reaction, area), the cell fields
+        # (error_indicator, error_density)
 
 
 def test_plot_script_writes_png(outdir):
