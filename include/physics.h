@@ -9,6 +9,7 @@ PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degr
 PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user);
 PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user);
 PetscErrorCode ElasticityRigidBodyModesP1(DM dm, Vec like, MatNullSpace *nullspace);
+PetscErrorCode ElasticityP1Gradients(PetscInt dim, const PetscReal x[], PetscReal g[][3], PetscReal *volume);
 PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, PetscReal mu, const PetscReal x[], PetscScalar Ke[]);
 PetscErrorCode ElasticityP1CellVertices(MeshClosure *mc, PetscSection csec, PetscSection lsec, const PetscScalar xc[], PetscInt c, PetscReal x[],
                                         PetscInt off[], PetscInt *nv);

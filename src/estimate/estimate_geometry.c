@@ -3,12 +3,10 @@
 #include "estimate_impl.h"
 #include "physics.h"
 
-/* The cell c: vertices, coordinates, displacement, the gradients of the barycentric coordinates (the rows of the
-   inverse of J = [x_1 - x_0, ..., x_d - x_0], and minus their sum for lambda_0), grad u_h and sigma(u_h). */
+/* The cell c: vertices, coordinates, displacement, the gradients of the barycentric coordinates, grad u_h and sigma(u_h). */
 PetscErrorCode EstimateCellLoad(EstimateWork *w, PetscInt c, EstimateCell *cell)
 {
   const PetscInt dim = w->dim;
-  PetscReal      J[9], Ji[9], det;
 
   PetscFunctionBeginUser;
   PetscCall(MeshClosureVertices(&w->mc, c, 4, &cell->nv, cell->vert));
@@ -23,33 +21,13 @@ PetscErrorCode EstimateCellLoad(EstimateWork *w, PetscInt c, EstimateCell *cell)
       cell->u[k * dim + d] = PetscRealPart(w->lu[cell->off[k] + d]);
     }
   }
-  for (PetscInt i = 0; i < dim; ++i)
-    for (PetscInt k = 0; k < dim; ++k) J[i * dim + k] = cell->x[(k + 1) * dim + i] - cell->x[i];
-  if (dim == 2) {
-    det   = J[0] * J[3] - J[1] * J[2];
-    Ji[0] = J[3] / det;
-    Ji[1] = -J[1] / det;
-    Ji[2] = -J[2] / det;
-    Ji[3] = J[0] / det;
-  } else {
-    det   = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
-    Ji[0] = (J[4] * J[8] - J[5] * J[7]) / det;
-    Ji[1] = (J[2] * J[7] - J[1] * J[8]) / det;
-    Ji[2] = (J[1] * J[5] - J[2] * J[4]) / det;
-    Ji[3] = (J[5] * J[6] - J[3] * J[8]) / det;
-    Ji[4] = (J[0] * J[8] - J[2] * J[6]) / det;
-    Ji[5] = (J[2] * J[3] - J[0] * J[5]) / det;
-    Ji[6] = (J[3] * J[7] - J[4] * J[6]) / det;
-    Ji[7] = (J[1] * J[6] - J[0] * J[7]) / det;
-    Ji[8] = (J[0] * J[4] - J[1] * J[3]) / det;
+  {
+    PetscReal g[4][3];
+
+    PetscCall(ElasticityP1Gradients(dim, cell->x, g, &cell->volume));
+    for (PetscInt k = 0; k < cell->nv; ++k)
+      for (PetscInt d = 0; d < dim; ++d) cell->dl[k * dim + d] = g[k][d];
   }
-  cell->volume = PetscAbsReal(det) / (dim == 2 ? 2.0 : 6.0);
-  for (PetscInt d = 0; d < dim; ++d) cell->dl[d] = 0.0;
-  for (PetscInt k = 1; k <= dim; ++k) /* d lambda_k / dx_j = (J^-1)_{k-1, j} */
-    for (PetscInt j = 0; j < dim; ++j) {
-      cell->dl[k * dim + j] = Ji[(k - 1) * dim + j];
-      cell->dl[j] -= Ji[(k - 1) * dim + j];
-    }
   cell->diameter = 0.0;
   for (PetscInt a = 0; a < cell->nv; ++a)
     for (PetscInt b = a + 1; b < cell->nv; ++b) {

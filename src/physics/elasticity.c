@@ -226,38 +226,37 @@ void ElasticStress(PetscInt dim, const Material *mat, const PetscReal grad[], Pe
     for (PetscInt j = 0; j < dim; ++j) sigma[i * dim + j] = mat->mu * (grad[i * dim + j] + grad[j * dim + i]) + (i == j ? mat->lambda * trace : 0.0);
 }
 
-/* Element stiffness of a P1 simplex with vertices x[(dim+1)*dim], dofs ordered vertex by vertex:
-   Ke[(a,c),(b,e)] = |T| (mu (g_a . g_b) delta_ce + mu g_a[e] g_b[c] + lambda g_a[c] g_b[e]), g_a = grad phi_a. */
-PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, PetscReal mu, const PetscReal x[], PetscScalar Ke[])
+/* The gradients g[a][d] of the barycentric coordinates (the P1 basis functions) of a simplex with vertices x[(dim+1)*dim],
+   and its volume: with J[i][k] = d x_i / d xi_k = x_{k+1,i} - x_{0,i}, grad phi_{k+1} is row k of J^-1 and grad phi_0
+   minus the sum of the others. */
+PetscErrorCode ElasticityP1Gradients(PetscInt dim, const PetscReal x[], PetscReal g[][3], PetscReal *volume)
 {
-  const PetscInt nv = dim + 1, n = nv * dim;
-  PetscReal      J[9], inv[9], det, vol, g[4][3];
+  PetscReal J[9], inv[9], det;
 
   PetscFunctionBeginUser;
-  for (PetscInt i = 0; i < dim; ++i) /* J[i][k] = d x_i / d xi_k = x_{k+1,i} - x_{0,i} */
+  for (PetscInt i = 0; i < dim; ++i)
     for (PetscInt k = 0; k < dim; ++k) J[i * dim + k] = x[(k + 1) * dim + i] - x[i];
   if (dim == 2) {
-    det    = J[0] * J[3] - J[1] * J[2];
-    inv[0] = J[3] / det;
-    inv[1] = -J[1] / det;
-    inv[2] = -J[2] / det;
-    inv[3] = J[0] / det;
-    vol    = PetscAbsReal(det) / 2.0;
+    det     = J[0] * J[3] - J[1] * J[2];
+    inv[0]  = J[3] / det;
+    inv[1]  = -J[1] / det;
+    inv[2]  = -J[2] / det;
+    inv[3]  = J[0] / det;
+    *volume = PetscAbsReal(det) / 2.0;
   } else {
-    det    = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
-    inv[0] = (J[4] * J[8] - J[5] * J[7]) / det;
-    inv[1] = (J[2] * J[7] - J[1] * J[8]) / det;
-    inv[2] = (J[1] * J[5] - J[2] * J[4]) / det;
-    inv[3] = (J[5] * J[6] - J[3] * J[8]) / det;
-    inv[4] = (J[0] * J[8] - J[2] * J[6]) / det;
-    inv[5] = (J[2] * J[3] - J[0] * J[5]) / det;
-    inv[6] = (J[3] * J[7] - J[4] * J[6]) / det;
-    inv[7] = (J[1] * J[6] - J[0] * J[7]) / det;
-    inv[8] = (J[0] * J[4] - J[1] * J[3]) / det;
-    vol    = PetscAbsReal(det) / 6.0;
+    det     = J[0] * (J[4] * J[8] - J[5] * J[7]) - J[1] * (J[3] * J[8] - J[5] * J[6]) + J[2] * (J[3] * J[7] - J[4] * J[6]);
+    inv[0]  = (J[4] * J[8] - J[5] * J[7]) / det;
+    inv[1]  = (J[2] * J[7] - J[1] * J[8]) / det;
+    inv[2]  = (J[1] * J[5] - J[2] * J[4]) / det;
+    inv[3]  = (J[5] * J[6] - J[3] * J[8]) / det;
+    inv[4]  = (J[0] * J[8] - J[2] * J[6]) / det;
+    inv[5]  = (J[2] * J[3] - J[0] * J[5]) / det;
+    inv[6]  = (J[3] * J[7] - J[4] * J[6]) / det;
+    inv[7]  = (J[1] * J[6] - J[0] * J[7]) / det;
+    inv[8]  = (J[0] * J[4] - J[1] * J[3]) / det;
+    *volume = PetscAbsReal(det) / 6.0;
   }
   PetscCheck(det != 0.0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Degenerate cell (zero volume)");
-  /* grad phi_{k+1} = J^-T e_k: row k of J^-1; grad phi_0 = -sum of the others */
   for (PetscInt d = 0; d < dim; ++d) {
     g[0][d] = 0.0;
     for (PetscInt k = 0; k < dim; ++k) {
@@ -265,6 +264,18 @@ PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, Pets
       g[0][d] -= inv[k * dim + d];
     }
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Element stiffness of a P1 simplex with vertices x[(dim+1)*dim], dofs ordered vertex by vertex:
+   Ke[(a,c),(b,e)] = |T| (mu (g_a . g_b) delta_ce + mu g_a[e] g_b[c] + lambda g_a[c] g_b[e]), g_a = grad phi_a. */
+PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, PetscReal mu, const PetscReal x[], PetscScalar Ke[])
+{
+  const PetscInt nv = dim + 1, n = nv * dim;
+  PetscReal      vol, g[4][3];
+
+  PetscFunctionBeginUser;
+  PetscCall(ElasticityP1Gradients(dim, x, g, &vol));
   for (PetscInt a = 0; a < nv; ++a)
     for (PetscInt b = 0; b < nv; ++b) {
       PetscReal gab = 0.0;
