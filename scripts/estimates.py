@@ -10,11 +10,14 @@ Usage: estimates.py [--outdir DIR] [--check]
 3. Hertz: how far from the contact zone's edge the largest error densities lie (the four cases of make hertz, on their
    coarsest graded mesh, eps = h/10), and a figure of the 2D cylinder's error density.
 
-DIR (default output/estimates) receives the runs, estimates.csv, penalty.csv, hertz.csv, estimates.md, effectivity.png
-and hertz_density.png. --check: exit 1 unless, in every series, the effectivity varies by at most 1.5x over the four
+4. The error bars (-bars) against the known values: the manufactured solution's force, largest pressure and contact size
+   in 2D and 3D, and the Hertz indenters' contact size and peak pressure at the run's force (--bars-only: this part alone).
+
+DIR (default output/estimates) receives the runs, estimates.csv, penalty.csv, hertz.csv, bars.csv, estimates.md, bars.md,
+effectivity.png and hertz_density.png. --check: exit 1 unless, in every series, the effectivity varies by at most 1.5x over the four
 finest meshes and the estimate's rate is the error's within 0.1; the effectivity over all series varies by at most 3x;
-every penalty ratio lies in [1/3, 3]; and on every Hertz case the densest cell lies within 2 cell diameters of the zone's
-edge.
+every penalty ratio lies in [1/3, 3]; on every Hertz case the densest cell lies within 2 cell diameters of the zone's
+edge; at least 9 in 10 error bars cover the true error, and none is over 10 times an error above 1e-4 relative.
 """
 import argparse
 import csv
@@ -85,6 +88,42 @@ def hertz_cases(outdir):
                      "median_of_10_densest": float(np.median(dist))})
         print(f"hertz {case}: densest cell {dist[0]:.2f} cells from the zone's edge")
     return rows, files
+
+
+def coverage(outdir):
+    """The bars against the known values: one row per (run, quantity)."""
+    from signorini.exact import mms_from_run, mms_quantities
+    rows = []
+    for dim, n, extra in st.COVERAGE_MMS:
+        out = os.path.join(outdir, f"bars_mms{dim}d_{n}.h5")
+        a = run(st.mms_command(dim, n, ["-bars"] + extra, display_path(out)), out)
+        exact = mms_quantities(mms_from_run(a), a["young_modulus"], a["poisson_ratio"])
+        for q in st.MMS_QUANTITIES:
+            name = f"contact_force_{'xyz'[dim - 1]}" if q == "contact_force" else q
+            rows.append(coverage_row(f"mms{dim}d {a['n_cells']} cells", name, *st.qoi(a, name), exact[name]))
+    for case, method in st.COVERAGE_HERTZ:
+        spec = hertz.CASES[case]
+        h_near = spec["h_near"][0]
+        mesh = os.path.join(outdir, hertz.mesh_name(case, h_near))
+        if not os.path.isfile(mesh):
+            hertz.write_mesh(case, h_near, mesh)
+        out = os.path.join(outdir, "bars_" + hertz.output_name(case, h_near, method))
+        cmd = hertz.command(case, display_path(mesh), method, display_path(out)) + ["-bars", "-contact_grid_sequence", "2"]
+        if spec["dim"] == 3:
+            cmd += st.SOLVER_3D
+        a = run(cmd, out)
+        for q, (name, exact) in st.hertz_truth(case, a).items():
+            rows.append(coverage_row(f"hertz {case} {a['n_cells']} cells", name, *st.qoi(a, name), exact))
+    return rows
+
+
+def coverage_row(case, name, value, bar, exact):
+    err = abs(value - exact)
+    row = {"case": case, "quantity": name, "value": value, "exact": exact, "error": err, "bar": bar,
+           "covered": int(bool(bar >= err)) if np.isfinite(bar) else "no bar", "bar_over_error": bar / err if err > 0 else float("nan")}
+    print(f"bars {case} {name}: {value:.6g} +- {bar:.2g} against {exact:.6g} (error {err:.2g}): "
+          f"{'covered' if row['covered'] == 1 else 'NOT covered' if row['covered'] == 0 else 'no bar'}")
+    return row
 
 
 def write_csv(rows, path):
@@ -159,8 +198,27 @@ def report(rows, pen, hz, outdir):
     return summaries, allfine
 
 
-def check(summaries, allfine, pen, hz):
+def bars_report(cov, outdir):
+    with_bar = [r for r in cov if r["covered"] != "no bar"]
+    covered = sum(r["covered"] for r in with_bar)
+    lines = ["# The error bars against the known values", "",
+             f"Made by `scripts/estimates.py` (make estimates). {covered} of {len(with_bar)} bars cover the true error; "
+             f"{len(cov) - len(with_bar)} quantities got no bar (outside the asymptotic range).", "",
+             "| run | quantity | value | bar | exact | error | covered | bar / error |", "|---|---|---|---|---|---|---|---|"]
+    for r in cov:
+        lines.append(f"| {r['case']} | {r['quantity']} | {r['value']:.6g} | {r['bar']:.2g} | {r['exact']:.6g} | {r['error']:.2g} | {r['covered']} | "
+                     f"{r['bar_over_error']:.2f} |")
+    with open(os.path.join(outdir, "bars.md"), "w") as fh:
+        fh.write("\n".join(lines) + "\n")
+
+
+def check(summaries, allfine, pen, hz, cov):
     bad = []
+    with_bar = [r for r in cov if r["covered"] != "no bar"]
+    if with_bar and sum(r["covered"] for r in with_bar) < 0.9 * len(with_bar):
+        bad.append(f"bars: {sum(r['covered'] for r in with_bar)} of {len(with_bar)} cover the true error (at least 9 in 10 asked)")
+    bad += [f"bars: {r['case']} {r['quantity']}: bar {r['bar']:.2g} over 10 times the error {r['error']:.2g}" for r in with_bar
+            if r["error"] > 1e-4 * abs(r["exact"]) and r["bar"] > 10 * r["error"]]
     for label, s in summaries.items():
         if s["eff_spread"] > 1.5:
             bad.append(f"{label}: effectivity spread {s['eff_spread']:.3f} > 1.5")
@@ -178,8 +236,14 @@ def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--outdir", default=os.path.join(ROOT, "output", "estimates"))
     p.add_argument("--check", action="store_true")
+    p.add_argument("--bars-only", action="store_true", help="only the coverage of the error bars (bars.csv, bars.md)")
     args = p.parse_args()
     os.makedirs(args.outdir, exist_ok=True)
+    cov = coverage(args.outdir)
+    write_csv(cov, os.path.join(args.outdir, "bars.csv"))
+    bars_report(cov, args.outdir)
+    if args.bars_only:
+        return 0
     rows = effectivity_series(args.outdir)
     pen = penalty_ladder(args.outdir)
     hz, hertz_files = hertz_cases(args.outdir)
@@ -190,7 +254,7 @@ def main():
     summaries, allfine = report(rows, pen, hz, args.outdir)
     print(f"wrote {display_path(os.path.join(args.outdir, 'estimates.md'))}")
     if args.check:
-        bad = check(summaries, allfine, pen, hz)
+        bad = check(summaries, allfine, pen, hz, cov)
         for b in bad:
             print("CHECK FAILED:", b, file=sys.stderr)
         return 1 if bad else 0

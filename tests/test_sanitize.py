@@ -39,6 +39,9 @@ CASES = {
                                      "-assembly", "fe", "-assembly_check", "-contact_condition_estimate",
                                      "-output", "tests/out/asan/graded_gmsh_fe_check_np2.h5"], 0),  # after the file's own output: its folder may not exist
     "sbaij_nodal_continuation": (1, ["-dm_plex_box_faces", "8,8", "-dm_mat_type", "sbaij", "-penalty_quadrature", "nodal", "-penalty_eps0", 1e-4], 0),
+    "bars_mms_np2": (2, ["-scene", "mms", "-dm_plex_box_faces", "16,16", "-bars"], 0),
+    "bars_3d_grid_sequence_nodal": (1, ["-dm_plex_dim", 3, "-dm_plex_box_faces", "2,2,2", "-penalty_quadrature", "nodal", "-contact_grid_sequence", 2,
+                                        "-bars"], 0),
     "failed_solve": (1, ["-dm_plex_box_faces", "8,8", "-snes_max_it", 1], 3),
     "bad_input": (1, ["-dm_plex_box_faces", "8,8", "-young_modulus", "nan"], None),
 }

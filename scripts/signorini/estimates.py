@@ -1,5 +1,7 @@
 """The study of the a posteriori estimate (make estimates, docs/estimate.md): its effectivity on the manufactured
 solutions, its penalty part against the distance to SNESVI, and where its indicator is largest on Hertz."""
+import math
+
 import h5py
 import numpy as np
 
@@ -77,3 +79,28 @@ def hertz_peak(case, path, top=10):
     order = np.argsort(dens)[::-1][:top]
     dist = np.hypot(r[order] - m["a_h"], cen[order, dim - 1])
     return m, dist / diam[order]
+
+
+# The coverage of the error bars (-bars): runs whose quantities have a known value. The manufactured solution in 2D
+# (the box's coarser levels) and 3D (-contact_grid_sequence 2 from the box of the options), and the two Hertz indenters,
+# whose flat block is refined without changing its geometry (the curved bodies of the other two Hertz cases are
+# faceted on the coarse mesh, which a uniform refinement keeps: their bars cannot see that error).
+COVERAGE_MMS = [(2, 32, []), (2, 64, []), (2, 128, []), (3, 4, ["-contact_grid_sequence", "2"] + SOLVER_3D),
+                (3, 8, ["-contact_grid_sequence", "2"] + SOLVER_3D)]
+COVERAGE_HERTZ = [("cylinder-indenter", "eps=h/10"), ("sphere-indenter", "eps=h/10")]
+MMS_QUANTITIES = ["contact_force", "pressure_max", "contact_size"]
+
+
+def qoi(attrs, name):
+    """(value, bar) of qoi_NAME (bar NaN where there is none)."""
+    return float(attrs[f"qoi_{name}"]), float(attrs.get(f"qoi_{name}_bar", float("nan")))
+
+
+def hertz_truth(case, attrs):
+    """The closed form at the run's force: {quantity: (qoi name, its exact value)} for the contact size (a half-width of
+    the half model in 2D, a quarter disk pi a^2 / 4 in 3D) and the largest pressure p0."""
+    spec = hertz.CASES[case]
+    dim = spec["dim"]
+    force = spec["parts"] * abs(float(attrs[f"qoi_contact_force_{'xyz'[dim - 1]}"]))
+    a, p0 = hertz.closed_form(dim, force)
+    return {"contact_size": ("contact_size", a if dim == 2 else math.pi * a * a / 4), "pressure_max": ("pressure_max", p0)}

@@ -264,11 +264,13 @@ PetscErrorCode OptionsCheckPrefixesUsed(MPI_Comm comm, const char prefixes[])
 /* Whether an option not read by the end of the set-up may still be read by the solve: PETSc reads its viewers and
    monitors when an object is viewed or solved, the options of a multigrid's levels, of the sub-solvers and of a
    factorization package when the preconditioner is built, and the project reads those of the coarser boxes
-   (-contact_coarse_) and of the finest smoother (-mg_fine_) when they exist. */
+   (-contact_coarse_) and of the finest smoother (-mg_fine_) when they exist, and those of the error norms' dual-norm
+   solve (-dual_) after the solve. */
 static PetscBool ReadDuringTheSolve(const char name[])
 {
   const char *const later[] = {"mg_levels_", "mg_coarse_",       "mg_fine_",   "sub_",           "contact_coarse_", "mat_", "pc_gamg_",   "pc_mg_",
-                               "pc_hypre_",  "snes_linesearch_", "snes_test_", "ksp_chebyshev_", "fieldsplit_",     "vec_", "pc_factor_", "ksp_"};
+                               "pc_hypre_",  "snes_linesearch_", "snes_test_", "ksp_chebyshev_", "fieldsplit_",     "vec_", "pc_factor_", "ksp_",
+                               "dual_"};
 
   if (strstr(name, "view") || strstr(name, "monitor") || strstr(name, "converged_reason") || strstr(name, "log")) return PETSC_TRUE;
   for (size_t k = 0; k < sizeof(later) / sizeof(later[0]); ++k)
