@@ -150,8 +150,8 @@ PetscErrorCode BarsView(MPI_Comm comm, const ErrorBars *b)
 {
   PetscFunctionBeginUser;
   if (!b->n) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscPrintf(comm, "  error bars (mesh: three nested meshes, h to 4h, grid convergence index; eps: a second solve at eps/%g):\n",
-                        (double)BARS_EPS_RATIO));
+  PetscCall(PetscPrintf(comm, "  error bars (mesh: three nested meshes, h to 4h, grid convergence index; eps: a second solve at eps/%d):\n",
+                        (int)BARS_EPS_RATIO));
   for (PetscInt k = 0; k < b->n; ++k) {
     if (PetscIsNanReal(b->bar[k]))
       PetscCall(PetscPrintf(comm, "    %-24s %.6g, no bar: %s\n", b->name[k], (double)b->value[k], b->note[k]));
