@@ -58,6 +58,9 @@ PetscErrorCode ContactView(Contact ct, PetscViewer viewer);
 PetscBool ContactHasPenalty(Contact ct); /* a penalty term with eps: the Jacobian differs from K in the contact rows */
 PetscBool ContactHasBounds(Contact ct);  /* SNESVI's bounds: the exact constraint */
 PetscBool ContactIsNone(Contact ct);     /* no contact term: the linear elastic problem */
+/* the contact traction is the penalty law (1/eps)[u . n - g]_+ at every point of Gamma_C (the Gauss rule); otherwise a
+   nodal force (the nodal rule, SNESVI), whose pressure is that force over the node's lumped area */
+PetscBool ContactPointwiseLaw(Contact ct);
 
 /* eps: computed from the options on each mesh (ContactSetUp()), changed by the continuation and the sweep through
    ContactSetEps(), which also updates the kernels' constants[CONST_PENALTY] = 1/eps; every reader of eps reads it here. */

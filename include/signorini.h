@@ -298,9 +298,9 @@ typedef struct {
 #define BARS_EPS_RATIO 10.0
 #define BARS_MAX (8 + 3 * BOUNDARY_MAX)
 typedef struct {
-  PetscInt   nlevels; /* levels recorded, coarsest first: the last is the final mesh */
-  Quantities level[BARS_LEVELS];
-  PetscReal  level_h[BARS_LEVELS];
+  PetscInt   nlevels; /* the two levels below the final mesh recorded, coarsest first (the final's are the run's) */
+  Quantities level[BARS_LEVELS - 1];
+  PetscReal  level_h[BARS_LEVELS - 1];
   PetscBool  eps_done;           /* the second eps was solved (the penalty method) */
   PetscReal  eps, eps_second;    /* the run's eps on the coarsest level and the second one */
   Quantities eps_level;          /* that level's quantities at eps_second */

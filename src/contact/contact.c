@@ -171,6 +171,11 @@ PetscBool ContactIsNone(Contact ct)
   return (PetscBool)(!ct->has_penalty && !ct->has_bounds);
 }
 
+PetscBool ContactPointwiseLaw(Contact ct)
+{
+  return (PetscBool)(ct->has_penalty && ct->opt.quadrature == PENALTY_QUADRATURE_GAUSS);
+}
+
 /* M of eps = eps0 h^power / M: E, or the P-wave modulus lambda + 2 mu, which grows without bound as nu -> 1/2. */
 static PetscReal ContactModulus(Contact ct)
 {

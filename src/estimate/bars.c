@@ -119,7 +119,7 @@ PetscErrorCode BarsCompute(DM dm, AppCtx *user)
   ErrorBars *b = &user->rec.bars;
   Quantities q;
   PetscInt   dim;
-  PetscReal  lv[BARS_LEVELS][BARS_MAX], ev[BARS_MAX], kind[BARS_MAX], unused[BARS_MAX];
+  PetscReal  lv[BARS_LEVELS - 1][BARS_MAX], ev[BARS_MAX], kind[BARS_MAX], unused[BARS_MAX];
 
   PetscFunctionBeginUser;
   b->n = 0;
@@ -130,11 +130,11 @@ PetscErrorCode BarsCompute(DM dm, AppCtx *user)
   for (PetscInt l = 0; l < b->nlevels; ++l) (void)List(user, dim, &b->level[l], NULL, lv[l], unused);
   if (b->eps_done) (void)List(user, dim, &b->eps_level, NULL, ev, unused);
   for (PetscInt k = 0; k < b->n; ++k) {
-    if (b->nlevels < BARS_LEVELS || !user->rec.stats.converged) {
+    if (b->nlevels < BARS_LEVELS - 1 || !user->rec.stats.converged) {
       b->bar_mesh[k] = b->order[k] = PETSC_NAN;
       PetscCall(PetscSNPrintf(b->note[k], sizeof(b->note[k]), "a solve of the three meshes failed"));
     } else {
-      const PetscReal f[3] = {lv[0][k], lv[1][k], lv[2][k]};
+      const PetscReal f[3] = {lv[0][k], lv[1][k], b->value[k]};
 
       MeshPart(f, kind[k], &b->bar_mesh[k], &b->order[k], b->note[k], sizeof(b->note[k]));
     }

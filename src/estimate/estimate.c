@@ -177,15 +177,10 @@ PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(VecCopy(user->prob.loc_bc, loc_u)); /* the Dirichlet values, inserted once by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc_u));
   PetscCall(VecGetArrayRead(loc_u, &w.lu));
-  if (!ContactIsNone(user->contact)) {
-    const ContactOptions *copt;
-
-    PetscCall(ContactGetOptions(user->contact, &copt));
-    if (!ContactHasPenalty(user->contact) || copt->quadrature == PENALTY_QUADRATURE_NODAL) { /* the nodal force over the lumped area */
-      PetscCall(DMGetLocalVector(dm, &loc_p));
-      PetscCall(ErrorNormsPressureVector(dm, user, loc_p));
-      PetscCall(VecGetArrayRead(loc_p, &w.lp));
-    }
+  if (!ContactIsNone(user->contact) && !ContactPointwiseLaw(user->contact)) { /* the nodal force over the lumped area */
+    PetscCall(DMGetLocalVector(dm, &loc_p));
+    PetscCall(ErrorNormsPressureVector(dm, user, loc_p));
+    PetscCall(VecGetArrayRead(loc_p, &w.lp));
   }
   PetscCall(DMGetDS(dm, &ds));
   PetscCall(PetscDSGetConstants(ds, &w.nconstants, &w.constants));

@@ -46,17 +46,14 @@ static PetscReal TangentialGradientSquared(PetscInt dim, const EstimateCell *cel
 
 PetscErrorCode EstimatePenaltyTerm(EstimateWork *w)
 {
-  const PetscInt        dim = w->dim;
-  const Material       *mat = &w->user->opt->material;
-  const BoundarySet    *bcs = &w->user->scene.bcs;
-  const ContactOptions *copt;
-  PetscReal            *share, sums[2] = {0.0, 0.0}, gsums[2], estar, eta2;
-  PetscBool             nodal;
+  const PetscInt     dim   = w->dim;
+  const Material    *mat   = &w->user->opt->material;
+  const BoundarySet *bcs   = &w->user->scene.bcs;
+  const PetscBool    nodal = (PetscBool)!ContactPointwiseLaw(w->user->contact); /* the nodal rule */
+  PetscReal         *share, sums[2] = {0.0, 0.0}, gsums[2], estar, eta2;
 
   PetscFunctionBeginUser;
   if (!ContactHasPenalty(w->user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(ContactGetOptions(w->user->contact, &copt));
-  nodal = (PetscBool)(copt->quadrature == PENALTY_QUADRATURE_NODAL);
   PetscCall(PetscCalloc1(2 * (w->cEnd - w->cStart), &share)); /* per cell: ||d||^2 and ||grad_t d||^2 on its contact faces */
   for (PetscInt s = 0; s < bcs->ncontact; ++s) {
     PetscInt *faces, nf;

@@ -109,9 +109,10 @@ static PetscErrorCode GridSequenceBarsEps(SNES snes, AppCtx *user, PetscInt nlev
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* -bars: the quantities of each of the three finest levels, and on the coarsest of them those of a second solve at
-   eps / BARS_EPS_RATIO from its solution (the penalty's part of the bars, src/estimate/bars.c); that solve leaves the
-   level's solution, eps and record of the outcome as they were, and counts in the run's totals. */
+/* -bars: the quantities of the two levels below the final one (the final mesh's are those of the run, computed after the
+   solve), and on the coarsest of them those of a second solve at eps / BARS_EPS_RATIO from its solution (the penalty's
+   part of the bars, src/estimate/bars.c); that solve leaves the level's solution, eps and record of the outcome as they
+   were, and counts in the run's totals. */
 static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, PetscInt nlevels)
 {
   ErrorBars     *b     = &user->rec.bars;
@@ -119,7 +120,7 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
   DM             dm;
 
   PetscFunctionBeginUser;
-  if (!user->opt->bars || user->prob.level < first || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt->bars || user->prob.level < first || user->prob.level >= nlevels || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(PostprocessContact(dm, user, u));
   PostprocessGetQuantities(user, &b->level[b->nlevels]);
