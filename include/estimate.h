@@ -13,5 +13,7 @@ PetscErrorCode EstimateView(MPI_Comm comm, const ErrorEstimate *est, const Error
 
 /* bars.c: -bars, the error bars of the quantities users read */
 PetscErrorCode BarsCheck(MPI_Comm comm, const AppCtx *user);
+PetscErrorCode BarsReset(ErrorBars *b);
+PetscErrorCode BarsRecordPressure(DM dm, AppCtx *user, const PetscReal p_eps[], const PetscReal p_second[]);
 PetscErrorCode BarsCompute(DM dm, AppCtx *user);
 PetscErrorCode BarsView(MPI_Comm comm, const ErrorBars *b);

@@ -24,7 +24,7 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u);
 PetscErrorCode PostprocessPenetration(AppCtx *user);
 void           PostprocessGetQuantities(const AppCtx *user, Quantities *q);
 /* contact_zone.c */
-PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size);
+PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size, PetscReal *band);
 
 /* contact_checks.c */
 PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user);

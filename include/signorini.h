@@ -255,6 +255,7 @@ typedef struct {
   PetscReal force[3];                  /* the obstacle's force on the body */
   PetscReal pressure_max;              /* the largest nodal contact pressure */
   PetscReal contact_size;              /* the contact zone's measure on Gamma_C: its width in 2D, its area in 3D */
+  PetscReal contact_size_band;         /* the measure of the one-cell strip along the zone's edge: the size's resolution */
   PetscReal penetration_max;           /* the largest penetration */
   PetscReal energy;                    /* 1/2 a(u,u) - L(u) + the contact term's energy */
   PetscReal reaction[BOUNDARY_MAX][3]; /* the force of each clamp or slip face set's support on the body */
@@ -285,6 +286,7 @@ typedef struct {
   PetscReal           max_penetration, contact_force, energy;
   PetscReal           pressure_max;              /* the largest nodal contact pressure */
   PetscReal           contact_size;              /* the contact zone's width (2D) or area (3D), PostprocessContactSize() */
+  PetscReal           contact_size_band;         /*   and the one-cell strip along its edge (its resolution on the mesh) */
   PetscReal           contact_force_vector[3];   /* the obstacle's force on the body: the sum of R = K u + r0 over the contact nodes */
   PetscReal           reaction[BOUNDARY_MAX][3]; /* force the support of each clamp or slip face set exerts on the body */
   MeshPartitionStats  partition;                 /* from MeshPartitionGetStats() */
@@ -293,16 +295,17 @@ typedef struct {
 
 /* Error bars of the quantities users read (-bars, src/estimate/bars.c): the mesh's part from the solutions on the three
    finest nested meshes (Richardson extrapolation with the observed order, Roache's grid convergence index), the penalty's
-   from a second solve at eps / BARS_EPS_RATIO on the coarsest of them. */
+   from a second solve at eps / BARS_EPS_RATIO on the level below the final one (BARS_EPS_LEVEL, an index of level[]). */
 #define BARS_LEVELS 3
 #define BARS_EPS_RATIO 10.0
+#define BARS_EPS_LEVEL (BARS_LEVELS - 2)
 #define BARS_MAX (8 + 3 * BOUNDARY_MAX)
 typedef struct {
   PetscInt   nlevels; /* the two levels below the final mesh recorded, coarsest first (the final's are the run's) */
   Quantities level[BARS_LEVELS - 1];
   PetscReal  level_h[BARS_LEVELS - 1];
   PetscBool  eps_done;           /* the second eps was solved (the penalty method) */
-  PetscReal  eps, eps_second;    /* the run's eps on the coarsest level and the second one */
+  PetscReal  eps, eps_second;    /* the run's eps on level[BARS_EPS_LEVEL] and the second one */
   Quantities eps_level;          /* that level's quantities at eps_second */
   PetscInt   n;                  /* the quantities, after BarsCompute(): */
   char       name[BARS_MAX][64]; /*   contact_force_x, ..., pressure_max, contact_size, penetration_max, energy, reaction_* */
@@ -310,6 +313,12 @@ typedef struct {
   PetscReal  bar[BARS_MAX];      /*   bar_mesh + bar_eps, NaN where there is none */
   PetscReal  bar_mesh[BARS_MAX], bar_eps[BARS_MAX], order[BARS_MAX];
   char       note[BARS_MAX][128]; /*   why there is no bar ("" if there is one) */
+  PetscReal *pressure_levels[2];  /* from the 2h level on, at the current mesh's vertices (v - vStart): the 2h level's nodal
+                                     pressure and its change at eps / R, carried to the finer meshes by interpolation */
+  PetscBool  pressure_recorded;   /* pressure_levels hold the 2h level's values (on every rank alike) */
+  PetscBool  pressure_band;       /* after BarsCompute(): the band was computed (on every rank alike), */
+  PetscInt   npressure;           /*   over the contact set's nodes of the final mesh, */
+  PetscReal *pressure_bar;        /*   the band of the nodal pressure at each (contact_pressure_bar), NaN without one */
 } ErrorBars;
 
 /* One solve of a run: a level of the grid sequence or an eps of the sweep (/solves in the output). */

@@ -11,6 +11,9 @@ are scattered and the mean per distinct abscissa is overlaid as a line.
 contact curve from its lowest vertex; r: the distance from the lowest vertex in
 the coordinates other than the last (a body touching a plane x_d = const).
 
+With -bars the file holds the pressure's error band (the vertex field contact_pressure_bar: the mesh's part from the
+2h level and the penalty's from the second eps, docs/estimate.md), drawn as a shaded band p +- bar around the pressure.
+
 --zoom auto|on|off: the abscissa range shown. auto (the default) zooms on the contact zone (the vertices with a
 positive pressure, and the free vertices next to them) when it spans less than a third of Gamma_C: a Hertz contact
 of width 0.03 on a unit arc is then the whole plot, not its first 4%; the title says so. off shows Gamma_C whole.
@@ -29,7 +32,7 @@ import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from signorini.figures import plt, save_png  # noqa: E402
-from signorini.runs import ABSCISSAE, read_contact  # noqa: E402,F401
+from signorini.runs import ABSCISSAE, read_contact_fields  # noqa: E402,F401
 
 
 def default_output(h5path):
@@ -75,11 +78,13 @@ XLABELS = {"x": "$x_1$", "y": "$x_2$", "z": "$x_3$", "arc": "arc length from the
 
 def plot_contact(h5path, pngpath, along="x", zoom="auto"):
     """Plot pressure and gap along Gamma_C of `h5path` into `pngpath`; return it."""
-    x1, p, g, run = read_contact(h5path, along)
+    x1, fields, run = read_contact_fields(h5path, along, optional=("contact_pressure_bar",))
+    p, g, bar = fields["contact_pressure"], fields["normal_gap"], fields.get("contact_pressure_bar")
     window = contact_window(x1, p, fraction=1.0 if zoom == "on" else 1.0 / 3.0) if zoom != "off" else None
     if window:  # the values inside the window only, so that the axes fit them
         inside = (x1 >= window[0]) & (x1 <= window[1])
         x1, p, g = x1[inside], p[inside], g[inside]
+        bar = bar[inside] if bar is not None else None
     keys = np.unique(np.round(x1, 10))
     many = len(keys) < len(x1)  # several vertices per x_1 (3D faces)
     fig, (ax_p, ax_g) = plt.subplots(2, 1, sharex=True, figsize=(8, 6.5))
@@ -89,9 +94,14 @@ def plot_contact(h5path, pngpath, along="x", zoom="auto"):
             ax.scatter(x1, vals, s=12, alpha=0.5, color=color, label="vertices")
             xm, vm = mean_per_x(x1, vals)
             ax.plot(xm, vm, "-o", ms=3, color="k", lw=1.2, label="mean per abscissa")
-            ax.legend(loc="best", fontsize=8)
         else:
-            ax.plot(x1, vals, "-o", ms=4, color=color)
+            xm, vm = x1, vals
+            ax.plot(x1, vals, "-o", ms=4, color=color, label=label if bar is not None and ax is ax_p else None)
+        if bar is not None and ax is ax_p:  # the band around the curve drawn (the mean per abscissa in 3D)
+            bm = mean_per_x(x1, bar)[1] if many else bar
+            ax.fill_between(xm, vm - bm, vm + bm, color=color, alpha=0.25, lw=0, label="error band (-bars: mesh + eps)")
+        if many or (bar is not None and ax is ax_p):
+            ax.legend(loc="best", fontsize=8)
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
     ax_g.axhline(0.0, color="gray", lw=1, ls="--")

@@ -141,6 +141,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(EstimateCheckSupported(dm, &user)); /* -estimate on a discretization it does not cover */
   PetscCall(BarsCheck(comm, &user));            /* -bars without three nested meshes */
   PetscCall(EstimateReset(&user.rec.estimate));
+  PetscCall(BarsReset(&user.rec.bars));
   PetscCall(ContactChecksGeometry(dm, &user)); /* initial overlap, an obstacle facing away: warnings */
   PetscCall(VecDuplicate(user.prob.r0, &u));   /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
@@ -206,6 +207,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(ContactFinalizePackage());
   PetscCall(PetscFree(user.rec.records));
   PetscCall(EstimateReset(&user.rec.estimate));
+  PetscCall(BarsReset(&user.rec.bars));
   PetscCall(SceneFinalize());
   *converged      = user.rec.stats.converged;
   *diagnostics_ok = (PetscBool)!user.rec.diagnostics_failed[0];

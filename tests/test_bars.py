@@ -7,7 +7,7 @@ import os
 import h5py
 import numpy as np
 
-from harness import OUT, load, run, solve
+from harness import OUT, load, run, solve, sorted_by_position
 from signorini.exact import mms_from_run, mms_quantities
 
 SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "false"]
@@ -38,20 +38,53 @@ def test_bars_cover_the_square_against_a_fine_run():
 
 
 def test_bars_cover_the_manufactured_solution():
-    """mms 2D at 64 x 64 and 128 x 128: the force and the largest pressure against the closed form: within the bar, and the
-    bar at most 10 times the error."""
+    """mms 2D at 64 x 64 and 128 x 128: the force, the largest pressure and the contact zone's width against the closed
+    form: within the bar, and the bar at most 10 times the error. The pressure's band (contact_pressure_bar) against the
+    exact pressure at the nodes of Gamma_C: it covers every node whose error is above 1e-3 of the peak, at a median of at
+    most 3 times the error there."""
     for n in (64, 128):
         _, h5 = run(["-scene", "mms", "-dm_plex_box_faces", f"{n},{n}", "-bars"], f"bars_mms_{n}")
-        a, _ = load(h5)
-        exact = mms_quantities(mms_from_run(a), a["young_modulus"], a["poisson_ratio"])
-        for name in ("contact_force_y", "pressure_max"):
+        a, fields = load(h5)
+        mms = mms_from_run(a)
+        exact = mms_quantities(mms, a["young_modulus"], a["poisson_ratio"])
+        for name in ("contact_force_y", "pressure_max", "contact_size"):
             value, bar, _, _, _ = bars(a, name)
             err = abs(value - exact[name])
             assert err <= bar <= 10 * err, (n, name, value, exact[name], bar)
+        on = fields["contact_boundary"].ravel() > 0.5
+        p_exact = -mms.normal_stress(fields["x"][on, 0], a["young_modulus"], a["poisson_ratio"])
+        err = np.abs(fields["contact_pressure"].ravel()[on] - p_exact)
+        band = fields["contact_pressure_bar"].ravel()[on]
+        large = err > 1e-3 * p_exact.max()
+        assert np.sum(large) > n / 3 and np.all(err[large] <= band[large]), (n, np.sum(large), np.sum(err[large] > band[large]))
+        assert np.median(band[large] / err[large]) <= 3.0, np.median(band[large] / err[large])
+
+
+def test_contact_size_band_is_a_cell():
+    """contact_size_band, the one-cell strip along the zone's edge, by hand: on the mms box the edge x = a crosses one face
+    of Gamma_C, of length 1/n in 2D; in 3D the line x = a (length 1) crosses triangles of diameter sqrt(2)/n."""
+    _, h5 = run(["-scene", "mms", "-dm_plex_box_faces", "64,64", "-estimate", "false"], "size_band_2d")
+    a, _ = load(h5)
+    assert abs(a["contact_size_band"] * 64 - 1.0) <= 1e-12, a["contact_size_band"]
+    _, h5 = run(["-scene", "mms", "-dm_plex_dim", "3", "-dm_plex_box_faces", "8,8,8", "-estimate", "false"], "size_band_3d")
+    a, _ = load(h5)
+    assert 1.0 <= a["contact_size_band"] * 8 / np.sqrt(2) <= 1.02, a["contact_size_band"]
+
+
+def test_contact_size_is_the_same_for_every_rule():
+    """The zone's width on the default square at eps = h/1000: the Gauss rule, the nodal rule and SNESVI within 1e-3 of
+    each other. (From u_n - g alone, the Gauss rule's nodal values oscillate at small eps / h and gave 0.4136 against the
+    nodal rule's 0.4375.)"""
+    sizes = {}
+    for name, args in (("gauss", ["-penalty_eps0", "0.001"]), ("nodal", ["-penalty_eps0", "0.001", "-penalty_quadrature", "nodal"]),
+                       ("vi", ["-contact_method", "vi"])):
+        _, h5 = run(SQUARE + ["-estimate", "false"] + args, f"size_rule_{name}")
+        sizes[name] = load(h5)[0]["contact_size"]
+    assert max(sizes.values()) - min(sizes.values()) <= 1e-3 * max(sizes.values()), sizes
 
 
 def test_levels_solve_at_the_final_eps():
-    """/solves: the three finest levels at the final mesh's eps, and one more solve at eps/10 on the coarsest of them."""
+    """/solves: the three finest levels at the final mesh's eps, and one more solve at eps/10 on the 2h level."""
     _, h5 = run(SQUARE + ["-bars"], "bars_levels")
     a, _ = load(h5)
     with h5py.File(h5) as f:
@@ -59,7 +92,8 @@ def test_levels_solve_at_the_final_eps():
     final = level.max()
     three = level >= final - 2
     assert np.sum(three) == 4, level
-    assert np.allclose(eps[three][[0, 2, 3]], a["eps"], rtol=1e-14) and np.isclose(eps[three][1], a["eps"] / 10, rtol=1e-14), eps
+    assert np.allclose(eps[three][[0, 1, 3]], a["eps"], rtol=1e-14) and np.isclose(eps[three][2], a["eps"] / 10, rtol=1e-14), eps
+    assert list(level[three]) == [final - 2, final - 1, final - 1, final], level
 
 
 def test_snesvi_has_no_penalty_part():
@@ -71,14 +105,17 @@ def test_snesvi_has_no_penalty_part():
 
 
 def test_bars_on_two_ranks():
+    """The bars and the pressure's band: 2 ranks as 1 (the band's values carried across the ranks' shared vertices)."""
     _, h1 = run(SQUARE + ["-bars"], "bars_np1")
     _, h2 = run(SQUARE + ["-bars"], "bars_np2", np_=2)
-    a1, _ = load(h1)
-    a2, _ = load(h2)
+    a1, f1 = load(h1)
+    a2, f2 = load(h2)
     keys = [k for k in a1 if k.startswith("qoi_") and not k.endswith("_note")]
     assert len(keys) >= 20 and keys == [k for k in a2 if k.startswith("qoi_") and not k.endswith("_note")]
     for k in keys:
         assert abs(a1[k] - a2[k]) <= 1e-8 * max(abs(a1[k]), abs(a1["qoi_contact_force_y"])), (k, a1[k], a2[k])
+    b1, b2 = sorted_by_position(f1, "contact_pressure_bar"), sorted_by_position(f2, "contact_pressure_bar")
+    assert b1.max() > 0 and np.max(np.abs(b1 - b2)) <= 1e-8 * b1.max()
 
 
 def test_no_bar_outside_the_asymptotic_range():

@@ -136,3 +136,28 @@ def test_plot_zooms_on_a_narrow_contact_zone(outdir):
         q = subprocess.run([sys.executable, os.path.join(ROOT, "scripts", "plot_contact.py"), h5, "-o", png, "--zoom", zoom], cwd=ROOT,
                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         assert q.returncode == 0 and open(png, "rb").read(8) == b"\x89PNG\r\n\x1a\n", q.stdout
+
+
+def test_plot_draws_the_pressure_band(outdir, monkeypatch):
+    """With -bars the plot shades the pressure's band: a filled region from p - bar to p + bar at the file's own vertices
+    (contact_pressure_bar); without -bars there is none."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    import plot_contact
+    from matplotlib.collections import PolyCollection
+    from signorini.runs import read_contact_fields
+    figures = []
+    monkeypatch.setattr(plot_contact, "save_png", lambda fig, path, dpi: figures.append(fig))
+    _, h5 = run(["-scene", "mms", "-dm_plex_box_faces", "32,32", "-bars", "-estimate", "false"], "outputs_band")
+    t, fields, _ = read_contact_fields(h5, "x", optional=("contact_pressure_bar",))
+    p, bar = fields["contact_pressure"], fields["contact_pressure_bar"]
+    assert bar.max() > 0 and np.all(bar >= 0)
+    plot_contact.plot_contact(h5, os.path.join(outdir, "band.png"))
+    bands = [c for c in figures[-1].axes[0].collections if isinstance(c, PolyCollection)]
+    assert len(bands) == 1
+    ys = bands[0].get_paths()[0].vertices[:, 1]
+    assert np.isclose(ys.max(), np.max(p + bar), rtol=1e-12) and np.isclose(ys.min(), np.min(p - bar), rtol=1e-12), (ys.min(), ys.max())
+    _, h5 = run(["-scene", "mms", "-dm_plex_box_faces", "32,32", "-estimate", "false"], "outputs_noband")
+    assert "contact_pressure_bar" not in read_contact_fields(h5, "x", optional=("contact_pressure_bar",))[1]
+    plot_contact.plot_contact(h5, os.path.join(outdir, "noband.png"))
+    assert not [c for c in figures[-1].axes[0].collections if isinstance(c, PolyCollection)]

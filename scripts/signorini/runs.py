@@ -142,7 +142,14 @@ def _arc_length(x, mask, cells):
 
 
 def read_contact(h5path, along="x"):
-    """Return (abscissa, pressure, gap, run_attrs) for the Gamma_C vertices, sorted by the abscissa.
+    """Return (abscissa, pressure, gap, run_attrs) for the Gamma_C vertices, sorted by the abscissa (read_contact_fields)."""
+    t, fields, run = read_contact_fields(h5path, along)
+    return t, fields["contact_pressure"], fields["normal_gap"], run
+
+
+def read_contact_fields(h5path, along="x", optional=()):
+    """Return (abscissa, {name: values}, run_attrs) for the Gamma_C vertices, sorted by the abscissa: the pressure and the
+    gap, and each vertex field of `optional` that the file has (contact_pressure_bar: the pressure's band of -bars).
 
     along: "x", "y", "z" (a coordinate), "arc" (2D: the signed arc length along the contact curve from its lowest vertex)
     or "r" (the distance from the lowest vertex in the coordinates other than the last, for bodies touching a plane
@@ -156,8 +163,9 @@ def read_contact(h5path, along="x"):
             x = f["geometry/vertices"][()]
             vf = f["vertex_fields"]
             mask = np.isclose(vf["contact_boundary"][()], 1.0)
-            p = vf["contact_pressure"][()]
-            g = vf["normal_gap"][()]
+            fields = {name: vf[name][()] for name in ("contact_pressure", "normal_gap") + tuple(optional) if name in vf}
+            if "contact_pressure" not in fields or "normal_gap" not in fields:
+                raise KeyError("contact_pressure or normal_gap")
             run = decoded_attrs(f["run"]) if "run" in f else {}
             cells = f["viz/topology/cells"][()] if along == "arc" else None
     except Exception as exc:
@@ -180,4 +188,4 @@ def read_contact(h5path, along="x"):
         low = x[idx[np.argmin(x[idx, -1])], :-1]
         t = np.linalg.norm(x[mask, :-1] - low, axis=1)
     order = np.argsort(t, kind="stable")
-    return t[order], p[mask][order], g[mask][order], run
+    return t[order], {name: np.ravel(v)[mask][order] for name, v in fields.items()}, run

@@ -12,17 +12,36 @@
    reason: the differences change sign (oscillatory convergence), or grow (divergence), or give an order outside
    [BARS_ORDER_MIN, BARS_ORDER_MAX] (a P1 quantity converges at an order between about 1/2, a pressure peak at a kink,
    and 2, a smooth functional; outside a wider range the ratio of two differences is noise).
-   The penalty's part. With the active set fixed, the penalty solution is affine in eps to first order, so
-   Q(eps) - Q(0) ~ (Q(eps) - Q(eps / R)) R / (R - 1), R = BARS_EPS_RATIO, measured on the coarsest of the three meshes,
-   which is cheap and has the same eps (the penalty error of Q depends on h only through the discretization).
-   The bar is their sum, bar_mesh + bar_eps. */
+
+   The penalty's part. A second solve at eps / R, R = BARS_EPS_RATIO, on the 2h level gives d = Q(eps) - Q(eps / R). If
+   Q(eps) = Q(0) + C eps^r with the order r known from theory, Roache's two-level index (safety factor 3, the one for a
+   study whose order is not observed) bounds the error of Q(eps / R) by 3 |d| / (R^r - 1), and that of Q(eps) by
+     bar_eps = |d| (1 + 3 / (R^r - 1)).
+   r = 1 for a functional of the displacement (the force, the reactions, the energy, the penetration, the largest
+   pressure): with the active set fixed the penalty solution is affine in eps to first order. r = 1/2 for the zone's
+   size: its free edge moves like eps^(1/k) where the gap opens like s^k (k = 3/2 for smooth bodies as in Hertz, 5/2 for
+   the manufactured solution), and 1/2 covers k up to 2.8 or so.
+
+   The zone's size is a free boundary, resolved to a cell: its edge on the mesh moves by whole faces as h or eps falls
+   (src/physics/contact_zone.c), so its differences are a staircase, not a power. Each level's band b (the one-cell strip
+   along the edge) is its resolution, the floor of the size's mesh part:
+     bar_mesh = max(grid convergence index, b1); where the levels are outside the asymptotic range but differ by no
+                more than their bands (|e21| <= b2, |e32| <= b3: the staircase), bar_mesh = max(|e21|, b1).
+   (Its penalty part is not floored: the 2h level sees the widening at eps = h only in part, 1/2 to 2/3 of the final
+   mesh's on the manufactured solution, which the factor 2.39 of r = 1/2 and the floor of the mesh part cover; a floor
+   of a 2h cell would make the bar of a Hertz zone at eps = h/10 thirty times its error. docs/estimate.md.)
+   The bar is the sum of the parts, bar_mesh + bar_eps. */
+#include <petscsf.h>
 #include "contact.h"
 #include "estimate.h"
 #include "physics.h"
 
-#define BARS_SAFETY 1.25
+#define BARS_SAFETY 1.25           /* Roache's safety factor of a three-mesh study with its observed order */
+#define BARS_SAFETY_TWO_LEVELS 3.0 /*   and of a two-level one whose order comes from theory */
 #define BARS_ORDER_MIN 0.3
 #define BARS_ORDER_MAX 5.0
+#define BARS_EPS_ORDER 1.0      /* the penalty's order in eps of a functional of the displacement */
+#define BARS_EPS_ORDER_EDGE 0.5 /*   and of the zone's size */
 
 /* -bars needs three nested meshes and one eps; refused before the solve otherwise. */
 PetscErrorCode BarsCheck(MPI_Comm comm, const AppCtx *user)
@@ -42,7 +61,13 @@ PetscErrorCode BarsCheck(MPI_Comm comm, const AppCtx *user)
 }
 
 /* The quantities of q in a fixed order, with their names and the size of their kind (the force's magnitude for its
-   components and the reactions, since a component may be zero): a difference below round-off of that size is none. */
+   components and the reactions, since a component may be zero): a difference below round-off of that size is none.
+   The zone's size is at index BarsSizeIndex(dim). */
+static PetscInt BarsSizeIndex(PetscInt dim)
+{
+  return dim + 1;
+}
+
 static PetscInt List(const AppCtx *user, PetscInt dim, const Quantities *q, char names[][64], PetscReal v[], PetscReal kind[])
 {
   PetscInt  n     = 0;
@@ -114,17 +139,45 @@ static void MeshPart(const PetscReal f[3], PetscReal kind, PetscReal *bar, Petsc
   *bar = BARS_SAFETY * PetscAbsReal(e21) / (PetscPowReal(2.0, *order) - 1.0);
 }
 
+/* The zone's size, a free boundary: the mesh's part where the levels are in the asymptotic range, floored at the final
+   mesh's band; where they are not but differ by no more than their bands (a staircase within the resolution), the last
+   difference, floored the same way. f[] the sizes and b[] the bands, coarsest first. */
+static void MeshPartEdge(const PetscReal f[3], const PetscReal b[3], PetscReal *bar, PetscReal *order, char note[], size_t len)
+{
+  const PetscReal e21 = f[1] - f[2], e32 = f[0] - f[1];
+
+  MeshPart(f, PetscAbsReal(f[2]), bar, order, note, len);
+  if (!PetscIsNanReal(*bar)) {
+    *bar = PetscMax(*bar, b[2]);
+    return;
+  }
+  if (PetscAbsReal(e21) <= b[1] && PetscAbsReal(e32) <= b[0]) {
+    *bar   = PetscMax(PetscAbsReal(e21), b[2]);
+    *order = PETSC_NAN;
+    PetscSNPrintf(note, len, "the meshes differ by less than the cells along the zone's edge: the last difference");
+  }
+}
+
+/* The penalty's part from d = Q(eps) - Q(eps / R) with the order r: |d| (1 + 3 / (R^r - 1)). */
+static PetscReal EpsPart(PetscReal d, PetscReal r)
+{
+  return PetscAbsReal(d) * (1.0 + BARS_SAFETY_TWO_LEVELS / (PetscPowReal(BARS_EPS_RATIO, r) - 1.0));
+}
+
+static PetscErrorCode BarsPressureBand(DM dm, AppCtx *user);
+
 PetscErrorCode BarsCompute(DM dm, AppCtx *user)
 {
   ErrorBars *b = &user->rec.bars;
   Quantities q;
-  PetscInt   dim;
+  PetscInt   dim, size;
   PetscReal  lv[BARS_LEVELS - 1][BARS_MAX], ev[BARS_MAX], kind[BARS_MAX], unused[BARS_MAX];
 
   PetscFunctionBeginUser;
   b->n = 0;
   if (!user->opt->bars) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
+  size = BarsSizeIndex(dim);
   PostprocessGetQuantities(user, &q); /* the final mesh's */
   b->n = List(user, dim, &q, b->name, b->value, kind);
   for (PetscInt l = 0; l < b->nlevels; ++l) (void)List(user, dim, &b->level[l], NULL, lv[l], unused);
@@ -136,12 +189,106 @@ PetscErrorCode BarsCompute(DM dm, AppCtx *user)
     } else {
       const PetscReal f[3] = {lv[0][k], lv[1][k], b->value[k]};
 
-      MeshPart(f, kind[k], &b->bar_mesh[k], &b->order[k], b->note[k], sizeof(b->note[k]));
+      if (k == size) {
+        const PetscReal band[3] = {b->level[0].contact_size_band, b->level[1].contact_size_band, q.contact_size_band};
+
+        MeshPartEdge(f, band, &b->bar_mesh[k], &b->order[k], b->note[k], sizeof(b->note[k]));
+      } else
+        MeshPart(f, kind[k], &b->bar_mesh[k], &b->order[k], b->note[k], sizeof(b->note[k]));
     }
-    b->bar_eps[k] = b->eps_done ? PetscAbsReal(lv[0][k] - ev[k]) * BARS_EPS_RATIO / (BARS_EPS_RATIO - 1.0) : 0.0;
-    if (b->bar_eps[k] <= 1e-10 * PetscMax(kind[k], PetscAbsReal(lv[0][k]))) b->bar_eps[k] = 0.0; /* round-off */
-    b->bar[k] = b->bar_mesh[k] + b->bar_eps[k];                                                  /* NaN with the mesh's part */
+    b->bar_eps[k] = 0.0;
+    if (b->eps_done) {
+      const PetscReal d = lv[BARS_EPS_LEVEL][k] - ev[k];
+
+      if (PetscAbsReal(d) > 1e-10 * PetscMax(kind[k], PetscAbsReal(lv[BARS_EPS_LEVEL][k])))
+        b->bar_eps[k] = EpsPart(d, k == size ? BARS_EPS_ORDER_EDGE : BARS_EPS_ORDER);
+    }
+    b->bar[k] = b->bar_mesh[k] + b->bar_eps[k]; /* NaN with the mesh's part */
   }
+  PetscCall(BarsPressureBand(dm, user));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode BarsReset(ErrorBars *b)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(b->pressure_levels[0]));
+  PetscCall(PetscFree(b->pressure_levels[1]));
+  PetscCall(PetscFree(b->pressure_bar));
+  b->npressure         = 0;
+  b->pressure_recorded = PETSC_FALSE;
+  b->pressure_band     = PETSC_FALSE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The pressure's band, the vertex field contact_pressure_bar: on the 2h level the nodal pressure p_2h(eps) and its
+   change d = p_2h(eps) - p_2h(eps / R) are kept at the vertices (p_eps[] and p_second[] over the contact set's nodes;
+   p_second NULL without a penalty), the grid sequence carries them to the final mesh by the nested P1 interpolation, and
+   there (BarsCompute()) each node of Gamma_C gets
+     bar_i = 3 |p_h,i - p_2h(x_i)| + |d(x_i)| (1 + 3 / (R - 1)),
+   the two-level index of the mesh's part with the safety factor 3 and the order 1 (a pointwise order of a profile is
+   not observed: Celik et al., J. Fluids Eng. 130, 2008, report profiles with one order), and the penalty's part as for
+   the quantities. Ghost vertices get their owners' values (the point SF), so every rank interpolates what it holds. */
+PetscErrorCode BarsRecordPressure(DM dm, AppCtx *user, const PetscReal p_eps[], const PetscReal p_second[])
+{
+  ErrorBars        *b = &user->rec.bars;
+  const ContactSet *cs;
+  PetscInt          pStart, pEnd, vStart, vEnd, nroots;
+  PetscReal        *chart[2];
+  PetscSF           sf;
+
+  PetscFunctionBeginUser;
+  PetscCall(BarsReset(b));
+  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(PetscCalloc2(pEnd - pStart, &chart[0], pEnd - pStart, &chart[1]));
+  for (PetscInt i = 0; i < cs->n; ++i) {
+    if (!cs->is_vertex[i]) continue;
+    chart[0][cs->point[i] - pStart] = p_eps[i];
+    chart[1][cs->point[i] - pStart] = p_second ? p_eps[i] - p_second[i] : 0.0;
+  }
+  PetscCall(DMGetPointSF(dm, &sf));
+  PetscCall(PetscSFGetGraph(sf, &nroots, NULL, NULL, NULL));
+  for (PetscInt k = 0; k < 2 && nroots >= 0; ++k) {
+    PetscCall(PetscSFBcastBegin(sf, MPIU_REAL, chart[k], chart[k], MPI_REPLACE));
+    PetscCall(PetscSFBcastEnd(sf, MPIU_REAL, chart[k], chart[k], MPI_REPLACE));
+  }
+  for (PetscInt k = 0; k < 2; ++k) {
+    PetscCall(PetscMalloc1(vEnd - vStart, &b->pressure_levels[k]));
+    PetscCall(PetscArraycpy(b->pressure_levels[k], chart[k] + (vStart - pStart), vEnd - vStart));
+  }
+  PetscCall(PetscFree2(chart[0], chart[1]));
+  b->pressure_recorded = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The band at the final mesh's contact nodes, from the values the grid sequence carried there. */
+static PetscErrorCode BarsPressureBand(DM dm, AppCtx *user)
+{
+  ErrorBars        *b = &user->rec.bars;
+  const ContactSet *cs;
+  PetscInt          vStart, vEnd;
+
+  PetscFunctionBeginUser;
+  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  b->pressure_band = (PetscBool)(b->pressure_recorded && user->rec.stats.converged && b->nlevels == BARS_LEVELS - 1);
+  if (b->pressure_band) {
+    b->npressure = cs->n;
+    PetscCall(PetscMalloc1(cs->n, &b->pressure_bar));
+    for (PetscInt i = 0; i < cs->n; ++i) {
+      const PetscInt v = cs->point[i] - vStart;
+
+      b->pressure_bar[i] = PETSC_NAN; /* not a vertex (P2) */
+      if (cs->is_vertex[i])
+        b->pressure_bar[i] =
+            BARS_SAFETY_TWO_LEVELS * PetscAbsReal(cs->pressure[i] - b->pressure_levels[0][v]) + EpsPart(b->pressure_levels[1][v], BARS_EPS_ORDER);
+    }
+  }
+  PetscCall(PetscFree(b->pressure_levels[0]));
+  PetscCall(PetscFree(b->pressure_levels[1]));
+  b->pressure_recorded = PETSC_FALSE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -150,11 +297,14 @@ PetscErrorCode BarsView(MPI_Comm comm, const ErrorBars *b)
 {
   PetscFunctionBeginUser;
   if (!b->n) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscPrintf(comm, "  error bars (mesh: three nested meshes, h to 4h, grid convergence index; eps: a second solve at eps/%d):\n",
+  PetscCall(PetscPrintf(comm, "  error bars (mesh: three nested meshes, h to 4h, grid convergence index; eps: a second solve at eps/%d on 2h):\n",
                         (int)BARS_EPS_RATIO));
   for (PetscInt k = 0; k < b->n; ++k) {
     if (PetscIsNanReal(b->bar[k]))
       PetscCall(PetscPrintf(comm, "    %-24s %.6g, no bar: %s\n", b->name[k], (double)b->value[k], b->note[k]));
+    else if (PetscIsNanReal(b->order[k]) && b->note[k][0])
+      PetscCall(PetscPrintf(comm, "    %-24s %.6g +- %.2g (mesh %.2g, eps %.2g; %s)\n", b->name[k], (double)b->value[k], (double)b->bar[k],
+                            (double)b->bar_mesh[k], (double)b->bar_eps[k], b->note[k]));
     else if (PetscIsNanReal(b->order[k]))
       PetscCall(PetscPrintf(comm, "    %-24s %.6g +- %.2g (mesh %.2g, eps %.2g; the same on the three meshes)\n", b->name[k], (double)b->value[k],
                             (double)b->bar[k], (double)b->bar_mesh[k], (double)b->bar_eps[k]));

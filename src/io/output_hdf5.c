@@ -164,6 +164,23 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
     PetscCall(ViewVertexField(exact, dim, viewer));
     PetscCall(ViewVertexField(error, dim, viewer));
   }
+  if (user->rec.bars.pressure_band) { /* -bars: the band of the nodal pressure (src/estimate/bars.c), 0 off Gamma_C */
+    Vec          band;
+    PetscScalar *bv;
+
+    PetscCall(VecDuplicate(pressure, &band));
+    PetscCall(PetscObjectSetName((PetscObject)band, "contact_pressure_bar"));
+    PetscCall(VecZeroEntries(band));
+    PetscCall(VecGetArray(band, &bv));
+    for (PetscInt i = 0; i < user->rec.bars.npressure; ++i) {
+      const PetscInt goff = cs->is_vertex[i] ? index[cs->point[i] - vStart] : -1;
+
+      if (goff >= 0) bv[goff] = user->rec.bars.pressure_bar[i];
+    }
+    PetscCall(VecRestoreArray(band, &bv));
+    PetscCall(ViewVertexField(band, 1, viewer));
+    PetscCall(VecDestroy(&band));
+  }
   PetscCall(VecDestroy(&exact));
   PetscCall(VecDestroy(&error));
   PetscCall(VecDestroy(&disp));
@@ -310,9 +327,10 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteRealAttr(v, "max_penetration", s->max_penetration));
   PetscCall(WriteRealAttr(v, "contact_force", s->contact_force));
   PetscCall(WriteRealAttr(v, "energy", s->energy));
-  PetscCall(WriteRealAttr(v, "pressure_max", s->pressure_max)); /* the largest nodal contact pressure */
-  PetscCall(WriteRealAttr(v, "contact_size", s->contact_size)); /* the contact zone's width (2D) or area (3D) */
-  for (PetscInt c = 0; c < dim; ++c) {                          /* the total force of the obstacle, contact_force_x, _y, _z */
+  PetscCall(WriteRealAttr(v, "pressure_max", s->pressure_max));           /* the largest nodal contact pressure */
+  PetscCall(WriteRealAttr(v, "contact_size", s->contact_size));           /* the contact zone's width (2D) or area (3D) */
+  PetscCall(WriteRealAttr(v, "contact_size_band", s->contact_size_band)); /* the one-cell strip along its edge */
+  for (PetscInt c = 0; c < dim; ++c) {                                    /* the total force of the obstacle, contact_force_x, _y, _z */
     char name[32];
 
     PetscCall(PetscSNPrintf(name, sizeof(name), "contact_force_%c", "xyz"[c]));
@@ -487,6 +505,13 @@ static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const cha
     else
       fprintf(fp, "    <DataItem Dimensions=\"%d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n",
               (int)nverts, h5name, fields[f]);
+    fprintf(fp, "   </Attribute>\n");
+  }
+  if (user->rec.bars.pressure_band) {
+    fprintf(fp, "   <Attribute Name=\"contact_pressure_bar\" AttributeType=\"Scalar\" Center=\"Node\">\n");
+    fprintf(fp,
+            "    <DataItem Dimensions=\"%d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/vertex_fields/contact_pressure_bar</DataItem>\n",
+            (int)nverts, h5name);
     fprintf(fp, "   </Attribute>\n");
   }
   for (PetscInt f = 0; f < 2 && user->rec.estimate.computed; ++f) {

@@ -203,6 +203,28 @@ PetscErrorCode MeshInterpolateVertexSources(DM dm, DM fine, const PetscInt verte
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The same interpolation for nc arrays of values at dm's vertices (index v - vStart, ghosts included): fine_values[k] over
+   fine's vertices, for the caller to free. */
+PetscErrorCode MeshInterpolateVertexArrays(DM dm, DM fine, const PetscInt vertex_source[], PetscInt nc, PetscReal *const coarse[],
+                                           PetscReal *fine_values[])
+{
+  PetscInt vStart, vEnd, cvb[2], ceb[2];
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetDepthStratum(fine, 0, &vStart, &vEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &cvb[0], &cvb[1]));
+  PetscCall(DMPlexGetDepthStratum(dm, 1, &ceb[0], &ceb[1]));
+  for (PetscInt k = 0; k < nc; ++k) PetscCall(PetscCalloc1(vEnd - vStart, &fine_values[k]));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    PetscInt verts[8], nv;
+
+    PetscCall(MeshSourceVertices(dm, cvb, ceb, vertex_source[v - vStart], verts, &nv));
+    for (PetscInt i = 0; i < nv; ++i)
+      for (PetscInt k = 0; k < nc; ++k) fine_values[k][v - vStart] += coarse[k][verts[i] - cvb[0]] / nv;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Interpolates the local vectors loc[] of dm (boundary values included) into new local vectors fine_loc[] of fine, which
    has the same discretization: every vertex of a fine cell gets the value of the FE function in its parent cell
    (exact for the nested P1/Q1 spaces). */

@@ -4,12 +4,64 @@
    converge smoothly with h and its error could not be extrapolated (src/estimate/bars.c). Instead each vertex of
    Gamma_C gets a signed value s, negative where the body is open (-s is the gap) and positive where it is in contact,
    and the zone is the part of Gamma_C where the linear interpolant of s is positive, measured exactly face by face (the
-   zero crossing on an edge, the clipped part of a triangle; a quadrilateral as two triangles):
-     the penalty method (and no contact): s = u_n - g, positive where the penalty force acts;
-     SNESVI, where u_n = g on the whole active set: s = u_n - g + (h_v / E) p, with h_v = (lumped boundary mass)^(1/(dim-1))
-     the local mesh size, so that the pressure marks the contact side. */
+   zero crossing on an edge, the clipped part of a triangle; a quadrilateral as two triangles), with
+     s = u_n - g + (h_v / E) p,
+   h_v = (lumped boundary mass)^(1/(dim-1)) the local mesh size and p the nodal pressure (the force the method exerts at
+   the node over its lumped area), so that the pressure marks the contact side:
+     SNESVI holds u_n = g on the whole active set, where u_n - g alone is 0;
+     the Gauss rule's penalty acts at the quadrature points, and at small eps / h its nodal u_n - g oscillates and is
+     negative at nodes that carry force (the default square at eps = h/100 measured 0.416 from u_n - g alone, 0.438
+     with the pressure, as the nodal rule and SNESVI do; a coarse Hertz indenter mesh at eps = h/40, 0);
+     the nodal rule has p = (u_n - g)_+ / eps at the node, so that s has the sign of u_n - g, scaled where it is positive.
+
+   The zone's edge is a free boundary, which P1 resolves to about a cell: the discrete exact contact ends at an active
+   node, so its size moves by whole faces as h falls (a staircase, not a power of h). The band along the edge, the measure
+   of the strip one cell wide that the edge crosses (the length of each face the edge cuts in 2D; the edge's length in
+   each cut triangle times the triangle's diameter in 3D), is that resolution: the error bars of the size take it as
+   the floor of their mesh part (src/estimate/bars.c). */
 #include <petscsf.h>
 #include "physics.h"
+
+/* Whether the linear function of the vertex values s[] changes sign strictly on the face (a 0 at a clamped node is no edge). */
+static PetscBool Crossed(PetscInt n, const PetscReal s[])
+{
+  PetscBool pos = PETSC_FALSE, neg = PETSC_FALSE;
+
+  for (PetscInt i = 0; i < n; ++i) {
+    pos = (PetscBool)(pos || s[i] > 0.0);
+    neg = (PetscBool)(neg || s[i] < 0.0);
+  }
+  return (PetscBool)(pos && neg);
+}
+
+static PetscReal Distance(const PetscReal a[], const PetscReal b[])
+{
+  return PetscSqrtReal(PetscSqr(a[0] - b[0]) + PetscSqr(a[1] - b[1]) + PetscSqr(a[2] - b[2]));
+}
+
+/* The band of a triangle (X, s) that the zero line of s crosses: the line's length in it times its diameter. */
+static PetscReal TriangleBand(PetscReal X[][3], const PetscInt v[3], const PetscReal s[])
+{
+  PetscReal pts[2][3];
+  PetscInt  k = 0;
+
+  if (!Crossed(3, s)) return 0.0;
+  for (PetscInt e = 0; e < 3 && k < 2; ++e) { /* the zero's points on the edges whose ends have strictly opposite signs */
+    const PetscInt i = e, j = (e + 1) % 3;
+
+    if (s[i] * s[j] < 0.0) {
+      const PetscReal t = s[i] / (s[i] - s[j]);
+
+      for (PetscInt d = 0; d < 3; ++d) pts[k][d] = X[v[i]][d] + t * (X[v[j]][d] - X[v[i]][d]);
+      k++;
+    } else if (s[i] == 0.0) {
+      for (PetscInt d = 0; d < 3; ++d) pts[k][d] = X[v[i]][d];
+      k++;
+    }
+  }
+  if (k < 2) return 0.0;
+  return Distance(pts[0], pts[1]) * PetscMax(PetscMax(Distance(X[v[0]], X[v[1]]), Distance(X[v[1]], X[v[2]])), Distance(X[v[0]], X[v[2]]));
+}
 
 /* The part of a face of measure area where the linear function of the vertex values s[] (2 or 3 of them) is positive. */
 static PetscReal PositiveMeasure(PetscInt n, const PetscReal s[], PetscReal area)
@@ -42,12 +94,12 @@ static PetscReal TriangleArea(const PetscReal a[], const PetscReal b[], const Pe
   return 0.5 * PetscSqrtReal(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
 }
 
-PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size)
+PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size, PetscReal *band)
 {
   const ContactSet  *cs;
   const PetscReal    E = user->opt->material.young_modulus;
   PetscInt           dim, pStart, pEnd, vStart, vEnd, nroots;
-  PetscReal         *s, local = 0.0;
+  PetscReal         *s, local[2] = {0.0, 0.0}, global[2];
   PetscSF            sf;
   DM                 cdm;
   PetscSection       csec;
@@ -64,7 +116,7 @@ PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *siz
   for (PetscInt i = 0; i < cs->n; ++i) {
     if (!cs->is_vertex[i]) continue;
     s[cs->point[i] - pStart] = ContactNodePenetration(cs, dim, i, x);
-    if (ContactHasBounds(user->contact)) s[cs->point[i] - pStart] += PetscPowReal(cs->weight[i], 1.0 / (dim - 1)) / E * cs->pressure[i];
+    s[cs->point[i] - pStart] += PetscPowReal(cs->weight[i], 1.0 / (dim - 1)) / E * cs->pressure[i];
   }
   PetscCall(VecRestoreArrayRead(u, &x));
   PetscCall(DMGetPointSF(dm, &sf)); /* the owners' values to the ranks that share the vertex */
@@ -101,15 +153,20 @@ PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *siz
       if (dim == 2) {
         const PetscReal len = PetscSqrtReal(PetscSqr(X[1][0] - X[0][0]) + PetscSqr(X[1][1] - X[0][1]));
 
-        local += PositiveMeasure(2, sv, len);
+        local[0] += PositiveMeasure(2, sv, len);
+        if (Crossed(2, sv)) local[1] += len;
       } else { /* a triangle, or a quadrilateral as two */
         const PetscReal t0[3] = {sv[0], sv[1], sv[2]};
+        const PetscInt  v0[3] = {0, 1, 2};
 
-        local += PositiveMeasure(3, t0, TriangleArea(X[0], X[1], X[2]));
+        local[0] += PositiveMeasure(3, t0, TriangleArea(X[0], X[1], X[2]));
+        local[1] += TriangleBand(X, v0, t0);
         if (nv == 4) {
           const PetscReal t1[3] = {sv[0], sv[2], sv[3]};
+          const PetscInt  v1[3] = {0, 2, 3};
 
-          local += PositiveMeasure(3, t1, TriangleArea(X[0], X[2], X[3]));
+          local[0] += PositiveMeasure(3, t1, TriangleArea(X[0], X[2], X[3]));
+          local[1] += TriangleBand(X, v1, t1);
         }
       }
     }
@@ -117,6 +174,8 @@ PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *siz
   }
   PetscCall(VecRestoreArrayRead(coords, &xc));
   PetscCall(PetscFree(s));
-  PetscCall(MPIU_Allreduce(&local, size, 1, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
+  PetscCall(MPIU_Allreduce(local, global, 2, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
+  *size = global[0];
+  *band = global[1];
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -33,7 +33,7 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
     for (PetscInt i = 0; i < cs->n; ++i) pmax = PetscMax(pmax, cs->pressure[i]);
     PetscCall(MPIU_Allreduce(&pmax, &st->pressure_max, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
   }
-  PetscCall(PostprocessContactSize(dm, user, u, &st->contact_size));
+  PetscCall(PostprocessContactSize(dm, user, u, &st->contact_size, &st->contact_size_band));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -43,10 +43,11 @@ void PostprocessGetQuantities(const AppCtx *user, Quantities *q)
   const RunStats *st = &user->rec.stats;
 
   for (PetscInt c = 0; c < 3; ++c) q->force[c] = st->contact_force_vector[c];
-  q->pressure_max    = st->pressure_max;
-  q->contact_size    = st->contact_size;
-  q->penetration_max = st->max_penetration;
-  q->energy          = st->energy;
+  q->pressure_max      = st->pressure_max;
+  q->contact_size      = st->contact_size;
+  q->contact_size_band = st->contact_size_band;
+  q->penetration_max   = st->max_penetration;
+  q->energy            = st->energy;
   for (PetscInt i = 0; i < BOUNDARY_MAX; ++i)
     for (PetscInt c = 0; c < 3; ++c) q->reaction[i][c] = st->reaction[i][c];
 }
