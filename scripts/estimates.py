@@ -16,7 +16,7 @@ Usage: estimates.py [--outdir DIR] [--parts estimate,bars] [--check]
    nodes (--parts bars: this part alone, --parts estimate: the others).
 
 DIR (default output/estimates) receives the runs, estimates.csv, penalty.csv, hertz.csv, bars.csv, estimates.md, bars.md,
-effectivity.png and hertz_density.png. --check: exit 1 unless, in every series, the effectivity varies by at most 1.5x over the four
+effectivity.png, hertz_density.png and band.png. --check: exit 1 unless, in every series, the effectivity varies by at most 1.5x over the four
 finest meshes and the estimate's rate is the error's within 0.1; the effectivity over all series varies by at most 3x;
 every penalty ratio lies in [1/3, 3]; on every Hertz case the densest cell lies within 2 cell diameters of the zone's
 edge; at least 9 in 10 error bars cover the true error, and none is over 10 times an error above 1e-4 relative; the
@@ -104,6 +104,9 @@ def coverage(outdir):
         for q in st.MMS_QUANTITIES:
             name = f"contact_force_{'xyz'[dim - 1]}" if q == "contact_force" else q
             rows.append(coverage_row(f"mms{dim}d {a['n_cells']} cells", name, *st.qoi(a, name), exact[name]))
+        if (dim, n) == (2, 32):  # the figure of the pressure with its band (docs/estimate_band.png)
+            from plot_contact import plot_contact
+            plot_contact(out, os.path.join(outdir, "band.png"))
         nodes, covered, median = st.pressure_band_coverage(out)
         bands.append({"case": f"mms{dim}d {a['n_cells']} cells", "nodes": nodes, "covered": covered, "median_band_over_error": median})
         print(f"pressure band mms{dim}d {a['n_cells']} cells: covers {covered} of {nodes} nodes, median band / error {median:.2f}")
