@@ -13,6 +13,10 @@ PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal
 PetscErrorCode MeshCreateBoxLevel(DM coarse, const MeshBox *box, PetscInt level, DM *fine, PetscInt **vertex_source);
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
 PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam);
+PetscErrorCode MeshCellSize(DM dm, PetscInt c, PetscReal *h);
+PetscErrorCode MeshGetMaxCellSize(DM dm, PetscReal *h);
+PetscErrorCode MeshSetCellSizes(DM dm, const char name[], PetscReal hmax, PetscReal *sizes);
+PetscErrorCode MeshGetCellSizes(DM dm, const char name[], PetscReal *hmax, const PetscReal **sizes);
 PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id);
 PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count);
 PetscErrorCode MeshOwnedIndex(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt **index, PetscInt *nowned);
@@ -66,6 +70,7 @@ PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[]);
 PetscErrorCode MeshCellVertices(DM dm, PetscInt c, PetscInt verts[], PetscInt *nv);
 PetscErrorCode MeshCellReferenceCoordinates(DM dm, PetscInt c, PetscInt n, const PetscReal x[], PetscReal xi[]);
 PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **parent, PetscInt **vertex_source);
+PetscErrorCode MeshDescendantSizes(DM dm, PetscInt levels, PetscReal power, PetscReal **sizes, PetscReal *hmax);
 PetscErrorCode MeshSourceVertices(DM dm, const PetscInt vb[2], const PetscInt eb[2], PetscInt src, PetscInt verts[], PetscInt *nv);
 PetscErrorCode MeshInterpolateVertexSources(DM dm, DM fine, const PetscInt vertex_source[], Vec loc, Vec *fine_loc);
 PetscErrorCode MeshInterpolateVertexArrays(DM dm, DM fine, const PetscInt vertex_source[], PetscInt nc, PetscReal *const coarse[],

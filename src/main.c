@@ -136,6 +136,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   }
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));        /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
+  PetscCall(GridSequenceBarsSizes(dm, &user));                            /* -bars on tetrahedra: the final mesh's eps on the levels below it */
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(ReferenceCheckFile(dm, &user));     /* before the solve, not after it */
   PetscCall(EstimateCheckSupported(dm, &user)); /* -estimate on a discretization it does not cover */

@@ -137,3 +137,34 @@ def test_bars_refused_without_three_meshes():
     _, h5 = run(mesh + ["-bars", "-contact_grid_sequence", "2", "-body_force", "0,-0.1"], "bars_file")
     a, _ = load(h5)
     assert "qoi_contact_force_y" in a and "qoi_energy" in a
+
+
+def test_levels_of_a_refined_tetrahedral_mesh_solve_at_one_eps(tmp_path):
+    """A Gmsh tetrahedral block refined twice (-contact_grid_sequence 2): the children of a tetrahedron are not similar
+    to it, so that the cells' diameters do not halve (here 0.64, 0.48, 0.24), and eps, which follows each cell's size,
+    did not either (the levels solved at 0.016, 0.024, 0.024). With -bars the two coarser levels take the eps of their
+    descendants on the final mesh: /solves has one eps for the three levels (and eps/10 for the second solve), and the
+    final mesh's answer is the run's without -bars, on 1 and 2 ranks."""
+    import sys
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "scripts"))
+    from signorini import geometry
+    mesh = str(tmp_path / "block.msh")
+    geometry.quarter_block(mesh, radius=1.0, h_far=0.5, h_near=0.15, width=0.5, near=0.2)
+    args = ["-dm_plex_filename", mesh, "-scene", "general", "-contact_faces", "contact", "-bc_clamp", "bottom", "-bc_slip",
+            "symmetry_x,symmetry_y", "-bc_slip_symmetry_x_components", "0", "-bc_slip_symmetry_y_components", "1", "-obstacle", "sphere",
+            "-obstacle_center", "0,0,1", "-obstacle_radius", "1", "-obstacle_translate", "0,0,-0.05", "-penalty_eps0", "0.1",
+            "-contact_grid_sequence", "2", "-estimate", "false"]
+    _, h5 = run(args + ["-bars"], "bars_tets")
+    _, h5_np2 = run(args + ["-bars"], "bars_tets_np2", np_=2)
+    _, h5_plain = run(args, "bars_tets_plain")
+    a, _ = load(h5)
+    with h5py.File(h5) as f:
+        level, eps, h = f["solves/level"][:].ravel(), f["solves/eps"][:].ravel(), f["solves/h"][:].ravel()
+    assert list(level) == [0, 1, 1, 2], level
+    assert not np.isclose(h[0], 2 * h[1], rtol=1e-3), h  # the diameters do not halve
+    assert np.allclose(eps[[0, 1, 3]], a["eps"], rtol=1e-14) and np.isclose(eps[2], a["eps"] / 10, rtol=1e-14), eps
+    for other in (load(h5_np2)[0], load(h5_plain)[0]):
+        for key in ("eps", "eps_min", "eps_max"):
+            assert other[key] == a[key], (key, other[key], a[key])
+        for key in ("contact_force_z", "energy", "contact_size"):
+            assert abs(other[key] - a[key]) <= 1e-9 * abs(a[key]), (key, other[key], a[key])

@@ -97,7 +97,7 @@ PetscErrorCode ContactSetBuild(Contact ct, DM dm, Vec like)
         PetscReal       diam;
 
         PetscCall(DMPlexGetSupport(dm, faces[i], &support));
-        PetscCall(MeshCellDiameter(dm, support[0], &diam));
+        PetscCall(MeshCellSize(dm, support[0], &diam));
         face_range[0] = PetscMin(face_range[0], ContactEpsFactor(ct, diam));
         face_range[1] = PetscMin(face_range[1], -ContactEpsFactor(ct, diam));
         PetscCall(DMPlexGetTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));

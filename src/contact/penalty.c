@@ -64,7 +64,7 @@ static PetscErrorCode PenaltySetUpLocalEps(Contact ct, DM dm)
       PetscReal       diam;
 
       PetscCall(DMPlexGetSupport(dm, faces[i], &support));
-      PetscCall(MeshCellDiameter(dm, support[0], &diam));
+      PetscCall(MeshCellSize(dm, support[0], &diam));
       PetscCall(PetscSectionGetOffset(sec, support[0], &off));
       a[off] = 1.0 / ContactEpsFactor(ct, diam);
     }

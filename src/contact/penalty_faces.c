@@ -118,7 +118,7 @@ PetscErrorCode PenaltyFacesSetUp(Contact ct, DM dm, PenaltyFaces *pf)
       if (local_eps) {
         PetscReal diam;
 
-        PetscCall(MeshCellDiameter(dm, support[0], &diam));
+        PetscCall(MeshCellSize(dm, support[0], &diam));
         pf->inv_factor[e] = 1.0 / ContactEpsFactor(ct, diam);
       }
     }

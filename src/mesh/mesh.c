@@ -289,6 +289,70 @@ PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The size of cell c that the penalty's eps follows (eps = eps0 h^power / M): its diameter, unless the mesh carries
+   sizes of its own for it (MeshSetCellSizes() with the name "eps_cell_size": the error bars' coarser levels of a
+   tetrahedral mesh, src/solver/grid_sequence.c). */
+PetscErrorCode MeshCellSize(DM dm, PetscInt c, PetscReal *h)
+{
+  const PetscReal *sizes;
+  PetscReal        hmax;
+  PetscInt         cStart;
+
+  PetscFunctionBeginUser;
+  PetscCall(MeshGetCellSizes(dm, "eps_cell_size", &hmax, &sizes));
+  if (sizes) {
+    PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, NULL));
+    *h = sizes[c - cStart];
+  } else
+    PetscCall(MeshCellDiameter(dm, c, h));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The h of eps = eps0 h^power / M on this mesh: the largest cell diameter, or that of the mesh's own sizes. */
+PetscErrorCode MeshGetMaxCellSize(DM dm, PetscReal *h)
+{
+  const PetscReal *sizes;
+
+  PetscFunctionBeginUser;
+  PetscCall(MeshGetCellSizes(dm, "eps_cell_size", h, &sizes));
+  if (!sizes) PetscCall(MeshGetMaxCellDiameter(dm, h));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Keeps with dm (a container composed under name) one size per local cell, sizes[c - cStart] (taken over: freed with
+   dm), and a global largest one hmax. */
+PetscErrorCode MeshSetCellSizes(DM dm, const char name[], PetscReal hmax, PetscReal *sizes)
+{
+  PetscContainer container;
+  PetscInt       cStart, cEnd;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  sizes[cEnd - cStart] = hmax; /* the array has one more entry */
+  PetscCall(PetscContainerCreate(PetscObjectComm((PetscObject)dm), &container));
+  PetscCall(PetscContainerSetPointer(container, sizes));
+  PetscCall(PetscContainerSetUserDestroy(container, PetscContainerUserDestroyDefault));
+  PetscCall(PetscObjectCompose((PetscObject)dm, name, (PetscObject)container));
+  PetscCall(PetscContainerDestroy(&container));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The sizes MeshSetCellSizes() kept with dm under name, or *sizes = NULL. */
+PetscErrorCode MeshGetCellSizes(DM dm, const char name[], PetscReal *hmax, const PetscReal **sizes)
+{
+  PetscContainer container;
+  PetscInt       cStart, cEnd;
+
+  PetscFunctionBeginUser;
+  *sizes = NULL;
+  PetscCall(PetscObjectQuery((PetscObject)dm, name, (PetscObject *)&container));
+  if (!container) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscContainerGetPointer(container, (void **)sizes));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  *hmax = (*sizes)[cEnd - cStart];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* h: the largest cell diameter (largest distance between two vertices of a cell) over all ranks. The diameter of a
    simplex is its longest edge: on an interpolated simplex mesh the edges are visited once, not the closure of every
    cell. */

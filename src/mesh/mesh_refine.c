@@ -137,6 +137,42 @@ PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **pa
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The size each cell of dm would have for eps = eps0 h^power / M if eps were that of its descendants on the mesh refined
+   `levels` times: 2^levels (the mean of their diameters^power)^(1/power), and hmax = 2^levels times their largest
+   diameter (over all ranks). sizes has one entry per local cell and one more (MeshSetCellSizes()). The refined mesh is
+   built for the measurement and destroyed. */
+PetscErrorCode MeshDescendantSizes(DM dm, PetscInt levels, PetscReal power, PetscReal **sizes, PetscReal *hmax)
+{
+  DM         fine;
+  PetscInt  *parent, *count, cStart, cEnd, fStart, fEnd;
+  PetscReal  scale = PetscPowReal(2.0, (PetscReal)levels), local = 0.0;
+  PetscReal *s;
+
+  PetscFunctionBeginUser;
+  PetscCall(MeshRefineRegular(dm, levels, &fine, &parent, NULL));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(DMPlexGetHeightStratum(fine, 0, &fStart, &fEnd));
+  PetscCall(PetscCalloc1(cEnd - cStart + 1, &s));
+  PetscCall(PetscCalloc1(cEnd - cStart + 1, &count));
+  for (PetscInt c = fStart; c < fEnd; ++c) {
+    PetscReal d;
+
+    PetscCall(MeshCellDiameter(fine, c, &d));
+    local = PetscMax(local, d);
+    s[parent[c - fStart] - cStart] += PetscPowReal(d, power);
+    count[parent[c - fStart] - cStart]++;
+  }
+  for (PetscInt c = cStart; c < cEnd; ++c)
+    s[c - cStart] = count[c - cStart] ? scale * PetscPowReal(s[c - cStart] / count[c - cStart], 1.0 / power) : 0.0;
+  PetscCall(MPIU_Allreduce(&local, hmax, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
+  *hmax *= scale;
+  *sizes = s;
+  PetscCall(PetscFree(count));
+  PetscCall(PetscFree(parent));
+  PetscCall(DMDestroy(&fine));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The coarse vertices whose mean is the fine vertex with source point src (MeshRefineRegular(), MeshCreateBoxLevel()): the
    vertex itself, an edge's cone, or the vertices of a quad's or hex's closure (at most 8). vb, eb: dm's vertex and edge
    strata. */

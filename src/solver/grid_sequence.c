@@ -31,6 +31,7 @@ static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *
   } else
     PetscCall(MeshRefineRegular(*dm, 1, &fine, &parent, &vertex_source));
   user->prob.level++;
+  PetscCall(GridSequenceBarsSizes(fine, user)); /* -bars on tetrahedra: the final mesh's eps on this level */
   PetscCall(ProblemSetUp(fine, user, snes));
   PetscCall(MultigridAddLevel(*snes, *dm, fine, vertex_source, user)); /* with -pc_type mg */
   if (user->opt->degree == 1)
@@ -96,6 +97,35 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOpt
   *min_levels = opt->bars ? BARS_LEVELS - 1 : 0; /* -bars: at least two boxes below the final one, whatever their size */
   /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels) */
   if (k < 0 && (!(ContactHasPenalty(ct) || (ContactIsNone(ct) && is_mg)) || opt->degree != 1)) *request = 0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -bars on a tetrahedral mesh that the grid sequence refines: the children of a tetrahedron are not similar to it (the
+   four inner ones are longer than half, by the diagonal of the octahedron they split), so that the cells do not halve
+   (the Hertz sphere indenter's largest: 0.297, 0.243, 0.121) and eps, which follows each cell's diameter, would differ
+   between the levels (0.0074, 0.0121, 0.0121): the bars' three levels would not solve one penalty problem. Each cell of
+   the two levels below the final one gets instead the size of its descendants on the final mesh (MeshDescendantSizes(),
+   the mean of their diameters^power: the mean of their eps), measured on the mesh refined for that purpose and
+   destroyed; the final mesh keeps its own diameters, so that the answer is the run's without -bars. Triangles,
+   quadrilaterals and hexahedra halve exactly and need none of it; nor do the boxes (built, not refined). */
+PetscErrorCode GridSequenceBarsSizes(DM dm, const AppCtx *user)
+{
+  const PetscInt        nlevels = user->box.coarse_levels + user->opt->solver.grid_sequence;
+  const ContactOptions *copt;
+  PetscInt              dim;
+  PetscBool             simplex;
+  PetscReal            *sizes, hmax;
+
+  PetscFunctionBeginUser;
+  if (!user->opt->bars || !ContactHasPenalty(user->contact) || (user->box.is_box && user->opt->degree == 1)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (user->prob.level >= nlevels || user->prob.level < nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetOptions(user->contact, &copt));
+  if (copt->eps_fixed > 0.0 || copt->eps_power <= 0.0) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexIsSimplex(dm, &simplex));
+  if (dim != 3 || !simplex) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(MeshDescendantSizes(dm, nlevels - user->prob.level, copt->eps_power, &sizes, &hmax));
+  PetscCall(MeshSetCellSizes(dm, "eps_cell_size", hmax, sizes));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
