@@ -173,9 +173,9 @@ def test_same_estimate_on_two_ranks():
 
 
 def test_cell_fields_open_in_paraview(tmp_path):
-    """ParaView's XDMF reader (pvbatch) finds error_indicator and error_density as cell data of every cell, with the
-    HDF5 file's values."""
-    _, h5 = run(["-options_file", "options/square.yaml", "-contact_monitor", "false"], "estimate_paraview")
+    """ParaView's XDMF reader (pvbatch) finds error_indicator and error_density as cell data of every cell, and with
+    -bars the pressure's band contact_pressure_bar as point data of every vertex, with the HDF5 file's values."""
+    _, h5 = run(["-options_file", "options/square.yaml", "-contact_monitor", "false", "-bars"], "estimate_paraview")
     xdmf = h5[:-3] + ".xdmf"
     script = tmp_path / "read.py"
     script.write_text(
@@ -187,13 +187,15 @@ def test_cell_fields_open_in_paraview(tmp_path):
         "cd = d.GetCellData()\n"
         "for name in ('error_indicator', 'error_density'):\n"
         "    a = cd.GetArray(name)\n"
-        "    print(name, d.GetNumberOfCells(), a.GetNumberOfTuples(), *a.GetRange())\n")
+        "    print(name, d.GetNumberOfCells(), a.GetNumberOfTuples(), *a.GetRange())\n"
+        "a = d.GetPointData().GetArray('contact_pressure_bar')\n"
+        "print('contact_pressure_bar', d.GetNumberOfPoints(), a.GetNumberOfTuples(), *a.GetRange())\n")
     p = subprocess.run(["pvbatch", "--force-offscreen-rendering", str(script)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                        timeout=300)
     assert p.returncode == 0, p.stdout[-3000:]
     with h5py.File(h5) as f:
-        for name in ("error_indicator", "error_density"):
-            v = f["cell_fields/" + name][:]
+        for name in ("error_indicator", "error_density", "contact_pressure_bar"):
+            v = f[("vertex_fields/" if name == "contact_pressure_bar" else "cell_fields/") + name][:]
             line = [ln.split() for ln in p.stdout.splitlines() if ln.startswith(name + " ")]
             assert line, p.stdout[-2000:]
             ncells, ntuples, lo, hi = int(line[0][1]), int(line[0][2]), float(line[0][3]), float(line[0][4])
