@@ -40,6 +40,9 @@
 #define BARS_SAFETY_TWO_LEVELS 3.0 /*   and of a two-level one whose order comes from theory */
 #define BARS_ORDER_MIN 0.3
 #define BARS_ORDER_MAX 5.0
+#define BARS_SAME                                                                                                         \
+  1e-8                          /* differences below this fraction of the quantity's kind are none: the solves' tolerance \
+                                   (an iterative solver leaves a force component that symmetry makes 0 at 1e-11 of the force) */
 #define BARS_EPS_ORDER 1.0      /* the penalty's order in eps of a functional of the displacement */
 #define BARS_EPS_ORDER_EDGE 0.5 /*   and of the zone's size */
 
@@ -61,7 +64,7 @@ PetscErrorCode BarsCheck(MPI_Comm comm, const AppCtx *user)
 }
 
 /* The quantities of q in a fixed order, with their names and the size of their kind (the force's magnitude for its
-   components and the reactions, since a component may be zero): a difference below round-off of that size is none.
+   components and the reactions, since a component may be zero): a difference below BARS_SAME of that size is none.
    The zone's size is at index BarsSizeIndex(dim). */
 static PetscInt BarsSizeIndex(PetscInt dim)
 {
@@ -118,7 +121,8 @@ static void MeshPart(const PetscReal f[3], PetscReal kind, PetscReal *bar, Petsc
   *bar    = PETSC_NAN;
   *order  = PETSC_NAN;
   note[0] = '\0';
-  if (PetscAbsReal(e21) <= 1e-10 * scale && PetscAbsReal(e32) <= 1e-10 * scale) { /* the same on every mesh to round-off: exact, or zero */
+  if (PetscAbsReal(e21) <= BARS_SAME * scale &&
+      PetscAbsReal(e32) <= BARS_SAME * scale) { /* the same on every mesh to the solves' tolerance: exact, or zero */
     *bar = 0.0;
     return;
   }
@@ -200,7 +204,7 @@ PetscErrorCode BarsCompute(DM dm, AppCtx *user)
     if (b->eps_done) {
       const PetscReal d = lv[BARS_EPS_LEVEL][k] - ev[k];
 
-      if (PetscAbsReal(d) > 1e-10 * PetscMax(kind[k], PetscAbsReal(lv[BARS_EPS_LEVEL][k])))
+      if (PetscAbsReal(d) > BARS_SAME * PetscMax(kind[k], PetscAbsReal(lv[BARS_EPS_LEVEL][k])))
         b->bar_eps[k] = EpsPart(d, k == size ? BARS_EPS_ORDER_EDGE : BARS_EPS_ORDER);
     }
     b->bar[k] = b->bar_mesh[k] + b->bar_eps[k]; /* NaN with the mesh's part */
