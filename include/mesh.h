@@ -14,9 +14,8 @@ PetscErrorCode MeshCreateBoxLevel(DM coarse, const MeshBox *box, PetscInt level,
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
 PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam);
 PetscErrorCode MeshCellSize(DM dm, PetscInt c, PetscReal *h);
-PetscErrorCode MeshGetMaxCellSize(DM dm, PetscReal *h);
-PetscErrorCode MeshSetCellSizes(DM dm, const char name[], PetscReal hmax, PetscReal *sizes);
-PetscErrorCode MeshGetCellSizes(DM dm, const char name[], PetscReal *hmax, const PetscReal **sizes);
+PetscErrorCode MeshGetMaxCellSize(DM dm, PetscReal diameter_max, PetscReal *h);
+PetscErrorCode MeshSetCellSizes(DM dm, PetscReal hmax, PetscReal *sizes);
 PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id);
 PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count);
 PetscErrorCode MeshOwnedIndex(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt **index, PetscInt *nowned);

@@ -16,8 +16,8 @@ Usage: estimates.py [--outdir DIR] [--parts estimate,bars] [--check]
    nodes (--parts bars: this part alone, --parts estimate: the others).
 
 DIR (default output/estimates) receives the runs, estimates.csv, penalty.csv, hertz.csv, bars.csv, estimates.md, bars.md,
-effectivity.png, hertz_density.png and band.png. --check: exit 1 unless, in every series, the effectivity varies by at most 1.5x over the four
-finest meshes and the estimate's rate is the error's within 0.1; the effectivity over all series varies by at most 3x;
+effectivity.png, hertz_density.png and band.png. --check: exit 1 unless, in every series, the effectivity varies by at
+most 1.5x over the four finest meshes and the estimate's rate is the error's within 0.1; the effectivity over all series varies by at most 3x;
 every penalty ratio lies in [1/3, 3]; on every Hertz case the densest cell lies within 2 cell diameters of the zone's
 edge; at least 9 in 10 error bars cover the true error, and none is over 10 times an error above 1e-4 relative; the
 pressure's band covers at least 9 in 10 of the nodes where the pressure's error is above 1e-3 of its peak.

@@ -93,6 +93,7 @@ def hertz_peak(case, path, top=10):
 COVERAGE_MMS = [(2, 32, []), (2, 64, []), (2, 128, []), (3, 4, ["-contact_grid_sequence", "2"] + SOLVER_3D),
                 (3, 8, ["-contact_grid_sequence", "2"] + SOLVER_3D)]
 COVERAGE_HERTZ = [("cylinder-indenter", "eps=h/10"), ("sphere-indenter", "eps=h/10")]
+MMS_QUANTITIES = ["contact_force", "pressure_max", "contact_size"]
 BLOCK = 10.0  # the indenters' block, [0, BLOCK] x [-BLOCK, 0] (2D) or [0, BLOCK]^2 x [-BLOCK, 0] (3D)
 
 
@@ -116,7 +117,6 @@ def pressure_band_coverage(path):
     err = np.abs(p - exact)
     large = err > 1e-3 * exact.max()
     return int(large.sum()), int(np.sum(err[large] <= band[large])), float(np.median(band[large] / err[large]))
-MMS_QUANTITIES = ["contact_force", "pressure_max", "contact_size"]
 
 
 def qoi(attrs, name):

@@ -289,9 +289,24 @@ PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The sizes MeshSetCellSizes() kept with dm, or *sizes = NULL. */
+static PetscErrorCode MeshGetCellSizes(DM dm, PetscReal *hmax, const PetscReal **sizes)
+{
+  PetscContainer container;
+  PetscInt       cStart, cEnd;
+
+  PetscFunctionBeginUser;
+  *sizes = NULL;
+  PetscCall(PetscObjectQuery((PetscObject)dm, "eps_cell_size", (PetscObject *)&container));
+  if (!container) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscContainerGetPointer(container, (void **)sizes));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  *hmax = (*sizes)[cEnd - cStart];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The size of cell c that the penalty's eps follows (eps = eps0 h^power / M): its diameter, unless the mesh carries
-   sizes of its own for it (MeshSetCellSizes() with the name "eps_cell_size": the error bars' coarser levels of a
-   tetrahedral mesh, src/solver/grid_sequence.c). */
+   sizes of its own (MeshSetCellSizes(): the error bars' coarser levels of a tetrahedral mesh, src/solver/grid_sequence.c). */
 PetscErrorCode MeshCellSize(DM dm, PetscInt c, PetscReal *h)
 {
   const PetscReal *sizes;
@@ -299,7 +314,7 @@ PetscErrorCode MeshCellSize(DM dm, PetscInt c, PetscReal *h)
   PetscInt         cStart;
 
   PetscFunctionBeginUser;
-  PetscCall(MeshGetCellSizes(dm, "eps_cell_size", &hmax, &sizes));
+  PetscCall(MeshGetCellSizes(dm, &hmax, &sizes));
   if (sizes) {
     PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, NULL));
     *h = sizes[c - cStart];
@@ -308,20 +323,21 @@ PetscErrorCode MeshCellSize(DM dm, PetscInt c, PetscReal *h)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The h of eps = eps0 h^power / M on this mesh: the largest cell diameter, or that of the mesh's own sizes. */
-PetscErrorCode MeshGetMaxCellSize(DM dm, PetscReal *h)
+/* The h of eps = eps0 h^power / M on this mesh: diameter_max (the caller's MeshGetMaxCellDiameter()), or the largest of
+   the mesh's own sizes. */
+PetscErrorCode MeshGetMaxCellSize(DM dm, PetscReal diameter_max, PetscReal *h)
 {
   const PetscReal *sizes;
 
   PetscFunctionBeginUser;
-  PetscCall(MeshGetCellSizes(dm, "eps_cell_size", h, &sizes));
-  if (!sizes) PetscCall(MeshGetMaxCellDiameter(dm, h));
+  PetscCall(MeshGetCellSizes(dm, h, &sizes));
+  if (!sizes) *h = diameter_max;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Keeps with dm (a container composed under name) one size per local cell, sizes[c - cStart] (taken over: freed with
-   dm), and a global largest one hmax. */
-PetscErrorCode MeshSetCellSizes(DM dm, const char name[], PetscReal hmax, PetscReal *sizes)
+/* Keeps with dm (a container composed on it) one size per local cell, sizes[c - cStart] (taken over: freed with dm), and
+   the global largest one, hmax, in the array's last entry. */
+PetscErrorCode MeshSetCellSizes(DM dm, PetscReal hmax, PetscReal *sizes)
 {
   PetscContainer container;
   PetscInt       cStart, cEnd;
@@ -332,24 +348,8 @@ PetscErrorCode MeshSetCellSizes(DM dm, const char name[], PetscReal hmax, PetscR
   PetscCall(PetscContainerCreate(PetscObjectComm((PetscObject)dm), &container));
   PetscCall(PetscContainerSetPointer(container, sizes));
   PetscCall(PetscContainerSetUserDestroy(container, PetscContainerUserDestroyDefault));
-  PetscCall(PetscObjectCompose((PetscObject)dm, name, (PetscObject)container));
+  PetscCall(PetscObjectCompose((PetscObject)dm, "eps_cell_size", (PetscObject)container));
   PetscCall(PetscContainerDestroy(&container));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The sizes MeshSetCellSizes() kept with dm under name, or *sizes = NULL. */
-PetscErrorCode MeshGetCellSizes(DM dm, const char name[], PetscReal *hmax, const PetscReal **sizes)
-{
-  PetscContainer container;
-  PetscInt       cStart, cEnd;
-
-  PetscFunctionBeginUser;
-  *sizes = NULL;
-  PetscCall(PetscObjectQuery((PetscObject)dm, name, (PetscObject *)&container));
-  if (!container) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscContainerGetPointer(container, (void **)sizes));
-  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
-  *hmax = (*sizes)[cEnd - cStart];
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

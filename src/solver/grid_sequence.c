@@ -125,7 +125,7 @@ PetscErrorCode GridSequenceBarsSizes(DM dm, const AppCtx *user)
   PetscCall(DMPlexIsSimplex(dm, &simplex));
   if (dim != 3 || !simplex) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(MeshDescendantSizes(dm, nlevels - user->prob.level, copt->eps_power, &sizes, &hmax));
-  PetscCall(MeshSetCellSizes(dm, "eps_cell_size", hmax, sizes));
+  PetscCall(MeshSetCellSizes(dm, hmax, sizes));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -172,8 +172,7 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
 
     PetscCall(ContactGetSet(user->contact, &cs));
     PetscCall(BarsRecordPressure(dm, user, cs->pressure, NULL)); /* the pressure's band: no penalty part */
-  }
-  if (user->prob.level == first + BARS_EPS_LEVEL && ContactHasPenalty(user->contact)) {
+  } else if (user->prob.level == first + BARS_EPS_LEVEL) {
     const RunStats    saved = user->rec.stats;
     const ContactSet *cs;
     PetscReal        *p_eps;

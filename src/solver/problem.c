@@ -30,17 +30,16 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   {
     ContactProblem cp;
 
-    cp.bcs      = &user->scene.bcs;
-    cp.obstacle = &user->scene.obstacle;
-    cp.material = &user->opt->material;
-    cp.degree   = user->opt->degree;
-    cp.h        = user->prob.h;
-    PetscCall(MeshGetMaxCellSize(dm, &cp.h)); /* the mesh's own sizes, if it has some (the bars' levels, grid_sequence.c) */
-    cp.assembly       = user->prob.assembly;  /* resolved above */
+    cp.bcs            = &user->scene.bcs;
+    cp.obstacle       = &user->scene.obstacle;
+    cp.material       = &user->opt->material;
+    cp.degree         = user->opt->degree;
+    cp.assembly       = user->prob.assembly; /* resolved above */
     cp.assembly_check = user->opt->assembly_check;
     cp.loc_bc         = user->prob.loc_bc;
     cp.like           = user->prob.r0;
-    PetscCall(ContactSetUp(user->contact, dm, &cp)); /* the contact set, eps, the penalty's faces or SNESVI's bounds */
+    PetscCall(MeshGetMaxCellSize(dm, user->prob.h, &cp.h)); /* h, or the mesh's own sizes (the bars' levels, grid_sequence.c) */
+    PetscCall(ContactSetUp(user->contact, dm, &cp));        /* the contact set, eps, the penalty's faces or SNESVI's bounds */
   }
   PetscCall(SolverAssembleBulk(dm, user));
   PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
