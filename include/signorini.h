@@ -361,6 +361,7 @@ typedef struct {
   Mat          K;                  /* bulk elastic operator, assembled once */
   Vec          r0;                 /* bulk residual at u = 0 (loads and Dirichlet lifting) */
   Vec          loc_r0;             /* the same, local, with the rows of the fixed components (for the supports' reactions) */
+  PetscReal    weak_load_lift;     /* a scene's load in weak form (weak_data.c) on the Dirichlet lift, L(u_D), for the energy */
   PetscReal    load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
   PetscReal    displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */
   SolverCtx    sctx;               /* the SNES's callbacks' context and the solver's own state (src/solver/solver_impl.h) */

@@ -60,6 +60,31 @@ def test_patch_slip_and_surface_load(outdir, dim, load_kind):
     assert attrs["active_vertices"] == 0
     left = "4" if dim == 2 else "6"
     assert abs(attrs[f"reaction_slip_{left}_x"] + s) < 1e-10, attrs[f"reaction_slip_{left}_x"]
+    # the potential energy 1/2 a(u, u) - L(u) = 1/2 s exx - s exx (the load s on the right face, of area 1, moves by exx);
+    # the top's lift carries no load and no stress (it follows the free contraction)
+    exx = (1 - NU**2) * s / E if dim == 2 else s / E
+    assert abs(attrs["energy"] + 0.5 * s * exx) < 1e-12 * s * exx, (attrs["energy"], -0.5 * s * exx)
+
+
+@pytest.mark.parametrize("np_", [1, 2])
+def test_energy_with_a_lift_and_a_body_force(outdir, np_):
+    """The potential energy J(u_h) = 1/2 a(u_h, u_h) - L(u_h) with Dirichlet data that are not zero, by hand: nu = 0, a
+    body force b along y, slips u_y = 0 at y = 0 and u_y = d at y = 1, u_x = 0 at x = 0. The solution is 1D,
+    u_y = d y + b/(2E) y (1 - y), with J(u) = E d^2/2 - b d/2 - b^2/(24 E); P1 is exact at the nodes (1D Galerkin), and
+    J(u_h) - J(u) = 1/2 a(u - u_h, u - u_h) = b^2 h^2 / (24 E) on n rows of height h = 1/n. The free unknowns alone
+    (1/2 w.K w + w.r0) miss J(u_D), which grows like 1/h: they gave -0.00087, -0.00134, -0.00218 on 4, 8, 16 rows
+    against -0.000595, -0.000605, -0.000608."""
+    d, b = 0.01, 0.1
+    for n in (4, 8, 16):
+        args = ["-scene", "general", "-dm_plex_box_faces", f"{n},{n}", "-young_modulus", E, "-poisson_ratio", 0, "-contact_faces", "2",
+                "-obstacle_point", "2,0", "-obstacle_normal", "1,0", "-bc_slip", "1,3,4", "-bc_slip_1_components", "1",
+                "-bc_slip_3_components", "1", "-bc_slip_3_translate", f"0,{d}", "-bc_slip_4_components", "0", "-body_force", f"0,{b}",
+                "-snes_rtol", "1e-12"]
+        _, h5 = run(args, "energy", np_=np_, output=os.path.join(outdir, f"energy_{n}.h5"))
+        attrs, _ = load(h5)
+        expected = E * d * d / 2 - b * d / 2 - b * b / (24 * E) + b * b / (24 * E * n * n)
+        assert attrs["active_vertices"] == 0
+        assert abs(attrs["energy"] - expected) < 1e-10 * abs(expected), (n, attrs["energy"], expected)
 
 
 @pytest.mark.parametrize("dim", [2, 3])

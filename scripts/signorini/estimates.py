@@ -93,7 +93,14 @@ def hertz_peak(case, path, top=10):
 COVERAGE_MMS = [(2, 32, []), (2, 64, []), (2, 128, []), (3, 4, ["-contact_grid_sequence", "2"] + SOLVER_3D),
                 (3, 8, ["-contact_grid_sequence", "2"] + SOLVER_3D)]
 COVERAGE_HERTZ = [("cylinder-indenter", "eps=h/10"), ("sphere-indenter", "eps=h/10")]
-MMS_QUANTITIES = ["contact_force", "pressure_max", "contact_size"]
+MMS_QUANTITIES = ["contact_force", "pressure_max", "contact_size", "energy"]
+
+
+def eps_over_1000(args):
+    """The options that take the run of args to eps/1000 on the same mesh (the last -penalty_eps0 wins): the limit
+    eps -> 0 of its quantities, against which the bars' penalty part is measured."""
+    eps0 = float(args[len(args) - 1 - args[::-1].index("-penalty_eps0") + 1]) if "-penalty_eps0" in args else 1.0
+    return ["-penalty_eps0", f"{eps0 * 1e-3:g}"]
 BLOCK = 10.0  # the indenters' block, [0, BLOCK] x [-BLOCK, 0] (2D) or [0, BLOCK]^2 x [-BLOCK, 0] (3D)
 
 

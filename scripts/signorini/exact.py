@@ -75,6 +75,21 @@ class MMS:
         G[:, d, d] = f3
         return G
 
+    def strain_energy(self, E, poisson, n=64):
+        """1/2 a(u, u) over the unit box (times the unit depth in 3D, where u does not depend on y and u_y = 0, so that
+        the strain is the 2D plane strain one): the kink x = a splits the x-integration, each part x - a = +-L t^2 from
+        it (the profiles' powers 1 + nu of the distance are then smooth in t), Gauss-Legendre in x and y."""
+        lam, mu = plane_strain_lame(E, poisson)
+        t, w = gauss_legendre01(n)
+        xs = np.concatenate([self.a - self.a * t * t, self.a + (1.0 - self.a) * t * t])
+        wx = np.concatenate([2.0 * self.a * t * w, 2.0 * (1.0 - self.a) * t * w])
+        X, Y = np.meshgrid(xs, t, indexing="ij")
+        W = np.outer(wx, w).ravel()
+        G = MMS(self.nu, self.a, self.A, self.B, 2).grad(np.column_stack([X.ravel(), Y.ravel()]))
+        e = 0.5 * (G + G.transpose(0, 2, 1))
+        tr = e[:, 0, 0] + e[:, 1, 1]
+        return float(W @ (0.5 * lam * tr * tr + mu * np.einsum("kij,kij->k", e, e)))
+
     def normal_stress(self, x1, E, poisson):
         """sigma_n on Gamma_C = {x_d = 0}: (lambda + 2 mu) psi(x_1)."""
         lam, mu = plane_strain_lame(E, poisson)
@@ -84,13 +99,16 @@ class MMS:
 def mms_quantities(mms, E, poisson):
     """The quantities of the error bars (/run qoi_*) of the exact solution: the obstacle's force on the body (the pressure
     (lambda + 2 mu) B (a - x)^q integrated over [0, a], times the unit depth in 3D, along +x_d), the largest pressure
-    (at x = 0), the contact zone's size (a: a width in 2D, a x 1 area in 3D) and the penetration (none)."""
+    (at x = 0), the contact zone's size (a: a width in 2D, a x 1 area in 3D), the penetration (none) and the energy.
+    The energy: the scene's load is L(v) = a(u, v) - int_Gamma_C sigma_n(u) v_n (src/physics/weak_data.c), so that
+    J(u) = 1/2 a(u, u) - L(u) = -1/2 a(u, u) + int_Gamma_C sigma_n u_n = -1/2 a(u, u), sigma_n u_n = 0 on Gamma_C."""
     lam, mu = plane_strain_lame(E, poisson)
     m = lam + 2 * mu
     axis = "xyz"[mms.dim - 1]
     q = {f"contact_force_{c}": 0.0 for c in "xyz"[: mms.dim]}
     q[f"contact_force_{axis}"] = m * mms.B * mms.a ** (mms.q + 1) / (mms.q + 1)
-    q.update({"pressure_max": m * mms.B * mms.a ** mms.q, "contact_size": mms.a, "penetration_max": 0.0})
+    q.update({"pressure_max": m * mms.B * mms.a ** mms.q, "contact_size": mms.a, "penetration_max": 0.0,
+              "energy": -mms.strain_energy(E, poisson)})
     return q
 
 

@@ -1,15 +1,61 @@
 /* Contact quantities after the solve: nodal pressure, penetration, total force, energy. */
 #include "physics.h"
 
+/* The potential energy of the Dirichlet lift u_D (loc_bc: the Dirichlet values, zero on the free unknowns),
+     J(u_D) = 1/2 a(u_D, u_D) - L(u_D) = u_D . r0_loc - 1/2 u_D . A u_D,
+   since r0_loc = A u_D - b holds every row (the fixed ones too) of the residual at u_D (SolverAssembleBulk() and the
+   surface loads of BoundaryAddLoads()); a scene's load in weak form is not in r0_loc, and WeakDataAddToResidual() gives
+   its L(u_D). Both vectors hold this rank's cells only, so that the local dot products add up over the ranks to the sums
+   over the cells. A u_D: the closed-form stiffness of the P1 simplices at Gamma_D, or PetscFE's residual at u_D less its
+   residual at 0. Zero when the Dirichlet data are. */
+static PetscErrorCode PostprocessLiftEnergy(DM dm, AppCtx *user, PetscReal *energy)
+{
+  Vec         locA, locZ, locR;
+  PetscReal   ud_max, local[2], global[2];
+  PetscScalar dot;
+
+  PetscFunctionBeginUser;
+  *energy = 0.0;
+  PetscCall(VecNorm(user->prob.loc_bc, NORM_INFINITY, &ud_max));
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ud_max, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
+  if (ud_max == 0.0) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(DMGetLocalVector(dm, &locA));
+  PetscCall(VecZeroEntries(locA));
+  if (user->prob.assembly == ASSEMBLY_P1)
+    PetscCall(ElasticityP1AddFixedCellsStiffness(dm, &user->opt->material, user->prob.loc_bc, locA));
+  else {
+    PetscCall(DMGetLocalVector(dm, &locZ));
+    PetscCall(DMGetLocalVector(dm, &locR));
+    PetscCall(VecZeroEntries(locZ));
+    PetscCall(VecZeroEntries(locR));
+    PetscCall(DMPlexSNESComputeResidualFEM(dm, user->prob.loc_bc, locA, user));
+    PetscCall(DMPlexSNESComputeResidualFEM(dm, locZ, locR, user));
+    PetscCall(VecAXPY(locA, -1.0, locR));
+    PetscCall(DMRestoreLocalVector(dm, &locZ));
+    PetscCall(DMRestoreLocalVector(dm, &locR));
+  }
+  PetscCall(VecDot(user->prob.loc_bc, user->prob.loc_r0, &dot));
+  local[0] = PetscRealPart(dot);
+  PetscCall(VecDot(user->prob.loc_bc, locA, &dot));
+  local[1] = PetscRealPart(dot);
+  PetscCall(DMRestoreLocalVector(dm, &locA));
+  PetscCall(MPIU_Allreduce(local, global, 2, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
+  *energy = global[0] - 0.5 * global[1] - user->prob.weak_load_lift;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The contact quantities of the run (ContactPostProcess(), include/contact.h: the force, pressure and active set from the
-   force the rule exerts), the supports' reactions, and the energy 1/2 a(u,u) - L(u) + the contact term's energy, with
-   K the bulk operator (exact for homogeneous Dirichlet data on the free unknowns). */
+   force the rule exerts), the supports' reactions, and the potential energy of u_h = w + u_D (w on the free unknowns),
+     J(u_h) = 1/2 a(u_h, u_h) - L(u_h) + the contact term's energy,
+   with 1/2 a(u_h, u_h) - L(u_h) = 1/2 w.K w + w.r0 + J(u_D): K the bulk operator on the free unknowns and r0 = A u_D - b
+   there, so that w.r0 = a(u_D, w) - L(w). */
 PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
 {
   RunStats     *st = &user->rec.stats;
   ContactResult res;
   Vec           R;
   PetscScalar   uKu, r0u;
+  PetscReal     lift;
 
   PetscFunctionBeginUser;
   PetscCall(VecDuplicate(u, &R));
@@ -24,7 +70,8 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   st->max_penetration = res.max_penetration;
   st->contact_force   = res.force;
   st->active_vertices = res.active_vertices;
-  st->energy          = 0.5 * PetscRealPart(uKu) + PetscRealPart(r0u) + res.energy;
+  PetscCall(PostprocessLiftEnergy(dm, user, &lift));
+  st->energy = 0.5 * PetscRealPart(uKu) + PetscRealPart(r0u) + lift + res.energy;
   {
     const ContactSet *cs;
     PetscReal         pmax = 0.0;

@@ -23,7 +23,9 @@ PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* r0 -= L: r0 holds the bulk residual at u = 0 (the Dirichlet lifting) on entry. */
+/* r0 -= L: r0 holds the bulk residual at u = 0 (the Dirichlet lifting) on entry. L(u_D) of the Dirichlet lift goes to
+   prob.weak_load_lift, for the energy (postprocess.c); loc_r0 does not take L: the supports' reactions stay the stress
+   a(u_h, phi) on Gamma_D that holds the body, which L on the fixed rows (a(u_exact, phi) there) would cancel. */
 PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0)
 {
   CellQuadrature cq;
@@ -59,7 +61,7 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0)
         elem[b] += cq.w[q] * s;
       }
     }
-    PetscCall(DMPlexVecSetClosure(dm, NULL, locL, c, elem, ADD_VALUES));
+    PetscCall(DMPlexVecSetClosure(dm, NULL, locL, c, elem, ADD_ALL_VALUES));
   }
   for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
     PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces));
@@ -78,9 +80,16 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0)
           elem[b] -= cq.w[q] * sn * vn;
         }
       }
-      PetscCall(DMPlexVecSetClosure(dm, NULL, locL, cq.cell, elem, ADD_VALUES));
+      PetscCall(DMPlexVecSetClosure(dm, NULL, locL, cq.cell, elem, ADD_ALL_VALUES));
     }
     PetscCall(PetscFree(faces));
+  }
+  {
+    PetscScalar lift;
+
+    PetscCall(VecDot(locL, user->prob.loc_bc, &lift)); /* this rank's cells only: the sum over the ranks is L(u_D) */
+    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &lift, 1, MPIU_SCALAR, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
+    user->prob.weak_load_lift = PetscRealPart(lift);
   }
   /* r0 -= L */
   PetscCall(VecScale(locL, -1.0));

@@ -43,6 +43,7 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   }
   PetscCall(SolverAssembleBulk(dm, user));
   PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
+  user->prob.weak_load_lift = 0.0; /* set by a scene's load in weak form */
   PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0));
   PetscCall(SolverCtxCreate(user->prob.K, user->prob.r0, user->contact, &user->opt->solver, &user->rec.stats, &user->prob.sctx));
   PetscCall(SolverComputeScales(dm, user));
