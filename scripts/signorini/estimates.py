@@ -136,6 +136,7 @@ def hertz_truth(case, attrs):
     the half model in 2D, a quarter disk pi a^2 / 4 in 3D) and the largest pressure p0."""
     spec = hertz.CASES[case]
     dim = spec["dim"]
-    force = spec["parts"] * abs(float(attrs[f"qoi_contact_force_{'xyz'[dim - 1]}"]))
+    axis = "xyz"[dim - 1]
+    force = spec["parts"] * abs(float(attrs.get(f"qoi_contact_force_{axis}", attrs[f"contact_force_{axis}"])))
     a, p0 = hertz.closed_form(dim, force)
     return {"contact_size": ("contact_size", a if dim == 2 else math.pi * a * a / 4), "pressure_max": ("pressure_max", p0)}
