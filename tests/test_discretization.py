@@ -30,6 +30,15 @@ def test_patch_test(mesh, method):
     err, scale = np.abs(f["error"]).max(), np.abs(f["exact_displacement"]).max()
     assert err <= 1e-11 * scale, f"patch test error {err:.3e} for a field of size {scale:.3e}"
     assert attrs["active_vertices"] == 0 and attrs["max_penetration"] <= 0.0
+    # the energy of the whole field (its Dirichlet values carry the load): 1/2 sigma : eps over the unit box, with the
+    # strain of the exact linear field fitted at the vertices (plane strain in 2D)
+    x, ue = f["x"], f["exact_displacement"]
+    G = np.linalg.lstsq(np.column_stack([x, np.ones(len(x))]), ue, rcond=None)[0][:-1].T
+    e = 0.5 * (G + G.T)
+    E, nu = attrs["young_modulus"], attrs["poisson_ratio"]
+    lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+    energy = 0.5 * (lam * np.trace(e) ** 2 + 2 * mu * np.sum(e * e))
+    assert abs(attrs["energy"] - energy) <= 1e-10 * energy, (attrs["energy"], energy)
 
 
 ACTIVE_PATCH = {
