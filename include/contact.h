@@ -52,6 +52,7 @@ PetscErrorCode ContactGetType(Contact ct, ContactType *type);
 PetscErrorCode ContactGetOptions(Contact ct, const ContactOptions **opt);
 PetscErrorCode ContactSetUp(Contact ct, DM dm, const ContactProblem *pb);
 PetscErrorCode ContactReset(Contact ct);
+PetscErrorCode ContactSetLoad(Contact ct, DM dm, const Obstacle *obstacle);
 PetscErrorCode ContactView(Contact ct, PetscViewer viewer);
 
 /* What the type does, asked instead of its name: */

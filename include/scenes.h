@@ -20,6 +20,10 @@ PetscErrorCode SceneSetFoundation(Scene *scene, PetscInt dim);
 PetscErrorCode SceneBoundaryGetOptions(DM dm, Scene *scene);
 PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene);
 
+/* scenes/load_factor.c: the factor of a load path on every prescribed datum */
+PetscErrorCode SceneCheckLoadPath(MPI_Comm comm, const Scene *scene);
+PetscErrorCode SceneSetLoadFactor(Scene *scene, PetscReal t);
+
 /* scenes/fingerprint.c: the problem as one string, for -reference */
 #define SCENE_FINGERPRINT_LEN 4096
 PetscErrorCode SceneFingerprint(const Scene *scene, const Material *mat, PetscInt dim, char buf[], size_t len);

@@ -94,6 +94,13 @@ typedef struct {
   PetscReal      kink_offset;
   PetscInt       num_constants; /* scene constants, stored from constants[CONST_SCENE] on */
   PetscScalar    constants[CONST_SCENE_MAX - CONST_SCENE];
+  PetscBool      load_constant[CONST_SCENE_MAX - CONST_SCENE]; /* the scene's constants that are loads (a body force's size) */
+  PetscReal      load_factor;                                  /* the factor of every prescribed datum (SceneSetLoadFactor()) */
+  struct {                                                     /* the prescribed data at the factor 1, kept by SceneSetLoadFactor() */
+    PetscBool   kept;
+    PetscReal   value[BOUNDARY_MAX][3], body_force[3], translate[3];
+    PetscScalar constants[CONST_SCENE_MAX - CONST_SCENE];
+  } full_load;
 } Scene;
 
 typedef PetscErrorCode (*SceneCreateFn)(DM dm, const Material *mat, Scene *scene);
@@ -321,6 +328,23 @@ typedef struct {
   PetscReal *pressure_bar;        /*   the band of the nodal pressure at each (contact_pressure_bar), NaN without one */
 } ErrorBars;
 
+/* A load path (-load_steps, -load_path): the factors of the prescribed data, solved in turn on the final mesh. */
+#define LOAD_PATH_MAX 1000
+typedef struct {
+  PetscInt  n; /* 0: no path (the one solve at the full load) */
+  PetscReal factor[LOAD_PATH_MAX];
+} LoadPathOptions;
+
+/* One step of a load path (/steps in the output): its factor, the obstacle's translation, the quantities, the solve. */
+typedef struct {
+  PetscReal  factor, obstacle_translate[3];
+  PetscReal  contact_force; /* the sum of the nodal normal reactions, as /run's contact_force */
+  Quantities q;
+  PetscInt   newton_its, ksp_its;
+  PetscReal  time; /* of the step's solve */
+  PetscBool  converged;
+} StepRecord;
+
 /* One solve of a run: a level of the grid sequence or an eps of the sweep (/solves in the output). */
 typedef struct {
   PetscInt  level, n_dofs;
@@ -333,19 +357,20 @@ typedef struct {
 
 /* The options of the run, read once before any set-up (each module's *GetOptions fills its part), read-only after. */
 typedef struct {
-  char          scene_name[64];
-  Material      material;
-  PetscInt      degree;        /* of the displacement, -displacement_petscspace_degree */
-  PetscBool     section_check; /* -section_check: the P1 section compared with PETSc's */
-  SolverOptions solver;
-  VerifyOptions verify;
-  AssemblyType  assembly;                 /* -assembly as given (auto, fe, p1) */
-  PetscBool     assembly_check;           /* -assembly_check: assemble K both ways and compare */
-  PetscBool     perf_bandwidth;           /* -perf_bandwidth: measure the memory bandwidths after the solve */
-  PetscBool     estimate, estimate_given; /* -estimate: the a posteriori error estimate after the solve (and whether it was given) */
-  PetscBool     bars;                     /* -bars: error bars of the quantities from the nested meshes and a second eps */
-  char          output[PETSC_MAX_PATH_LEN];
-  PetscBool     output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
+  char            scene_name[64];
+  Material        material;
+  PetscInt        degree;        /* of the displacement, -displacement_petscspace_degree */
+  PetscBool       section_check; /* -section_check: the P1 section compared with PETSc's */
+  SolverOptions   solver;
+  VerifyOptions   verify;
+  AssemblyType    assembly;                 /* -assembly as given (auto, fe, p1) */
+  PetscBool       assembly_check;           /* -assembly_check: assemble K both ways and compare */
+  PetscBool       perf_bandwidth;           /* -perf_bandwidth: measure the memory bandwidths after the solve */
+  PetscBool       estimate, estimate_given; /* -estimate: the a posteriori error estimate after the solve (and whether it was given) */
+  PetscBool       bars;                     /* -bars: error bars of the quantities from the nested meshes and a second eps */
+  LoadPathOptions load_path;                /* -load_steps, -load_path */
+  char            output[PETSC_MAX_PATH_LEN];
+  PetscBool       output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
 } RunOptions;
 
 typedef struct _n_SolverCtx *SolverCtx; /* private to src/solver/ */
@@ -372,6 +397,8 @@ typedef struct {
   RunStats      stats;
   SolveRecord  *records; /* one per solve, any number */
   PetscInt      nrecords, maxrecords;
+  StepRecord   *steps; /* one per step of a load path solved (the failed one included) */
+  PetscInt      nsteps;
   ErrorNorms    errors;                   /* against the scene's exact solution */
   ErrorNorms    ref_errors;               /* against the -reference solution */
   ErrorEstimate estimate;                 /* the a posteriori estimate of the error */

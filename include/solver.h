@@ -7,6 +7,7 @@
 /* the bound of Eisenstat-Walker's linear tolerances, the penalty method's default with an iterative preconditioner */
 #define SOLVER_EW_RTOL_MAX 0.01
 PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user);
+PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user);
 PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
 PetscErrorCode SolverComputeScales(DM dm, AppCtx *user);
 /* Where a solve starts: from zero, from the solution for a nearby eps (the sweep), or from a coarser mesh's (nested
@@ -35,6 +36,12 @@ PetscErrorCode SolverGivenEsteig(const SolverGiven *g, const char prefix[], Pets
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
 PetscErrorCode GridSequenceBarsSizes(DM dm, const AppCtx *user);
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
+
+/* load_path.c: -load_steps, -load_path */
+PetscErrorCode LoadPathGetOptions(MPI_Comm comm, LoadPathOptions *lp);
+PetscErrorCode LoadPathSetUp(MPI_Comm comm, AppCtx *user);
+PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u);
+PetscErrorCode LoadPathView(MPI_Comm comm, const AppCtx *user);
 
 /* multigrid.c */
 PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt vertex_source[], AppCtx *user);

@@ -57,6 +57,7 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
                             (double)r->time_solve, r->converged ? "" : "  FAILED"));
     }
   }
+  PetscCall(LoadPathView(comm, user));
   PetscCall(EstimateView(comm, &user->rec.estimate, &user->rec.errors));
   PetscCall(BarsView(comm, &user->rec.bars));
   PetscCall(ContactChecksWarnings(comm, &s->checks, PETSC_TRUE, NULL));
@@ -124,6 +125,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(EstimateGetOptions(comm, &opt));
   PetscCall(AssemblyGetOptions(comm, &opt.assembly, &opt.assembly_check));
   PetscCall(OutputGetOptions(comm, &opt));
+  PetscCall(LoadPathGetOptions(comm, &opt.load_path));
   PetscCall(BandwidthGetOptions(comm, &opt.perf_bandwidth));
   user.opt = &opt;
 
@@ -136,6 +138,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   }
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));        /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
+  PetscCall(LoadPathSetUp(comm, &user));                                  /* a load path: the scene at its first factor */
   PetscCall(GridSequenceBarsSizes(dm, &user));                            /* -bars on tetrahedra: the final mesh's eps on the levels below it */
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(ReferenceCheckFile(dm, &user));     /* before the solve, not after it */
@@ -153,6 +156,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
 
   PetscCall(GridSequenceSolve(&dm, &user, &snes, &u)); /* one solve without nested iteration */
   PetscCall(EpsSweepSolve(dm, &user, snes, u));
+  PetscCall(LoadPathSolve(dm, &user, snes, u)); /* the steps after the first, each from the last */
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
   PetscCall(BarsCompute(dm, &user));             /* -bars: from the levels' quantities and this mesh's */
@@ -207,6 +211,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(ContactDestroy(&user.contact));
   PetscCall(ContactFinalizePackage());
   PetscCall(PetscFree(user.rec.records));
+  PetscCall(PetscFree(user.rec.steps));
   PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(BarsReset(&user.rec.bars));
   PetscCall(SceneFinalize());

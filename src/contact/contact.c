@@ -284,6 +284,20 @@ PetscErrorCode ContactSetUp(Contact ct, DM dm, const ContactProblem *pb)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* A new load state on the same mesh (a step of a load path): the obstacle at its new translation, and the Dirichlet
+   values that loc_bc (referenced at ContactSetUp()) now holds. The contact set's gaps, normals and fixed values follow;
+   the Gauss rule's kernels read the obstacle from constants[], which ElasticityUpdateConstants() rewrote. The bounds of
+   SNESVI would have to follow too: it is refused with a load path (LoadPathCheck()). */
+PetscErrorCode ContactSetLoad(Contact ct, DM dm, const Obstacle *obstacle)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(ct->set_up, ct->comm, PETSC_ERR_ORDER, "ContactSetLoad() needs ContactSetUp() first");
+  ct->obstacle = *obstacle;
+  ObstaclePack(&ct->obstacle, ct->obstacle_packed);
+  PetscCall(ContactSetUpdateData(ct, dm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The type and its parameters, as the run's summary line shows them: "method penalty (gauss quadrature, eps = ...)". */
 PetscErrorCode ContactView(Contact ct, PetscViewer viewer)
 {

@@ -52,6 +52,7 @@ struct _p_Contact {
 
 /* contact_set.c */
 PetscErrorCode ContactSetBuild(Contact ct, DM dm, Vec like);
+PetscErrorCode ContactSetUpdateData(Contact ct, DM dm);
 PetscErrorCode ContactSetFree(ContactSet *cs);
 PetscReal      ContactEpsFactor(Contact ct, PetscReal h_local);
 PetscErrorCode ContactComputeBdResidual(Contact ct, DM dm, PetscWeakForm wf, PetscInt part, Vec locX, Vec locF);

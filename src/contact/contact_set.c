@@ -228,6 +228,32 @@ PetscErrorCode ContactSetBuild(Contact ct, DM dm, Vec like)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The set's gaps and normals from the packed obstacle, and the values of its fixed components from loc_bc, as
+   ContactSetBuild() computes them: again after the obstacle or the Dirichlet values changed (ContactSetLoad()). */
+PetscErrorCode ContactSetUpdateData(Contact ct, DM dm)
+{
+  ContactSet        *cs  = &ct->set;
+  const PetscInt     dim = ct->dim;
+  PetscSection       lsec;
+  const PetscScalar *bcv;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetLocalSection(dm, &lsec));
+  PetscCall(VecGetArrayRead(ct->loc_bc, &bcv));
+  for (PetscInt i = 0; i < cs->n; ++i) {
+    PetscInt  loff;
+    PetscReal x[3] = {0.0, 0.0, 0.0};
+
+    PetscCall(PetscSectionGetOffset(lsec, cs->point[i], &loff));
+    PetscCall(MeshPointPosition(dm, cs->point[i], x));
+    for (PetscInt c = 0; c < dim; ++c)
+      if (cs->dof[i * dim + c] < 0) cs->fixed[i * dim + c] = PetscRealPart(bcv[loff + c]);
+    ObstacleGapNormal(dim, ct->obstacle_packed, x, &cs->normal[i * dim], &cs->gap[i]);
+  }
+  PetscCall(VecRestoreArrayRead(ct->loc_bc, &bcv));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode ContactSetFree(ContactSet *cs)
 {
   PetscFunctionBeginUser;

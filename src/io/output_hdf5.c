@@ -473,6 +473,75 @@ static PetscErrorCode WriteSolves(MPI_Comm comm, const AppCtx *user, PetscViewer
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* One column of /steps (a dataset of length nsteps, on rank 0). */
+static PetscErrorCode WriteStepColumn(MPI_Comm comm, PetscViewer v, const char name[], PetscInt n, const PetscReal values[])
+{
+  Vec          col;
+  PetscScalar *a;
+  PetscMPIInt  rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCall(VecCreateMPI(comm, rank == 0 ? n : 0, n, &col));
+  PetscCall(PetscObjectSetName((PetscObject)col, name));
+  PetscCall(VecGetArray(col, &a));
+  for (PetscInt i = 0; rank == 0 && i < n; ++i) a[i] = values[i];
+  PetscCall(VecRestoreArray(col, &a));
+  PetscCall(VecView(col, v));
+  PetscCall(VecDestroy(&col));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* /steps/<column>: one row per step of a load path (load_path.c), the failed one included: the factor, the obstacle's
+   translation and force, the supports' reactions, the contact size, the largest pressure and penetration, the energy,
+   the solve's Newton steps, linear iterations, time and whether it converged. */
+static PetscErrorCode WriteSteps(MPI_Comm comm, const AppCtx *user, PetscViewer v, PetscInt dim)
+{
+  const PetscInt    n  = user->rec.nsteps;
+  const StepRecord *st = user->rec.steps;
+  PetscReal        *col;
+  char              name[128];
+
+  PetscFunctionBeginUser;
+  if (!n) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc1(n, &col));
+  PetscCall(PetscViewerHDF5PushGroup(v, "/steps"));
+#define STEP_COLUMN(label, expr)                        \
+  do {                                                  \
+    for (PetscInt i = 0; i < n; ++i) col[i] = (expr);   \
+    PetscCall(WriteStepColumn(comm, v, label, n, col)); \
+  } while (0)
+  STEP_COLUMN("factor", st[i].factor);
+  STEP_COLUMN("contact_force", st[i].contact_force);
+  for (PetscInt c = 0; c < dim; ++c) {
+    PetscCall(PetscSNPrintf(name, sizeof(name), "obstacle_translate_%c", "xyz"[c]));
+    STEP_COLUMN(name, st[i].obstacle_translate[c]);
+    PetscCall(PetscSNPrintf(name, sizeof(name), "contact_force_%c", "xyz"[c]));
+    STEP_COLUMN(name, st[i].q.force[c]);
+  }
+  for (PetscInt b = 0; b < user->scene.bcs.n; ++b) {
+    const BoundaryCondition *bc = &user->scene.bcs.bc[b];
+
+    if (bc->kind != BC_CLAMP && bc->kind != BC_SLIP) continue;
+    for (PetscInt c = 0; c < dim; ++c) {
+      PetscCall(PetscSNPrintf(name, sizeof(name), "reaction_%s_%s_%c", BoundaryKinds[bc->kind], bc->token, "xyz"[c]));
+      STEP_COLUMN(name, st[i].q.reaction[b][c]);
+    }
+  }
+  STEP_COLUMN("contact_size", st[i].q.contact_size);
+  STEP_COLUMN("pressure_max", st[i].q.pressure_max);
+  STEP_COLUMN("penetration_max", st[i].q.penetration_max);
+  STEP_COLUMN("energy", st[i].q.energy);
+  STEP_COLUMN("newton_its", (PetscReal)st[i].newton_its);
+  STEP_COLUMN("ksp_its", (PetscReal)st[i].ksp_its);
+  STEP_COLUMN("time", st[i].time);
+  STEP_COLUMN("converged", st[i].converged ? 1.0 : 0.0);
+#undef STEP_COLUMN
+  PetscCall(PetscViewerHDF5PopGroup(v));
+  PetscCall(PetscFree(col));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* XDMF for ParaView into the file xdmf, pointing into h5name, the final .h5 beside it (rank 0 only). The reals are
    declared 8-byte (XDMF's default precision is 4: ParaView would read them as floats). */
 static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const char h5name[], PetscInt dim, PetscInt ncells, PetscInt ncorners,
@@ -559,6 +628,7 @@ static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, const char h5
   PetscCall(PetscViewerPopFormat(viewer));
   PetscCall(WriteRunMetadata(dm, user, u, viewer, ncells, nverts));
   PetscCall(WriteSolves(comm, user, viewer));
+  PetscCall(WriteSteps(comm, user, viewer, dim));
   PetscCall(PetscViewerDestroy(&viewer));
   if (rank == 0) PetscCall(WriteXdmf(user, xdmftmp, h5name, dim, ncells, ncorners, nverts));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -49,9 +49,10 @@ PetscErrorCode SceneCreate_Square(DM dm, const Material *mat, Scene *scene)
   }
   PetscCall(SceneAddContactFaces(scene, 1));                            /* bottom, x_d = 0, in 2D and 3D */
   PetscCall(SceneAddBoundary(scene, BC_CLAMP, dim == 2 ? 3 : 2, NULL)); /* top, x_d = 1 */
-  scene->f0_body                = f0_body_square;
-  scene->num_constants          = SQUARE_NUM_CONSTANTS;
-  scene->constants[SQUARE_BETA] = beta;
-  scene->constants[SQUARE_X0]   = x0;
+  scene->f0_body                    = f0_body_square;
+  scene->num_constants              = SQUARE_NUM_CONSTANTS;
+  scene->constants[SQUARE_BETA]     = beta;
+  scene->load_constant[SQUARE_BETA] = PETSC_TRUE; /* the body force's size: scaled by a load path */
+  scene->constants[SQUARE_X0]       = x0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

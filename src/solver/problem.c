@@ -42,9 +42,7 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
     PetscCall(ContactSetUp(user->contact, dm, &cp));        /* the contact set, eps, the penalty's faces or SNESVI's bounds */
   }
   PetscCall(SolverAssembleBulk(dm, user));
-  PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
-  user->prob.weak_load_lift = 0.0; /* set by a scene's load in weak form */
-  PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0));
+  PetscCall(SolverAssembleLoad(dm, user));
   PetscCall(SolverCtxCreate(user->prob.K, user->prob.r0, user->contact, &user->opt->solver, &user->rec.stats, &user->prob.sctx));
   PetscCall(SolverComputeScales(dm, user));
   PetscCall(SolverCreateSNES(dm, user, snes));

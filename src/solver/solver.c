@@ -8,7 +8,7 @@
 
 PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
 {
-  Vec          locX, locF;
+  Vec          locX;
   MatNullSpace rigid;
 
   PetscFunctionBeginUser;
@@ -17,29 +17,46 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   else
     PetscCall(DMCreateMatrix(dm, &user->prob.K));
   PetscCall(DMGetLocalVector(dm, &locX));
-  PetscCall(DMGetLocalVector(dm, &locF));
   PetscCall(VecCopy(user->prob.loc_bc, locX)); /* u = 0 with the Dirichlet values, inserted once by ProblemSetUp() */
-  PetscCall(VecZeroEntries(locF));
   if (user->prob.assembly == ASSEMBLY_FE) PetscCall(DMPlexSNESComputeJacobianFEM(dm, locX, user->prob.K, user->prob.K, user));
   if (user->opt->assembly_check) PetscCall(AssemblyP1Check(dm, user, locX));
   PetscCall(MatAssemblyBegin(user->prob.K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(user->prob.K, MAT_FINAL_ASSEMBLY));
-  if (user->prob.assembly == ASSEMBLY_P1)
-    PetscCall(AssemblyP1Residual(dm, user, locX, locF)); /* the same residual without PetscFE's generic cell loop */
-  else
-    PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
-  PetscCall(VecZeroEntries(user->prob.r0));
-  PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, user->prob.r0));
-  PetscCall(VecDuplicate(locF, &user->prob.loc_r0)); /* with the fixed rows, which the global vector drops */
-  PetscCall(VecCopy(locF, user->prob.loc_r0));
   PetscCall(DMRestoreLocalVector(dm, &locX));
-  PetscCall(DMRestoreLocalVector(dm, &locF));
   if (user->opt->degree == 1)
     PetscCall(ElasticityRigidBodyModesP1(dm, user->prob.r0, &rigid)); /* unknowns at the vertices only */
   else
     PetscCall(DMPlexCreateRigidBody(dm, 0, &rigid));
   PetscCall(MatSetNearNullSpace(user->prob.K, rigid));
   PetscCall(MatNullSpaceDestroy(&rigid));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* r0 = F_bulk(u_D) - f, the residual at u = 0 with the Dirichlet values of loc_bc (the lifting K u_D and the body
+   force), the surface loads and a scene's load in weak form, and its local copy loc_r0 with the fixed rows. Assembled
+   by ProblemSetUp() and again at each step of a load path (the data changed, K did not). */
+PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user)
+{
+  Vec locX, locF;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetLocalVector(dm, &locX));
+  PetscCall(DMGetLocalVector(dm, &locF));
+  PetscCall(VecCopy(user->prob.loc_bc, locX));
+  PetscCall(VecZeroEntries(locF));
+  if (user->prob.assembly == ASSEMBLY_P1)
+    PetscCall(AssemblyP1Residual(dm, user, locX, locF)); /* the same residual without PetscFE's generic cell loop */
+  else
+    PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
+  PetscCall(VecZeroEntries(user->prob.r0));
+  PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, user->prob.r0));
+  if (!user->prob.loc_r0) PetscCall(VecDuplicate(locF, &user->prob.loc_r0)); /* with the fixed rows, which the global vector drops */
+  PetscCall(VecCopy(locF, user->prob.loc_r0));
+  PetscCall(DMRestoreLocalVector(dm, &locX));
+  PetscCall(DMRestoreLocalVector(dm, &locF));
+  PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
+  user->prob.weak_load_lift = 0.0; /* set by a scene's load in weak form */
+  PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

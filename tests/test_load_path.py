@@ -1,0 +1,104 @@
+"""Load paths (-load_steps, -load_path; issue 32): each step's answer is the direct solve's at its factor, with the
+data scaled in the options instead (frictionless elasticity has no history), whether the factor is reached by loading,
+by unloading or directly; 2 ranks give 1 rank's steps; a failed step ends the path, flagged; bad input is refused before
+any solve, with no output written."""
+import os
+
+import h5py
+import numpy as np
+import pytest
+
+from harness import load, run, solve
+
+SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "false", "-snes_rtol", "1e-12"]
+# a cylinder pressed into the top of a clamped block: the contact zone grows with the indentation (a curved gap)
+INDENT = ["-scene", "general", "-dm_plex_box_faces", "32,16", "-contact_faces", "3", "-bc_clamp", "1", "-obstacle", "cylinder",
+          "-obstacle_center", "0.5,1.5", "-obstacle_radius", "0.5", "-snes_rtol", "1e-12"]
+QUANTITIES = ("contact_force", "contact_force_x", "contact_force_y", "energy", "pressure_max", "contact_size")
+
+
+def steps(path):
+    with h5py.File(path, "r") as f:
+        return {k: f["steps"][k][:] for k in f["steps"]}
+
+
+def vec(values):
+    return ",".join(f"{v:.17g}" for v in values)
+
+
+def assert_step_is_direct(st, k, attrs, rtol=1e-8):
+    for q in QUANTITIES + tuple(k_ for k_ in st if k_.startswith("reaction_")):
+        tol = rtol * abs(attrs[q]) + 1e-12 * abs(attrs["contact_force"])  # a component zero by symmetry is round-off
+        assert abs(st[q][k] - attrs[q]) <= tol, (k, q, st[q][k], attrs[q])
+
+
+def test_steps_are_the_direct_solves_square(outdir):
+    """The square (its body force scales: square_beta) along 0.5, 1.5, 1: each row of /steps is the direct run with
+    -square_beta 2t; the last step's fields are the direct run's at 1."""
+    _, h5 = run(SQUARE + ["-load_path", "0.5,1.5,1"], "path", output=os.path.join(outdir, "path.h5"))
+    st = steps(h5)
+    assert list(st["factor"]) == [0.5, 1.5, 1.0] and st["converged"].all()
+    for k, t in enumerate((0.5, 1.5, 1.0)):
+        _, d = run(SQUARE + ["-square_beta", 2 * t], f"direct_{k}", output=os.path.join(outdir, f"direct_{k}.h5"))
+        attrs, fields = load(d)
+        assert_step_is_direct(st, k, attrs)
+    last, path_fields = load(h5)
+    assert np.max(np.abs(path_fields["displacement"] - fields["displacement"])) <= 1e-8 * np.max(np.abs(fields["displacement"]))
+
+
+@pytest.mark.parametrize("np_", [1, 2])
+def test_steps_are_the_direct_solves_indentation(outdir, np_):
+    """A cylinder driven by displacement into a block whose clamp also moves and whose side carries a traction, in 3
+    steps: the obstacle's translation, the clamp's and the traction scale, the gap does not; each row is the direct run
+    with the scaled options, on 1 and 2 ranks."""
+    move, clamp, load_ = np.array([0.0, -0.02]), np.array([0.002, 0.0]), np.array([0.0, -0.01])
+    data = lambda t: ["-obstacle_translate", vec(t * move), "-bc_clamp_1_translate", vec(t * clamp), "-bc_traction", "2",  # noqa: E731
+                      "-bc_traction_2", vec(t * load_)]
+    _, h5 = run(INDENT + data(1.0) + ["-load_steps", "3"], "steps", np_=np_, output=os.path.join(outdir, "steps.h5"))
+    st = steps(h5)
+    assert np.allclose(st["factor"], [1 / 3, 2 / 3, 1]) and st["converged"].all()
+    assert np.all(np.diff(st["contact_size"]) > 0), st["contact_size"]  # the zone grows: the curved gap is not scaled
+    assert np.allclose(st["obstacle_translate_y"], st["factor"] * move[1], rtol=1e-14)
+    for k, t in enumerate(st["factor"]):
+        _, d = run(INDENT + data(t), f"direct_{k}", np_=np_, output=os.path.join(outdir, f"direct_{k}.h5"))
+        assert_step_is_direct(st, k, load(d)[0])
+
+
+def test_the_same_factor_by_any_path(outdir):
+    """Factor 1 reached directly, by loading (0.25, 0.5, 1) and by unloading (2, 1): the same displacement to the solver's
+    tolerance."""
+    fields = {}
+    for name, path in (("direct", "1"), ("loading", "0.25,0.5,1"), ("unloading", "2,1")):
+        _, h5 = run(INDENT + ["-obstacle_translate", "0,-0.02", "-load_path", path], name, output=os.path.join(outdir, f"{name}.h5"))
+        fields[name] = load(h5)[1]["displacement"]
+    scale = np.max(np.abs(fields["direct"]))
+    for name in ("loading", "unloading"):
+        assert np.max(np.abs(fields[name] - fields["direct"])) <= 1e-8 * scale, name
+
+
+def test_a_failed_step_ends_the_path(outdir):
+    """A step whose solve fails (3 Newton steps allowed for a jump to 30 times the load) ends the path: /steps holds the
+    steps up to it, the failed one with converged = 0, /run converged = 0, the summary names it, the exit status is 3."""
+    out = os.path.join(outdir, "failed.h5")
+    rc, text = solve(INDENT + ["-obstacle_translate", "0,-0.02", "-load_path", "0.3,30,1", "-snes_max_it", "3"], output=out)
+    assert rc == 3, text[-2000:]
+    st = steps(out)
+    assert list(st["converged"]) == [1.0, 0.0] and list(st["factor"]) == [0.3, 30.0]
+    assert load(out)[0]["converged"] == 0
+    assert "stopped at step 2 of 3" in text
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["-load_steps", "2", "-load_path", "1"], "-load_steps and -load_path both give the load path"),
+    (["-load_steps", "0"], "-load_steps must lie in [1, 1000]"),
+    (["-load_path", "0.5,nan"], "-load_path"),
+    (["-load_steps", "2", "-scene", "mms"], "the scene mms takes its load from its manufactured solution"),
+    (["-load_steps", "2", "-scene", "patch"], "prescribes its own displacement"),
+    (["-load_steps", "2", "-contact_method", "vi"], "SNESVI's bounds do not follow the load yet"),
+    (["-load_steps", "2", "-bars"], "-bars measures one load state"),
+])
+def test_bad_load_path_refused(outdir, extra, message):
+    out = os.path.join(outdir, "bad.h5")
+    rc, text = solve(["-dm_plex_box_faces", "8,8"] + extra, output=out)
+    assert rc != 0 and message in text, text[-2000:]
+    assert not os.path.exists(out)
