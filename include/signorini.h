@@ -397,7 +397,8 @@ typedef struct {
   RunStats      stats;
   SolveRecord  *records; /* one per solve, any number */
   PetscInt      nrecords, maxrecords;
-  StepRecord   *steps; /* one per step of a load path solved (the failed one included) */
+  StepRecord   *steps;       /* one per step of a load path solved (the failed one included) */
+  Vec          *step_fields; /*   and its state at the vertices, OUTPUT_STATE_FIELDS per step (include/io.h) */
   PetscInt      nsteps;
   ErrorNorms    errors;                   /* against the scene's exact solution */
   ErrorNorms    ref_errors;               /* against the -reference solution */

@@ -212,6 +212,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(ContactFinalizePackage());
   PetscCall(PetscFree(user.rec.records));
   PetscCall(PetscFree(user.rec.steps));
+  for (PetscInt k = 0; k < user.rec.nsteps * OUTPUT_STATE_FIELDS; ++k) PetscCall(VecDestroy(&user.rec.step_fields[k]));
+  PetscCall(PetscFree(user.rec.step_fields));
   PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(BarsReset(&user.rec.bars));
   PetscCall(SceneFinalize());

@@ -102,3 +102,50 @@ def test_bad_load_path_refused(outdir, extra, message):
     rc, text = solve(["-dm_plex_box_faces", "8,8"] + extra, output=out)
     assert rc != 0 and message in text, text[-2000:]
     assert not os.path.exists(out)
+
+
+def test_time_series_opens_in_paraview(outdir, tmp_path):
+    """The steps' state (displacement, contact_pressure, normal_gap, contact_boundary) is a time series under
+    /vertex_fields, the step the first dimension (PETSc's timestepping); ParaView's own XDMF reader (pvbatch) finds one
+    time per step (1, 2, 3) and at each the step's arrays, equal to the HDF5 file's; the last step's are the direct
+    run's at its factor (signorini.runs.read_output)."""
+    import subprocess
+    import sys
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "scripts"))
+    from signorini.runs import read_steps
+    _, h5 = run(INDENT + ["-obstacle_translate", "0,-0.02", "-load_path", "0.3,1.2,1"], "series", output=os.path.join(outdir, "series.h5"))
+    st, series = read_steps(h5)
+    assert sorted(series) == ["contact_boundary", "contact_pressure", "displacement", "normal_gap"]
+    assert series["displacement"].shape[:2] == (3, series["contact_pressure"].shape[1])
+    npz = tmp_path / "pv.npz"
+    script = tmp_path / "read.py"
+    script.write_text(
+        "import numpy as np\n"
+        "from paraview.simple import XDMFReader\n"
+        "from paraview import servermanager as sm\n"
+        "from vtk.util.numpy_support import vtk_to_numpy\n"
+        f"r = XDMFReader(FileNames=[{h5[:-3] + '.xdmf'!r}])\n"
+        "r.UpdatePipelineInformation()\n"
+        "out = {'times': np.array(r.TimestepValues)}\n"
+        "for k, t in enumerate(r.TimestepValues):\n"
+        "    r.UpdatePipeline(t)\n"
+        "    pd = sm.Fetch(r).GetPointData()\n"
+        "    for name in ('displacement', 'contact_pressure', 'normal_gap', 'contact_boundary'):\n"
+        "        out[f'{name}_{k}'] = vtk_to_numpy(pd.GetArray(name))\n"
+        f"np.savez({str(npz)!r}, **out)\n")
+    p = subprocess.run(["pvbatch", "--force-offscreen-rendering", str(script)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                       timeout=300)
+    assert p.returncode == 0, p.stdout[-3000:]
+    pv = np.load(npz)
+    assert list(pv["times"]) == [1.0, 2.0, 3.0]
+    for k in range(3):
+        for name, values in series.items():
+            got = pv[f"{name}_{k}"]
+            want = values[k]
+            if name == "displacement":  # ParaView pads 2D vectors with a zero third component
+                assert np.all(got[:, 2] == 0.0)
+                got = got[:, :2]
+            assert got.shape == want.shape and np.array_equal(got, want), (k, name)
+    _, d = run(INDENT + ["-obstacle_translate", "0,-0.02"], "series_direct", output=os.path.join(outdir, "direct.h5"))
+    last, direct = load(h5)[1], load(d)[1]
+    assert np.max(np.abs(last["displacement"] - direct["displacement"])) <= 1e-8 * np.max(np.abs(direct["displacement"]))

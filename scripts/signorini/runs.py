@@ -83,22 +83,38 @@ def vertex_order(x):
     return np.lexsort(np.round(x, 12).T)
 
 
+def field_at(ds, step=-1):
+    """The values of a /vertex_fields dataset: of one step (the last by default) where it is a load path's time series
+    (attribute timestepping: the step the first dimension), else the dataset itself."""
+    return ds[step] if int(ds.attrs.get("timestepping", 0)) else ds[()]
+
+
+def read_steps(path):
+    """({column: 1-D array} of /steps, {name: array of the steps' values} of the time series of /vertex_fields) of a load
+    path's output; ({}, {}) for a run without one."""
+    with h5py.File(path, "r") as f:
+        steps = {k: np.asarray(f["steps"][k][:]).ravel() for k in f["steps"]} if "steps" in f else {}
+        series = {k: f["vertex_fields"][k][()] for k in f["vertex_fields"] if int(f["vertex_fields"][k].attrs.get("timestepping", 0))}
+    return steps, series
+
+
 def read_output(path):
     """(attrs, fields) of the output `path`: the /run attributes with bytes decoded (numbers stay numpy scalars), and
-    {name: array} of /vertex_fields in the file's vertex order, plus "x": /geometry/vertices (vertex_order(fields["x"])
-    sorts them)."""
+    {name: array} of /vertex_fields in the file's vertex order (a load path's: its last step), plus "x":
+    /geometry/vertices (vertex_order(fields["x"]) sorts them)."""
     with h5py.File(path, "r") as f:
         attrs = decoded_attrs(f["run"])
-        fields = {k: f["vertex_fields"][k][:] for k in f["vertex_fields"]}
+        fields = {k: field_at(f["vertex_fields"][k]) for k in f["vertex_fields"]}
         fields["x"] = f["geometry/vertices"][:]
     return attrs, fields
 
 
 def vertex_fields(path):
-    """{name: array} of /vertex_fields, the vertices sorted by position (vertex_order: rank-independent)."""
+    """{name: array} of /vertex_fields (a load path's: its last step), the vertices sorted by position (vertex_order:
+    rank-independent)."""
     with h5py.File(path, "r") as f:
         order = vertex_order(f["geometry/vertices"][:])
-        return {k: f["vertex_fields"][k][:][order] for k in f["vertex_fields"]}
+        return {k: field_at(f["vertex_fields"][k])[order] for k in f["vertex_fields"]}
 
 
 def read_solves(f):
@@ -162,8 +178,8 @@ def read_contact_fields(h5path, along="x", optional=()):
         with h5py.File(h5path, "r") as f:
             x = f["geometry/vertices"][()]
             vf = f["vertex_fields"]
-            mask = np.isclose(vf["contact_boundary"][()], 1.0)
-            fields = {name: vf[name][()] for name in ("contact_pressure", "normal_gap") + tuple(optional) if name in vf}
+            mask = np.isclose(field_at(vf["contact_boundary"]), 1.0)
+            fields = {name: field_at(vf[name]) for name in ("contact_pressure", "normal_gap") + tuple(optional) if name in vf}
             if "contact_pressure" not in fields or "normal_gap" not in fields:
                 raise KeyError("contact_pressure or normal_gap")
             run = decoded_attrs(f["run"]) if "run" in f else {}

@@ -50,18 +50,19 @@ static PetscErrorCode ViewVertexField(Vec v, PetscInt nc, PetscViewer viewer)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The vertex fields: displacement, contact pressure, normal gap g - u_n, Gamma_C indicator,
-   and the exact solution and error when the scene has one. */
-static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscViewer viewer)
+/* The state of a solution at the owned vertices (plain vectors, in the order of /geometry/vertices), the fields a load
+   path keeps at every step: the displacement (with the Dirichlet values), the nodal contact pressure, the normal gap
+   g - u_n and the Gamma_C indicator, from u and the contact set as PostprocessContact() left it. */
+PetscErrorCode OutputStateFields(DM dm, const AppCtx *user, Vec u, Vec fields[OUTPUT_STATE_FIELDS])
 {
+  const char *const  names[OUTPUT_STATE_FIELDS] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary"};
   const ContactSet  *cs;
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
-  DM                 cdm;
-  Vec                locU, disp, pressure, gap, mask, react, area, exact = NULL, error = NULL, coords;
-  PetscSection       usec, csec;
+  Vec                locU;
+  PetscSection       usec;
   PetscInt           dim, vStart, vEnd, nowned = 0, *index = NULL;
-  const PetscScalar *lu, *xc, *x;
-  PetscScalar       *d, *p, *g, *m, *fr, *ar, *ex = NULL, *er = NULL;
+  const PetscScalar *lu, *x;
+  PetscScalar       *d, *p, *g, *m;
 
   PetscFunctionBeginUser;
   PetscCall(ContactGetSet(user->contact, &cs));
@@ -69,98 +70,128 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
   PetscCall(MeshOwnedIndex(dm, vStart, vEnd, &index, &nowned)); /* plain vectors over the owned vertices, no DM clone */
   PetscCall(DMGetLocalSection(dm, &usec));
-  PetscCall(DMGetCoordinateDM(dm, &cdm));
-  PetscCall(DMGetLocalSection(cdm, &csec));
-  PetscCall(DMGetCoordinatesLocal(dm, &coords));
-  PetscCall(VecCreateMPI(comm, nowned * dim, PETSC_DETERMINE, &disp));
-  PetscCall(VecCreateMPI(comm, nowned, PETSC_DETERMINE, &pressure));
-  PetscCall(VecDuplicate(pressure, &gap));
-  PetscCall(VecDuplicate(pressure, &mask));
-  PetscCall(VecDuplicate(pressure, &react));
-  PetscCall(PetscObjectSetName((PetscObject)react, "contact_reaction")); /* the nodal force of the obstacle along n */
-  PetscCall(VecZeroEntries(react));
-  PetscCall(VecDuplicate(pressure, &area));
-  PetscCall(PetscObjectSetName((PetscObject)area, "contact_area")); /* the lumped boundary mass: reaction / area is a pressure */
-  PetscCall(VecZeroEntries(area));
-  PetscCall(PetscObjectSetName((PetscObject)disp, "displacement"));
-  PetscCall(PetscObjectSetName((PetscObject)pressure, "contact_pressure"));
-  PetscCall(PetscObjectSetName((PetscObject)gap, "normal_gap"));
-  PetscCall(PetscObjectSetName((PetscObject)mask, "contact_boundary"));
-  PetscCall(VecZeroEntries(pressure));
-  PetscCall(VecZeroEntries(gap));
-  PetscCall(VecZeroEntries(mask));
-  if (user->scene.exact) {
-    PetscCall(VecDuplicate(disp, &exact));
-    PetscCall(VecDuplicate(disp, &error));
-    PetscCall(PetscObjectSetName((PetscObject)exact, "exact_displacement"));
-    PetscCall(PetscObjectSetName((PetscObject)error, "error"));
-    PetscCall(VecGetArray(exact, &ex));
-    PetscCall(VecGetArray(error, &er));
+  PetscCall(VecCreateMPI(comm, nowned * dim, PETSC_DETERMINE, &fields[0]));
+  PetscCall(VecCreateMPI(comm, nowned, PETSC_DETERMINE, &fields[1]));
+  PetscCall(VecDuplicate(fields[1], &fields[2]));
+  PetscCall(VecDuplicate(fields[1], &fields[3]));
+  for (PetscInt f = 0; f < OUTPUT_STATE_FIELDS; ++f) {
+    PetscCall(PetscObjectSetName((PetscObject)fields[f], names[f]));
+    PetscCall(VecZeroEntries(fields[f]));
   }
-
   PetscCall(DMGetLocalVector(dm, &locU));
   PetscCall(VecCopy(user->prob.loc_bc, locU)); /* the Dirichlet values, inserted once by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, locU));
   PetscCall(VecGetArrayRead(locU, &lu));
-  PetscCall(VecGetArrayRead(coords, &xc));
-  PetscCall(VecGetArray(disp, &d));
+  PetscCall(VecGetArray(fields[0], &d));
   for (PetscInt v = vStart; v < vEnd; ++v) {
-    PetscInt goff, uoff, coff;
+    PetscInt uoff;
 
     if (index[v - vStart] < 0) continue; /* not owned */
-    goff = index[v - vStart] * dim;
     PetscCall(PetscSectionGetOffset(usec, v, &uoff));
-    for (PetscInt c = 0; c < dim; ++c) d[goff + c] = lu[uoff + c];
-    if (ex) {
-      PetscReal xv[3];
-
-      PetscCall(PetscSectionGetOffset(csec, v, &coff));
-      for (PetscInt c = 0; c < dim; ++c) xv[c] = PetscRealPart(xc[coff + c]);
-      PetscCall((*user->scene.exact)(dim, 0.0, xv, dim, &ex[goff], (void *)user->scene.constants));
-      for (PetscInt c = 0; c < dim; ++c) er[goff + c] = d[goff + c] - ex[goff + c];
-    }
+    for (PetscInt c = 0; c < dim; ++c) d[index[v - vStart] * dim + c] = lu[uoff + c];
   }
-  PetscCall(VecRestoreArray(disp, &d));
-  PetscCall(VecRestoreArrayRead(coords, &xc));
+  PetscCall(VecRestoreArray(fields[0], &d));
   PetscCall(VecRestoreArrayRead(locU, &lu));
   PetscCall(DMRestoreLocalVector(dm, &locU));
-  if (ex) {
-    PetscCall(VecRestoreArray(exact, &ex));
-    PetscCall(VecRestoreArray(error, &er));
-  }
-
   PetscCall(VecGetArrayRead(u, &x));
-  PetscCall(VecGetArray(pressure, &p));
-  PetscCall(VecGetArray(gap, &g));
-  PetscCall(VecGetArray(mask, &m));
-  PetscCall(VecGetArray(react, &fr));
-  PetscCall(VecGetArray(area, &ar));
+  PetscCall(VecGetArray(fields[1], &p));
+  PetscCall(VecGetArray(fields[2], &g));
+  PetscCall(VecGetArray(fields[3], &m));
   for (PetscInt i = 0; i < cs->n; ++i) {
     PetscInt goff;
 
     if (!cs->is_vertex[i]) continue;
     goff = index[cs->point[i] - vStart];
     if (goff < 0) continue; /* owned by another rank */
-    p[goff]  = cs->pressure[i];
-    g[goff]  = -ContactNodePenetration(cs, dim, i, x);
-    m[goff]  = 1.0;
+    p[goff] = cs->pressure[i];
+    g[goff] = -ContactNodePenetration(cs, dim, i, x);
+    m[goff] = 1.0;
+  }
+  PetscCall(VecRestoreArray(fields[3], &m));
+  PetscCall(VecRestoreArray(fields[2], &g));
+  PetscCall(VecRestoreArray(fields[1], &p));
+  PetscCall(VecRestoreArrayRead(u, &x));
+  PetscCall(PetscFree(index));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The vertex fields: the state (OutputStateFields(): displacement, contact pressure, normal gap g - u_n, Gamma_C
+   indicator), of the last solution or, with a load path, of every step as a time series (the step the first dimension,
+   PETSc's timestepping); the nodal reaction and lumped area; the exact solution and error when the scene has one; the
+   pressure's band with -bars. */
+static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscViewer viewer)
+{
+  const ContactSet  *cs;
+  DM                 cdm;
+  Vec                state[OUTPUT_STATE_FIELDS], react, area, exact = NULL, error = NULL, coords;
+  PetscSection       csec;
+  PetscInt           dim, vStart, vEnd, nowned = 0, *index = NULL;
+  const PetscScalar *xc, *d;
+  PetscScalar       *fr, *ar, *ex = NULL, *er = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(MeshOwnedIndex(dm, vStart, vEnd, &index, &nowned));
+  PetscCall(OutputStateFields(dm, user, u, state));
+  if (user->rec.nsteps) {
+    for (PetscInt f = 0; f < OUTPUT_STATE_FIELDS; ++f) {
+      PetscCall(PetscViewerHDF5PushTimestepping(viewer));
+      for (PetscInt k = 0; k < user->rec.nsteps; ++k) {
+        PetscCall(PetscViewerHDF5SetTimestep(viewer, k));
+        PetscCall(ViewVertexField(user->rec.step_fields[k * OUTPUT_STATE_FIELDS + f], f ? 1 : dim, viewer));
+      }
+      PetscCall(PetscViewerHDF5PopTimestepping(viewer));
+    }
+  } else
+    for (PetscInt f = 0; f < OUTPUT_STATE_FIELDS; ++f) PetscCall(ViewVertexField(state[f], f ? 1 : dim, viewer));
+  PetscCall(VecDuplicate(state[1], &react));
+  PetscCall(PetscObjectSetName((PetscObject)react, "contact_reaction")); /* the nodal force of the obstacle along n */
+  PetscCall(VecZeroEntries(react));
+  PetscCall(VecDuplicate(state[1], &area));
+  PetscCall(PetscObjectSetName((PetscObject)area, "contact_area")); /* the lumped boundary mass: reaction / area is a pressure */
+  PetscCall(VecZeroEntries(area));
+  PetscCall(VecGetArray(react, &fr));
+  PetscCall(VecGetArray(area, &ar));
+  for (PetscInt i = 0; i < cs->n; ++i) {
+    const PetscInt goff = cs->is_vertex[i] ? index[cs->point[i] - vStart] : -1;
+
+    if (goff < 0) continue; /* not a vertex, or owned by another rank */
     fr[goff] = cs->reaction[i];
     ar[goff] = cs->weight[i];
   }
-  PetscCall(VecRestoreArray(mask, &m));
   PetscCall(VecRestoreArray(react, &fr));
   PetscCall(VecRestoreArray(area, &ar));
-  PetscCall(VecRestoreArray(gap, &g));
-  PetscCall(VecRestoreArray(pressure, &p));
-  PetscCall(VecRestoreArrayRead(u, &x));
-
-  PetscCall(ViewVertexField(disp, dim, viewer));
-  PetscCall(ViewVertexField(pressure, 1, viewer));
-  PetscCall(ViewVertexField(gap, 1, viewer));
-  PetscCall(ViewVertexField(mask, 1, viewer));
   PetscCall(ViewVertexField(react, 1, viewer));
   PetscCall(ViewVertexField(area, 1, viewer));
-  if (exact) {
+  if (user->scene.exact) {
+    PetscCall(DMGetCoordinateDM(dm, &cdm));
+    PetscCall(DMGetLocalSection(cdm, &csec));
+    PetscCall(DMGetCoordinatesLocal(dm, &coords));
+    PetscCall(VecDuplicate(state[0], &exact));
+    PetscCall(VecDuplicate(state[0], &error));
+    PetscCall(PetscObjectSetName((PetscObject)exact, "exact_displacement"));
+    PetscCall(PetscObjectSetName((PetscObject)error, "error"));
+    PetscCall(VecGetArray(exact, &ex));
+    PetscCall(VecGetArray(error, &er));
+    PetscCall(VecGetArrayRead(state[0], &d));
+    PetscCall(VecGetArrayRead(coords, &xc));
+    for (PetscInt v = vStart; v < vEnd; ++v) {
+      PetscInt  goff, coff;
+      PetscReal xv[3];
+
+      if (index[v - vStart] < 0) continue; /* not owned */
+      goff = index[v - vStart] * dim;
+      PetscCall(PetscSectionGetOffset(csec, v, &coff));
+      for (PetscInt c = 0; c < dim; ++c) xv[c] = PetscRealPart(xc[coff + c]);
+      PetscCall((*user->scene.exact)(dim, 0.0, xv, dim, &ex[goff], (void *)user->scene.constants));
+      for (PetscInt c = 0; c < dim; ++c) er[goff + c] = d[goff + c] - ex[goff + c];
+    }
+    PetscCall(VecRestoreArrayRead(coords, &xc));
+    PetscCall(VecRestoreArrayRead(state[0], &d));
+    PetscCall(VecRestoreArray(exact, &ex));
+    PetscCall(VecRestoreArray(error, &er));
     PetscCall(ViewVertexField(exact, dim, viewer));
     PetscCall(ViewVertexField(error, dim, viewer));
   }
@@ -168,7 +199,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
     Vec          band;
     PetscScalar *bv;
 
-    PetscCall(VecDuplicate(pressure, &band));
+    PetscCall(VecDuplicate(state[1], &band));
     PetscCall(PetscObjectSetName((PetscObject)band, "contact_pressure_bar"));
     PetscCall(VecZeroEntries(band));
     PetscCall(VecGetArray(band, &bv));
@@ -183,10 +214,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   }
   PetscCall(VecDestroy(&exact));
   PetscCall(VecDestroy(&error));
-  PetscCall(VecDestroy(&disp));
-  PetscCall(VecDestroy(&pressure));
-  PetscCall(VecDestroy(&gap));
-  PetscCall(VecDestroy(&mask));
+  for (PetscInt f = 0; f < OUTPUT_STATE_FIELDS; ++f) PetscCall(VecDestroy(&state[f]));
   PetscCall(VecDestroy(&react));
   PetscCall(VecDestroy(&area));
   PetscCall(PetscFree(index));
@@ -544,54 +572,81 @@ static PetscErrorCode WriteSteps(MPI_Comm comm, const AppCtx *user, PetscViewer 
 
 /* XDMF for ParaView into the file xdmf, pointing into h5name, the final .h5 beside it (rank 0 only). The reals are
    declared 8-byte (XDMF's default precision is 4: ParaView would read them as floats). */
+/* One node or cell attribute of an XDMF grid: the whole dataset /group/name (n values of nc components), or with
+   step >= 0 the step's slab of a load path's time series (nsteps x n [x nc], the step the first dimension). */
+static void XdmfAttribute(FILE *fp, const char h5name[], const char group[], const char name[], const char center[], PetscInt n, PetscInt nc,
+                          PetscInt step, PetscInt nsteps)
+{
+  char dims[64];
+
+  if (nc > 1)
+    snprintf(dims, sizeof(dims), "%d %d", (int)n, (int)nc);
+  else
+    snprintf(dims, sizeof(dims), "%d", (int)n);
+  fprintf(fp, "   <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"%s\">\n", name, nc > 1 ? "Vector" : "Scalar", center);
+  if (step < 0)
+    fprintf(fp, "    <DataItem Dimensions=\"%s\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/%s/%s</DataItem>\n", dims, h5name, group,
+            name);
+  else {
+    fprintf(fp, "    <DataItem ItemType=\"HyperSlab\" Dimensions=\"%s\" Type=\"HyperSlab\">\n", dims);
+    if (nc > 1)
+      fprintf(fp, "     <DataItem Dimensions=\"3 3\" Format=\"XML\">%d 0 0 1 1 1 1 %d %d</DataItem>\n", (int)step, (int)n, (int)nc);
+    else
+      fprintf(fp, "     <DataItem Dimensions=\"3 2\" Format=\"XML\">%d 0 1 1 1 %d</DataItem>\n", (int)step, (int)n);
+    fprintf(fp, "     <DataItem Dimensions=\"%d %s\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/%s/%s</DataItem>\n", (int)nsteps, dims,
+            h5name, group, name);
+    fprintf(fp, "    </DataItem>\n");
+  }
+  fprintf(fp, "   </Attribute>\n");
+}
+
+/* XDMF for ParaView into the file xdmf, pointing into h5name, the final .h5 beside it (rank 0 only). The reals are
+   declared 8-byte (XDMF's default precision is 4: ParaView would read them as floats). With a load path, a temporal
+   collection of one grid per step (time = the step's number, 1, 2, ...: a path may go back to a factor, which a time
+   cannot), each with the step's state fields; the fields of the last solution only (reaction, area, exact solution,
+   band, estimate) are in the last step's grid. */
 static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const char h5name[], PetscInt dim, PetscInt ncells, PetscInt ncorners,
                                 PetscInt nverts)
 {
   const char    *fields[] = {"displacement",     "contact_pressure", "normal_gap",         "contact_boundary",
                              "contact_reaction", "contact_area",     "exact_displacement", "error"};
   const PetscInt ncomp[]  = {dim, 1, 1, 1, 1, 1, dim, dim};
-  const PetscInt nfields  = user->scene.exact ? 8 : 6;
-  const char    *topo     = dim == 2 ? (ncorners == 3 ? "Triangle" : "Quadrilateral") : (ncorners == 4 ? "Tetrahedron" : "Hexahedron");
+  const PetscInt nfields = user->scene.exact ? 8 : 6, nsteps = user->rec.nsteps;
+  const char    *topo = dim == 2 ? (ncorners == 3 ? "Triangle" : "Quadrilateral") : (ncorners == 4 ? "Tetrahedron" : "Hexahedron");
   FILE          *fp;
   int            bad;
 
   PetscFunctionBeginUser;
   fp = fopen(xdmf, "w");
   PetscCheck(fp, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "%s", strerror(errno));
-  fprintf(fp, "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"2.0\">\n <Domain>\n  <Grid Name=\"mesh\" GridType=\"Uniform\">\n");
-  fprintf(fp, "   <Topology TopologyType=\"%s\" NumberOfElements=\"%d\">\n", topo, (int)ncells);
-  fprintf(fp, "    <DataItem Dimensions=\"%d %d\" NumberType=\"Int\" Format=\"HDF\">%s:/viz/topology/cells</DataItem>\n   </Topology>\n", (int)ncells,
-          (int)ncorners, h5name);
-  fprintf(fp, "   <Geometry GeometryType=\"%s\">\n", dim == 2 ? "XY" : "XYZ");
-  fprintf(fp,
-          "    <DataItem Dimensions=\"%d %d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n   </Geometry>\n",
-          (int)nverts, (int)dim, h5name);
-  for (PetscInt f = 0; f < nfields; ++f) {
-    fprintf(fp, "   <Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", fields[f], ncomp[f] > 1 ? "Vector" : "Scalar");
-    if (ncomp[f] > 1)
-      fprintf(fp, "    <DataItem Dimensions=\"%d %d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n",
-              (int)nverts, (int)ncomp[f], h5name, fields[f]);
-    else
-      fprintf(fp, "    <DataItem Dimensions=\"%d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/vertex_fields/%s</DataItem>\n",
-              (int)nverts, h5name, fields[f]);
-    fprintf(fp, "   </Attribute>\n");
-  }
-  if (user->rec.bars.pressure_band) {
-    fprintf(fp, "   <Attribute Name=\"contact_pressure_bar\" AttributeType=\"Scalar\" Center=\"Node\">\n");
-    fprintf(fp,
-            "    <DataItem Dimensions=\"%d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/vertex_fields/contact_pressure_bar</DataItem>\n",
-            (int)nverts, h5name);
-    fprintf(fp, "   </Attribute>\n");
-  }
-  for (PetscInt f = 0; f < 2 && user->rec.estimate.computed; ++f) {
-    const char *name = f ? "error_density" : "error_indicator";
+  fprintf(fp, "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"2.0\">\n <Domain>\n");
+  if (nsteps) fprintf(fp, "  <Grid Name=\"load path\" GridType=\"Collection\" CollectionType=\"Temporal\">\n");
+  for (PetscInt k = nsteps ? 0 : -1; k < nsteps; ++k) {
+    const PetscBool last = (PetscBool)(k == nsteps - 1);
 
-    fprintf(fp, "   <Attribute Name=\"%s\" AttributeType=\"Scalar\" Center=\"Cell\">\n", name);
-    fprintf(fp,
-            "    <DataItem Dimensions=\"%d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/cell_fields/%s</DataItem>\n   </Attribute>\n",
-            (int)ncells, h5name, name);
+    if (k < 0)
+      fprintf(fp, "  <Grid Name=\"mesh\" GridType=\"Uniform\">\n");
+    else
+      fprintf(fp, "  <Grid Name=\"step %d\" GridType=\"Uniform\">\n   <Time Value=\"%d\"/>\n", (int)(k + 1), (int)(k + 1));
+    fprintf(fp, "   <Topology TopologyType=\"%s\" NumberOfElements=\"%d\">\n", topo, (int)ncells);
+    fprintf(fp, "    <DataItem Dimensions=\"%d %d\" NumberType=\"Int\" Format=\"HDF\">%s:/viz/topology/cells</DataItem>\n   </Topology>\n",
+            (int)ncells, (int)ncorners, h5name);
+    fprintf(fp, "   <Geometry GeometryType=\"%s\">\n", dim == 2 ? "XY" : "XYZ");
+    fprintf(
+        fp,
+        "    <DataItem Dimensions=\"%d %d\" NumberType=\"Float\" Precision=\"8\" Format=\"HDF\">%s:/geometry/vertices</DataItem>\n   </Geometry>\n",
+        (int)nverts, (int)dim, h5name);
+    for (PetscInt f = 0; f < nfields; ++f) {
+      if (f >= OUTPUT_STATE_FIELDS && !last) continue; /* the last solution's only */
+      XdmfAttribute(fp, h5name, "vertex_fields", fields[f], "Node", nverts, ncomp[f], f < OUTPUT_STATE_FIELDS ? k : -1, nsteps);
+    }
+    if (user->rec.bars.pressure_band && last) XdmfAttribute(fp, h5name, "vertex_fields", "contact_pressure_bar", "Node", nverts, 1, -1, 0);
+    for (PetscInt f = 0; f < 2 && user->rec.estimate.computed && last; ++f)
+      XdmfAttribute(fp, h5name, "cell_fields", f ? "error_density" : "error_indicator", "Cell", ncells, 1, -1, 0);
+    fprintf(fp, "  </Grid>\n");
   }
-  fprintf(fp, "  </Grid>\n </Domain>\n</Xdmf>\n");
+  if (nsteps) fprintf(fp, "  </Grid>\n");
+  fprintf(fp, " </Domain>\n</Xdmf>\n");
   bad = fflush(fp) != 0 || ferror(fp);
   bad = (fclose(fp) != 0) || bad;
   PetscCheck(!bad, PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "%s", strerror(errno));

@@ -6,6 +6,7 @@
    the Dirichlet values, the load r0 = K_fD u_D - f, the kernels' constants and the contact set's gaps. */
 #include "app.h"
 #include "contact.h"
+#include "io.h"
 #include "physics.h"
 #include "scenes.h"
 #include "solver_impl.h"
@@ -77,16 +78,22 @@ static PetscErrorCode ProblemSetLoadFactor(DM dm, AppCtx *user, PetscReal t)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The step just solved at factor t: its quantities (PostprocessContact()) and its solve's record. */
+/* The step just solved at factor t: its quantities (PostprocessContact()), its solve's record and its state at the
+   vertices (OutputStateFields(): the output's time series). */
 static PetscErrorCode LoadPathRecordStep(DM dm, AppCtx *user, Vec u, PetscReal t)
 {
   StepRecord        *s;
   const SolveRecord *r = &user->rec.records[user->rec.nrecords - 1];
 
   PetscFunctionBeginUser;
-  if (!user->rec.steps) PetscCall(PetscCalloc1(user->opt->load_path.n, &user->rec.steps));
-  s = &user->rec.steps[user->rec.nsteps++];
+  if (!user->rec.steps) {
+    PetscCall(PetscCalloc1(user->opt->load_path.n, &user->rec.steps));
+    PetscCall(PetscCalloc1(user->opt->load_path.n * OUTPUT_STATE_FIELDS, &user->rec.step_fields));
+  }
+  s = &user->rec.steps[user->rec.nsteps];
   PetscCall(PostprocessContact(dm, user, u));
+  PetscCall(OutputStateFields(dm, user, u, &user->rec.step_fields[user->rec.nsteps * OUTPUT_STATE_FIELDS]));
+  user->rec.nsteps++;
   PostprocessGetQuantities(user, &s->q);
   s->factor        = t;
   s->contact_force = user->rec.stats.contact_force;
