@@ -149,3 +149,30 @@ def test_time_series_opens_in_paraview(outdir, tmp_path):
     _, d = run(INDENT + ["-obstacle_translate", "0,-0.02"], "series_direct", output=os.path.join(outdir, "direct.h5"))
     last, direct = load(h5)[1], load(d)[1]
     assert np.max(np.abs(last["displacement"] - direct["displacement"])) <= 1e-8 * np.max(np.abs(direct["displacement"]))
+
+
+def test_plot_history(outdir):
+    """scripts/plot_history.py: the CSV holds every column of /steps, and the depth (the obstacle's translation along
+    its motion) and the force along it, positive as it presses; the PNG is written; a file without /steps is refused
+    (exit 2) by name."""
+    import csv
+    import subprocess
+    import sys
+    from harness import ROOT
+    _, h5 = run(INDENT + ["-obstacle_translate", "0,-0.02", "-load_steps", "4"], "history", output=os.path.join(outdir, "history.h5"))
+    png, table = os.path.join(outdir, "h.png"), os.path.join(outdir, "h.csv")
+    script = os.path.join(ROOT, "scripts", "plot_history.py")
+    p = subprocess.run([sys.executable, script, h5, "-o", png, "--csv", table], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert p.returncode == 0, p.stdout
+    assert os.path.getsize(png) > 10000
+    rows = list(csv.DictReader(open(table)))
+    st = steps(h5)
+    assert len(rows) == 4
+    for k, row in enumerate(rows):
+        for name, values in st.items():
+            assert float(row[name]) == values[k], (k, name)
+        assert abs(float(row["depth"]) - 0.005 * (k + 1)) <= 1e-15
+        assert abs(float(row["force_along"]) + st["contact_force_y"][k]) <= 1e-15 and float(row["force_along"]) > 0
+    _, plain = run(INDENT + ["-obstacle_translate", "0,-0.02"], "no_history", output=os.path.join(outdir, "plain.h5"))
+    p = subprocess.run([sys.executable, script, plain, "-o", png], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    assert p.returncode == 2 and "no /steps" in p.stdout, p.stdout
