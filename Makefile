@@ -23,7 +23,7 @@ SRC = $(wildcard src/*.c src/*/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test test-long asan rates extremes tradeoff hertz estimates bench format clean
+.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path estimates bench format clean
 STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
@@ -99,6 +99,12 @@ tradeoff: deps
 hertz: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/hertz.py --check 0.01
+
+# Hertz along a load path (docs/hertz.md): the two indenters in 10 steps, a and p0 at every step against the closed form
+# at its force, the sphere's force-depth exponent: output/hertz_path/hertz_path.{md,csv,png}
+hertz-path: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) scripts/hertz_path.py --check 0.01
 
 # The a posteriori estimate (docs/estimate.md): effectivity on the manufactured solutions, its penalty part against SNESVI,
 # the error density on Hertz: output/estimates/estimates.{md,csv}, penalty.csv, hertz.csv, effectivity.png, hertz_density.png

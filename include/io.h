@@ -16,7 +16,7 @@ PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, cha
 /* output_hdf5.c */
 PetscErrorCode OutputGetOptions(MPI_Comm comm, RunOptions *opt);
 PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u);
-#define OUTPUT_STATE_FIELDS 4 /* displacement, contact_pressure, normal_gap, contact_boundary */
+#define OUTPUT_STATE_FIELDS 5 /* displacement, contact_pressure, normal_gap, contact_boundary, contact_reaction */
 PetscErrorCode OutputStateFields(DM dm, const AppCtx *user, Vec u, Vec fields[OUTPUT_STATE_FIELDS]);
 /* output_mesh.c */
 PetscErrorCode OutputViewMesh(DM dm, PetscViewer viewer);

@@ -105,7 +105,7 @@ def test_bad_load_path_refused(outdir, extra, message):
 
 
 def test_time_series_opens_in_paraview(outdir, tmp_path):
-    """The steps' state (displacement, contact_pressure, normal_gap, contact_boundary) is a time series under
+    """The steps' state (displacement, contact_pressure, normal_gap, contact_boundary, contact_reaction) is a time series under
     /vertex_fields, the step the first dimension (PETSc's timestepping); ParaView's own XDMF reader (pvbatch) finds one
     time per step (1, 2, 3) and at each the step's arrays, equal to the HDF5 file's; the last step's are the direct
     run's at its factor (signorini.runs.read_output)."""
@@ -115,7 +115,7 @@ def test_time_series_opens_in_paraview(outdir, tmp_path):
     from signorini.runs import read_steps
     _, h5 = run(INDENT + ["-obstacle_translate", "0,-0.02", "-load_path", "0.3,1.2,1"], "series", output=os.path.join(outdir, "series.h5"))
     st, series = read_steps(h5)
-    assert sorted(series) == ["contact_boundary", "contact_pressure", "displacement", "normal_gap"]
+    assert sorted(series) == ["contact_boundary", "contact_pressure", "contact_reaction", "displacement", "normal_gap"]
     assert series["displacement"].shape[:2] == (3, series["contact_pressure"].shape[1])
     npz = tmp_path / "pv.npz"
     script = tmp_path / "read.py"
@@ -130,7 +130,7 @@ def test_time_series_opens_in_paraview(outdir, tmp_path):
         "for k, t in enumerate(r.TimestepValues):\n"
         "    r.UpdatePipeline(t)\n"
         "    pd = sm.Fetch(r).GetPointData()\n"
-        "    for name in ('displacement', 'contact_pressure', 'normal_gap', 'contact_boundary'):\n"
+        "    for name in ('displacement', 'contact_pressure', 'normal_gap', 'contact_boundary', 'contact_reaction'):\n"
         "        out[f'{name}_{k}'] = vtk_to_numpy(pd.GetArray(name))\n"
         f"np.savez({str(npz)!r}, **out)\n")
     p = subprocess.run(["pvbatch", "--force-offscreen-rendering", str(script)], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
@@ -176,3 +176,24 @@ def test_plot_history(outdir):
     _, plain = run(INDENT + ["-obstacle_translate", "0,-0.02"], "no_history", output=os.path.join(outdir, "plain.h5"))
     p = subprocess.run([sys.executable, script, plain, "-o", png], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert p.returncode == 2 and "no /steps" in p.stdout, p.stdout
+
+
+def test_hertz_measures_each_step(outdir):
+    """signorini.hertz.measure(case, path, step=k) reads step k of a load path (its row of /steps, its slab of the time
+    series): on the cylinder indenter along 0.5, 1, the first step's a, p0 and load are the direct run's at half the
+    indentation, to the solver's tolerance."""
+    import sys
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "scripts"))
+    from signorini import hertz
+    mesh = os.path.join(outdir, "block.msh")
+    hertz.write_mesh("cylinder-indenter", 0.004, mesh)
+    path, direct = os.path.join(outdir, "path.h5"), os.path.join(outdir, "direct.h5")
+    base = hertz.command("cylinder-indenter", mesh, "eps=h/10", path)[3:-2]  # without mpiexec -n 1 and -output
+    assert base[0].endswith("bin/signorini")
+    run(base[1:] + ["-load_path", "0.5,1", "-snes_rtol", "1e-12"], "hertz_path", output=path)
+    run(base[1:] + ["-obstacle_translate", "0,-0.0005", "-snes_rtol", "1e-12"], "hertz_direct", output=direct)
+    m_step, m_direct, m_last = hertz.measure("cylinder-indenter", path, step=0), hertz.measure("cylinder-indenter", direct), \
+        hertz.measure("cylinder-indenter", path)
+    for key in ("load", "a_h", "p0_h"):
+        assert abs(m_step[key] - m_direct[key]) <= 1e-8 * abs(m_direct[key]), (key, m_step[key], m_direct[key])
+    assert m_last["load"] > 1.9 * m_step["load"]

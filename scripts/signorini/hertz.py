@@ -25,6 +25,7 @@ import numpy as np
 
 from . import geometry
 from .paths import BIN
+from .runs import field_at
 
 YOUNG, POISSON, RADIUS = 1.0, 0.3, 1.0
 
@@ -102,19 +103,23 @@ def command(case, mesh, method, output, ranks=1, mpiexec="mpiexec"):
              str(POISSON)] + CASES[case]["args"] + METHODS[method] + ["-output", output])
 
 
-def measure(case, path):
+def measure(case, path, step=None):
     """What a run gives against the closed form: a dict with the load, a, p0 (measured and closed form), their relative
     errors, the force balance (|obstacle force + supports' reactions| / obstacle force, along the pressing axis), and the
-    contact nodes. Raises ValueError if the run has no contact."""
+    contact nodes. step: of a load path's output, the step's (0-based: its row of /steps and its slab of the time
+    series) instead of the last. Raises ValueError if the run has no contact."""
     c = CASES[case]
     dim = c["dim"]
     axis = "xyz"[dim - 1]
+    at = -1 if step is None else step
     with h5py.File(path, "r") as f:
         run = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in f["run"].attrs.items()}
+        if step is not None:  # the step's quantities, from its row of /steps
+            run.update({k: float(np.ravel(f["steps"][k][:])[step]) for k in f["steps"]})
         x = f["geometry/vertices"][:]
-        force = f["vertex_fields/contact_reaction"][:].ravel()
-        pressure = f["vertex_fields/contact_pressure"][:].ravel()
-        boundary = f["vertex_fields/contact_boundary"][:].ravel() > 0
+        force = field_at(f["vertex_fields/contact_reaction"], at).ravel()
+        pressure = field_at(f["vertex_fields/contact_pressure"], at).ravel()
+        boundary = field_at(f["vertex_fields/contact_boundary"], at).ravel() > 0
         area = f["vertex_fields/contact_area"][:].ravel()
     r2 = (x[:, 0] ** 2) if dim == 2 else (x[:, 0] ** 2 + x[:, 1] ** 2)
     m0 = float(np.sum(force[boundary]))
@@ -157,3 +162,32 @@ def output_name(case, h_near, method):
     label = method.replace("=", "").replace("/", "_")
     return f"{case}_h{h_near:g}_{label}.h5"
 
+
+# Hertz along a load path (scripts/hertz_path.py, make hertz-path): the two indenters, driven by the obstacle's
+# translation in PATH_STEPS equal steps, each step measured as a run at its force. The finest meshes of make hertz,
+# eps = h/100.
+PATH_CASES = {"cylinder-indenter": 0.001, "sphere-indenter": 0.007}
+PATH_METHOD = "eps=h/100"
+PATH_STEPS = 10
+
+
+def path_rows(case, path):
+    """One row per step of a load path's output of the Hertz case: the step, its factor, the indentation depth (the
+    obstacle's translation along its motion), the load and measure()'s a, p0 and their errors at the step's force."""
+    from .history import history
+    steps = history(path)
+    rows = []
+    for k in range(len(steps["factor"])):
+        m = measure(case, path, step=k)
+        rows.append({"case": case, "step": k + 1, "factor": float(steps["factor"][k]), "depth": float(steps["depth"][k]),
+                     "load": m["load"], "a": m["a"], "a_h": m["a_h"], "a_error": m["a_error"], "p0": m["p0"], "p0_h": m["p0_h"],
+                     "p0_error": m["p0_error"], "newton_its": int(steps["newton_its"][k]), "converged": int(steps["converged"][k])})
+    return rows
+
+
+def force_depth_exponent(rows):
+    """The exponent of the load against the depth, fitted over the steps (log-log least squares): 3/2 for a sphere on
+    a half-space, F = (4/3) E* R^(1/2) d^(3/2)."""
+    d = np.array([r["depth"] for r in rows])
+    F = np.array([r["load"] for r in rows])
+    return float(np.polyfit(np.log(d), np.log(F), 1)[0])

@@ -55,14 +55,14 @@ static PetscErrorCode ViewVertexField(Vec v, PetscInt nc, PetscViewer viewer)
    g - u_n and the Gamma_C indicator, from u and the contact set as PostprocessContact() left it. */
 PetscErrorCode OutputStateFields(DM dm, const AppCtx *user, Vec u, Vec fields[OUTPUT_STATE_FIELDS])
 {
-  const char *const  names[OUTPUT_STATE_FIELDS] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary"};
+  const char *const  names[OUTPUT_STATE_FIELDS] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "contact_reaction"};
   const ContactSet  *cs;
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
   Vec                locU;
   PetscSection       usec;
   PetscInt           dim, vStart, vEnd, nowned = 0, *index = NULL;
   const PetscScalar *lu, *x;
-  PetscScalar       *d, *p, *g, *m;
+  PetscScalar       *d, *p, *g, *m, *fr;
 
   PetscFunctionBeginUser;
   PetscCall(ContactGetSet(user->contact, &cs));
@@ -74,6 +74,7 @@ PetscErrorCode OutputStateFields(DM dm, const AppCtx *user, Vec u, Vec fields[OU
   PetscCall(VecCreateMPI(comm, nowned, PETSC_DETERMINE, &fields[1]));
   PetscCall(VecDuplicate(fields[1], &fields[2]));
   PetscCall(VecDuplicate(fields[1], &fields[3]));
+  PetscCall(VecDuplicate(fields[1], &fields[4]));
   for (PetscInt f = 0; f < OUTPUT_STATE_FIELDS; ++f) {
     PetscCall(PetscObjectSetName((PetscObject)fields[f], names[f]));
     PetscCall(VecZeroEntries(fields[f]));
@@ -97,16 +98,19 @@ PetscErrorCode OutputStateFields(DM dm, const AppCtx *user, Vec u, Vec fields[OU
   PetscCall(VecGetArray(fields[1], &p));
   PetscCall(VecGetArray(fields[2], &g));
   PetscCall(VecGetArray(fields[3], &m));
+  PetscCall(VecGetArray(fields[4], &fr));
   for (PetscInt i = 0; i < cs->n; ++i) {
     PetscInt goff;
 
     if (!cs->is_vertex[i]) continue;
     goff = index[cs->point[i] - vStart];
     if (goff < 0) continue; /* owned by another rank */
-    p[goff] = cs->pressure[i];
-    g[goff] = -ContactNodePenetration(cs, dim, i, x);
-    m[goff] = 1.0;
+    p[goff]  = cs->pressure[i];
+    g[goff]  = -ContactNodePenetration(cs, dim, i, x);
+    m[goff]  = 1.0;
+    fr[goff] = cs->reaction[i]; /* the nodal force of the obstacle along n */
   }
+  PetscCall(VecRestoreArray(fields[4], &fr));
   PetscCall(VecRestoreArray(fields[3], &m));
   PetscCall(VecRestoreArray(fields[2], &g));
   PetscCall(VecRestoreArray(fields[1], &p));
@@ -123,11 +127,11 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
 {
   const ContactSet  *cs;
   DM                 cdm;
-  Vec                state[OUTPUT_STATE_FIELDS], react, area, exact = NULL, error = NULL, coords;
+  Vec                state[OUTPUT_STATE_FIELDS], area, exact = NULL, error = NULL, coords;
   PetscSection       csec;
   PetscInt           dim, vStart, vEnd, nowned = 0, *index = NULL;
   const PetscScalar *xc, *d;
-  PetscScalar       *fr, *ar, *ex = NULL, *er = NULL;
+  PetscScalar       *ar, *ex = NULL, *er = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(ContactGetSet(user->contact, &cs));
@@ -146,24 +150,16 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
     }
   } else
     for (PetscInt f = 0; f < OUTPUT_STATE_FIELDS; ++f) PetscCall(ViewVertexField(state[f], f ? 1 : dim, viewer));
-  PetscCall(VecDuplicate(state[1], &react));
-  PetscCall(PetscObjectSetName((PetscObject)react, "contact_reaction")); /* the nodal force of the obstacle along n */
-  PetscCall(VecZeroEntries(react));
   PetscCall(VecDuplicate(state[1], &area));
   PetscCall(PetscObjectSetName((PetscObject)area, "contact_area")); /* the lumped boundary mass: reaction / area is a pressure */
   PetscCall(VecZeroEntries(area));
-  PetscCall(VecGetArray(react, &fr));
   PetscCall(VecGetArray(area, &ar));
   for (PetscInt i = 0; i < cs->n; ++i) {
     const PetscInt goff = cs->is_vertex[i] ? index[cs->point[i] - vStart] : -1;
 
-    if (goff < 0) continue; /* not a vertex, or owned by another rank */
-    fr[goff] = cs->reaction[i];
-    ar[goff] = cs->weight[i];
+    if (goff >= 0) ar[goff] = cs->weight[i]; /* skips non-vertices and vertices owned by another rank */
   }
-  PetscCall(VecRestoreArray(react, &fr));
   PetscCall(VecRestoreArray(area, &ar));
-  PetscCall(ViewVertexField(react, 1, viewer));
   PetscCall(ViewVertexField(area, 1, viewer));
   if (user->scene.exact) {
     PetscCall(DMGetCoordinateDM(dm, &cdm));
@@ -215,7 +211,6 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscCall(VecDestroy(&exact));
   PetscCall(VecDestroy(&error));
   for (PetscInt f = 0; f < OUTPUT_STATE_FIELDS; ++f) PetscCall(VecDestroy(&state[f]));
-  PetscCall(VecDestroy(&react));
   PetscCall(VecDestroy(&area));
   PetscCall(PetscFree(index));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -10,35 +10,6 @@
 #include "contact.h"
 #include "solver_impl.h"
 
-/* u <- u + factor dir if the penalty is active there at the same points as at u (the last solution) and the residual
-   at the current eps is lower, or, whatever the points, if that residual is below relaxed times the last one (the
-   tangent's guess, below; 0 for the secant's). A secant guess active elsewhere is not taken: a Gauss point it lifts off that the new eps keeps
-   in contact (near the edge of the contact zone) makes the line search cut every Newton step at that kink, and Newton
-   stalls. Such a guess that still lowers
-   the residual gives, with step_guess, the first linear solve's initial guess instead (step_guess.c): Newton starts
-   from u, with its active points, and CG from the step factor dir; dir is then scaled. */
-static PetscErrorCode ExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscReal factor, PetscReal relaxed, PetscBool step_guess)
-{
-  Vec       guess;
-  PetscReal f_last, f_guess;
-  PetscBool same;
-
-  PetscFunctionBeginUser;
-  PetscCall(VecDuplicate(u, &guess));
-  PetscCall(VecWAXPY(guess, factor, dir, u));
-  PetscCall(ContactSameActivity(user->contact, dm, u, guess, &same));
-  PetscCall(SolverResidualNorm(snes, user->prob.sctx, u, &f_last)); /* every start needs both: the tangent's and the secant's rules */
-  PetscCall(SolverResidualNorm(snes, user->prob.sctx, guess, &f_guess));
-  if ((same && f_guess < f_last) || f_guess < relaxed * f_last)
-    PetscCall(VecCopy(guess, u));
-  else if (step_guess && f_guess < f_last) {
-    PetscCall(VecScale(dir, factor));
-    PetscCall(SolverSetStepGuess(user->prob.sctx, dir));
-  }
-  PetscCall(VecDestroy(&guess));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* The first new value has no earlier solution to extrapolate from: its start follows the tangent of the solution path
    at the last eps instead. F(u; eps) = K u + r0 + P(u; eps) with the penalty term P proportional to 1/eps, so
    du/deps = J^-1 P(u; eps) / eps, J the Jacobian, which K and the SNES's preconditioner still hold from the last Newton
@@ -97,12 +68,12 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
     PetscCall(VecCopy(u, last));
     if (k > 1 && eps_last != eps_prev) { /* the secant of the last two solutions */
       PetscCall(VecWAXPY(dir, -1.0, prev, u));
-      PetscCall(ExtrapolatedStart(snes, dm, user, u, dir, (eps - eps_last) / (eps_last - eps_prev), 0.0, PETSC_TRUE));
+      PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, (eps - eps_last) / (eps_last - eps_prev), 0.0, PETSC_TRUE));
     } else if (k == 1 && ContactHasPenalty(user->contact) && eps != eps_last) { /* the tangent */
       PetscBool ok = PETSC_FALSE;
 
       PetscCall(TangentDirection(snes, dm, user, u, dir, &ok));
-      if (ok) PetscCall(ExtrapolatedStart(snes, dm, user, u, dir, (eps - eps_last) * eps / (eps_last * eps_last), 1e-2, PETSC_FALSE));
+      if (ok) PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, (eps - eps_last) * eps / (eps_last * eps_last), 1e-2, PETSC_FALSE));
     }
     if (!prev) PetscCall(VecDuplicate(u, &prev));
     PetscCall(VecSwap(prev, last));

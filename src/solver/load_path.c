@@ -105,20 +105,41 @@ static PetscErrorCode LoadPathRecordStep(DM dm, AppCtx *user, Vec u, PetscReal t
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The steps after the first (the run's main solve, at the first factor), each from the last solution. A failed step
-   ends the path: the output is its state, with converged = 0, and /steps holds the steps up to it. */
+/* The steps after the first (the run's main solve, at the first factor), each from the last solution extrapolated
+   along the path: the secant of the last two solutions, u_k = u_{k-1} + (t_k - t_{k-1}) / (t_{k-1} - t_{k-2})
+   (u_{k-1} - u_{k-2}), and for the second step the secant from u = 0 at t = 0 (a linear problem's u is proportional to
+   t; the contact's active set makes it piecewise so). The guess is taken where it keeps the penalty's active points and
+   lowers the residual at the new load, and else gives the first linear solve's initial guess (SolverExtrapolatedStart(),
+   as the eps sweep's). A failed step ends the path: the output is its state, with converged = 0, and /steps holds the
+   steps up to it. */
 PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 {
-  const LoadPathOptions *lp = &user->opt->load_path;
+  const LoadPathOptions *lp   = &user->opt->load_path;
+  Vec                    prev = NULL, dir = NULL;
 
   PetscFunctionBeginUser;
   if (!lp->n) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[0]));
+  if (lp->n > 1) {
+    PetscCall(VecDuplicate(u, &prev));
+    PetscCall(VecDuplicate(u, &dir));
+    PetscCall(VecZeroEntries(prev)); /* u = 0 at t = 0 */
+  }
   for (PetscInt k = 1; k < lp->n && user->rec.stats.converged; ++k) {
+    const PetscReal t_last = lp->factor[k - 1], t_prev = k > 1 ? lp->factor[k - 2] : 0.0;
+
     PetscCall(ProblemSetLoadFactor(dm, user, lp->factor[k]));
+    if (t_last != t_prev && ContactHasPenalty(user->contact)) {
+      PetscCall(VecWAXPY(dir, -1.0, prev, u));
+      PetscCall(VecCopy(u, prev));
+      PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, (lp->factor[k] - t_last) / (t_last - t_prev), 0.0, PETSC_TRUE));
+    } else
+      PetscCall(VecCopy(u, prev));
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
     PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[k]));
   }
+  PetscCall(VecDestroy(&prev));
+  PetscCall(VecDestroy(&dir));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

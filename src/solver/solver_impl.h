@@ -134,6 +134,7 @@ PetscErrorCode SolverStepGuessSetUp(KSP ksp, SolverCtx sc);
 PetscErrorCode SolverSetStepGuess(SolverCtx sc, Vec du);
 PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, SolverCtx sc);
 PetscErrorCode SolverStepGuessDrop(SolverCtx sc);
+PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscReal factor, PetscReal relaxed, PetscBool step_guess);
 
 /* pc_reuse.c */
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X);

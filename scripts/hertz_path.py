@@ -1,0 +1,124 @@
+#!/usr/bin/python3
+"""Hertz along a load path against the closed form: the cylinder and sphere indenters of scripts/signorini/hertz.py
+(PATH_CASES: make hertz's finest mesh of each) driven by the obstacle's translation in 10 equal steps (-load_steps 10,
+eps = h/100), each step's contact half-width a and peak pressure p0 measured as make hertz measures a run (from the
+step's nodal reactions) and compared with the closed form at the step's force, and the 3D force-depth curve's
+exponent.
+
+Usage: hertz_path.py [--outdir DIR] [--cases C,...] [--check TOL]
+
+DIR (default output/hertz_path) receives the meshes, the runs, and
+  hertz_path.csv   one row per step: case, step, factor, depth, load, a, a_h, a_error, p0, p0_h, p0_error, newton_its, converged
+  hertz_path.md    the table, the largest errors of each case and the sphere's force-depth exponent
+  hertz_path.png   a and p0 against the load, with the closed form, and the sphere's force against the depth
+--check TOL: exit 1 unless every step converged with a and p0 within TOL (relative) of the closed form, and the sphere's
+force-depth exponent is within 0.03 of 3/2.
+"""
+import argparse
+import csv
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from signorini import hertz  # noqa: E402
+from signorini.figures import plt, save_png  # noqa: E402
+from signorini.mpirun import error_line, run_mpi  # noqa: E402
+from signorini.paths import ROOT, display_path  # noqa: E402
+
+
+def run_case(case, outdir):
+    h_near = hertz.PATH_CASES[case]
+    mesh = os.path.join(outdir, hertz.mesh_name(case, h_near))
+    if not os.path.isfile(mesh):
+        hertz.write_mesh(case, h_near, mesh)
+    out = os.path.join(outdir, f"{case}_h{h_near:g}_path.h5")
+    cmd = hertz.command(case, display_path(mesh), hertz.PATH_METHOD, display_path(out)) + ["-load_steps", str(hertz.PATH_STEPS)]
+    res = run_mpi(cmd, log=out[:-3] + ".log", timeout=3600, header=" ".join(cmd) + "\n")
+    if res.returncode != 0 or not os.path.isfile(out):
+        sys.exit(f"failed: {' '.join(cmd)}: {error_line(res.output)}")
+    return hertz.path_rows(case, out)
+
+
+def figure(rows, path):
+    cases = sorted({r["case"] for r in rows})
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4))
+    for case in cases:
+        sel = [r for r in rows if r["case"] == case]
+        load = np.array([r["load"] for r in sel])
+        for ax, key, label in ((axes[0], "a", "contact half-width a"), (axes[1], "p0", "peak pressure p0")):
+            ax.loglog(load, [r[key + "_h"] for r in sel], "o", label=f"{case} (run)")
+            ax.loglog(load, [r[key] for r in sel], "-", label=f"{case} (closed form)")
+            ax.set_xlabel("load (force of the whole body)")
+            ax.set_ylabel(label)
+    for ax in axes[:2]:
+        ax.legend(fontsize=7)
+        ax.grid(True, which="both", alpha=0.3)
+    sphere = [r for r in rows if hertz.CASES[r["case"]]["dim"] == 3]
+    if sphere:
+        d = np.array([r["depth"] for r in sphere])
+        F = np.array([r["load"] for r in sphere])
+        es = hertz.e_star()
+        axes[2].loglog(d, F, "o", label="run")
+        axes[2].loglog(d, 4.0 / 3.0 * es * np.sqrt(hertz.RADIUS) * d**1.5, "-", label="half-space: (4/3) E* R^1/2 d^3/2")
+        axes[2].set_xlabel("indentation depth (the sphere's translation)")
+        axes[2].set_ylabel("force")
+        axes[2].set_title(f"fitted exponent {hertz.force_depth_exponent(sphere):.3f}", fontsize=9)
+        axes[2].legend(fontsize=7)
+        axes[2].grid(True, which="both", alpha=0.3)
+    save_png(fig, path, 120)
+
+
+def report(rows, outdir):
+    lines = ["# Hertz along a load path", "", f"Made by `scripts/hertz_path.py` (make hertz-path): {hertz.PATH_STEPS} equal steps of the "
+             f"obstacle's translation, {hertz.PATH_METHOD}, make hertz's finest mesh of each case.", "",
+             "| case | step | factor | depth | load | a error | p0 error | Newton |", "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        lines.append(f"| {r['case']} | {r['step']} | {r['factor']:.2f} | {r['depth']:.3g} | {r['load']:.4g} | {r['a_error']:+.4f} | "
+                     f"{r['p0_error']:+.4f} | {r['newton_its']} |")
+    lines.append("")
+    for case in sorted({r["case"] for r in rows}):
+        sel = [r for r in rows if r["case"] == case]
+        lines.append(f"- {case}: largest |a error| {max(abs(r['a_error']) for r in sel):.4f}, largest |p0 error| "
+                     f"{max(abs(r['p0_error']) for r in sel):.4f}")
+        if hertz.CASES[case]["dim"] == 3:
+            lines.append(f"- {case}: force-depth exponent {hertz.force_depth_exponent(sel):.4f} (half-space: 1.5)")
+    with open(os.path.join(outdir, "hertz_path.md"), "w") as fh:
+        fh.write("\n".join(lines) + "\n")
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--outdir", default=os.path.join(ROOT, "output", "hertz_path"))
+    p.add_argument("--cases", default=",".join(hertz.PATH_CASES))
+    p.add_argument("--check", type=float, default=None)
+    args = p.parse_args()
+    os.makedirs(args.outdir, exist_ok=True)
+    rows = []
+    for case in args.cases.split(","):
+        rows += run_case(case, args.outdir)
+        for r in rows[-hertz.PATH_STEPS:]:
+            print(f"{case} step {r['step']}: load {r['load']:.4g}, a {r['a_error']:+.4f}, p0 {r['p0_error']:+.4f}")
+    with open(os.path.join(args.outdir, "hertz_path.csv"), "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    report(rows, args.outdir)
+    figure(rows, os.path.join(args.outdir, "hertz_path.png"))
+    print(f"wrote {display_path(os.path.join(args.outdir, 'hertz_path.md'))}")
+    if args.check is None:
+        return 0
+    bad = [f"{r['case']} step {r['step']}: not converged" for r in rows if not r["converged"]]
+    bad += [f"{r['case']} step {r['step']}: a {r['a_error']:+.4f}, p0 {r['p0_error']:+.4f}" for r in rows
+            if max(abs(r["a_error"]), abs(r["p0_error"])) > args.check]
+    sphere = [r for r in rows if hertz.CASES[r["case"]]["dim"] == 3]
+    if sphere and abs(hertz.force_depth_exponent(sphere) - 1.5) > 0.03:
+        bad.append(f"force-depth exponent {hertz.force_depth_exponent(sphere):.4f}")
+    for b in bad:
+        print("CHECK FAILED:", b, file=sys.stderr)
+    return 1 if bad else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
