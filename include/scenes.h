@@ -21,8 +21,9 @@ PetscErrorCode SceneBoundaryGetOptions(DM dm, Scene *scene);
 PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene);
 
 /* scenes/load_factor.c: the factor of a load path on every prescribed datum */
-PetscErrorCode SceneCheckLoadPath(MPI_Comm comm, const Scene *scene);
+PetscErrorCode SceneCheckLoadPath(MPI_Comm comm, const Scene *scene, const char what[]);
 PetscErrorCode SceneSetLoadFactor(Scene *scene, PetscReal t);
+PetscErrorCode SceneSetObstaclePosition(Scene *scene, PetscReal s);
 
 /* scenes/fingerprint.c: the problem as one string, for -reference */
 #define SCENE_FINGERPRINT_LEN 4096

@@ -76,6 +76,7 @@ typedef struct {
   PetscReal    direction[3]; /* plane: unit normal from the body into the obstacle; cylinder: unit axis (3D) */
   PetscReal    radius;
   PetscReal    translate[3]; /* rigid translation of the obstacle (-obstacle_translate) */
+  PetscReal    force;        /* -obstacle_force: the force it presses with along the translation's direction (0: driven by the translation) */
 } Obstacle;
 
 /* What a scene (a problem set-up) provides: its defaults of the boundary and obstacle options, filled by its
@@ -98,7 +99,7 @@ typedef struct {
   PetscReal      load_factor;                                  /* the factor of every prescribed datum (SceneSetLoadFactor()) */
   struct {                                                     /* the prescribed data at the factor 1, kept by SceneSetLoadFactor() */
     PetscBool   kept;
-    PetscReal   value[BOUNDARY_MAX][3], body_force[3], translate[3];
+    PetscReal   value[BOUNDARY_MAX][3], body_force[3], translate[3], force;
     PetscScalar constants[CONST_SCENE_MAX - CONST_SCENE];
   } full_load;
 } Scene;
@@ -278,6 +279,7 @@ typedef struct {
   PetscReal           residual_norm;
   PetscReal           residual_start;      /* |F| at the start of the last Newton solve */
   PetscInt            continuation_stages; /* solves of the eps sequence before the target eps (0: none) */
+  PetscInt            force_control_its;   /* positions of the obstacle solved by force control (-obstacle_force), all steps */
   PetscInt            active_set_cycles;   /* active-set cycles detected (and damped) in the Newton iterations */
   PetscInt            pc_builds;           /* preconditioner (factorization) builds of the Newton steps */
   PetscInt            pc_updates;          /* updates of a GAMG hierarchy's coarse operators instead of builds (-contact_pc_update) */

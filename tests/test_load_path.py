@@ -197,3 +197,38 @@ def test_hertz_measures_each_step(outdir):
     for key in ("load", "a_h", "p0_h"):
         assert abs(m_step[key] - m_direct[key]) <= 1e-8 * abs(m_direct[key]), (key, m_step[key], m_direct[key])
     assert m_last["load"] > 1.9 * m_step["load"]
+
+
+@pytest.mark.parametrize("np_", [1, 2])
+def test_force_control(outdir, np_):
+    """-obstacle_force F drives the cylinder along -obstacle_translate's direction until it presses with F: along 3
+    steps (targets F/3, 2F/3, F) the obstacle's force along its motion equals each target to 1e-8; the displacement-
+    driven run at each position found gives that force to 1e-6 (the depth is the displacement-driven run's at that
+    force); 2 ranks as 1."""
+    F = 0.01
+    _, h5 = run(INDENT + ["-obstacle_translate", "0,-0.01", "-obstacle_force", F, "-load_steps", "3"], "force", np_=np_,
+                output=os.path.join(outdir, "force.h5"))
+    st = steps(h5)
+    assert st["converged"].all()
+    targets = st["factor"] * F
+    assert np.all(np.abs(-st["contact_force_y"] - targets) <= 1e-8 * targets), (st["contact_force_y"], targets)
+    attrs = load(h5)[0]
+    assert attrs["force_control_its"] >= 3 and attrs["obstacle_translate_y"] == st["obstacle_translate_y"][-1]
+    for k in range(3):
+        _, d = run(INDENT + ["-obstacle_translate", vec([0.0, st["obstacle_translate_y"][k]])], f"depth_{k}", np_=np_,
+                   output=os.path.join(outdir, f"depth_{k}.h5"))
+        force = -load(d)[0]["contact_force_y"]
+        assert abs(force - targets[k]) <= 1e-6 * targets[k], (k, force, targets[k])
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["-obstacle_force", "0.01"], "-obstacle_force needs -obstacle_translate to give the direction"),
+    (["-obstacle_force", "-1", "-obstacle_translate", "0,-0.01"], "-obstacle_force must be positive"),
+    (["-obstacle_force", "0.01", "-obstacle_translate", "0,-0.01", "-contact_method", "vi"], "SNESVI's bounds do not follow the load yet"),
+    (["-obstacle_force", "0.01", "-obstacle_translate", "0,-0.01", "-contact_method", "none"], "-obstacle_force needs a contact to press on"),
+])
+def test_bad_force_control_refused(outdir, extra, message):
+    out = os.path.join(outdir, "bad.h5")
+    rc, text = solve(INDENT + extra, output=out)
+    assert rc != 0 and message in text, text[-2000:]
+    assert not os.path.exists(out)

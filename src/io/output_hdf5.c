@@ -371,6 +371,16 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     }
   }
   PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "obstacle", PETSC_STRING, ObstacleTypes[user->scene.obstacle.type]));
+  for (PetscInt c = 0; c < dim; ++c) { /* where it ended: the translation of the options, a load path's last, force control's */
+    char name[32];
+
+    PetscCall(PetscSNPrintf(name, sizeof(name), "obstacle_translate_%c", "xyz"[c]));
+    PetscCall(WriteRealAttr(v, name, user->scene.obstacle.translate[c]));
+  }
+  if (user->scene.obstacle.force > 0.0) {
+    PetscCall(WriteRealAttr(v, "obstacle_force", user->scene.obstacle.force)); /* the target (the last step's) */
+    PetscCall(WriteIntAttr(v, "force_control_its", s->force_control_its));
+  }
   {
     char problem[SCENE_FINGERPRINT_LEN];
 

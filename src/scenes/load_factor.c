@@ -6,18 +6,18 @@
 
 /* Whether the scene's data can be scaled: a scene that prescribes its solution (an exact displacement on Gamma_D, a
    load in weak form from it) is one load state. */
-PetscErrorCode SceneCheckLoadPath(MPI_Comm comm, const Scene *scene)
+PetscErrorCode SceneCheckLoadPath(MPI_Comm comm, const Scene *scene, const char what[])
 {
   PetscFunctionBeginUser;
   PetscCheck(!scene->weak_data, comm, PETSC_ERR_USER_INPUT,
-             "-load_steps and -load_path scale the loads and translations that the options give; the scene %s takes its load from its "
-             "manufactured solution, one load state: use the scene general (or square) for a load path",
-             scene->name);
+             "%s change the loads and translations that the options give; the scene %s takes its load from its "
+             "manufactured solution, one load state: use the scene general (or square)",
+             what, scene->name);
   for (PetscInt i = 0; i < scene->bcs.n; ++i)
     PetscCheck(!scene->bcs.bc[i].fn, comm, PETSC_ERR_USER_INPUT,
-               "-load_steps and -load_path scale the loads and translations that the options give; the scene %s prescribes its own "
+               "%s change the loads and translations that the options give; the scene %s prescribes its own "
                "displacement on face set %s: give it by -bc_clamp_%s_translate, or use the scene general",
-               scene->name, scene->bcs.bc[i].token, scene->bcs.bc[i].token);
+               what, scene->name, scene->bcs.bc[i].token, scene->bcs.bc[i].token);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -37,7 +37,8 @@ PetscErrorCode SceneSetLoadFactor(Scene *scene, PetscReal t)
       scene->full_load.translate[c]  = scene->obstacle.translate[c];
     }
     for (PetscInt k = 0; k < nc; ++k) scene->full_load.constants[k] = scene->constants[k];
-    scene->full_load.kept = PETSC_TRUE;
+    scene->full_load.force = scene->obstacle.force;
+    scene->full_load.kept  = PETSC_TRUE;
   }
   for (PetscInt i = 0; i < scene->bcs.n; ++i)
     for (PetscInt c = 0; c < 3; ++c) scene->bcs.bc[i].value[c] = t * scene->full_load.value[i][c];
@@ -46,6 +47,21 @@ PetscErrorCode SceneSetLoadFactor(Scene *scene, PetscReal t)
     scene->obstacle.translate[c] = t * scene->full_load.translate[c];
   }
   for (PetscInt k = 0; k < nc; ++k) scene->constants[k] = scene->load_constant[k] ? t * scene->full_load.constants[k] : scene->full_load.constants[k];
-  scene->load_factor = t;
+  scene->obstacle.force = t * scene->full_load.force;
+  scene->load_factor    = t;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The obstacle at the translation s times the unit direction of its full translation (force control, load_path.c). */
+PetscErrorCode SceneSetObstaclePosition(Scene *scene, PetscReal s)
+{
+  PetscReal len = 0.0;
+
+  PetscFunctionBeginUser;
+  if (!scene->full_load.kept) PetscCall(SceneSetLoadFactor(scene, 1.0));
+  for (PetscInt c = 0; c < 3; ++c) len += PetscSqr(scene->full_load.translate[c]);
+  len = PetscSqrtReal(len);
+  PetscCheck(len > 0.0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the obstacle has no direction to move in");
+  for (PetscInt c = 0; c < 3; ++c) scene->obstacle.translate[c] = s * scene->full_load.translate[c] / len;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -93,6 +93,21 @@ PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
   }
   PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_translate", "Rigid translation of the obstacle (an indenter driven by displacement)", dim,
                        PETSC_FALSE, what, obs->translate));
+  {
+    PetscBool set;
+    PetscReal len = 0.0;
+
+    PetscCall(PetscOptionsReal("-obstacle_force", "Drive the obstacle along -obstacle_translate's direction until it presses with this force", NULL,
+                               obs->force, &obs->force, &set));
+    if (set) {
+      PetscCall(OptionsCheckFinite(comm, "-obstacle_force", obs->force));
+      PetscCheck(obs->force > 0.0, comm, PETSC_ERR_USER_INPUT, "-obstacle_force must be positive (the obstacle can only press on the body), got %g",
+                 (double)obs->force);
+      for (PetscInt c = 0; c < dim; ++c) len += obs->translate[c] * obs->translate[c];
+      PetscCheck(len > 0.0, comm, PETSC_ERR_USER_INPUT,
+                 "-obstacle_force needs -obstacle_translate to give the direction the obstacle moves in (its length is the first position tried)");
+    }
+  }
   PetscOptionsEnd();
   PetscFunctionReturn(PETSC_SUCCESS);
 }

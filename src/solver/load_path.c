@@ -41,32 +41,36 @@ PetscErrorCode LoadPathGetOptions(MPI_Comm comm, LoadPathOptions *lp)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* What a load path cannot do yet, refused before the set-up; then the scene at the path's first factor. */
+/* What a load path or force control cannot do yet, refused before the set-up; then the scene at the path's first
+   factor. */
 PetscErrorCode LoadPathSetUp(MPI_Comm comm, AppCtx *user)
 {
   const RunOptions     *opt = user->opt;
   const ContactOptions *copt;
+  const char           *what = opt->load_path.n ? "-load_steps and -load_path" : "-obstacle_force";
 
   PetscFunctionBeginUser;
-  if (!opt->load_path.n) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!opt->load_path.n && !(user->scene.obstacle.force > 0.0)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactGetOptions(user->contact, &copt));
-  PetscCall(SceneCheckLoadPath(comm, &user->scene));
+  PetscCall(SceneCheckLoadPath(comm, &user->scene, what));
   PetscCheck(!ContactHasBounds(user->contact), comm, PETSC_ERR_USER_INPUT,
-             "-load_steps and -load_path work with -contact_method penalty or none: SNESVI's bounds do not follow the load yet");
-  PetscCheck(!opt->bars, comm, PETSC_ERR_USER_INPUT, "-bars measures one load state: give it without -load_steps or -load_path");
-  PetscCheck(copt->n_sweep <= 1, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep and a load path both solve a sequence: give one of them");
-  PetscCheck(!opt->verify.reference[0], comm, PETSC_ERR_USER_INPUT, "-reference compares one load state: give it without -load_steps or -load_path");
-  PetscCall(SceneSetLoadFactor(&user->scene, opt->load_path.factor[0]));
+             "%s work with -contact_method penalty or none: SNESVI's bounds do not follow the load yet", what);
+  PetscCheck(ContactHasPenalty(user->contact) || !(user->scene.obstacle.force > 0.0), comm, PETSC_ERR_USER_INPUT,
+             "-obstacle_force needs a contact to press on: -contact_method penalty");
+  PetscCheck(!opt->bars, comm, PETSC_ERR_USER_INPUT, "-bars measures one load state: give it without %s", what);
+  PetscCheck(copt->n_sweep <= 1, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep and %s both solve a sequence: give one of them", what);
+  PetscCheck(!opt->verify.reference[0], comm, PETSC_ERR_USER_INPUT, "-reference compares one load state: give it without %s", what);
+  PetscCall(SceneSetLoadFactor(&user->scene, opt->load_path.n ? opt->load_path.factor[0] : 1.0)); /* keeps the data at the factor 1 */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The problem on the current mesh at the load factor t: K stays, the data follow. */
-static PetscErrorCode ProblemSetLoadFactor(DM dm, AppCtx *user, PetscReal t)
+/* The problem on the current mesh at the scene's current data: K stays, the Dirichlet values, the kernels' constants,
+   the contact set's gaps, the load r0 and the scales follow. */
+static PetscErrorCode ProblemUpdateData(DM dm, AppCtx *user)
 {
   PetscReal eps;
 
   PetscFunctionBeginUser;
-  PetscCall(SceneSetLoadFactor(&user->scene, t));
   PetscCall(VecZeroEntries(user->prob.loc_bc));
   PetscCall(BoundaryInsertDirichlet(dm, user, user->prob.loc_bc));
   PetscCall(ElasticityUpdateConstants(dm, user)); /* the obstacle, the body force, the scene's loads; 1/eps is reset below */
@@ -78,12 +82,92 @@ static PetscErrorCode ProblemSetLoadFactor(DM dm, AppCtx *user, PetscReal t)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The step just solved at factor t: its quantities (PostprocessContact()), its solve's record and its state at the
-   vertices (OutputStateFields(): the output's time series). */
-static PetscErrorCode LoadPathRecordStep(DM dm, AppCtx *user, Vec u, PetscReal t)
+/* The obstacle's force on the body along the unit direction of its translation (positive as it presses), of the
+   solution PostprocessContact() last measured, and its position s along that direction. */
+static void ForceAlong(const AppCtx *user, PetscReal *force, PetscReal *s)
 {
-  StepRecord        *s;
-  const SolveRecord *r = &user->rec.records[user->rec.nrecords - 1];
+  PetscReal len = 0.0, f = 0.0, x = 0.0;
+
+  for (PetscInt c = 0; c < 3; ++c) len += PetscSqr(user->scene.full_load.translate[c]);
+  len = PetscSqrtReal(len);
+  for (PetscInt c = 0; c < 3; ++c) {
+    f += user->rec.stats.contact_force_vector[c] * user->scene.full_load.translate[c] / len;
+    x += user->scene.obstacle.translate[c] * user->scene.full_load.translate[c] / len;
+  }
+  *force = f;
+  *s     = x;
+}
+
+#define FORCE_CONTROL_RTOL 1e-8 /* |F - target| / target at which the position is found */
+#define FORCE_CONTROL_MAX_ITS 60
+
+/* Force control (-obstacle_force F): the obstacle's position s along its direction such that its force equals the
+   target, from the solution at the position it has (the translation's length times the load factor on the first
+   call, the last step's position after). The force is a nondecreasing function of s (the energy is convex in the
+   obstacle's position; frictionless, linear), piecewise smooth as nodes enter the contact: the secant through the last
+   two positions, kept inside the bracket [s_lo, s_hi] of positions below and above the target once there is one
+   (Illinois' regula falsi halves the stale end's residual), a step that doubles the last move while the force stays
+   below the target and the secant has nothing to go on. Each position is a warm penalty solve. *ok is false when the
+   solve fails or the target is not reached in FORCE_CONTROL_MAX_ITS positions; *its counts the positions solved. */
+static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscReal target, PetscBool *ok, PetscInt *its)
+{
+  PetscReal f, s, f_prev = 0.0, s_prev = 0.0, s_lo = 0.0, f_lo = 0.0, s_hi = 0.0, f_hi = 0.0;
+  PetscBool have_lo = PETSC_FALSE, have_hi = PETSC_FALSE;
+  PetscInt  side = 0; /* the bracket's end kept last time (Illinois) */
+
+  PetscFunctionBeginUser;
+  *ok  = PETSC_FALSE;
+  *its = 0;
+  PetscCall(PostprocessContact(dm, user, u));
+  ForceAlong(user, &f, &s);
+  for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && user->rec.stats.converged; ++it) {
+    PetscReal s_next;
+
+    if (PetscAbsReal(f - target) <= FORCE_CONTROL_RTOL * target) {
+      *ok = PETSC_TRUE;
+      break;
+    }
+    if (it && f == f_prev && s != s_prev) { /* the solve did not move: the force is as exact as the Newton tolerance */
+      PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm),
+                            "  force control: stalled %g from the force %g (relative); the force is the residual of the solve, exact to about "
+                            "-snes_rtol times the load: lower -snes_rtol\n",
+                            (double)(PetscAbsReal(f - target) / target), (double)target));
+      break;
+    }
+    if (f < target && (!have_lo || s > s_lo)) {
+      if (side == -1) f_hi = target + 0.5 * (f_hi - target);
+      s_lo = s, f_lo = f, side = -1, have_lo = PETSC_TRUE;
+    } else if (f > target && (!have_hi || s < s_hi)) {
+      if (side == 1) f_lo = target + 0.5 * (f_lo - target);
+      s_hi = s, f_hi = f, side = 1, have_hi = PETSC_TRUE;
+    }
+    if (!have_lo || !have_hi) { /* no bracket yet: the secant, or a doubled move outward */
+      const PetscReal move = it ? s - s_prev : (s != 0.0 ? s : 1.0);
+
+      if (it && f != f_prev && (f - f_prev) / (s - s_prev) > 0.0)
+        s_next = s + (target - f) * (s - s_prev) / (f - f_prev);
+      else
+        s_next = s + (f < target ? 1.0 : -1.0) * PetscAbsReal(move);
+      if (f < target && s_next > s + 4.0 * PetscAbsReal(move) && it) s_next = s + 4.0 * PetscAbsReal(move);
+    } else
+      s_next = s_lo + (target - f_lo) * (s_hi - s_lo) / (f_hi - f_lo); /* regula falsi in the bracket */
+    s_prev = s, f_prev = f;
+    PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
+    PetscCall(ProblemUpdateData(dm, user));
+    PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
+    PetscCall(PostprocessContact(dm, user, u));
+    ForceAlong(user, &f, &s);
+    ++*its;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The step just solved at factor t: its quantities (PostprocessContact()), its solves' records from first_record on
+   (summed: force control solves several positions) and its state at the vertices (OutputStateFields(): the output's
+   time series). */
+static PetscErrorCode LoadPathRecordStep(DM dm, AppCtx *user, Vec u, PetscReal t, PetscInt first_record, PetscBool ok)
+{
+  StepRecord *s;
 
   PetscFunctionBeginUser;
   if (!user->rec.steps) {
@@ -98,10 +182,33 @@ static PetscErrorCode LoadPathRecordStep(DM dm, AppCtx *user, Vec u, PetscReal t
   s->factor        = t;
   s->contact_force = user->rec.stats.contact_force;
   for (PetscInt c = 0; c < 3; ++c) s->obstacle_translate[c] = user->scene.obstacle.translate[c];
-  s->newton_its = r->newton_its;
-  s->ksp_its    = r->ksp_its;
-  s->time       = r->time_solve;
-  s->converged  = r->converged;
+  s->newton_its = s->ksp_its = 0;
+  s->time                    = 0.0;
+  for (PetscInt i = first_record; i < user->rec.nrecords; ++i) {
+    s->newton_its += user->rec.records[i].newton_its;
+    s->ksp_its += user->rec.records[i].ksp_its;
+    s->time += user->rec.records[i].time_solve;
+  }
+  s->converged = (PetscBool)(user->rec.records[user->rec.nrecords - 1].converged && ok);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Force control at the current load (-obstacle_force): the obstacle moved until it presses with the scene's force
+   (the factor times -obstacle_force); a target not reached fails the solve, as a failed Newton solve does. */
+static PetscErrorCode LoadPathForce(DM dm, AppCtx *user, SNES snes, Vec u, PetscBool *ok)
+{
+  PetscInt its;
+
+  PetscFunctionBeginUser;
+  *ok = PETSC_TRUE;
+  if (!(user->scene.obstacle.force > 0.0) || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ForceControlSolve(dm, user, snes, u, user->scene.obstacle.force, ok, &its));
+  user->rec.stats.force_control_its += its;
+  if (!*ok && user->rec.stats.converged) {
+    PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm), "  force control: the force %g was not reached in %d positions of the obstacle\n",
+                          (double)user->scene.obstacle.force, FORCE_CONTROL_MAX_ITS));
+    user->rec.stats.converged = PETSC_FALSE;
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -110,16 +217,24 @@ static PetscErrorCode LoadPathRecordStep(DM dm, AppCtx *user, Vec u, PetscReal t
    (u_{k-1} - u_{k-2}), and for the second step the secant from u = 0 at t = 0 (a linear problem's u is proportional to
    t; the contact's active set makes it piecewise so). The guess is taken where it keeps the penalty's active points and
    lowers the residual at the new load, and else gives the first linear solve's initial guess (SolverExtrapolatedStart(),
-   as the eps sweep's). A failed step ends the path: the output is its state, with converged = 0, and /steps holds the
-   steps up to it. */
+   as the eps sweep's). Under force control each step starts at the last step's position and solution instead, and
+   moves the obstacle to the step's force. A failed step ends the path: the output is its state, with converged = 0, and
+   /steps holds the steps up to it. Without a path, force control at the run's one load. */
 PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 {
-  const LoadPathOptions *lp   = &user->opt->load_path;
+  const LoadPathOptions *lp    = &user->opt->load_path;
+  const PetscBool        force = (PetscBool)(user->scene.obstacle.force > 0.0);
   Vec                    prev = NULL, dir = NULL;
+  PetscInt               first = 0;
+  PetscBool              ok;
 
   PetscFunctionBeginUser;
-  if (!lp->n) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[0]));
+  if (!lp->n) {
+    PetscCall(LoadPathForce(dm, user, snes, u, &ok));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  PetscCall(LoadPathForce(dm, user, snes, u, &ok));
+  PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[0], first, ok));
   if (lp->n > 1) {
     PetscCall(VecDuplicate(u, &prev));
     PetscCall(VecDuplicate(u, &dir));
@@ -127,26 +242,40 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
   }
   for (PetscInt k = 1; k < lp->n && user->rec.stats.converged; ++k) {
     const PetscReal t_last = lp->factor[k - 1], t_prev = k > 1 ? lp->factor[k - 2] : 0.0;
+    PetscReal       f, s;
 
-    PetscCall(ProblemSetLoadFactor(dm, user, lp->factor[k]));
-    if (t_last != t_prev && ContactHasPenalty(user->contact)) {
+    first = user->rec.nrecords;
+    ForceAlong(user, &f, &s);
+    PetscCall(SceneSetLoadFactor(&user->scene, lp->factor[k]));
+    if (force) PetscCall(SceneSetObstaclePosition(&user->scene, s)); /* the last step's position */
+    PetscCall(ProblemUpdateData(dm, user));
+    if (!force && t_last != t_prev && ContactHasPenalty(user->contact)) {
       PetscCall(VecWAXPY(dir, -1.0, prev, u));
       PetscCall(VecCopy(u, prev));
       PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, (lp->factor[k] - t_last) / (t_last - t_prev), 0.0, PETSC_TRUE));
     } else
       PetscCall(VecCopy(u, prev));
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
-    PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[k]));
+    PetscCall(LoadPathForce(dm, user, snes, u, &ok));
+    PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[k], first, ok));
   }
   PetscCall(VecDestroy(&prev));
   PetscCall(VecDestroy(&dir));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The steps in the summary: one line each. */
+/* The steps in the summary, one line each, and where force control left the obstacle. */
 PetscErrorCode LoadPathView(MPI_Comm comm, const AppCtx *user)
 {
   PetscFunctionBeginUser;
+  if (user->scene.obstacle.force > 0.0) {
+    PetscReal f, s;
+
+    ForceAlong(user, &f, &s);
+    PetscCall(PetscPrintf(comm,
+                          "  force control: the obstacle %g along its direction presses with %.10g (target %g; %" PetscInt_FMT " positions solved)\n",
+                          (double)s, (double)f, (double)user->scene.obstacle.force, user->rec.stats.force_control_its));
+  }
   if (!user->rec.nsteps) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(
       PetscPrintf(comm, "  load path: step  factor      contact force  largest pressure  contact size  penetration  energy        Newton  Krylov\n"));

@@ -66,32 +66,3 @@ PetscErrorCode SolverStepGuessDrop(SolverCtx sc)
   PetscCall(VecDestroy(&sc->step_guess.du));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
-
-/* u <- u + factor dir if the penalty is active there at the same points as at u (the last solution) and the residual
-   at the current eps is lower, or, whatever the points, if that residual is below relaxed times the last one (the
-   tangent's guess, below; 0 for the secant's). A secant guess active elsewhere is not taken: a Gauss point it lifts off that the new eps keeps
-   in contact (near the edge of the contact zone) makes the line search cut every Newton step at that kink, and Newton
-   stalls. Such a guess that still lowers
-   the residual gives, with step_guess, the first linear solve's initial guess instead (step_guess.c): Newton starts
-   from u, with its active points, and CG from the step factor dir; dir is then scaled. */
-PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscReal factor, PetscReal relaxed, PetscBool step_guess)
-{
-  Vec       guess;
-  PetscReal f_last, f_guess;
-  PetscBool same;
-
-  PetscFunctionBeginUser;
-  PetscCall(VecDuplicate(u, &guess));
-  PetscCall(VecWAXPY(guess, factor, dir, u));
-  PetscCall(ContactSameActivity(user->contact, dm, u, guess, &same));
-  PetscCall(SolverResidualNorm(snes, user->prob.sctx, u, &f_last)); /* every start needs both: the tangent's and the secant's rules */
-  PetscCall(SolverResidualNorm(snes, user->prob.sctx, guess, &f_guess));
-  if ((same && f_guess < f_last) || f_guess < relaxed * f_last)
-    PetscCall(VecCopy(guess, u));
-  else if (step_guess && f_guess < f_last) {
-    PetscCall(VecScale(dir, factor));
-    PetscCall(SolverSetStepGuess(user->prob.sctx, dir));
-  }
-  PetscCall(VecDestroy(&guess));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
