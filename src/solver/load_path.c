@@ -105,10 +105,13 @@ static void ForceAlong(const AppCtx *user, PetscReal *force, PetscReal *s)
    target, from the solution at the position it has (the translation's length times the load factor on the first
    call, the last step's position after). The force is a nondecreasing function of s (the energy is convex in the
    obstacle's position; frictionless, linear), piecewise smooth as nodes enter the contact: the secant through the last
-   two positions, kept inside the bracket [s_lo, s_hi] of positions below and above the target once there is one
-   (Illinois' regula falsi halves the stale end's residual), a step that doubles the last move while the force stays
-   below the target and the secant has nothing to go on. Each position is a warm penalty solve. *ok is false when the
-   solve fails or the target is not reached in FORCE_CONTROL_MAX_ITS positions; *its counts the positions solved. */
+   two positions (the first through the origin, where the obstacle does not press yet), kept inside the bracket
+   [s_lo, s_hi] of positions below and above the target once there is one (Illinois' regula falsi halves the stale end's
+   residual), a step that doubles the last move while the force stays below the target and the secant has nothing to
+   go on. Each position is a warm penalty solve, and where that fails (a
+   semismooth Newton cycling between active sets, seen at eps = h/100 in 3D) a solve from zero as a direct run's (both
+   in /solves). *ok is false when the solve fails or the target is not reached in FORCE_CONTROL_MAX_ITS positions;
+   *its counts the positions solved. */
 static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscReal target, PetscBool *ok, PetscInt *its)
 {
   PetscReal f, s, f_prev = 0.0, s_prev = 0.0, s_lo = 0.0, f_lo = 0.0, s_hi = 0.0, f_hi = 0.0;
@@ -146,6 +149,8 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
 
       if (it && f != f_prev && (f - f_prev) / (s - s_prev) > 0.0)
         s_next = s + (target - f) * (s - s_prev) / (f - f_prev);
+      else if (!it && f > 0.0 && s > 0.0)
+        s_next = s * target / f; /* the secant through (0, 0): no force before the contact */
       else
         s_next = s + (f < target ? 1.0 : -1.0) * PetscAbsReal(move);
       if (f < target && s_next > s + 4.0 * PetscAbsReal(move) && it) s_next = s + 4.0 * PetscAbsReal(move);
@@ -155,6 +160,8 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
     PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
     PetscCall(ProblemUpdateData(dm, user));
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
+    if (!user->rec.stats.converged) /* Newton from the last position's solution can cycle between active sets: from zero, as a direct run */
+      PetscCall(SolverSolve(snes, user, u, SOLVER_START_ZERO));
     PetscCall(PostprocessContact(dm, user, u));
     ForceAlong(user, &f, &s);
     ++*its;
