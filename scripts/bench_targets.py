@@ -294,6 +294,28 @@ def measure_estimate(out, s, pairs):
                 b[0] / e[0] <= 1.25, cmd)]
 
 
+def measure_load_path(out, s, pairs):
+    """A 10-step load path (issue 32) against one solve at the final load, side by side: the default square at 512 x 512
+    with GAMG, and the 3D sphere indenter of make hertz (h_near 0.02, eps = h/100): at most 3 single solves each."""
+    from signorini import hertz
+    n = 512 // s
+    box = ["-dm_plex_box_faces", f"{n},{n}"]
+    r = side_by_side({"path_square": (box + ["-load_steps", "10"], 1), "single_square": (box, 1)}, pairs, out)
+    mesh = os.path.join(out, "sphere_indenter_h0.02.msh")
+    if not os.path.isfile(mesh):
+        hertz.write_mesh("sphere-indenter", 0.02, mesh)
+    sphere = hertz.command("sphere-indenter", mesh, "eps=h/100", "unused.h5")[4:-2]  # the options, without mpiexec, the binary and -output
+    r3 = side_by_side({"path_sphere": (["-load_steps", "10"], 1, sphere), "single_sphere": ([], 1, sphere)}, pairs, out)
+    rows = []
+    for (p, o), what, cmd in (((r["path_square"], r["single_square"]), f"the default square, {n} x {n}, GAMG",
+                               f"bin/signorini {' '.join(BASE)} -dm_plex_box_faces {n},{n} [-load_steps 10]"),
+                              ((r3["path_sphere"], r3["single_sphere"]), "the 3D sphere indenter (h_near 0.02, eps = h/100)",
+                               "bin/signorini (make hertz's sphere-indenter options, eps=h/100) [-load_steps 10]")):
+        rows.append(row(f"a 10-step load path <= 3 single solves at the final load: {what}", f"{p[0] / o[0]:.2f} ({p[0]:.2f} s / {o[0]:.2f} s; {pair_range(p, o)})",
+                        p[0] / o[0] <= 3.0, cmd))
+    return rows
+
+
 def measure_getfem(out, s, pairs):
     """The ratio of bench/getfem.csv (scripts/bench_getfem.py)."""
     gcsv = os.path.join(os.path.dirname(os.path.dirname(out)), "getfem.csv")
@@ -306,7 +328,7 @@ def measure_getfem(out, s, pairs):
 
 
 SECTIONS = {"default": measure_default, "mg": measure_mg, "iterations": measure_iterations, "eps": measure_eps, "parallel": measure_parallel, "getfem": measure_getfem,
-            "estimate": measure_estimate}
+            "estimate": measure_estimate, "load_path": measure_load_path}
 
 
 def rows_of_table(path):
