@@ -16,11 +16,12 @@ PetscErrorCode ElasticityP1CellVertices(MeshClosure *mc, PetscSection csec, Pets
 PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Vec locU, Vec locF);
 
 /* weak_data.c: the load of a scene with an exact solution, L(v) = a(u_exact, v) - int_Gamma_C sigma_n(u_exact) v_n */
-PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0);
+PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0, PetscReal *lift);
 PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal *sn);
 
 /* postprocess.c */
 PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u);
+PetscErrorCode PostprocessLiftEnergy(DM dm, const AppCtx *user, PetscReal weak_lift, PetscReal *energy);
 PetscErrorCode PostprocessPenetration(AppCtx *user);
 void           PostprocessGetQuantities(const AppCtx *user, Quantities *q);
 /* contact_zone.c */

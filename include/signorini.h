@@ -96,7 +96,6 @@ typedef struct {
   PetscInt       num_constants; /* scene constants, stored from constants[CONST_SCENE] on */
   PetscScalar    constants[CONST_SCENE_MAX - CONST_SCENE];
   PetscBool      load_constant[CONST_SCENE_MAX - CONST_SCENE]; /* the scene's constants that are loads (a body force's size) */
-  PetscReal      load_factor;                                  /* the factor of every prescribed datum (SceneSetLoadFactor()) */
   struct {                                                     /* the prescribed data at the factor 1, kept by SceneSetLoadFactor() */
     PetscBool   kept;
     PetscReal   value[BOUNDARY_MAX][3], body_force[3], translate[3], force;
@@ -388,7 +387,7 @@ typedef struct {
   Mat          K;                  /* bulk elastic operator, assembled once */
   Vec          r0;                 /* bulk residual at u = 0 (loads and Dirichlet lifting) */
   Vec          loc_r0;             /* the same, local, with the rows of the fixed components (for the supports' reactions) */
-  PetscReal    weak_load_lift;     /* a scene's load in weak form (weak_data.c) on the Dirichlet lift, L(u_D), for the energy */
+  PetscReal    lift_energy;        /* J(u_D) = 1/2 a(u_D, u_D) - L(u_D) of the Dirichlet lift, part of the energy (postprocess.c) */
   PetscReal    load_norm;          /* ||F(0)||_2, the size of the load (loads, Dirichlet lifting, initial penetration) */
   PetscReal    displacement_scale; /* U, a power of 2: the SNES solves for u/U with the residual F/U (unit-free tolerances) */
   SolverCtx    sctx;               /* the SNES's callbacks' context and the solver's own state (src/solver/solver_impl.h) */

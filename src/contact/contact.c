@@ -287,7 +287,7 @@ PetscErrorCode ContactSetUp(Contact ct, DM dm, const ContactProblem *pb)
 /* A new load state on the same mesh (a step of a load path): the obstacle at its new translation, and the Dirichlet
    values that loc_bc (referenced at ContactSetUp()) now holds. The contact set's gaps, normals and fixed values follow;
    the Gauss rule's kernels read the obstacle from constants[], which ElasticityUpdateConstants() rewrote. The bounds of
-   SNESVI would have to follow too: it is refused with a load path (LoadPathCheck()). */
+   SNESVI would have to follow too: it is refused with a load path (LoadPathSetUp()). */
 PetscErrorCode ContactSetLoad(Contact ct, DM dm, const Obstacle *obstacle)
 {
   PetscFunctionBeginUser;

@@ -65,7 +65,7 @@ PetscErrorCode ContactSetBuild(Contact ct, DM dm, Vec like)
   PetscSection       lsec, gsec;
   PetscInt           dim, npts = 0, *pts = NULL, rstart;
   Vec                M;
-  const PetscScalar *m, *bcv, *hn;
+  const PetscScalar *m, *hn;
   Vec                H;
   PetscReal          face_range[2] = {PETSC_MAX_REAL, PETSC_MAX_REAL}; /* min and -max of the eps factors of the contact faces */
 
@@ -159,7 +159,6 @@ PetscErrorCode ContactSetBuild(Contact ct, DM dm, Vec like)
   PetscCall(VecGetOwnershipRange(M, &rstart, NULL));
   PetscCall(VecGetArrayRead(M, &m));
   PetscCall(VecGetArrayRead(H, &hn));
-  PetscCall(VecGetArrayRead(ct->loc_bc, &bcv));
   PetscCall(PetscMalloc4(npts, &cs->point, npts, &cs->global_off, npts * dim, &cs->dof, npts, &cs->is_vertex));
   PetscCall(PetscMalloc3(npts * dim, &cs->fixed, npts * dim, &cs->normal, npts, &cs->eps_factor));
   PetscCall(PetscMalloc4(npts, &cs->gap, npts, &cs->weight, npts, &cs->active, npts, &cs->pressure));
@@ -167,8 +166,7 @@ PetscErrorCode ContactSetBuild(Contact ct, DM dm, Vec like)
   for (PetscInt i = 0; i < npts; ++i) {
     const PetscInt  p    = pts[i];
     const PetscInt *cind = NULL;
-    PetscInt        dof, cdof, gdof, goff, loff, depth, k = 0;
-    PetscReal       x[3] = {0.0, 0.0, 0.0};
+    PetscInt        dof, cdof, gdof, goff, depth, k = 0;
 
     PetscCall(PetscSectionGetDof(lsec, p, &dof));
     PetscCall(PetscSectionGetConstraintDof(lsec, p, &cdof));
@@ -179,20 +177,15 @@ PetscErrorCode ContactSetBuild(Contact ct, DM dm, Vec like)
     if (gdof - cdof <= 0) continue; /* every component fixed, or owned by another rank */
     if (cdof) PetscCall(PetscSectionGetConstraintIndices(lsec, p, &cind));
     PetscCall(PetscSectionGetOffset(gsec, p, &goff));
-    PetscCall(PetscSectionGetOffset(lsec, p, &loff));
     PetscCall(DMPlexGetPointDepth(dm, p, &depth));
-    PetscCall(MeshPointPosition(dm, p, x));
     for (PetscInt c = 0; c < dim; ++c) { /* the free components are numbered in order, after the fixed ones are skipped */
       if (k < cdof && cind[k] == c) {
-        cs->dof[cs->n * dim + c]   = -1;
-        cs->fixed[cs->n * dim + c] = PetscRealPart(bcv[loff + c]);
+        cs->dof[cs->n * dim + c] = -1;
         ++k;
-      } else {
-        cs->dof[cs->n * dim + c]   = goff - rstart + c - k;
-        cs->fixed[cs->n * dim + c] = 0.0;
-      }
+      } else
+        cs->dof[cs->n * dim + c] = goff - rstart + c - k;
+      cs->fixed[cs->n * dim + c] = 0.0; /* a fixed component's value: ContactSetUpdateData(), below */
     }
-    ObstacleGapNormal(dim, ct->obstacle_packed, x, &cs->normal[cs->n * dim], &cs->gap[cs->n]);
     cs->point[cs->n]      = p;
     cs->global_off[cs->n] = goff - rstart;
     cs->is_vertex[cs->n]  = (PetscBool)(depth == 0);
@@ -202,8 +195,8 @@ PetscErrorCode ContactSetBuild(Contact ct, DM dm, Vec like)
     cs->pressure[cs->n]   = 0.0;
     cs->n++;
   }
-  PetscCall(VecRestoreArrayRead(ct->loc_bc, &bcv));
   PetscCall(VecRestoreArrayRead(H, &hn));
+  PetscCall(ContactSetUpdateData(ct, dm)); /* the fixed components' values, the gaps and the normals */
   PetscCall(VecDestroy(&H));
   {
     PetscReal range[2] = {PETSC_MAX_REAL, PETSC_MAX_REAL}, grange[2];

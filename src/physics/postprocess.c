@@ -3,12 +3,12 @@
 
 /* The potential energy of the Dirichlet lift u_D (loc_bc: the Dirichlet values, zero on the free unknowns),
      J(u_D) = 1/2 a(u_D, u_D) - L(u_D) = u_D . r0_loc - 1/2 u_D . A u_D,
-   since r0_loc = A u_D - b holds every row (the fixed ones too) of the residual at u_D (SolverAssembleBulk() and the
-   surface loads of BoundaryAddLoads()); a scene's load in weak form is not in r0_loc, and WeakDataAddToResidual() gives
-   its L(u_D). Both vectors hold this rank's cells only, so that the local dot products add up over the ranks to the sums
-   over the cells. A u_D: the closed-form stiffness of the P1 simplices at Gamma_D, or PetscFE's residual at u_D less its
-   residual at 0. Zero when the Dirichlet data are. */
-static PetscErrorCode PostprocessLiftEnergy(DM dm, AppCtx *user, PetscReal *energy)
+   since r0_loc = A u_D - b holds every row (the fixed ones too) of the residual at u_D (SolverAssembleLoad(): the bulk
+   and the surface loads of BoundaryAddLoads()); a scene's load in weak form is not in r0_loc, and WeakDataAddToResidual()
+   gives its L(u_D), weak_lift. Computed once per load state, by SolverAssembleLoad(). Both vectors hold this rank's cells only, so that the local dot
+   products add up over the ranks to the sums over the cells. A u_D: the closed-form stiffness of the P1 simplices at Gamma_D, or PetscFE's residual
+   at u_D less its residual at 0. Zero when the Dirichlet data are. */
+PetscErrorCode PostprocessLiftEnergy(DM dm, const AppCtx *user, PetscReal weak_lift, PetscReal *energy)
 {
   Vec         locA, locZ, locR;
   PetscReal   ud_max, local[2], global[2];
@@ -28,8 +28,8 @@ static PetscErrorCode PostprocessLiftEnergy(DM dm, AppCtx *user, PetscReal *ener
     PetscCall(DMGetLocalVector(dm, &locR));
     PetscCall(VecZeroEntries(locZ));
     PetscCall(VecZeroEntries(locR));
-    PetscCall(DMPlexSNESComputeResidualFEM(dm, user->prob.loc_bc, locA, user));
-    PetscCall(DMPlexSNESComputeResidualFEM(dm, locZ, locR, user));
+    PetscCall(DMPlexSNESComputeResidualFEM(dm, user->prob.loc_bc, locA, (void *)user));
+    PetscCall(DMPlexSNESComputeResidualFEM(dm, locZ, locR, (void *)user));
     PetscCall(VecAXPY(locA, -1.0, locR));
     PetscCall(DMRestoreLocalVector(dm, &locZ));
     PetscCall(DMRestoreLocalVector(dm, &locR));
@@ -40,7 +40,7 @@ static PetscErrorCode PostprocessLiftEnergy(DM dm, AppCtx *user, PetscReal *ener
   local[1] = PetscRealPart(dot);
   PetscCall(DMRestoreLocalVector(dm, &locA));
   PetscCall(MPIU_Allreduce(local, global, 2, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
-  *energy = global[0] - 0.5 * global[1] - user->prob.weak_load_lift;
+  *energy = global[0] - 0.5 * global[1] - weak_lift;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -55,7 +55,6 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   ContactResult res;
   Vec           R;
   PetscScalar   uKu, r0u;
-  PetscReal     lift;
 
   PetscFunctionBeginUser;
   PetscCall(VecDuplicate(u, &R));
@@ -70,8 +69,7 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   st->max_penetration = res.max_penetration;
   st->contact_force   = res.force;
   st->active_vertices = res.active_vertices;
-  PetscCall(PostprocessLiftEnergy(dm, user, &lift));
-  st->energy = 0.5 * PetscRealPart(uKu) + PetscRealPart(r0u) + lift + res.energy;
+  st->energy          = 0.5 * PetscRealPart(uKu) + PetscRealPart(r0u) + user->prob.lift_energy + res.energy;
   {
     const ContactSet *cs;
     PetscReal         pmax = 0.0;

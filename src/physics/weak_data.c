@@ -23,10 +23,10 @@ PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* r0 -= L: r0 holds the bulk residual at u = 0 (the Dirichlet lifting) on entry. L(u_D) of the Dirichlet lift goes to
-   prob.weak_load_lift, for the energy (postprocess.c); loc_r0 does not take L: the supports' reactions stay the stress
-   a(u_h, phi) on Gamma_D that holds the body, which L on the fixed rows (a(u_exact, phi) there) would cancel. */
-PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0)
+/* r0 -= L: r0 holds the bulk residual at u = 0 (the Dirichlet lifting) on entry. *lift = L(u_D) of the Dirichlet lift,
+   for the energy (PostprocessLiftEnergy()), 0 without weak data; loc_r0 does not take L: the supports' reactions stay the
+   stress a(u_h, phi) on Gamma_D that holds the body, which L on the fixed rows (a(u_exact, phi) there) would cancel. */
+PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0, PetscReal *lift)
 {
   CellQuadrature cq;
   Vec            locL;
@@ -34,6 +34,7 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0)
   PetscScalar   *elem;
 
   PetscFunctionBeginUser;
+  *lift = 0.0;
   if (!user->scene.weak_data) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCheck(user->scene.exact && user->scene.exact_gradient, PetscObjectComm((PetscObject)dm), PETSC_ERR_PLIB,
              "Scene %s asks for weak data but has no exact solution and gradient", user->scene.name);
@@ -85,11 +86,11 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0)
     PetscCall(PetscFree(faces));
   }
   {
-    PetscScalar lift;
+    PetscScalar dot;
 
-    PetscCall(VecDot(locL, user->prob.loc_bc, &lift)); /* this rank's cells only: the sum over the ranks is L(u_D) */
-    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &lift, 1, MPIU_SCALAR, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
-    user->prob.weak_load_lift = PetscRealPart(lift);
+    PetscCall(VecDot(locL, user->prob.loc_bc, &dot)); /* this rank's cells only: the sum over the ranks is L(u_D) */
+    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &dot, 1, MPIU_SCALAR, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
+    *lift = PetscRealPart(dot);
   }
   /* r0 -= L */
   PetscCall(VecScale(locL, -1.0));

@@ -48,17 +48,17 @@ PetscErrorCode SceneSetLoadFactor(Scene *scene, PetscReal t)
   }
   for (PetscInt k = 0; k < nc; ++k) scene->constants[k] = scene->load_constant[k] ? t * scene->full_load.constants[k] : scene->full_load.constants[k];
   scene->obstacle.force = t * scene->full_load.force;
-  scene->load_factor    = t;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The obstacle at the translation s times the unit direction of its full translation (force control, load_path.c). */
+/* The obstacle at the translation s times the unit direction of its full translation (force control, load_path.c;
+   after SceneSetLoadFactor(), which keeps it). */
 PetscErrorCode SceneSetObstaclePosition(Scene *scene, PetscReal s)
 {
   PetscReal len = 0.0;
 
   PetscFunctionBeginUser;
-  if (!scene->full_load.kept) PetscCall(SceneSetLoadFactor(scene, 1.0));
+  PetscCheck(scene->full_load.kept, PETSC_COMM_SELF, PETSC_ERR_ORDER, "SceneSetObstaclePosition() needs SceneSetLoadFactor() first");
   for (PetscInt c = 0; c < 3; ++c) len += PetscSqr(scene->full_load.translate[c]);
   len = PetscSqrtReal(len);
   PetscCheck(len > 0.0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the obstacle has no direction to move in");

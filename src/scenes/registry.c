@@ -42,7 +42,6 @@ PetscErrorCode SceneCreate(const char name[], DM dm, const Material *mat, Scene 
              "Unknown scene '%s' (-scene); run with -help to list the registered scenes", name);
   PetscCall(PetscMemzero(scene, sizeof(*scene)));
   PetscCall(PetscStrncpy(scene->name, name, sizeof(scene->name)));
-  scene->load_factor = 1.0;
   PetscCall((*create)(dm, mat, scene)); /* the scene's own options and its defaults of the ones below */
   PetscCall(SceneBoundaryGetOptions(dm, scene));
   PetscCall(SceneObstacleGetOptions(dm, scene));

@@ -236,11 +236,8 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
   PetscBool              ok;
 
   PetscFunctionBeginUser;
-  if (!lp->n) {
-    PetscCall(LoadPathForce(dm, user, snes, u, &ok));
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-  PetscCall(LoadPathForce(dm, user, snes, u, &ok));
+  PetscCall(LoadPathForce(dm, user, snes, u, &ok)); /* the first step's force, or the run's one force without a path */
+  if (!lp->n) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[0], first, ok));
   if (lp->n > 1) {
     PetscCall(VecDuplicate(u, &prev));

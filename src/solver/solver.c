@@ -33,11 +33,13 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
 }
 
 /* r0 = F_bulk(u_D) - f, the residual at u = 0 with the Dirichlet values of loc_bc (the lifting K u_D and the body
-   force), the surface loads and a scene's load in weak form, and its local copy loc_r0 with the fixed rows. Assembled
-   by ProblemSetUp() and again at each step of a load path (the data changed, K did not). */
+   force), the surface loads and a scene's load in weak form, and its local copy loc_r0 with the fixed rows; and the
+   energy of the Dirichlet lift, which these data fix. Assembled by ProblemSetUp() and again at each step of a load path
+   (the data changed, K did not). */
 PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user)
 {
-  Vec locX, locF;
+  Vec       locX, locF;
+  PetscReal weak_lift;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetLocalVector(dm, &locX));
@@ -55,8 +57,8 @@ PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user)
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscCall(DMRestoreLocalVector(dm, &locF));
   PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
-  user->prob.weak_load_lift = 0.0; /* set by a scene's load in weak form */
-  PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0));
+  PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0, &weak_lift));
+  PetscCall(PostprocessLiftEnergy(dm, user, weak_lift, &user->prob.lift_energy)); /* a datum of the load state, not of u */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
