@@ -244,13 +244,15 @@ typedef struct {
 } Bandwidth;
 
 /* Checks of the contact set-up and of the contact zone's resolution (src/physics/contact_checks.c): warnings only. */
-#define CONTACT_CHECK_OVERLAP_CELLS 1.0 /* an initial overlap deeper than this many cells is warned of */
+#define CONTACT_CHECK_OVERLAP_CELLS 1.0 /* an initial overlap deeper than this many cells */
+#define CONTACT_CHECK_OVERLAP_RATIO 0.1 /*   and than this part of the overlapped part's width is warned of */
 #define CONTACT_CHECK_ZONE_CELLS_2D 4.0 /* a contact zone spanning fewer cells is warned of (bench/zone_resolution.md) */
 #define CONTACT_CHECK_ZONE_CELLS_3D 6.0 /*   in 3D (bench/zone_resolution_3d.md) */
 typedef struct {
   PetscBool geometry_checked, resolution_checked;
   PetscReal overlap_cells;    /* largest initial overlap -g/h at Gamma_C's vertices, h the diameter of the face's cell */
   PetscReal overlap_fraction; /* part of Gamma_C's area whose faces start inside the obstacle (g < 0 at the centroid) */
+  PetscReal overlap_ratio;    /* largest initial overlap -g over the width of that part: its length in 2D, 2 sqrt(area / pi) in 3D */
   PetscReal away_fraction;    /* part of Gamma_C's area where the obstacle's normal points into the body */
   PetscInt  zone_faces;       /* faces of Gamma_C whose every node carries contact force */
   PetscReal zone_cells;       /* cells across the contact zone: zone_faces in 2D, sqrt(2 zone_faces / pi) in 3D */

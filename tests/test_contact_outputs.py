@@ -97,6 +97,25 @@ def test_under_resolved_contact_zone_is_warned_in_3d():
     assert a["contact_zone_cells"] < 6 and a["warnings"] == 1 and "fewer than 6" in out
 
 
+def test_indentation_by_overlap_is_not_warned_however_fine_the_mesh(tmp_path):
+    """A rigid cylinder prescribed 0.001 into the block of make hertz (2D), on a mesh graded down to 5e-5 at the axis:
+    Gamma_C starts many cells deep there, but over a part whose half-length is sqrt(2 R d) (the half model), so the
+    depth is sqrt(d / 2R) = 0.022 of that width, far below the warning's 0.1: no warning, the ratio within 10% of
+    sqrt(d / 2R) (the overlapped length is measured by faces, to a cell at its end). Warned before by the depth in cells
+    alone."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    from signorini import hertz
+    mesh = str(tmp_path / "graded_block.msh")
+    hertz.write_mesh("cylinder-indenter", 5e-5, mesh, grade=0.05, near=0.06)
+    out, h5 = run(["-dm_plex_filename", mesh] + hertz.CASES["cylinder-indenter"]["args"] + ["-penalty_eps0", 0.1], "overlap_indentation")
+    a, _ = load(h5)
+    depth = 0.001
+    assert a["initial_overlap_cells"] > 5, a["initial_overlap_cells"]
+    assert abs(a["initial_overlap_ratio"] / (depth / 2) ** 0.5 - 1) < 0.1, a["initial_overlap_ratio"]
+    assert "cells deep inside the obstacle" not in out and a["warnings"] == 0, out
+
+
 def test_obstacle_facing_away_and_deep_overlap_are_warned():
     """A plane whose normal points into the body (the foundation given upside down), and an obstacle placed half the body
     deep: each warned in the summary and counted in /run; the default square is not."""
@@ -107,6 +126,7 @@ def test_obstacle_facing_away_and_deep_overlap_are_warned():
     out, h5 = run(base + ["-obstacle_point", "0,0.5"], "warn_overlap")
     a, _ = load(h5)
     assert abs(a["initial_overlap_cells"] - 0.5 / (2 ** 0.5 / 16)) < 1e-9 and a["initial_overlap_fraction"] == 1.0
+    assert abs(a["initial_overlap_ratio"] - 0.5) < 1e-12  # 0.5 deep over the whole contact side, of length 1
     assert a["warnings"] >= 1 and "cells deep inside the obstacle" in out
     out, h5 = run(["-dm_plex_box_faces", "16,16"], "warn_none")
     a, _ = load(h5)

@@ -403,6 +403,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     if (s->checks.geometry_checked) {
       PetscCall(WriteRealAttr(v, "initial_overlap_cells", s->checks.overlap_cells));
       PetscCall(WriteRealAttr(v, "initial_overlap_fraction", s->checks.overlap_fraction));
+      PetscCall(WriteRealAttr(v, "initial_overlap_ratio", s->checks.overlap_ratio));
       PetscCall(WriteRealAttr(v, "obstacle_away_fraction", s->checks.away_fraction));
     }
     if (s->checks.resolution_checked) {

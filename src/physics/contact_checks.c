@@ -39,7 +39,7 @@ PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
   MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
   ContactChecks *ck   = &user->rec.stats.checks;
   PetscInt       dim, vStart, vEnd;
-  PetscReal      sums[3] = {0.0, 0.0, 0.0}, overlap = 0.0; /* area, area facing away, area overlapping */
+  PetscReal      sums[3] = {0.0, 0.0, 0.0}, overlap[2] = {0.0, 0.0}; /* area, area facing away, area overlapping; -g/h and -g */
 
   PetscFunctionBeginUser;
   if (ContactIsNone(user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
@@ -69,16 +69,28 @@ PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
         if (closure[2 * j] < vStart || closure[2 * j] >= vEnd) continue;
         PetscCall(MeshPointPosition(dm, closure[2 * j], x));
         ObstacleGapNormalAt(&user->scene.obstacle, dim, x, nv, &g);
-        overlap = PetscMax(overlap, -g / diam);
+        overlap[0] = PetscMax(overlap[0], -g / diam);
+        overlap[1] = PetscMax(overlap[1], -g);
       }
       PetscCall(DMPlexRestoreTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
     }
     PetscCall(PetscFree(faces));
   }
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, sums, 3, MPIU_REAL, MPIU_SUM, comm));
-  PetscCall(MPIU_Allreduce(&overlap, &ck->overlap_cells, 1, MPIU_REAL, MPIU_MAX, comm));
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, overlap, 2, MPIU_REAL, MPIU_MAX, comm));
+  ck->overlap_cells    = overlap[0];
   ck->away_fraction    = sums[0] > 0.0 ? sums[1] / sums[0] : 0.0;
   ck->overlap_fraction = sums[0] > 0.0 ? sums[2] / sums[0] : 0.0;
+  {
+    /* The overlap against the width of the part that overlaps: an indentation prescribed by overlap (a sphere pressed d
+       into a body meets it on a disk of radius about sqrt(2 R d), so d is a few percent of that width at the small
+       strains of linear elasticity) is no misplaced obstacle, however fine the mesh makes d in cells; an obstacle put
+       half the body deep is (0.5 of the width). The width of a half or quarter of a round part, as a symmetric model
+       meshes it, is half the whole's: the ratio errs toward a warning. */
+    const PetscReal width = dim == 2 ? sums[2] : 2.0 * PetscSqrtReal(sums[2] / PETSC_PI);
+
+    ck->overlap_ratio = width > 0.0 ? overlap[1] / width : 0.0;
+  }
   ck->geometry_checked = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -155,13 +167,13 @@ PetscErrorCode ContactChecksWarnings(MPI_Comm comm, const ContactChecks *ck, Pet
   PetscInt n = 0;
 
   PetscFunctionBeginUser;
-  if (ck->geometry_checked && ck->overlap_cells > CONTACT_CHECK_OVERLAP_CELLS) {
+  if (ck->geometry_checked && ck->overlap_cells > CONTACT_CHECK_OVERLAP_CELLS && ck->overlap_ratio > CONTACT_CHECK_OVERLAP_RATIO) {
     ++n;
     if (print)
       PetscCall(PetscPrintf(comm,
-                            "  WARNING: Gamma_C starts %.3g cells deep inside the obstacle (on %.0f%% of its area): a misplaced obstacle? (check "
-                            "-obstacle_point, -obstacle_center, -obstacle_translate)\n",
-                            (double)ck->overlap_cells, (double)(100.0 * ck->overlap_fraction)));
+                            "  WARNING: Gamma_C starts %.3g cells deep inside the obstacle (on %.0f%% of its area, %.2g times the width of that "
+                            "part): a misplaced obstacle? (check -obstacle_point, -obstacle_center, -obstacle_translate)\n",
+                            (double)ck->overlap_cells, (double)(100.0 * ck->overlap_fraction), (double)ck->overlap_ratio));
   }
   if (ck->geometry_checked && ck->away_fraction > 0.5) {
     ++n;
