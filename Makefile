@@ -95,10 +95,12 @@ tradeoff: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/tradeoff.py options/studies/tradeoff.yaml
 
-# Hertz contact against the closed form, 2D and 3D (docs/verification.md, "Hertz contact against the closed form"): output/hertz/hertz.{md,csv}, hertz_<case>.png
+# Hertz contact against the closed form, 2D and 3D (docs/verification.md, "Hertz contact against the closed form"): output/hertz/hertz.{md,csv}, hertz_<case>.png;
+# then the indenters along a load path, with the force-depth curve against the closed form (hertz-path, below)
 hertz: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/hertz.py --check 0.01
+	$(PYTHON) scripts/hertz_path.py --check 0.01
 
 # Hertz along a load path (docs/hertz.md): the two indenters in 10 steps, a and p0 at every step against the closed form
 # at its force, the sphere's force-depth exponent: output/hertz_path/hertz_path.{md,csv,png}

@@ -8,8 +8,9 @@
   make_mesh.py block          -o FILE.msh [--radius R] ...   (2D: [0,R] x [-R,0], indented at the origin from above)
   make_mesh.py quarter-block  -o FILE.msh [--radius R] ...   (3D: [0,R]^2 x [-R,0])
 
-The mesh size is h_near up to the distance --near from the origin (default 0), then grows linearly to h_far over the
-distance W (default R/2).
+The mesh size is h_near at the origin and h_near + G r up to the distance --near from it (--grade G, default 0: the
+size is h_near there), then grows linearly to h_far over the distance W (default R/2). A grade keeps the cells across
+a contact zone that grows, as along a load path, about as many at every size of it (docs/hertz.md).
 Physical groups ("Face Sets" values, and names): half-disk contact 1, top 3; quarter-disk contact 1, top 3,
 symmetry_x 4; quarter-sphere contact 1, top 2, symmetry_y 3, symmetry_x 6; block contact 1, bottom 2, symmetry_x 4,
 side 5; quarter-block contact 1, bottom 2, symmetry_y 3, side 5, symmetry_x 6; the body 10. The built-in scenes
@@ -33,12 +34,13 @@ def main(argv=None):
     parser.add_argument("--h-far", type=float, help="mesh size far from the contact point")
     parser.add_argument("--h-near", type=float, help="mesh size at the contact point")
     parser.add_argument("--width", type=float, help="distance over which the size grows from h-near to h-far (default radius/2)")
-    parser.add_argument("--near", type=float, default=0.0, help="distance from the origin up to which the size is h-near (default 0)")
+    parser.add_argument("--near", type=float, default=0.0, help="distance from the origin up to which the size is h-near + grade r (default 0)")
+    parser.add_argument("--grade", type=float, default=0.0, help="growth of the size with the distance r inside --near (default 0)")
     args = parser.parse_args(argv)
     h_far = args.h_far if args.h_far is not None else DEFAULTS[args.shape][0] * args.radius
     h_near = args.h_near if args.h_near is not None else DEFAULTS[args.shape][1] * args.radius
     try:
-        SHAPES[args.shape](args.output, radius=args.radius, h_far=h_far, h_near=h_near, width=args.width, near=args.near)
+        SHAPES[args.shape](args.output, radius=args.radius, h_far=h_far, h_near=h_near, width=args.width, near=args.near, grade=args.grade)
     except ValueError as exc:
         print(f"make_mesh.py: {exc}", file=sys.stderr)
         return 2

@@ -96,6 +96,31 @@ def test_bad_sizes_are_refused(tmp_path):
     assert not os.path.exists(path)
 
 
+def test_graded_size_follows_h_near_plus_grade_r(tmp_path):
+    """--grade G: inside --near the cells' size follows h_near + G r (the path meshes of docs/hertz.md), measured on
+    rings of a 2D mesh: each ring's mean largest edge within 35% of the field at its centroids, and growing with r as
+    the field does (a constant size would fail both); a grade that would exceed h_far at --near is refused."""
+    path = str(tmp_path / "graded.msh")
+    p = subprocess.run([sys.executable, MAKE_MESH, "half-disk", "-o", path, "--radius", str(RADIUS), "--h-far", "0.05", "--h-near", "0.001",
+                        "--grade", "0.1", "--near", "0.3"], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                       timeout=300)
+    assert p.returncode == 0, p.stdout
+    r, h = cell_sizes(path, 2)
+    means = []
+    for lo, hi in ((0.02, 0.04), (0.08, 0.12), (0.18, 0.25)):
+        sel = (r > lo * RADIUS) & (r < hi * RADIUS)
+        field = 0.001 + 0.1 * r[sel]
+        ratio = h[sel].mean() / field.mean()
+        assert 1 / 1.35 <= ratio <= 1.35, f"ring {lo}-{hi}: cells {h[sel].mean():.4g}, field {field.mean():.4g}"
+        means.append(h[sel].mean())
+    assert means[2] > 3 * means[0], means
+    bad = str(tmp_path / "bad.msh")
+    p = subprocess.run([sys.executable, MAKE_MESH, "half-disk", "-o", bad, "--h-far", "0.05", "--h-near", "0.01", "--grade", "1", "--near", "0.3"],
+                       cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, timeout=300)
+    assert p.returncode == 2 and "h_near + grade near (0.31), must not exceed h_far (0.05)" in p.stdout, p.stdout
+    assert not os.path.exists(bad)
+
+
 def test_pressure_along_the_arc_and_the_radius(meshes, tmp_path):
     """scripts/plot_contact.py --along arc (2D) follows the contact curve: the abscissa of each vertex is its arc length
     R phi from the lowest point, to the chords' error; --along r (3D) is the distance from the touching point in the plane."""

@@ -3,7 +3,9 @@ one point, meshed finer toward that point, with physical groups (numbered and na
 "Face Sets" values through -dm_plex_filename.
 
 Every shape rests on the plane {x_d = 0} and touches it at the origin (or, for the blocks, is indented there); the mesh
-size is h_near up to the distance near from the origin and grows linearly to h_far over the distance width.
+size is h_near at the origin, grows as h_near + grade r up to the distance near from it (grade 0: constant), and then
+linearly to h_far over the distance width. A grade makes the cells across a contact zone of radius a about as many at
+every a inside near: what a load path, whose zone grows from small, needs at every step.
 """
 import contextlib
 
@@ -20,13 +22,14 @@ QUARTER_BLOCK_GROUPS = {"contact": 1, "bottom": 2, "symmetry_y": 3, "symmetry_x"
 BODY_GROUP = 10
 
 
-def _size_field(h_near, h_far, width, dim, near=0.0):
-    """A mesh size field equal to h_near up to the distance near from the origin, then growing linearly to h_far over
-    the distance width, used everywhere."""
+def _size_field(h_near, h_far, width, dim, near=0.0, grade=0.0):
+    """A mesh size field equal to h_near + grade r up to the distance near from the origin (r), then growing linearly
+    to h_far over the distance width, used everywhere."""
     r = "Sqrt(x^2 + y^2)" if dim == 2 else "Sqrt(x^2 + y^2 + z^2)"
+    h_edge = h_near + grade * near
     field = gmsh.model.mesh.field.add("MathEval")
     gmsh.model.mesh.field.setString(
-        field, "F", f"Min({h_far!r}, {h_near!r} + ({h_far!r} - {h_near!r}) * Max({r} - {near!r}, 0) / {width!r})")
+        field, "F", f"Min({h_far!r}, {h_near!r} + {grade!r} * Min({r}, {near!r}) + ({h_far!r} - {h_edge!r}) * Max({r} - {near!r}, 0) / {width!r})")
     gmsh.model.mesh.field.setAsBackgroundMesh(field)
     for option in ("Mesh.MeshSizeExtendFromBoundary", "Mesh.MeshSizeFromPoints", "Mesh.MeshSizeFromCurvature"):
         gmsh.option.setNumber(option, 0)
@@ -55,29 +58,33 @@ def _model(name):
         gmsh.finalize()
 
 
-def _write(path, dim, h_near, h_far, width, near=0.0):
+def _write(path, dim, h_near, h_far, width, near=0.0, grade=0.0):
     """The body's physical group, the size field, the mesh, and the file."""
     _physical(dim, [tag for _, tag in gmsh.model.getEntities(dim)], BODY_GROUP, "body")
-    _size_field(h_near, h_far, width, dim, near)
+    _size_field(h_near, h_far, width, dim, near, grade)
     gmsh.model.mesh.generate(dim)
     gmsh.write(path)
 
 
-def _check(radius, h_far, h_near, width, near=0.0):
+def _check(radius, h_far, h_near, width, near=0.0, grade=0.0):
     for name, value in (("radius", radius), ("h_far", h_far), ("h_near", h_near), ("width", width)):
         if not value > 0:
             raise ValueError(f"{name} must be positive, got {value}")
     if not 0 <= near < radius:
         raise ValueError(f"near must lie in [0, radius), got {near}")
+    if not grade >= 0:
+        raise ValueError(f"grade must be >= 0, got {grade}")
     if h_near > h_far:
         raise ValueError(f"h_near ({h_near}) must not exceed h_far ({h_far})")
+    if h_near + grade * near > h_far:
+        raise ValueError(f"the size at near, h_near + grade near ({h_near + grade * near:g}), must not exceed h_far ({h_far})")
 
 
-def half_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0):
+def half_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0, grade=0.0):
     """The lower half of the disk of the given radius centred at (0, radius): the arc (Gamma_C, "contact") touches the
     plane y = 0 at the origin, the flat top y = radius is "top". Triangles; writes a Gmsh .msh file at path."""
     width = radius / 2 if width is None else width
-    _check(radius, h_far, h_near, width, near)
+    _check(radius, h_far, h_near, width, near, grade)
     with _model("half_disk"):
         disk = gmsh.model.occ.addDisk(0, radius, 0, radius, radius)
         upper = gmsh.model.occ.addRectangle(-2 * radius, radius, 0, 4 * radius, 2 * radius)
@@ -88,15 +95,15 @@ def half_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0):
         curves = [tag for _, tag in gmsh.model.getEntities(1)]
         _physical(1, [c for c in curves if c not in top], HALF_DISK_GROUPS["contact"], "contact")
         _physical(1, top, HALF_DISK_GROUPS["top"], "top")
-        _write(path, 2, h_near, h_far, width, near)
+        _write(path, 2, h_near, h_far, width, near, grade)
 
 
-def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.0):
+def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.0, grade=0.0):
     """The quarter of the lower half of the ball of the given radius centred at (0, 0, radius) with x >= 0 and y >= 0:
     the curved surface ("contact") touches the plane z = 0 at the origin, the flat top z = radius is "top", and the
     planes x = 0 and y = 0 are "symmetry_x" and "symmetry_y". Tetrahedra; writes a Gmsh .msh file at path."""
     width = radius / 2 if width is None else width
-    _check(radius, h_far, h_near, width, near)
+    _check(radius, h_far, h_near, width, near, grade)
     with _model("quarter_sphere"):
         ball = gmsh.model.occ.addSphere(0, 0, radius, radius)
         box = gmsh.model.occ.addBox(0, 0, 0, 2 * radius, 2 * radius, radius)
@@ -111,14 +118,14 @@ def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.
         _physical(2, top, QUARTER_SPHERE_GROUPS["top"], "top")
         _physical(2, sym_y, QUARTER_SPHERE_GROUPS["symmetry_y"], "symmetry_y")
         _physical(2, sym_x, QUARTER_SPHERE_GROUPS["symmetry_x"], "symmetry_x")
-        _write(path, 3, h_near, h_far, width, near)
+        _write(path, 3, h_near, h_far, width, near, grade)
 
 
-def quarter_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0):
+def quarter_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0, grade=0.0):
     """The half of the half-disk with x >= 0: the arc ("contact") touches the plane y = 0 at the origin, the flat top
     y = radius is "top", the plane x = 0 is "symmetry_x". Triangles; writes a Gmsh .msh file at path."""
     width = radius / 2 if width is None else width
-    _check(radius, h_far, h_near, width, near)
+    _check(radius, h_far, h_near, width, near, grade)
     with _model("quarter_disk"):
         disk = gmsh.model.occ.addDisk(0, radius, 0, radius, radius)
         box = gmsh.model.occ.addRectangle(0, 0, 0, 2 * radius, radius)
@@ -131,14 +138,14 @@ def quarter_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0)
         _physical(1, [c for c in curves if c not in top + sym_x], QUARTER_DISK_GROUPS["contact"], "contact")
         _physical(1, top, QUARTER_DISK_GROUPS["top"], "top")
         _physical(1, sym_x, QUARTER_DISK_GROUPS["symmetry_x"], "symmetry_x")
-        _write(path, 2, h_near, h_far, width, near)
+        _write(path, 2, h_near, h_far, width, near, grade)
 
 
-def block(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0):
+def block(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0, grade=0.0):
     """The rectangle [0, radius] x [-radius, 0], to be indented at the origin from above: its top y = 0 is "contact",
     its bottom "bottom", x = 0 "symmetry_x", x = radius "side". Triangles; writes a Gmsh .msh file at path."""
     width = radius / 2 if width is None else width
-    _check(radius, h_far, h_near, width, near)
+    _check(radius, h_far, h_near, width, near, grade)
     with _model("block"):
         gmsh.model.occ.addRectangle(0, -radius, 0, radius, radius)
         gmsh.model.occ.synchronize()
@@ -149,14 +156,14 @@ def block(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0):
                   "side": _entities_in_box(1, (radius, -radius, 0), (radius, 0, 0), eps)}
         for name, tags in groups.items():
             _physical(1, tags, BLOCK_GROUPS[name], name)
-        _write(path, 2, h_near, h_far, width, near)
+        _write(path, 2, h_near, h_far, width, near, grade)
 
 
-def quarter_block(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.0):
+def quarter_block(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.0, grade=0.0):
     """The box [0, radius]^2 x [-radius, 0], to be indented at the origin from above: its top z = 0 is "contact", its
     bottom "bottom", x = 0 "symmetry_x", y = 0 "symmetry_y", the faces x = radius and y = radius "side". Tetrahedra."""
     width = radius / 2 if width is None else width
-    _check(radius, h_far, h_near, width, near)
+    _check(radius, h_far, h_near, width, near, grade)
     with _model("quarter_block"):
         gmsh.model.occ.addBox(0, 0, -radius, radius, radius, radius)
         gmsh.model.occ.synchronize()
@@ -169,7 +176,7 @@ def quarter_block(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.0
                   "side": _entities_in_box(2, (r, 0, -r), (r, r, 0), eps) + _entities_in_box(2, (0, r, -r), (r, r, 0), eps)}
         for name, tags in groups.items():
             _physical(2, tags, QUARTER_BLOCK_GROUPS[name], name)
-        _write(path, 3, h_near, h_far, width, near)
+        _write(path, 3, h_near, h_far, width, near, grade)
 
 
 SHAPES = {"half-disk": half_disk, "quarter-disk": quarter_disk, "quarter-sphere": quarter_sphere, "block": block, "quarter-block": quarter_block}

@@ -223,11 +223,12 @@ static PetscErrorCode LoadPathForce(DM dm, AppCtx *user, SNES snes, Vec u, Petsc
    along the path: the secant of the last two solutions, u_k = u_{k-1} + (t_k - t_{k-1}) / (t_{k-1} - t_{k-2})
    (u_{k-1} - u_{k-2}), and for the second step the secant from u = 0 at t = 0 (a linear problem's u is proportional to
    t; the contact's active set makes it piecewise so). The guess is taken wherever it lowers the residual at the new
-   load, even where it moves the penalty's active points (the contact zone grows along a path: the 3D sphere indenter's
-   warm steps took 6 Newton steps from the last solution and 4 from the secant, docs/solvers.md, "Load paths"), and else gives the
-   first linear solve's initial guess (SolverExtrapolatedStart(), as the eps sweep's). Under force control each step starts at the last step's position and solution instead, and
-   moves the obstacle to the step's force. A failed step ends the path: the output is its state, with converged = 0, and
-   /steps holds the steps up to it. Without a path, force control at the run's one load. */
+   load, even where it moves the penalty's active points (the contact zone grows along a path: the 3D sphere
+   indenter's warm steps took 6 Newton steps from the last solution and 4 from the secant, docs/solvers.md, "Load
+   paths"), and else gives the first linear solve's initial guess (SolverExtrapolatedStart(), as the eps sweep's).
+   Under force control each step starts at the last step's position and solution instead, and moves the obstacle to
+   the step's force. A failed step ends the path: the output is its state, with converged = 0, and /steps holds the
+   steps up to it. Without a path, force control at the run's one load. */
 PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 {
   const LoadPathOptions *lp    = &user->opt->load_path;
