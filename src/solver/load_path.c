@@ -98,29 +98,69 @@ static void ForceAlong(const AppCtx *user, PetscReal *force, PetscReal *s)
   *s     = x;
 }
 
+/* A step's force and position along the obstacle's direction, as ForceAlong() gives them for the current state. */
+static void StepAlong(const AppCtx *user, const StepRecord *step, PetscReal *force, PetscReal *s)
+{
+  PetscReal len = 0.0, f = 0.0, x = 0.0;
+
+  for (PetscInt c = 0; c < 3; ++c) len += PetscSqr(user->scene.full_load.translate[c]);
+  len = PetscSqrtReal(len);
+  for (PetscInt c = 0; c < 3; ++c) {
+    f += step->q.force[c] * user->scene.full_load.translate[c] / len;
+    x += step->obstacle_translate[c] * user->scene.full_load.translate[c] / len;
+  }
+  *force = f;
+  *s     = x;
+}
+
 #define FORCE_CONTROL_RTOL 1e-8 /* |F - target| / target at which the position is found */
 #define FORCE_CONTROL_MAX_ITS 60
+#define FORCE_CONTROL_SOLVE_TOL 1e-2 /* each position's Newton residual, relative to FORCE_CONTROL_RTOL times the target */
 
 /* Force control (-obstacle_force F): the obstacle's position s along its direction such that its force equals the
    target, from the solution at the position it has (the translation's length times the load factor on the first
    call, the last step's position after). The force is a nondecreasing function of s (the energy is convex in the
-   obstacle's position; frictionless, linear), piecewise smooth as nodes enter the contact: the secant through the last
-   two positions (the first through the origin, where the obstacle does not press yet), kept inside the bracket
-   [s_lo, s_hi] of positions below and above the target once there is one (Illinois' regula falsi halves the stale end's
-   residual), a step that doubles the last move while the force stays below the target and the secant has nothing to
-   go on. Each position is a warm penalty solve, and where that fails (a
-   semismooth Newton cycling between active sets, seen at eps = h/100 in 3D) a solve from zero as a direct run's (both
-   in /solves). *ok is false when the solve fails or the target is not reached in FORCE_CONTROL_MAX_ITS positions;
-   *its counts the positions solved. */
+   obstacle's position; frictionless, linear), piecewise smooth as nodes enter the contact, and near a power of s
+   (F ~ s^(3/2) for a sphere's indentation, s for a flat punch). Until the target is bracketed, the secant of log f
+   against log s through the last two positions; the first move, the power law through the origin (where the obstacle
+   does not press yet) with the power of the last two steps (1 before there are two). Once the target is bracketed
+   by [s_lo, s_hi], Illinois' regula falsi (it halves the stale end's residual). A step doubles the last move where
+   the force stays below the target and the secant has nothing to go on.
+   Each position is a warm penalty solve from the solution's secant along s (through u = 0 at s = 0 for the first
+   move), and where that fails (Newton's line search stalls at a kink of the penalty, seen at eps = h/100 in 3D)
+   a solve from zero as a direct run's (both in /solves). On the 3D sphere indenter of make hertz-path (10 steps, the
+   graded mesh) the secant start and the powers took the path from 994 to 292 Newton steps and the failed warm solves
+   from 10 to 2 (docs/hertz.md).
+   The force is a sum of the solve's nodal reactions, exact to about the Newton residual: each position's solve stops
+   at FORCE_CONTROL_SOLVE_TOL times FORCE_CONTROL_RTOL times the target (or at -snes_rtol times the load, if tighter),
+   so that the force is known well below the tolerance it must reach. At -snes_rtol times the load alone the first
+   step's force there (4e-5, the load 0.0045) was exact to about 1e-6 relative, and the search stalled at 1.0e-8.
+   Once the active set settles a solve is linear, so the tighter stop costs about one Newton step. *ok is false when
+   the solve fails or the target is not reached in FORCE_CONTROL_MAX_ITS positions; *its counts the positions solved. */
 static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscReal target, PetscBool *ok, PetscInt *its)
 {
-  PetscReal f, s, f_prev = 0.0, s_prev = 0.0, s_lo = 0.0, f_lo = 0.0, s_hi = 0.0, f_hi = 0.0;
+  PetscReal f, s, f_prev = 0.0, s_prev = 0.0, s_lo = 0.0, f_lo = 0.0, s_hi = 0.0, f_hi = 0.0, atol, rtol, stol, power = 1.0;
   PetscBool have_lo = PETSC_FALSE, have_hi = PETSC_FALSE;
-  PetscInt  side = 0; /* the bracket's end kept last time (Illinois) */
+  PetscInt  side = 0, maxit, maxf; /* side: the bracket's end kept last time (Illinois) */
+  Vec       u_prev, dir;
 
   PetscFunctionBeginUser;
   *ok  = PETSC_FALSE;
   *its = 0;
+  if (user->rec.nsteps >= 2) { /* the force's local power of the position, from the last two steps: 1.5 for a sphere's indentation */
+    PetscReal f1, s1, f2, s2;
+
+    StepAlong(user, &user->rec.steps[user->rec.nsteps - 2], &f1, &s1);
+    StepAlong(user, &user->rec.steps[user->rec.nsteps - 1], &f2, &s2);
+    if (f1 > 0.0 && f2 > f1 && s1 > 0.0 && s2 > s1) power = PetscMin(PetscMax(PetscLogReal(f2 / f1) / PetscLogReal(s2 / s1), 1.0), 3.0);
+  }
+  PetscCall(VecDuplicate(u, &u_prev)); /* the solution at s_prev: u = 0 at s = 0, before the obstacle presses */
+  PetscCall(VecDuplicate(u, &dir));
+  PetscCall(VecZeroEntries(u_prev));
+  PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
+  if (user->prob.load_norm > 0.0)
+    PetscCall(SNESSetTolerances(snes, atol, PetscMin(rtol, FORCE_CONTROL_SOLVE_TOL * FORCE_CONTROL_RTOL * target / user->prob.load_norm), stol, maxit,
+                                maxf));
   PetscCall(PostprocessContact(dm, user, u));
   ForceAlong(user, &f, &s);
   for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && user->rec.stats.converged; ++it) {
@@ -147,18 +187,26 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
     if (!have_lo || !have_hi) { /* no bracket yet: the secant, or a doubled move outward */
       const PetscReal move = it ? s - s_prev : (s != 0.0 ? s : 1.0);
 
-      if (it && f != f_prev && (f - f_prev) / (s - s_prev) > 0.0)
+      if (it && f > 0.0 && f_prev > 0.0 && s > 0.0 && s_prev > 0.0 && f != f_prev && (f - f_prev) / (s - s_prev) > 0.0)
+        s_next = s * PetscPowReal(target / f, PetscLogReal(s / s_prev) / PetscLogReal(f / f_prev)); /* the secant of log f against log s */
+      else if (it && f != f_prev && (f - f_prev) / (s - s_prev) > 0.0)
         s_next = s + (target - f) * (s - s_prev) / (f - f_prev);
       else if (!it && f > 0.0 && s > 0.0)
-        s_next = s * target / f; /* the secant through (0, 0): no force before the contact */
+        s_next = s * PetscPowReal(target / f, 1.0 / power); /* the power law through (0, 0): no force before the contact */
       else
         s_next = s + (f < target ? 1.0 : -1.0) * PetscAbsReal(move);
       if (f < target && s_next > s + 4.0 * PetscAbsReal(move) && it) s_next = s + 4.0 * PetscAbsReal(move);
     } else
       s_next = s_lo + (target - f_lo) * (s_hi - s_lo) / (f_hi - f_lo); /* regula falsi in the bracket */
-    s_prev = s, f_prev = f;
     PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
     PetscCall(ProblemUpdateData(dm, user));
+    if (s != s_prev) { /* the solution's secant along the position, as a load path's along its factor */
+      PetscCall(VecWAXPY(dir, -1.0, u_prev, u));
+      PetscCall(VecCopy(u, u_prev));
+      PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, (s_next - s) / (s - s_prev), 1.0, PETSC_TRUE));
+    } else
+      PetscCall(VecCopy(u, u_prev));
+    s_prev = s, f_prev = f;
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
     if (!user->rec.stats.converged) /* Newton from the last position's solution can cycle between active sets: from zero, as a direct run */
       PetscCall(SolverSolve(snes, user, u, SOLVER_START_ZERO));
@@ -166,6 +214,9 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
     ForceAlong(user, &f, &s);
     ++*its;
   }
+  PetscCall(SNESSetTolerances(snes, atol, rtol, stol, maxit, maxf));
+  PetscCall(VecDestroy(&u_prev));
+  PetscCall(VecDestroy(&dir));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -212,8 +263,9 @@ static PetscErrorCode LoadPathForce(DM dm, AppCtx *user, SNES snes, Vec u, Petsc
   PetscCall(ForceControlSolve(dm, user, snes, u, user->scene.obstacle.force, ok, &its));
   user->rec.stats.force_control_its += its;
   if (!*ok && user->rec.stats.converged) {
-    PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm), "  force control: the force %g was not reached in %d positions of the obstacle\n",
-                          (double)user->scene.obstacle.force, FORCE_CONTROL_MAX_ITS));
+    PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm),
+                          "  force control: the force %g was not reached in %" PetscInt_FMT " positions of the obstacle\n",
+                          (double)user->scene.obstacle.force, its));
     user->rec.stats.converged = PETSC_FALSE;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
