@@ -295,6 +295,7 @@ PetscErrorCode ContactSetLoad(Contact ct, DM dm, const Obstacle *obstacle)
   ct->obstacle = *obstacle;
   ObstaclePack(&ct->obstacle, ct->obstacle_packed);
   PetscCall(ContactSetUpdateData(ct, dm));
+  if (ct->ops.load) PetscCall((*ct->ops.load)(ct, dm)); /* what the type made of the gaps: SNESVI's bounds */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

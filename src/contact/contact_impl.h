@@ -19,6 +19,7 @@ typedef struct {
   PetscErrorCode (*setup_snes)(Contact, DM, SNES);                      /* the SNES type and bounds (NULL: Newton, ContactSetUpSNES()) */
   PetscErrorCode (*check)(Contact, DM, Vec u);                          /* -assembly_check after the solve (NULL: none) */
   PetscErrorCode (*scale_bounds)(Contact, PetscReal);                   /* the bounds times a factor (NULL: none) */
+  PetscErrorCode (*load)(Contact, DM);                                  /* after the set's gaps changed, ContactSetLoad() (NULL: none) */
   PetscErrorCode (*view)(Contact, PetscViewer);                         /* the type's part of the summary line */
 } ContactOps;
 

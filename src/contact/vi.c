@@ -26,8 +26,10 @@ static void AxisOfNormal(PetscInt dim, const PetscReal n[], PetscInt *axis, Pets
   *sign = n[*axis] > 0.0 ? 1.0 : -1.0;
 }
 
-/* n = +e_k: u_k <= g;  n = -e_k: u_k >= -g. Every other unknown is free; a fixed axis component needs no bound. */
-static PetscErrorCode ContactSetUp_VI(Contact ct, DM dm)
+/* The bounds from the set's gaps and normals: n = +e_k: u_k <= g;  n = -e_k: u_k >= -g. Every other unknown is free; a
+   fixed axis component needs no bound. At set-up, and again at each load state of a path (the obstacle's translation
+   changes the gaps), before the SNES scales them (SolverSNESSolve()). Refused where a normal is not an axis. */
+static PetscErrorCode FillBounds(Contact ct)
 {
   Contact_VI       *vi   = (Contact_VI *)ct->data;
   MPI_Comm          comm = ct->comm;
@@ -37,8 +39,6 @@ static PetscErrorCode ContactSetUp_VI(Contact ct, DM dm)
   PetscScalar      *xl, *xu;
 
   PetscFunctionBeginUser;
-  PetscCall(DMCreateGlobalVector(dm, &vi->xl));
-  PetscCall(DMCreateGlobalVector(dm, &vi->xu));
   PetscCall(VecSet(vi->xl, PETSC_NINFINITY));
   PetscCall(VecSet(vi->xu, PETSC_INFINITY));
   PetscCall(VecGetArray(vi->xl, &xl));
@@ -79,6 +79,25 @@ static PetscErrorCode ContactSetUp_VI(Contact ct, DM dm)
             "%" PetscInt_FMT " contact nodes of the scene have another normal, for example (%g, %g, %g): use -contact_method penalty",
             total, (double)n[0], (double)n[1], (double)n[2]);
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode ContactSetUp_VI(Contact ct, DM dm)
+{
+  Contact_VI *vi = (Contact_VI *)ct->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMCreateGlobalVector(dm, &vi->xl));
+  PetscCall(DMCreateGlobalVector(dm, &vi->xu));
+  PetscCall(FillBounds(ct));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* A new load state (ContactSetLoad()): the bounds of the new gaps, in the vectors SNESVISetVariableBounds() holds. */
+static PetscErrorCode ContactLoad_VI(Contact ct, DM dm)
+{
+  PetscFunctionBeginUser;
+  PetscCall(FillBounds(ct));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -126,5 +145,6 @@ PetscErrorCode ContactCreate_VI(Contact ct)
   ct->ops.reset        = ContactReset_VI;
   ct->ops.setup_snes   = ContactSetUpSNES_VI;
   ct->ops.scale_bounds = ContactScaleBounds_VI;
+  ct->ops.load         = ContactLoad_VI;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -53,10 +53,8 @@ PetscErrorCode LoadPathSetUp(MPI_Comm comm, AppCtx *user)
   if (!opt->load_path.n && !(user->scene.obstacle.force > 0.0)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactGetOptions(user->contact, &copt));
   PetscCall(SceneCheckLoadPath(comm, &user->scene, what));
-  PetscCheck(!ContactHasBounds(user->contact), comm, PETSC_ERR_USER_INPUT,
-             "%s work with -contact_method penalty or none: SNESVI's bounds do not follow the load yet", what);
   PetscCheck(ContactHasPenalty(user->contact) || !(user->scene.obstacle.force > 0.0), comm, PETSC_ERR_USER_INPUT,
-             "-obstacle_force needs a contact to press on: -contact_method penalty");
+             "-obstacle_force works with -contact_method penalty (its positions' warm solves and force secant are the penalty's)");
   PetscCheck(!opt->bars, comm, PETSC_ERR_USER_INPUT, "-bars measures one load state: give it without %s", what);
   PetscCheck(copt->n_sweep <= 1, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep and %s both solve a sequence: give one of them", what);
   PetscCheck(!opt->verify.reference[0], comm, PETSC_ERR_USER_INPUT, "-reference compares one load state: give it without %s", what);
