@@ -60,7 +60,8 @@ def force_control(case, outdir, rows):
     if res.returncode != 0 or not os.path.isfile(out):
         sys.exit(f"failed: {' '.join(cmd)}: {error_line(res.output)}")
     fc = history(out)
-    full = abs(float(hertz.CASES[case]["args"][hertz.CASES[case]["args"].index("-obstacle_translate") + 1].split(",")[-1]))
+    args = hertz.CASES[case]["args"]
+    full = float(np.linalg.norm([float(x) for x in args[args.index("-obstacle_translate") + 1].split(",")]))  # the travel at factor 1
     out_d = mesh[:-4] + "_at_force_positions.h5"
     cmd = (hertz.command(case, display_path(mesh), hertz.PATH_METHOD, display_path(out_d)) + ["-load_path", ",".join(repr(float(d) / full) for d in fc["depth"])]
            + solver)
@@ -165,8 +166,9 @@ def main():
     forced = []
     for case in args.cases.split(","):
         if hertz.CASES[case]["dim"] == 3 and not args.no_force:
-            forced += force_control(case, args.outdir, [r for r in rows if r["case"] == case])
-            for r in forced:
+            new = force_control(case, args.outdir, [r for r in rows if r["case"] == case])
+            forced += new
+            for r in new:
                 print(f"{case} force control step {r['step']}: force {r['force_error']:.1e}, depth against displacement {r['depth_error']:.1e}")
     report(rows, args.outdir, forced)
     figure(rows, os.path.join(args.outdir, "hertz_path.png"))

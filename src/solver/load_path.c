@@ -80,35 +80,40 @@ static PetscErrorCode ProblemUpdateData(DM dm, AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The obstacle's force on the body along the unit direction of its translation (positive as it presses), of the
-   solution PostprocessContact() last measured, and its position s along that direction. */
-static void ForceAlong(const AppCtx *user, PetscReal *force, PetscReal *s)
+/* A force and a position of the obstacle along the unit direction of its full translation (the force positive as
+   the obstacle presses): of the solution PostprocessContact() last measured (ForceAlong()) or of a recorded step. */
+static void Along(const AppCtx *user, const PetscReal force[3], const PetscReal translate[3], PetscReal *f, PetscReal *s)
 {
-  PetscReal len = 0.0, f = 0.0, x = 0.0;
+  const PetscReal *dir = user->scene.full_load.translate;
+  PetscReal        len = 0.0;
 
-  for (PetscInt c = 0; c < 3; ++c) len += PetscSqr(user->scene.full_load.translate[c]);
+  *f = *s = 0.0;
+  for (PetscInt c = 0; c < 3; ++c) len += PetscSqr(dir[c]);
   len = PetscSqrtReal(len);
   for (PetscInt c = 0; c < 3; ++c) {
-    f += user->rec.stats.contact_force_vector[c] * user->scene.full_load.translate[c] / len;
-    x += user->scene.obstacle.translate[c] * user->scene.full_load.translate[c] / len;
+    *f += force[c] * dir[c] / len;
+    *s += translate[c] * dir[c] / len;
   }
-  *force = f;
-  *s     = x;
 }
 
-/* A step's force and position along the obstacle's direction, as ForceAlong() gives them for the current state. */
-static void StepAlong(const AppCtx *user, const StepRecord *step, PetscReal *force, PetscReal *s)
+static void ForceAlong(const AppCtx *user, PetscReal *f, PetscReal *s)
 {
-  PetscReal len = 0.0, f = 0.0, x = 0.0;
+  Along(user, user->rec.stats.contact_force_vector, user->scene.obstacle.translate, f, s);
+}
 
-  for (PetscInt c = 0; c < 3; ++c) len += PetscSqr(user->scene.full_load.translate[c]);
-  len = PetscSqrtReal(len);
-  for (PetscInt c = 0; c < 3; ++c) {
-    f += step->q.force[c] * user->scene.full_load.translate[c] / len;
-    x += step->obstacle_translate[c] * user->scene.full_load.translate[c] / len;
-  }
-  *force = f;
-  *s     = x;
+/* The start of a solve on the secant of the solutions: u <- u + factor (u - prev) where SolverExtrapolatedStart()
+   takes it (use), and prev <- the old u. Shared by the path's steps (along the factor) and force control's positions
+   (along the position). */
+static PetscErrorCode SecantStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor)
+{
+  PetscFunctionBeginUser;
+  if (use) {
+    PetscCall(VecWAXPY(dir, -1.0, prev, u));
+    PetscCall(VecCopy(u, prev));
+    PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, factor, 1.0, PETSC_TRUE));
+  } else
+    PetscCall(VecCopy(u, prev));
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 #define FORCE_CONTROL_RTOL 1e-8 /* |F - target| / target at which the position is found */
@@ -148,8 +153,10 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
   if (user->rec.nsteps >= 2) { /* the force's local power of the position, from the last two steps: 1.5 for a sphere's indentation */
     PetscReal f1, s1, f2, s2;
 
-    StepAlong(user, &user->rec.steps[user->rec.nsteps - 2], &f1, &s1);
-    StepAlong(user, &user->rec.steps[user->rec.nsteps - 1], &f2, &s2);
+    const StepRecord *st = &user->rec.steps[user->rec.nsteps - 2];
+
+    Along(user, st[0].q.force, st[0].obstacle_translate, &f1, &s1);
+    Along(user, st[1].q.force, st[1].obstacle_translate, &f2, &s2);
     if (f1 > 0.0 && f2 > f1 && s1 > 0.0 && s2 > s1) power = PetscMin(PetscMax(PetscLogReal(f2 / f1) / PetscLogReal(s2 / s1), 1.0), 3.0);
   }
   PetscCall(VecDuplicate(u, &u_prev)); /* the solution at s_prev: u = 0 at s = 0, before the obstacle presses */
@@ -171,8 +178,8 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
     if (it && f == f_prev && s != s_prev) { /* the solve did not move: the force is as exact as the Newton tolerance */
       PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm),
                             "  force control: stalled %g from the force %g (relative); the force is the residual of the solve, exact to about "
-                            "-snes_rtol times the load: lower -snes_rtol\n",
-                            (double)(PetscAbsReal(f - target) / target), (double)target));
+                            "its Newton tolerance (%g times the force, or -snes_rtol times the load where tighter)\n",
+                            (double)(PetscAbsReal(f - target) / target), (double)target, (double)(FORCE_CONTROL_SOLVE_TOL * FORCE_CONTROL_RTOL)));
       break;
     }
     if (f < target && (!have_lo || s > s_lo)) {
@@ -198,12 +205,7 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
       s_next = s_lo + (target - f_lo) * (s_hi - s_lo) / (f_hi - f_lo); /* regula falsi in the bracket */
     PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
     PetscCall(ProblemUpdateData(dm, user));
-    if (s != s_prev) { /* the solution's secant along the position, as a load path's along its factor */
-      PetscCall(VecWAXPY(dir, -1.0, u_prev, u));
-      PetscCall(VecCopy(u, u_prev));
-      PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, (s_next - s) / (s - s_prev), 1.0, PETSC_TRUE));
-    } else
-      PetscCall(VecCopy(u, u_prev));
+    PetscCall(SecantStart(snes, dm, user, u, u_prev, dir, (PetscBool)(s != s_prev), s != s_prev ? (s_next - s) / (s - s_prev) : 0.0));
     s_prev = s, f_prev = f;
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
     if (!user->rec.stats.converged) /* Newton from the last position's solution can cycle between active sets: from zero, as a direct run */
@@ -305,12 +307,11 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
     PetscCall(SceneSetLoadFactor(&user->scene, lp->factor[k]));
     if (force) PetscCall(SceneSetObstaclePosition(&user->scene, s)); /* the last step's position */
     PetscCall(ProblemUpdateData(dm, user));
-    if (!force && t_last != t_prev && ContactHasPenalty(user->contact)) {
-      PetscCall(VecWAXPY(dir, -1.0, prev, u));
-      PetscCall(VecCopy(u, prev));
-      PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, (lp->factor[k] - t_last) / (t_last - t_prev), 1.0, PETSC_TRUE));
-    } else
-      PetscCall(VecCopy(u, prev));
+    {
+      const PetscBool secant = (PetscBool)(!force && t_last != t_prev && ContactHasPenalty(user->contact));
+
+      PetscCall(SecantStart(snes, dm, user, u, prev, dir, secant, secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0));
+    }
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
     PetscCall(LoadPathForce(dm, user, snes, u, &ok));
     PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[k], first, ok));
