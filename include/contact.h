@@ -84,6 +84,11 @@ PetscErrorCode ContactSetUpSNES(Contact ct, DM dm, SNES snes);
 PetscErrorCode ContactScaleBounds(Contact ct, PetscReal s);
 PetscErrorCode ContactRoundoffTerm(Contact ct, Vec u, PetscReal *sum_sq);
 PetscErrorCode ContactSameActivity(Contact ct, DM dm, Vec X, Vec Y, PetscBool *same);
+/* The SNES's own unknowns: SNESVI iterates on w = Q^T u, Q orthogonal, rotating the free components of the contact nodes
+   whose normal is not an axis into (normal, tangents) so that u . n <= g bounds one unknown (src/contact/vi_frames.c).
+   v <- Q^T v (to_solver) or v <- Q v; the identity for the other types and where every normal is an axis. */
+PetscErrorCode ContactSolverFrame(Contact ct, Vec v, PetscBool to_solver);
+PetscBool      ContactHasFrames(Contact ct);
 
 /* The state of the contact nodes at an iterate (contact_set.c) */
 PetscErrorCode ContactCountActive(Contact ct, Vec X, PetscReal tol_scale, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left);

@@ -59,10 +59,18 @@ def sorted_by_position(fields, key):
     return fields[key][vertex_order(fields["x"])]
 
 
-def write_gmsh_square(path, n, with_contact=True, with_clamp=True, quads=False):
+def rotated(nodes, rotation):
+    """The points times the matrix rotation (rows of the matrix; None: the points as they are)."""
+    if rotation is None:
+        return nodes
+    return [tuple(sum(rotation[a][b] * p[b] for b in range(len(p))) for a in range(len(p))) for p in nodes]
+
+
+def write_gmsh_square(path, n, with_contact=True, with_clamp=True, quads=False, rotation=None):
     """A Gmsh 2.2 file of the unit square in n x n cells, triangles split like the built-in simplex box (or quadrilaterals),
-    physical lines 1-4 numbered as PETSc's box (bottom 1 = Gamma_C, top 3 = the clamped face of the built-in scenes)."""
-    nodes = [(i / n, j / n) for j in range(n + 1) for i in range(n + 1)]
+    physical lines 1-4 numbered as PETSc's box (bottom 1 = Gamma_C, right 2, top 3 = the clamped face of the built-in
+    scenes, left 4); rotation: a 2 x 2 matrix applied to the coordinates."""
+    nodes = rotated([(i / n, j / n) for j in range(n + 1) for i in range(n + 1)], rotation)
     vid = lambda i, j: j * (n + 1) + i + 1  # noqa: E731
     sides = {1: [(vid(i, 0), vid(i + 1, 0)) for i in range(n)], 2: [(vid(n, j), vid(n, j + 1)) for j in range(n)],
              3: [(vid(i, n), vid(i + 1, n)) for i in range(n)], 4: [(vid(0, j), vid(0, j + 1)) for j in range(n)]}
@@ -85,11 +93,11 @@ def write_gmsh_square(path, n, with_contact=True, with_clamp=True, quads=False):
         fp.write("$EndElements\n")
 
 
-def write_gmsh_cube(path, n):
+def write_gmsh_cube(path, n, rotation=None):
     """A Gmsh 2.2 file of the unit cube in n^3 cubes of 6 Kuhn tetrahedra, physical surfaces numbered as PETSc's box
-    (bottom z = 0 1, top 2)."""
+    (bottom z = 0 1, top 2); rotation: a 3 x 3 matrix applied to the coordinates."""
     vid = lambda i, j, k: (k * (n + 1) + j) * (n + 1) + i + 1  # noqa: E731
-    nodes = [(i / n, j / n, k / n) for k in range(n + 1) for j in range(n + 1) for i in range(n + 1)]
+    nodes = rotated([(i / n, j / n, k / n) for k in range(n + 1) for j in range(n + 1) for i in range(n + 1)], rotation)
     elems = []
     for k_face, tag in ((0, 1), (n, 2)):
         for j in range(n):

@@ -173,8 +173,6 @@ BAD = [  # (options after a valid general set-up on the unit square, a fragment 
     (["-bc_clamp", "3", "-obstacle", "sphere", "-obstacle_radius", "1"], "-obstacle sphere needs -obstacle_center"),
     (["-bc_clamp", "3", "-obstacle_normal", "0,0"], "-obstacle_normal must not be the zero vector"),
     (["-bc_clamp", "3", "-obstacle", "plane", "-obstacle_radius", "1"], "-obstacle_radius"),
-    (["-bc_clamp", "3", "-contact_method", "vi", "-obstacle", "cylinder", "-obstacle_center", "0.5,-1", "-obstacle_radius", "1"],
-     "-contact_method vi needs the obstacle's normal along a coordinate axis"),
 ]
 
 

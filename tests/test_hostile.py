@@ -113,7 +113,6 @@ OPTION_CASES = [
     ("beta_nan", ["-square_beta", "nan"], "-square_beta must be a finite number"),
     ("x0_inf", ["-square_x0", "-inf"], "-square_x0 must be a finite number"),
     ("tilt_range", ["-square_tilt", 60], "-square_tilt must lie in (-45, 45) degrees"),
-    ("vi_tilted", ["-contact_method", "vi", "-square_tilt", 5], "-contact_method vi needs the obstacle's normal along a coordinate axis"),
     ("mms_amplitude_inf", ["-scene", "mms", "-mms_amplitude_A", "inf"], "-mms_amplitude_A must be a finite number"),
     ("mms_nu_zero", ["-scene", "mms", "-mms_nu", 0], "-mms_nu must lie in (0, 1]"),
     ("mms_a_outside", ["-scene", "mms", "-mms_a", 1.5], "-mms_a must lie in (0, 1)"),

@@ -99,6 +99,28 @@ def test_snesvi_path_follows_the_gap(outdir, np_):
     assert np.max(np.abs(last - fields["displacement"])) <= 1e-10 * np.max(np.abs(fields["displacement"]))
 
 
+@pytest.mark.parametrize("np_", [1, 2])
+def test_snesvi_path_on_a_curved_obstacle(outdir, np_):
+    """SNESVI along a path on a cylinder pressed into a block's top face: at each step the obstacle's move changes the
+    contact nodes' normals, so their rotated frames (src/contact/vi_frames.c), the bounds and Q^T K Q are renewed. Each
+    step of 0.3, 1.5, 1 is the direct SNESVI run at its factor (force to 1e-10, the last displacement to 1e-10), on 1
+    and 2 ranks."""
+    base = ["-scene", "general", "-dm_plex_box_faces", "32,8", "-contact_faces", "3", "-bc_clamp", "1", "-contact_method", "vi",
+            "-snes_rtol", "1e-12", "-obstacle", "cylinder", "-obstacle_center", "0.4,2.001", "-obstacle_radius", "1"]
+    data = lambda t: ["-obstacle_translate", vec(t * np.array([0.0, -0.03]))]  # noqa: E731
+    _, h5 = run(base + data(1.0) + ["-load_path", "0.3,1.5,1"], "vi_path", np_=np_, output=os.path.join(outdir, "vi_path.h5"))
+    st = steps(h5)
+    assert list(st["factor"]) == [0.3, 1.5, 1.0] and st["converged"].all()
+    assert st["contact_force"][0] > 0 and st["contact_force"][1] > 1.5 * st["contact_force"][2]
+    for k, t in enumerate(st["factor"]):
+        _, d = run(base + data(t), f"vi_direct_{k}", np_=np_, output=os.path.join(outdir, f"vi_direct_{k}.h5"))
+        attrs, fields = load(d)
+        assert attrs["active_vertices"] >= 3
+        assert abs(st["contact_force"][k] - attrs["contact_force"]) <= 1e-10 * attrs["contact_force"], (k, st["contact_force"][k], attrs["contact_force"])
+    last = load(h5)[1]["displacement"]
+    assert np.max(np.abs(last - fields["displacement"])) <= 1e-10 * np.max(np.abs(fields["displacement"]))
+
+
 def test_a_failed_step_ends_the_path(outdir):
     """A step whose solve fails (3 Newton steps allowed for a jump to 30 times the load) ends the path: /steps holds the
     steps up to it, the failed one with converged = 0, /run converged = 0, the summary names it, the exit status is 3."""

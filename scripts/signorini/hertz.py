@@ -52,14 +52,14 @@ def pressure_profile(r, a, p0):
 # SNESVI applies (a flat foundation: the normal is an axis at every node), the imposed displacement, and the options.
 CASES = {
     "cylinder": {
-        "dim": 2, "shape": geometry.quarter_disk, "parts": 2, "vi": True, "near": 0.06, "h_far": 0.05, "width": 0.3,
+        "dim": 2, "shape": geometry.quarter_disk, "parts": 2, "near": 0.06, "h_far": 0.05, "width": 0.3,
         "h_near": [0.004, 0.002, 0.001],
         "args": ["-scene", "general", "-contact_faces", "contact", "-bc_slip", "top,symmetry_x",
                  "-bc_slip_top_components", "1", "-bc_slip_top_translate", "0,-0.002", "-bc_slip_symmetry_x_components", "0"],
         "what": "elastic cylinder (quarter disk, radius 1) pressed on a rigid plane by a displacement 0.002 of its axis plane",
     },
     "sphere": {
-        "dim": 3, "shape": geometry.quarter_sphere, "parts": 4, "vi": True, "near": 0.15, "h_far": 0.2, "width": 0.4,
+        "dim": 3, "shape": geometry.quarter_sphere, "parts": 4, "near": 0.15, "h_far": 0.2, "width": 0.4,
         "h_near": [0.02, 0.01, 0.005],
         "args": ["-scene", "general", "-contact_faces", "contact", "-bc_slip", "top,symmetry_x,symmetry_y",
                  "-bc_slip_top_components", "2", "-bc_slip_top_translate", "0,0,-0.01", "-bc_slip_symmetry_x_components", "0",
@@ -67,7 +67,7 @@ CASES = {
         "what": "elastic sphere (quarter sphere, radius 1) pressed on a rigid plane by a displacement 0.01 of its equator plane",
     },
     "cylinder-indenter": {
-        "dim": 2, "shape": geometry.block, "parts": 2, "vi": False, "near": 0.06, "h_far": 0.05, "width": 0.3,
+        "dim": 2, "shape": geometry.block, "parts": 2, "near": 0.06, "h_far": 0.05, "width": 0.3,
         "h_near": [0.004, 0.002, 0.001],
         "args": ["-scene", "general", "-contact_faces", "contact", "-bc_clamp", "bottom", "-bc_slip", "symmetry_x",
                  "-bc_slip_symmetry_x_components", "0", "-obstacle", "cylinder", "-obstacle_center", "0,1", "-obstacle_radius", "1",
@@ -75,7 +75,7 @@ CASES = {
         "what": "rigid cylinder (radius 1) indenting an elastic block [0,1] x [-1,0] (clamped bottom) by 0.001",
     },
     "sphere-indenter": {
-        "dim": 3, "shape": geometry.quarter_block, "parts": 4, "vi": False, "near": 0.2, "h_far": 0.15, "width": 0.5,
+        "dim": 3, "shape": geometry.quarter_block, "parts": 4, "near": 0.2, "h_far": 0.15, "width": 0.5,
         "h_near": [0.02, 0.01, 0.007],
         "args": ["-scene", "general", "-contact_faces", "contact", "-bc_clamp", "bottom", "-bc_slip", "symmetry_x,symmetry_y",
                  "-bc_slip_symmetry_x_components", "0", "-bc_slip_symmetry_y_components", "1", "-obstacle", "sphere",

@@ -383,6 +383,20 @@ PetscErrorCode ContactScaleBounds(Contact ct, PetscReal s)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The SNES's unknowns: v <- Q^T v (to_solver) or v <- Q v, Q the orthogonal change to the frames of vi_frames.c where
+   the type has them, the identity otherwise. */
+PetscErrorCode ContactSolverFrame(Contact ct, Vec v, PetscBool to_solver)
+{
+  PetscFunctionBeginUser;
+  if (ct->has_frames && ct->ops.frame) PetscCall((*ct->ops.frame)(ct, v, to_solver));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscBool ContactHasFrames(Contact ct)
+{
+  return ct->has_frames;
+}
+
 PetscErrorCode ContactSameActivity(Contact ct, DM dm, Vec X, Vec Y, PetscBool *same)
 {
   PetscFunctionBeginUser;

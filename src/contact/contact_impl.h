@@ -20,6 +20,7 @@ typedef struct {
   PetscErrorCode (*check)(Contact, DM, Vec u);                          /* -assembly_check after the solve (NULL: none) */
   PetscErrorCode (*scale_bounds)(Contact, PetscReal);                   /* the bounds times a factor (NULL: none) */
   PetscErrorCode (*load)(Contact, DM);                                  /* after the set's gaps changed, ContactSetLoad() (NULL: none) */
+  PetscErrorCode (*frame)(Contact, Vec, PetscBool to_solver);           /* v <- Q^T v or Q v, the SNES's own frame (NULL: none) */
   PetscErrorCode (*view)(Contact, PetscViewer);                         /* the type's part of the summary line */
 } ContactOps;
 
@@ -30,7 +31,8 @@ struct _p_Contact {
   void          *data;        /* the type's own state */
   PetscBool      has_penalty; /* set by the type's create function */
   PetscBool      has_bounds;
-  ContactOptions opt; /* read once by ContactSetFromOptions() */
+  PetscBool      has_frames; /* the SNES iterates in frames of its own at some nodes (vi on this mesh; ops.frame) */
+  ContactOptions opt;        /* read once by ContactSetFromOptions() */
 
   /* on the mesh of ContactSetUp() */
   PetscBool    set_up;
@@ -58,6 +60,23 @@ PetscErrorCode ContactSetFree(ContactSet *cs);
 PetscReal      ContactEpsFactor(Contact ct, PetscReal h_local);
 PetscErrorCode ContactComputeBdResidual(Contact ct, DM dm, PetscWeakForm wf, PetscInt part, Vec locX, Vec locF);
 PetscErrorCode ContactGetLocalSolution(Contact ct, DM dm, Vec X, Vec *locX);
+
+/* vi_frames.c: the rotated frames of SNESVI at the contact nodes whose normal is not an axis */
+typedef struct {
+  PetscInt         nrotated;       /* nodes of all ranks whose normal needs a frame now (0: no frames, the SNES iterates on u) */
+  PetscInt         n;              /* this rank's nodes that may carry a frame (two or more free components) */
+  PetscInt        *node;           /*   their index in the contact set */
+  PetscReal       *R;              /*   [n][3][3] row-major: u_free = R w_free, column 0 along the normal's free part */
+  Mat              Q;              /* u = Q w: block diagonal, orthogonal */
+  PetscObjectState state;          /* of the frames, counted by ViFramesUpdate() */
+  PetscObjectState operator_state; /* of the frames Q^T K Q was made for */
+} ViFrames;
+void           ViNodeConstraint(const ContactSet *cs, PetscInt dim, PetscInt i, PetscInt *comp, PetscReal *coef, PetscReal *rhs, PetscBool *rotate);
+PetscErrorCode ViFramesSetUp(MPI_Comm comm, const ContactSet *cs, PetscInt dim, Vec like, ViFrames *fr);
+PetscErrorCode ViFramesUpdate(const ContactSet *cs, PetscInt dim, ViFrames *fr);
+PetscErrorCode ViFramesApply(const ContactSet *cs, PetscInt dim, const ViFrames *fr, Vec v, PetscBool to_solver);
+PetscErrorCode ViFramesOperator(const ContactSet *cs, PetscInt dim, ViFrames *fr, Mat K, Mat *Kw);
+PetscErrorCode ViFramesDestroy(ViFrames *fr);
 
 /* the types */
 PetscErrorCode ContactCreate_Penalty(Contact ct);

@@ -1,34 +1,22 @@
 /* The Contact type "vi", the reference for the exact constraint: u . n <= g as bounds of SNESVI on one unknown of each
-   Gamma_C node, which needs the obstacle's normal along a coordinate axis at that node (a flat foundation normal to an
-   axis, for example). The contact pressure is the reaction of the bound (ContactPostProcess()). */
+   Gamma_C node: the component along n where n is a coordinate axis, the normal unknown of the node's rotated frame
+   everywhere else (vi_frames.c: tilted planes, spheres, cylinders). The contact pressure is the reaction of the bound
+   (ContactPostProcess()). */
 #include "contact_impl.h"
 
 typedef struct {
-  Vec xl, xu; /* SNESVI's bounds */
+  Vec      xl, xu; /* SNESVI's bounds, on the SNES's unknowns (the frames' where there are frames) */
+  ViFrames frames;
+  Mat      K;  /* the bulk operator (referenced), and */
+  Mat      Kw; /* Q^T K Q, the SNES's Jacobian where there are frames */
 } Contact_VI;
 
-/* The axis k and the sign s of n = s e_k, or k = -1 when n is not along an axis. */
-static void AxisOfNormal(PetscInt dim, const PetscReal n[], PetscInt *axis, PetscReal *sign)
-{
-  PetscInt count = 0;
-
-  *axis = -1;
-  *sign = 0.0;
-  for (PetscInt d = 0; d < dim; ++d)
-    if (PetscAbsReal(n[d]) > 1e-12) {
-      ++count;
-      *axis = d;
-    }
-  if (count != 1 || PetscAbsReal(PetscAbsReal(n[*axis]) - 1.0) > 1e-12) {
-    *axis = -1;
-    return;
-  }
-  *sign = n[*axis] > 0.0 ? 1.0 : -1.0;
-}
-
-/* The bounds from the set's gaps and normals: n = +e_k: u_k <= g;  n = -e_k: u_k >= -g. Every other unknown is free; a
-   fixed axis component needs no bound. At set-up, and again at each load state of a path (the obstacle's translation
-   changes the gaps), before the SNES scales them (SolverSNESSolve()). Refused where a normal is not an axis. */
+/* The bounds from the set's gaps and normals (ViNodeConstraint(): coef x <= rhs on the node's one constrained
+   unknown): x <= rhs / coef for coef > 0 (n = +e_k: u_k <= g; a frame's w_n), x >= rhs / coef for coef < 0 (n = -e_k:
+   u_k >= -g). Every other unknown is free; a node whose normal meets no free component needs no bound. At set-up, and
+   again at each load state of a path (the obstacle's translation changes the gaps and a curved obstacle's normals),
+   before the SNES scales them (SolverSNESSolve()). A normal that needs a frame on a mesh set up without frames (the
+   obstacle's normals were all axes then) is refused. */
 static PetscErrorCode FillBounds(Contact ct)
 {
   Contact_VI       *vi   = (Contact_VI *)ct->data;
@@ -39,26 +27,28 @@ static PetscErrorCode FillBounds(Contact ct)
   PetscScalar      *xl, *xu;
 
   PetscFunctionBeginUser;
+  PetscCall(ViFramesUpdate(cs, dim, &vi->frames));
   PetscCall(VecSet(vi->xl, PETSC_NINFINITY));
   PetscCall(VecSet(vi->xu, PETSC_INFINITY));
   PetscCall(VecGetArray(vi->xl, &xl));
   PetscCall(VecGetArray(vi->xu, &xu));
   for (PetscInt i = 0; i < cs->n; ++i) {
-    PetscInt  axis, k;
-    PetscReal sign;
+    PetscInt  comp, k;
+    PetscReal coef, rhs;
+    PetscBool rotate;
 
-    AxisOfNormal(dim, &cs->normal[i * dim], &axis, &sign);
-    if (axis < 0) {
+    ViNodeConstraint(cs, dim, i, &comp, &coef, &rhs, &rotate);
+    if (comp < 0) continue; /* the normal component is prescribed */
+    if (rotate && !vi->frames.nrotated) {
       if (bad < 0) bad = i;
       ++nbad;
       continue;
     }
-    k = cs->dof[i * dim + axis];
-    if (k < 0) continue; /* the normal component is prescribed */
-    if (sign > 0.0)
-      xu[k] = cs->gap[i];
+    k = cs->dof[i * dim + comp];
+    if (coef > 0.0)
+      xu[k] = rhs / coef;
     else
-      xl[k] = -cs->gap[i];
+      xl[k] = rhs / coef;
   }
   PetscCall(VecRestoreArray(vi->xl, &xl));
   PetscCall(VecRestoreArray(vi->xu, &xu));
@@ -75,10 +65,12 @@ static PetscErrorCode FillBounds(Contact ct)
       for (PetscInt d = 0; d < dim; ++d) n[d] = cs->normal[bad * dim + d];
     PetscCallMPI(MPI_Bcast(n, 3, MPIU_REAL, first, comm));
     SETERRQ(comm, PETSC_ERR_USER_INPUT,
-            "-contact_method vi needs the obstacle's normal along a coordinate axis at every contact node (its bounds act on one unknown each); "
-            "%" PetscInt_FMT " contact nodes of the scene have another normal, for example (%g, %g, %g): use -contact_method penalty",
+            "-contact_method vi: the obstacle's normals were coordinate axes at every contact node when the mesh was set up, and now "
+            "%" PetscInt_FMT
+            " contact nodes have another normal, for example (%g, %g, %g): start the load path where the normals are as they will be",
             total, (double)n[0], (double)n[1], (double)n[2]);
   }
+  if (vi->Kw && vi->frames.operator_state != vi->frames.state) PetscCall(ViFramesOperator(cs, dim, &vi->frames, vi->K, &vi->Kw));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -89,6 +81,8 @@ static PetscErrorCode ContactSetUp_VI(Contact ct, DM dm)
   PetscFunctionBeginUser;
   PetscCall(DMCreateGlobalVector(dm, &vi->xl));
   PetscCall(DMCreateGlobalVector(dm, &vi->xu));
+  PetscCall(ViFramesSetUp(ct->comm, &ct->set, ct->dim, vi->xl, &vi->frames));
+  ct->has_frames = (PetscBool)(vi->frames.nrotated > 0);
   PetscCall(FillBounds(ct));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -108,15 +102,33 @@ static PetscErrorCode ContactReset_VI(Contact ct)
   PetscFunctionBeginUser;
   PetscCall(VecDestroy(&vi->xl));
   PetscCall(VecDestroy(&vi->xu));
+  PetscCall(ViFramesDestroy(&vi->frames));
+  ct->has_frames = PETSC_FALSE;
+  PetscCall(MatDestroy(&vi->K));
+  PetscCall(MatDestroy(&vi->Kw));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* SNESVI's reduced-space method with the bounds; the options may choose vinewtonssls instead. */
+/* SNESVI's reduced-space method with the bounds; the options may choose vinewtonssls instead. With frames, the
+   Jacobian is Q^T K Q (made once per mesh and frames; the SNES's Jacobian callback leaves it as it is). */
 static PetscErrorCode ContactSetUpSNES_VI(Contact ct, DM dm, SNES snes)
 {
   Contact_VI *vi = (Contact_VI *)ct->data;
 
   PetscFunctionBeginUser;
+  if (vi->frames.nrotated) {
+    Mat K;
+
+    PetscCall(SNESGetJacobian(snes, &K, NULL, NULL, NULL));
+    if (vi->K != K) {
+      PetscCall(PetscObjectReference((PetscObject)K));
+      PetscCall(MatDestroy(&vi->K));
+      PetscCall(MatDestroy(&vi->Kw));
+      vi->K = K;
+    }
+    if (!vi->Kw || vi->frames.operator_state != vi->frames.state) PetscCall(ViFramesOperator(&ct->set, ct->dim, &vi->frames, vi->K, &vi->Kw));
+    PetscCall(SNESSetJacobian(snes, vi->Kw, vi->Kw, NULL, NULL)); /* the callback stays */
+  }
   PetscCall(SNESSetType(snes, SNESVINEWTONRSLS));
   PetscCall(SNESVISetVariableBounds(snes, vi->xl, vi->xu));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -133,6 +145,16 @@ static PetscErrorCode ContactScaleBounds_VI(Contact ct, PetscReal s)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* v <- Q^T v (to the SNES's unknowns) or v <- Q v (back to u). */
+static PetscErrorCode ContactFrame_VI(Contact ct, Vec v, PetscBool to_solver)
+{
+  Contact_VI *vi = (Contact_VI *)ct->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(ViFramesApply(&ct->set, ct->dim, &vi->frames, v, to_solver));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode ContactCreate_VI(Contact ct)
 {
   Contact_VI *vi;
@@ -146,5 +168,6 @@ PetscErrorCode ContactCreate_VI(Contact ct)
   ct->ops.setup_snes   = ContactSetUpSNES_VI;
   ct->ops.scale_bounds = ContactScaleBounds_VI;
   ct->ops.load         = ContactLoad_VI;
+  ct->ops.frame        = ContactFrame_VI;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

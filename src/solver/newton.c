@@ -42,14 +42,16 @@ PetscErrorCode SolverBulkResidual(SolverCtx sc, Vec X, Vec R)
 /* The SNES works on x~ = u/U with the residual F~(x~) = F(U x~)/U, U = sc->snes_scale a power of 2 (exact in floating
    point): F~ has the Jacobian of F, so Newton's iterates are U times smaller and the same, while the absolute tolerances
    inside PETSc (SNESVI's bound tolerance, the line searches' maximal step) see a displacement of size one in any units.
-   The displacement of the iterate, U x~, goes to sc->work. */
+   The displacement of the iterate, U x~, goes to sc->work; with SNESVI's rotated frames (ContactSolverFrame()) the SNES's
+   unknowns are x~ = Q^T u/U and the displacement U Q x~. */
 PetscErrorCode SolverIterateDisplacement(SolverCtx sc, Vec X, Vec *u)
 {
   PetscFunctionBeginUser;
   *u = X;
-  if (sc->snes_scale == 1.0) PetscFunctionReturn(PETSC_SUCCESS);
+  if (sc->snes_scale == 1.0 && !ContactHasFrames(sc->contact)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(VecCopy(X, sc->work));
-  PetscCall(VecScale(sc->work, sc->snes_scale));
+  PetscCall(ContactSolverFrame(sc->contact, sc->work, PETSC_FALSE));
+  if (sc->snes_scale != 1.0) PetscCall(VecScale(sc->work, sc->snes_scale));
   *u = sc->work;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -88,6 +90,7 @@ PetscErrorCode SolverFormFunction(SNES snes, Vec X, Vec F, void *ctx)
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(SolverIterateDisplacement(sc, X, &u));
   PetscCall(SolverResidual(sc, dm, u, F));
+  PetscCall(ContactSolverFrame(sc->contact, F, PETSC_TRUE)); /* F_w = Q^T F(Q w) */
   if (sc->snes_scale != 1.0) PetscCall(VecScale(F, 1.0 / sc->snes_scale));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

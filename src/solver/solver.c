@@ -338,7 +338,8 @@ static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* SNESSolve on x~ = u/U (and the bounds of SNESVI divided by U): see SolverIterateDisplacement(). */
+/* SNESSolve on x~ = u/U, or Q^T u/U in SNESVI's frames (and the bounds of SNESVI divided by U): see
+   SolverIterateDisplacement(). */
 static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
 {
   const PetscReal U = user->prob.displacement_scale;
@@ -346,9 +347,11 @@ static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
   PetscFunctionBeginUser;
   user->prob.sctx->snes_scale = U;
   PetscCall(VecScale(u, 1.0 / U));
+  PetscCall(ContactSolverFrame(user->contact, u, PETSC_TRUE)); /* the SNES's unknowns: Q^T u/U */
   PetscCall(ContactScaleBounds(user->contact, 1.0 / U));
   PetscCall(SNESSolve(snes, NULL, u));
   PetscCall(SolverStepGuessDrop(user->prob.sctx)); /* unused if no linear solve came */
+  PetscCall(ContactSolverFrame(user->contact, u, PETSC_FALSE));
   PetscCall(VecScale(u, U));
   PetscCall(ContactScaleBounds(user->contact, U));
   user->prob.sctx->snes_scale = 1.0;
