@@ -1,7 +1,9 @@
 """An independent solution of the nodal penalty contact problem with every boundary-condition family, by GetFEM
 (Debian's python3-getfem) on the very mesh the solver reads: GetFEM assembles the plane-strain stiffness, the body
 force, the traction, the pressure and the lumped contact masses; the obstacle's gap and normal, the Dirichlet
-elimination and the semismooth Newton iteration are written here in numpy, from the formulas, not from the solver."""
+elimination and the semismooth Newton iteration are written here in numpy, from the formulas, not from the solver.
+solve_exact(): the exact nodal contact (u . n <= g at every contact node, the reference of -contact_method vi) on the
+same GetFEM operators, by a primal-dual active set iteration on the saddle-point system with the nodal multipliers."""
 import gmsh
 import numpy as np
 
@@ -60,18 +62,20 @@ def obstacle_normal_gap(x, obstacle="cylinder"):
     return -r / dist[:, None], dist - RADIUS
 
 
-def solver_options(obstacle="cylinder"):
-    """The same problem as bin/signorini options (scene general, nodal penalty quadrature, a fixed eps)."""
+def solver_options(obstacle="cylinder", method="penalty"):
+    """The same problem as bin/signorini options (scene general; the nodal penalty quadrature with a fixed eps, or
+    method "vi": SNESVI)."""
+    contact = (["-penalty_quadrature", "nodal", "-penalty_eps", EPS] if method == "penalty" else ["-contact_method", "vi"])
     return ["-scene", "general", "-young_modulus", E, "-poisson_ratio", NU, "-contact_faces", "contact_a,contact_b",
             "-bc_clamp", "clamp", "-bc_clamp_clamp_translate", f"{CLAMP[0]},{CLAMP[1]}", "-bc_slip", "left",
             "-bc_slip_left_components", "0", "-bc_slip_left_translate", f"{SLIP_LEFT},0", "-bc_traction", "traction",
             "-bc_traction_traction", f"{TRACTION[0]},{TRACTION[1]}", "-bc_pressure", "right", "-bc_pressure_right", PRESSURE,
-            "-body_force", f"{BODY_FORCE[0]},{BODY_FORCE[1]}"] + obstacle_options(obstacle) + [
-            "-penalty_quadrature", "nodal", "-penalty_eps", EPS, "-snes_rtol", "1e-14"]
+            "-body_force", f"{BODY_FORCE[0]},{BODY_FORCE[1]}"] + obstacle_options(obstacle) + contact + ["-snes_rtol", "1e-14"]
 
 
-def solve(path, tol=1e-13, max_it=50, obstacle="cylinder"):
-    """(vertex coordinates [n, 2], displacement [n, 2], contact force) of the nodal penalty problem on the mesh at path."""
+def operators(path, obstacle):
+    """GetFEM's K, F, the dofs' coordinates, the Dirichlet dofs and values, the contact nodes with their normals, gaps
+    and lumped masses, on the mesh at path."""
     import getfem as gf
 
     lam, mu = E * NU / ((1 + NU) * (1 - 2 * NU)), E / (2 * (1 + NU))
@@ -98,6 +102,12 @@ def solve(path, tol=1e-13, max_it=50, obstacle="cylinder"):
     nodes = np.unique(np.concatenate([mfu.basic_dof_on_region(GROUPS[r]) for r in ("contact_a", "contact_b")]) // 2)
     normal, gap = obstacle_normal_gap(x[2 * nodes], obstacle)
     weight = W[2 * nodes]
+    return K, F, x, fixed, value, nodes, normal, gap, weight
+
+
+def solve(path, tol=1e-13, max_it=50, obstacle="cylinder"):
+    """(vertex coordinates [n, 2], displacement [n, 2], contact force) of the nodal penalty problem on the mesh at path."""
+    K, F, x, fixed, value, nodes, normal, gap, weight = operators(path, obstacle)
     free = ~fixed
     u = value.copy()
     for _ in range(max_it):
@@ -117,3 +127,42 @@ def solve(path, tol=1e-13, max_it=50, obstacle="cylinder"):
         raise RuntimeError("the GetFEM reference Newton did not converge")
     force = float(np.sum(weight / EPS * np.maximum(d, 0.0)))
     return x[0::2], u.reshape(-1, 2), force
+
+
+def solve_exact(path, max_it=50, obstacle="cylinder"):
+    """(vertex coordinates, displacement, contact force) of the exact nodal contact: K u = F - N^T lam, N u <= g,
+    lam >= 0, lam . (g - N u) = 0, with N's row k the normal n_k at node k's two dofs. The primal-dual active set
+    iteration: A = {k : lam_k + c (N u - g)_k > 0}; on A the constraint holds as an equality, off A lam_k = 0; it stops
+    when A repeats. The Dirichlet values are eliminated; a node's fixed component moves its part of n . u to the right
+    side. The force is sum(lam), the multipliers being the nodal normal reactions."""
+    K, F, x, fixed, value, nodes, normal, gap, weight = operators(path, obstacle)
+    free = np.nonzero(~fixed)[0]
+    m = len(nodes)
+    N = np.zeros((m, K.shape[0]))
+    for k, node in enumerate(nodes):
+        N[k, 2 * node:2 * node + 2] = normal[k]
+    g = gap - N[:, fixed] @ value[fixed]  # N_free u_free <= g - N_fixed u_fixed
+    Nf, Kff, Ff = N[:, free], K[np.ix_(free, free)], F[free] - K[np.ix_(free, fixed)] @ value[fixed]
+    c = float(np.max(np.diag(Kff)))  # any positive c; K's scale makes lam and c (N u - g) comparable
+    lam, uf = np.zeros(m), np.linalg.solve(Kff, Ff)
+    active = None
+    for _ in range(max_it):
+        new = lam + c * (Nf @ uf - g) > 0
+        if active is not None and np.array_equal(new, active):
+            break
+        active = new
+        a = np.nonzero(active)[0]
+        n_a = len(a)
+        S = np.zeros((len(free) + n_a, len(free) + n_a))
+        S[:len(free), :len(free)] = Kff
+        S[:len(free), len(free):] = Nf[a].T
+        S[len(free):, :len(free)] = Nf[a]
+        sol = np.linalg.solve(S, np.concatenate([Ff, g[a]]))
+        uf, lam = sol[:len(free)], np.zeros(m)
+        lam[a] = sol[len(free):]
+    else:
+        raise RuntimeError("the exact-contact active set iteration did not settle")
+    assert np.all(lam >= -1e-12 * max(1.0, np.max(np.abs(lam)))) and np.all(Nf @ uf - g <= 1e-12), "not a solution"
+    u = value.copy()
+    u[free] = uf
+    return x[0::2], u.reshape(-1, 2), float(np.sum(lam))

@@ -63,3 +63,30 @@ def test_tilted_plane_against_getfem(outdir, problem_plane):
     n, g = ref.obstacle_normal_gap(fields["x"][on], "plane")
     un = np.sum(fields["displacement"][on] * n, axis=1)
     assert np.max(np.abs(fields["normal_gap"][on] - (g - un))) < 1e-12
+
+
+@pytest.fixture(scope="module")
+def exact(problem):
+    path = problem[0]
+    return {obstacle: ref.solve_exact(path, obstacle=obstacle) for obstacle in ("cylinder", "plane")}
+
+
+@pytest.mark.parametrize("obstacle,ranks", [("cylinder", 1), ("cylinder", 2), ("plane", 1)])
+def test_snesvi_against_getfem_exact_contact(outdir, problem, exact, obstacle, ranks):
+    """SNESVI (-contact_method vi) on the disk and on the tilted plane, whose normals are no axis at any contact node
+    (the rotated frames of src/contact/vi_frames.c), against the exact nodal contact on GetFEM's operators
+    (getfem_reference.solve_exact: an active set iteration on the saddle-point system, in numpy): the displacements
+    agree to 1e-8 of their size, the contact force (sum of the multipliers there, of the nodal reactions here) to 1e-8."""
+    path = problem[0]
+    x_ref, u_ref, force_ref = exact[obstacle]
+    _, h5 = run(["-dm_plex_filename", path] + ref.solver_options(obstacle, "vi"), "vi", np_=ranks, output=os.path.join(outdir, "vi.h5"))
+    attrs, fields = load(h5)
+    assert attrs["converged"] == 1 and attrs["method"] == "vi"
+    assert 3 < attrs["active_vertices"] < attrs["contact_nodes"], (attrs["active_vertices"], attrs["contact_nodes"])
+    order_ref = np.lexsort(np.round(x_ref, 9).T)
+    order = np.lexsort(np.round(fields["x"], 9).T)
+    assert np.allclose(x_ref[order_ref], fields["x"][order], atol=1e-12)
+    diff = np.max(np.abs(u_ref[order_ref] - fields["displacement"][order]))
+    scale = np.max(np.abs(u_ref))
+    assert diff < 1e-8 * scale, f"max difference {diff:.3e} against GetFEM's exact contact (displacement scale {scale:.3e})"
+    assert abs(attrs["contact_force"] / force_ref - 1) < 1e-8, (attrs["contact_force"], force_ref)
