@@ -326,6 +326,23 @@ def measure_load_path(out, s, pairs):
     return rows
 
 
+def measure_vi(out, s, pairs):
+    """SNESVI (issue 33) on the 3D sphere indenter of make hertz, whose normals are no axis (its rotated frames), against
+    the penalty at eps = h/10 on the same mesh (make hertz's finest, h_near 0.007; --small: 0.02), side by side, each
+    with its default solver: at most 3 times the penalty's time."""
+    from signorini import hertz
+    h_near = 0.007 if s == 1 else 0.02
+    mesh = os.path.join(out, hertz.mesh_name("sphere-indenter", h_near))
+    if not os.path.isfile(mesh):
+        hertz.write_mesh("sphere-indenter", h_near, mesh)
+    opts = lambda m: hertz.command("sphere-indenter", mesh, m, "unused.h5")[4:-2]  # noqa: E731  (without mpiexec, the binary and -output)
+    r = side_by_side({"vi_sphere": ([], 1, opts("vi")), "penalty_h10_sphere": ([], 1, opts("eps=h/10"))}, pairs, out)
+    v, p = r["vi_sphere"], r["penalty_h10_sphere"]
+    return [row(f"SNESVI on the 3D sphere indenter (h_near {h_near}, {int(v[2]['n_dofs'])} unknowns, rotated frames) <= 3 times the penalty at eps = h/10",
+                f"{v[0] / p[0]:.2f} ({v[0]:.2f} s / {p[0]:.2f} s; {pair_range(v, p)}; {int(v[2]['newton_its'])} and {int(p[2]['newton_its'])} Newton steps)",
+                v[0] / p[0] <= 3.0, "bin/signorini (make hertz's sphere-indenter options) [-contact_method vi | -penalty_eps0 0.1]")]
+
+
 def measure_getfem(out, s, pairs):
     """The ratio of bench/getfem.csv (scripts/bench_getfem.py)."""
     gcsv = os.path.join(os.path.dirname(os.path.dirname(out)), "getfem.csv")
@@ -338,7 +355,7 @@ def measure_getfem(out, s, pairs):
 
 
 SECTIONS = {"default": measure_default, "mg": measure_mg, "iterations": measure_iterations, "eps": measure_eps, "parallel": measure_parallel, "getfem": measure_getfem,
-            "estimate": measure_estimate, "load_path": measure_load_path}
+            "estimate": measure_estimate, "load_path": measure_load_path, "vi": measure_vi}
 
 
 def rows_of_table(path):
