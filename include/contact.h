@@ -94,6 +94,7 @@ PetscBool      ContactHasFrames(Contact ct);
 PetscErrorCode ContactCountActive(Contact ct, Vec X, PetscReal tol_scale, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left);
 PetscErrorCode ContactPenetrationHash(Contact ct, Vec X, PetscInt64 *hash);
 PetscErrorCode ContactMaxNodePenetration(Contact ct, Vec u, PetscReal *dmax);
+PetscErrorCode ContactMaxPenetration(Contact ct, DM dm, Vec u, PetscReal *dmax); /* the nodes' and the rule's points' */
 
 /* After the solve: the pressure and the reaction at each node (kept in the contact set), the force, the active set, the energy */
 PetscErrorCode ContactPostProcess(Contact ct, DM dm, Vec R, Vec u, PetscReal tol_scale, ContactResult *res);

@@ -116,6 +116,7 @@ typedef struct {
   PetscReal         continuation_factor;        /* ratio of two consecutive eps of the sequence, in (0, 1) */
   PetscReal        *eps0_sweep;                 /* eps0 values solved in turn on the final mesh, each from the last solution (any number) */
   PetscInt          n_sweep;
+  PetscReal         penetration_tol; /* the largest penetration allowed: eps lowered from the measured one until then (0: none) */
 } ContactOptions;
 
 /* PETSc's own options whose presence changes the project's defaults ("where the options say nothing"), read with the
@@ -278,16 +279,18 @@ typedef struct {
   PetscBool           roundoff_stop;                   /* or Newton stalled at the round-off of the terms the residual sums */
   SNESConvergedReason reason;
   PetscReal           residual_norm;
-  PetscReal           residual_start;      /* |F| at the start of the last Newton solve */
-  PetscInt            continuation_stages; /* solves of the eps sequence before the target eps (0: none) */
-  PetscInt            force_control_its;   /* positions of the obstacle solved by force control (-obstacle_force), all steps */
-  PetscInt            active_set_cycles;   /* active-set cycles detected (and damped) in the Newton iterations */
-  PetscInt            pc_builds;           /* preconditioner (factorization) builds of the Newton steps */
-  PetscInt            pc_updates;          /* updates of a GAMG hierarchy's coarse operators instead of builds (-contact_pc_update) */
-  PetscBool           coarse_mg;           /* the coarser boxes solved with the geometric multigrid of the boxes below, if any */
-  PetscInt            pc_breakdowns;       /* preconditioner breakdowns recovered from (pc_recovery.c), */
-  char                pc_recovery[512];    /*   and what was done, "; "-separated */
-  PetscBool           ksp_ew;              /* Eisenstat-Walker linear tolerances (-snes_ksp_ew) */
+  PetscReal           residual_start;           /* |F| at the start of the last Newton solve */
+  PetscInt            continuation_stages;      /* solves of the eps sequence before the target eps (0: none) */
+  PetscInt            force_control_its;        /* positions of the obstacle solved by force control (-obstacle_force), all steps */
+  PetscInt            penetration_tol_solves;   /* solves at the values of eps of -contact_penetration_tol (0 without it) */
+  PetscReal           penetration_tol_measured; /*   the largest penetration at the nodes and the rule's points it ended with */
+  PetscInt            active_set_cycles;        /* active-set cycles detected (and damped) in the Newton iterations */
+  PetscInt            pc_builds;                /* preconditioner (factorization) builds of the Newton steps */
+  PetscInt            pc_updates;               /* updates of a GAMG hierarchy's coarse operators instead of builds (-contact_pc_update) */
+  PetscBool           coarse_mg;                /* the coarser boxes solved with the geometric multigrid of the boxes below, if any */
+  PetscInt            pc_breakdowns;            /* preconditioner breakdowns recovered from (pc_recovery.c), */
+  char                pc_recovery[512];         /*   and what was done, "; "-separated */
+  PetscBool           ksp_ew;                   /* Eisenstat-Walker linear tolerances (-snes_ksp_ew) */
   Bandwidth           bandwidth;
   PetscReal           condition_1norm;                      /* estimate of cond_1 of the final Jacobian, NaN if not computed */
   PetscReal           peak_memory_mb, peak_memory_total_mb; /* resident set size: maximum over ranks, and summed */

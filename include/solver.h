@@ -36,6 +36,7 @@ PetscErrorCode SolverGivenEsteig(const SolverGiven *g, const char prefix[], Pets
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
 PetscErrorCode GridSequenceBarsSizes(DM dm, const AppCtx *user);
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
+PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u); /* penetration_tol.c: -contact_penetration_tol */
 
 /* load_path.c: -load_steps, -load_path */
 PetscErrorCode LoadPathGetOptions(MPI_Comm comm, LoadPathOptions *lp);

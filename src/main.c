@@ -156,7 +156,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
 
   PetscCall(GridSequenceSolve(&dm, &user, &snes, &u)); /* one solve without nested iteration */
   PetscCall(EpsSweepSolve(dm, &user, snes, u));
-  PetscCall(LoadPathSolve(dm, &user, snes, u)); /* the steps after the first, each from the last */
+  PetscCall(PenetrationTolSolve(dm, &user, snes, u)); /* -contact_penetration_tol: eps lowered until the penetration is reached */
+  PetscCall(LoadPathSolve(dm, &user, snes, u));       /* the steps after the first, each from the last */
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
   PetscCall(BarsCompute(dm, &user));             /* -bars: from the levels' quantities and this mesh's */

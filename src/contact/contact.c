@@ -51,7 +51,7 @@ PetscErrorCode ContactSetFromOptions(Contact ct)
   MPI_Comm        comm              = ct->comm;
   ContactOptions *opts              = &ct->opt;
   PetscErrorCode (*create)(Contact) = NULL;
-  PetscBool eps_set, sweep_set;
+  PetscBool eps_set, sweep_set, tol_set;
 
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, NULL, "Contact on Gamma_C", "Signorini");
@@ -88,10 +88,15 @@ PetscErrorCode ContactSetFromOptions(Contact ct)
   PetscCall(PetscOptionsRealArray("-penalty_eps0_sweep", "eps0 values solved in turn on the final mesh, each from the last solution", NULL,
                                   opts->eps0_sweep, &opts->n_sweep, &sweep_set));
   if (!sweep_set) opts->n_sweep = 0;
+  opts->penetration_tol = 0.0;
+  PetscCall(PetscOptionsReal("-contact_penetration_tol",
+                             "Largest penetration allowed, a length: eps is lowered from the measured penetration until it is reached "
+                             "(src/solver/penetration_tol.c)",
+                             NULL, opts->penetration_tol, &opts->penetration_tol, &tol_set));
   PetscOptionsEnd();
   {
-    const char *names[]  = {"-penalty_eps0", "-penalty_eps_power", "-penalty_eps", "-penalty_continuation_factor"};
-    PetscReal   values[] = {opts->eps0, opts->eps_power, opts->eps_fixed, opts->continuation_factor};
+    const char *names[]  = {"-penalty_eps0", "-penalty_eps_power", "-penalty_eps", "-penalty_continuation_factor", "-contact_penetration_tol"};
+    PetscReal   values[] = {opts->eps0, opts->eps_power, opts->eps_fixed, opts->continuation_factor, opts->penetration_tol};
 
     for (size_t i = 0; i < sizeof(values) / sizeof(values[0]); ++i) PetscCall(OptionsCheckFinite(comm, names[i], values[i]));
     PetscCall(OptionsCheckFiniteArray(comm, "-penalty_eps0_sweep", opts->n_sweep, opts->eps0_sweep));
@@ -107,6 +112,12 @@ PetscErrorCode ContactSetFromOptions(Contact ct)
                (double)opts->eps0_sweep[k]);
   PetscCheck(!(sweep_set && eps_set), comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep cannot be given together with -penalty_eps");
   PetscCheck(!sweep_set || ct->has_penalty, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep needs -contact_method penalty");
+  PetscCheck(!tol_set || opts->penetration_tol > 0.0, comm, PETSC_ERR_USER_INPUT, "-contact_penetration_tol must be positive, got %g",
+             (double)opts->penetration_tol);
+  PetscCheck(!tol_set || ct->has_penalty, comm, PETSC_ERR_USER_INPUT,
+             "-contact_penetration_tol needs -contact_method penalty (SNESVI's penetration is zero at the nodes already)");
+  PetscCheck(!(tol_set && sweep_set), comm, PETSC_ERR_USER_INPUT,
+             "-contact_penetration_tol and -penalty_eps0_sweep both choose the values of eps: give one of them");
   if (opts->n_sweep) opts->eps0 = opts->eps0_sweep[0]; /* the sweep starts with its first value, in place of -penalty_eps0 */
   PetscCheck(opts->continuation_factor > 0.0 && opts->continuation_factor < 1.0, comm, PETSC_ERR_USER_INPUT,
              "-penalty_continuation_factor must lie in (0, 1), got %g", (double)opts->continuation_factor);
@@ -402,6 +413,25 @@ PetscErrorCode ContactSameActivity(Contact ct, DM dm, Vec X, Vec Y, PetscBool *s
   PetscFunctionBeginUser;
   *same = PETSC_TRUE;
   if (ct->ops.same_activity) PetscCall((*ct->ops.same_activity)(ct, dm, X, Y, same));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The largest penetration u . n - g at u over the contact nodes and the points of the penalty's rule (where they are
+   at hand: ContactPostProcess()'s "max penetration"), on every rank. */
+PetscErrorCode ContactMaxPenetration(Contact ct, DM dm, Vec u, PetscReal *dmax)
+{
+  PetscReal drule = -PETSC_MAX_REAL;
+
+  PetscFunctionBeginUser;
+  PetscCall(ContactMaxNodePenetration(ct, u, dmax));
+  if (ct->ops.acts) {
+    PetscBool *acts;
+
+    PetscCall(PetscMalloc1(ct->set.n + 1, &acts));
+    PetscCall((*ct->ops.acts)(ct, dm, u, acts, &drule));
+    PetscCall(PetscFree(acts));
+  }
+  *dmax = PetscMax(*dmax, drule);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -382,6 +382,16 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     PetscCall(WriteIntAttr(v, "force_control_its", s->force_control_its));
   }
   {
+    const ContactOptions *copt;
+
+    PetscCall(ContactGetOptions(user->contact, &copt));
+    if (copt->penetration_tol > 0.0) { /* -contact_penetration_tol: the tolerance and the solves that reached it (the run's eps the last) */
+      PetscCall(WriteRealAttr(v, "penetration_tol", copt->penetration_tol));
+      PetscCall(WriteIntAttr(v, "penetration_tol_solves", s->penetration_tol_solves));
+      PetscCall(WriteRealAttr(v, "penetration_tol_measured", s->penetration_tol_measured)); /* at the nodes and the rule's points */
+    }
+  }
+  {
     char problem[SCENE_FINGERPRINT_LEN];
 
     PetscCall(SceneFingerprint(&user->scene, &user->opt->material, dim, problem, sizeof(problem)));

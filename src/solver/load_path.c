@@ -57,6 +57,8 @@ PetscErrorCode LoadPathSetUp(MPI_Comm comm, AppCtx *user)
              "-obstacle_force works with -contact_method penalty (its positions' warm solves and force secant are the penalty's)");
   PetscCheck(!opt->bars, comm, PETSC_ERR_USER_INPUT, "-bars measures one load state: give it without %s", what);
   PetscCheck(copt->n_sweep <= 1, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep and %s both solve a sequence: give one of them", what);
+  PetscCheck(!(copt->penetration_tol > 0.0), comm, PETSC_ERR_USER_INPUT, "-contact_penetration_tol and %s both solve a sequence: give one of them",
+             what);
   PetscCheck(!opt->verify.reference[0], comm, PETSC_ERR_USER_INPUT, "-reference compares one load state: give it without %s", what);
   PetscCall(SceneSetLoadFactor(&user->scene, opt->load_path.n ? opt->load_path.factor[0] : 1.0)); /* keeps the data at the factor 1 */
   PetscFunctionReturn(PETSC_SUCCESS);

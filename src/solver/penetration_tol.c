@@ -1,0 +1,79 @@
+/* -contact_penetration_tol d: the penalty run ends when the largest penetration (over the contact nodes and the
+   points of the rule: the output's max_penetration) is at most d, a length, as engineers state it (ANSYS's FTOLN, NX's
+   TMAX, MOOSE's al_penetration_tolerance) instead of an eps. The penetration is the one the contact treatment controls:
+   at the contact nodes and at the rule's points (ContactMaxPenetration(); /run penetration_tol_measured). Between
+   them a curved obstacle cuts the straight faces by up to about h^2 / 8R whatever eps is (the output's
+   max_penetration, measured with the finer quadrature of the error norms, includes it): that part is the mesh's,
+   which only refinement reduces.
+   The penalty law p = (1/eps)[u . n - g]_+ makes the penetration at a point eps times the pressure there, and the
+   pressure tends to the exact contact's as eps -> 0 (the discrete penalty solution tends to SNESVI's linearly in eps,
+   docs/verification.md). So after a solve at eps whose largest penetration d_max exceeds d,
+       eps <- eps * PENETRATION_TOL_AIM * d / d_max
+   predicts a largest penetration of PENETRATION_TOL_AIM d; the aim below 1 is the margin for the pressure's growth as
+   eps falls (a wider zone of smaller penetration). eps falls by at most -penalty_continuation_factor (1e-2) a solve,
+   as in the continuation of a solve from zero (SolverSolve()): a warm start 1e5 times stiffer, the 3D sphere
+   indenter's from eps = h to 1e-5 h in one solve, did not converge in 50 Newton steps. Each solve starts from the last solution, from the third on
+   from the secant of the last two in eps (the eps sweep's start: u(eps) is nearly linear in eps once the penalty dominates); a warm solve that fails
+   (the 3D sphere indenter's from eps = 1e-2 h to 2.7e-4 h stalled at a kink of the penalty, the critical-point line search's steps shrinking to
+   nothing, as force control's did) is solved again from zero, as a direct run. The run's eps is the last one. A run that has not reached d in
+   PENETRATION_TOL_MAX_SOLVES solves, or whose solve failed, is reported failed (converged = 0). Each solve is a row of /solves, with its eps and its
+   largest penetration at the nodes. */
+#include "contact.h"
+#include "solver_impl.h"
+
+#define PENETRATION_TOL_AIM 0.9
+#define PENETRATION_TOL_MAX_SOLVES 12
+
+PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
+{
+  const ContactOptions *copt;
+  MPI_Comm              comm = PetscObjectComm((PetscObject)dm);
+  Vec                   prev = NULL, dir = NULL;
+  PetscReal             d_max, eps, eps_prev = 0.0;
+  PetscInt              solves = 1;
+
+  PetscFunctionBeginUser;
+  PetscCall(ContactGetOptions(user->contact, &copt));
+  if (!(copt->penetration_tol > 0.0) || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactMaxPenetration(user->contact, dm, u, &d_max));
+  PetscCall(ContactGetEps(user->contact, &eps));
+  while (d_max > copt->penetration_tol && user->rec.stats.converged && solves < PENETRATION_TOL_MAX_SOLVES) {
+    const PetscReal eps_new = eps * PetscMax(PENETRATION_TOL_AIM * copt->penetration_tol / d_max, copt->continuation_factor);
+
+    PetscCall(PetscPrintf(comm, "  penetration tolerance: eps = %g gives the largest penetration %g > %g: eps = %g next\n", (double)eps,
+                          (double)d_max, (double)copt->penetration_tol, (double)eps_new));
+    if (!dir) PetscCall(VecDuplicate(u, &dir));
+    if (prev) { /* the secant in eps of the last two solutions */
+      PetscCall(VecWAXPY(dir, -1.0, prev, u));
+      PetscCall(VecCopy(u, prev));
+      PetscCall(ContactSetEps(user->contact, dm, eps_new));
+      PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, (eps_new - eps) / (eps - eps_prev), 0.0, PETSC_TRUE));
+    } else {
+      PetscCall(VecDuplicate(u, &prev));
+      PetscCall(VecCopy(u, prev));
+      PetscCall(ContactSetEps(user->contact, dm, eps_new));
+    }
+    eps_prev = eps;
+    eps      = eps_new;
+    PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
+    if (!user->rec.stats.converged) { /* stalled at a kink of the penalty (the line search's steps shrink to nothing): from zero, as a direct run */
+      PetscCall(PetscPrintf(comm, "  penetration tolerance: the warm solve at eps = %g failed; solving again from zero\n", (double)eps));
+      PetscCall(SolverSolve(snes, user, u, SOLVER_START_ZERO));
+    }
+    ++solves;
+    PetscCall(ContactMaxPenetration(user->contact, dm, u, &d_max));
+  }
+  user->rec.stats.penetration_tol_solves   = solves;
+  user->rec.stats.penetration_tol_measured = d_max;
+  if (user->rec.stats.converged && d_max > copt->penetration_tol) {
+    PetscCall(PetscPrintf(comm,
+                          "  penetration tolerance: the largest penetration %g is above -contact_penetration_tol %g after %" PetscInt_FMT " solves\n",
+                          (double)d_max, (double)copt->penetration_tol, solves));
+    user->rec.stats.converged = PETSC_FALSE;
+  } else if (user->rec.stats.converged)
+    PetscCall(PetscPrintf(comm, "  penetration tolerance: the largest penetration %g <= %g at eps = %g, in %" PetscInt_FMT " solve(s)\n",
+                          (double)d_max, (double)copt->penetration_tol, (double)eps, solves));
+  PetscCall(VecDestroy(&prev));
+  PetscCall(VecDestroy(&dir));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
