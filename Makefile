@@ -23,7 +23,7 @@ SRC = $(wildcard src/*.c src/*/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path estimates bench format clean
+.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path penetration-tol estimates bench format clean
 STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
@@ -107,6 +107,12 @@ hertz: deps
 hertz-path: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/hertz_path.py --check 0.01
+
+# -contact_penetration_tol on a ladder of tolerances (docs/solvers.md, "A penetration tolerance"): the square at 512 x 512
+# with GAMG and the 3D sphere indenter, d = 1e-2, 1e-4, 1e-6 h: output/penetration_tol/penetration_tol.{md,csv}
+penetration-tol: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) scripts/penetration_tol.py
 
 # The a posteriori estimate (docs/estimate.md): effectivity on the manufactured solutions, its penalty part against SNESVI,
 # the error density on Hertz: output/estimates/estimates.{md,csv}, penalty.csv, hertz.csv, effectivity.png, hertz_density.png

@@ -78,3 +78,24 @@ def test_bad_penetration_tol_refused(outdir, extra, message):
     rc, text = solve(["-dm_plex_box_faces", "8,8"] + extra, output=out)
     assert rc != 0 and message in text, text[-2000:]
     assert not os.path.exists(out)
+
+
+def test_ladder_script(outdir):
+    """scripts/penetration_tol.py --small: its table's rows are the runs' own figures (the penetration over d read back
+    from each output, at most 1 where converged)."""
+    import csv
+    import subprocess
+
+    from harness import ENV, ROOT
+    from signorini.runs import read_run
+
+    r = subprocess.run(["/usr/bin/python3", "scripts/penetration_tol.py", "--small", "--cases", "square512", "--outdir", outdir], cwd=ROOT,
+                       env=ENV, capture_output=True, text=True, timeout=600)
+    assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
+    rows = list(csv.DictReader(open(os.path.join(outdir, "penetration_tol.csv"))))
+    assert [x["d_over_h"] for x in rows] == ["1e-2", "1e-4", "1e-6"]
+    for k, x in zip((2, 4, 6), rows):
+        a = read_run(os.path.join(outdir, f"square512_d{k}.h5"))
+        assert int(x["converged"]) == int(a["converged"]) == 1
+        assert float(x["penetration"]) == float(a["penetration_tol_measured"]) <= float(x["d"])
+        assert int(x["solves"]) == int(a["penetration_tol_solves"]) >= 2
