@@ -11,6 +11,14 @@ import getfem_reference as ref
 from harness import load, run
 
 
+def displacement_difference(x_ref, u_ref, fields):
+    """(max |u_ref - u| over the vertices matched by position, max |u_ref|): the reference's vertices are the file's."""
+    order_ref = np.lexsort(np.round(x_ref, 9).T)
+    order = np.lexsort(np.round(fields["x"], 9).T)
+    assert np.allclose(x_ref[order_ref], fields["x"][order], atol=1e-12)
+    return np.max(np.abs(u_ref[order_ref] - fields["displacement"][order])), np.max(np.abs(u_ref))
+
+
 @pytest.fixture(scope="module")
 def problem(tmp_path_factory):
     path = str(tmp_path_factory.mktemp("getfem") / "every_family.msh")
@@ -32,11 +40,7 @@ def test_every_family_against_getfem(outdir, problem, ranks):
     _, h5 = run(["-dm_plex_filename", path] + ref.solver_options(), "every_family", np_=ranks, output=os.path.join(outdir, "ef.h5"))
     attrs, fields = load(h5)
     assert attrs["converged"] == 1 and attrs["active_vertices"] > 3 and attrs["active_vertices"] < attrs["contact_nodes"]
-    order_ref = np.lexsort(np.round(x_ref, 9).T)
-    order = np.lexsort(np.round(fields["x"], 9).T)
-    assert np.allclose(x_ref[order_ref], fields["x"][order], atol=1e-12)
-    diff = np.max(np.abs(u_ref[order_ref] - fields["displacement"][order]))
-    scale = np.max(np.abs(u_ref))
+    diff, scale = displacement_difference(x_ref, u_ref, fields)
     assert diff < 1e-10 * scale, f"max difference {diff:.3e} against GetFEM (displacement scale {scale:.3e})"
     assert abs(attrs["contact_force"] / force_ref - 1) < 1e-9
 
@@ -51,11 +55,7 @@ def test_tilted_plane_against_getfem(outdir, problem_plane):
     attrs, fields = load(h5)
     assert attrs["converged"] == 1 and attrs["obstacle"] == "plane"
     assert 3 < attrs["active_vertices"] < attrs["contact_nodes"], (attrs["active_vertices"], attrs["contact_nodes"])
-    order_ref = np.lexsort(np.round(x_ref, 9).T)
-    order = np.lexsort(np.round(fields["x"], 9).T)
-    assert np.allclose(x_ref[order_ref], fields["x"][order], atol=1e-12)
-    diff = np.max(np.abs(u_ref[order_ref] - fields["displacement"][order]))
-    scale = np.max(np.abs(u_ref))
+    diff, scale = displacement_difference(x_ref, u_ref, fields)
     assert diff < 1e-10 * scale, f"max difference {diff:.3e} against GetFEM (displacement scale {scale:.3e})"
     assert abs(attrs["contact_force"] / force_ref - 1) < 1e-9
     # the gap written by the solver is the plane's: normal_gap = g - u_n at every contact node
@@ -83,10 +83,6 @@ def test_snesvi_against_getfem_exact_contact(outdir, problem, exact, obstacle, r
     attrs, fields = load(h5)
     assert attrs["converged"] == 1 and attrs["method"] == "vi"
     assert 3 < attrs["active_vertices"] < attrs["contact_nodes"], (attrs["active_vertices"], attrs["contact_nodes"])
-    order_ref = np.lexsort(np.round(x_ref, 9).T)
-    order = np.lexsort(np.round(fields["x"], 9).T)
-    assert np.allclose(x_ref[order_ref], fields["x"][order], atol=1e-12)
-    diff = np.max(np.abs(u_ref[order_ref] - fields["displacement"][order]))
-    scale = np.max(np.abs(u_ref))
+    diff, scale = displacement_difference(x_ref, u_ref, fields)
     assert diff < 1e-8 * scale, f"max difference {diff:.3e} against GetFEM's exact contact (displacement scale {scale:.3e})"
     assert abs(attrs["contact_force"] / force_ref - 1) < 1e-8, (attrs["contact_force"], force_ref)
