@@ -4,6 +4,8 @@
    Types:
      penalty  (1/eps) int [u . n - g]_+ v . n, with the Gauss rule (the paper's L2 product) or the nodal rule
               (-penalty_quadrature), eps = eps0 h^power / M (Chouly & Hild 2013, eps = h in Corollary 3.3);
+     al       the penalty term with a multiplier at each point of its rule, (1/eps)[u . n - g + eps lambda]_+, lambda
+              updated by Uzawa's rule between solves until -contact_penetration_tol is met (the augmented Lagrangian);
      vi       the exact constraint u . n <= g as bounds of SNESVI, the reference for the penalty;
      none     no contact: the linear elastic problem.
 
@@ -16,6 +18,7 @@
 
 typedef const char *ContactType;
 #define CONTACTPENALTY "penalty"
+#define CONTACTAL "al"
 #define CONTACTVI "vi"
 #define CONTACTNONE "none"
 
@@ -89,6 +92,9 @@ PetscErrorCode ContactSameActivity(Contact ct, DM dm, Vec X, Vec Y, PetscBool *s
    v <- Q^T v (to_solver) or v <- Q v; the identity for the other types and where every normal is an axis. */
 PetscErrorCode ContactSolverFrame(Contact ct, Vec v, PetscBool to_solver);
 PetscBool      ContactHasFrames(Contact ct);
+/* The augmented Lagrangian (type al): whether the type has multipliers, and their update at u (Uzawa). */
+PetscBool      ContactCanAugment(Contact ct);
+PetscErrorCode ContactAugment(Contact ct, DM dm, Vec u);
 
 /* The state of the contact nodes at an iterate (contact_set.c) */
 PetscErrorCode ContactCountActive(Contact ct, Vec X, PetscReal tol_scale, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left);

@@ -22,7 +22,7 @@ def problems(outdir):
             "sphere-indenter": hertz.command("sphere-indenter", sphere, "eps=h", "unused")[4:-2]}
 
 
-@pytest.mark.parametrize("name", ["square", "square-nodal", "cylinder-indenter", "sphere-indenter"])
+@pytest.mark.parametrize("name", ["square", "square-nodal", "cylinder-indenter", "sphere-indenter", "square-al", "cylinder-indenter-al"])
 def test_penetration_ladder(outdir, name):
     """d = 1e-1, 1e-3, 1e-5 times the plain run's largest penetration (eps = h/E; the graded meshes' h near the contact
     is not their largest) on the square, 1e-1 to 1e-3 on the indenters (the 3D sphere's default solver fails from zero
@@ -33,26 +33,56 @@ def test_penetration_ladder(outdir, name):
     is the direct run's at its final eps to 1e-7."""
     import numpy as np
 
-    args = problems(outdir)[name]
+    al = name.endswith("-al")
+    args = problems(outdir)[name[:-3] if al else name]
+    if al:  # the augmented Lagrangian: the plain run is the nodal penalty at the same eps, which it starts from
+        args = args + ["-penalty_quadrature", "nodal"]
     _, plain = run(args, "plain", output=os.path.join(outdir, "plain.h5"))
     a0 = load(plain)[0]
     pen0 = float(a0["max_penetration"])
     assert pen0 > 0
     for k in ((1, 3, 5) if name.startswith("square") else (1, 2, 3)):
         d = 10.0 ** -k * pen0
-        _, out = run(args + ["-contact_penetration_tol", d], f"tol{k}", output=os.path.join(outdir, f"tol{k}.h5"))
+        _, out = run(args + ["-contact_penetration_tol", d] + (["-contact_method", "al"] if al else []), f"tol{k}", output=os.path.join(outdir, f"tol{k}.h5"))
         attrs, fields = load(out)
         measured = float(attrs["penetration_tol_measured"])
-        assert attrs["converged"] == 1 and 0.5 * d < measured <= d, (k, measured, d)
+        assert attrs["converged"] == 1 and (0.5 * d < measured or al) and measured <= d, (k, measured, d)
         assert int(attrs["penetration_tol_solves"]) >= 2 and float(attrs["penetration_tol"]) == d
         on = fields["contact_boundary"] > 0.5
         assert np.max(-fields["normal_gap"][on]) <= measured * (1 + 1e-9)  # the nodes' penetration, g - u_n = -(u_n - g)
         if name.startswith("square"):
             assert float(attrs["max_penetration"]) <= d
+    if al:  # eps stays; the multipliers move the answer to the exact contact's: checked against SNESVI below
+        assert float(attrs["eps"]) == float(a0["eps"])
+        return
     # eps0 = 1 in every problem here: the final eps is eps0 = eps_final / eps_plain times h/E, with its local factors
     _, direct = run(args + ["-penalty_eps0", float(attrs["eps"]) / float(a0["eps"])], "direct", output=os.path.join(outdir, "direct.h5"))
     u, ud = fields["displacement"], load(direct)[1]["displacement"]
     assert np.max(np.abs(u - ud)) <= 1e-7 * np.max(np.abs(ud))
+
+
+@pytest.mark.parametrize("name", ["square", "cylinder-indenter"])
+def test_augmented_lagrangian_tends_to_snesvi(outdir, name):
+    """The augmented Lagrangian's fixed point is the exact nodal contact: its distance to SNESVI (max |u_al - u_vi| /
+    max |u_vi|) falls with the tolerance d = 1e-4 and 1e-6 times max |u_vi|: at most 30 d / max |u_vi| (measured 0.77 and
+    0.77 on the square, 0.55 and 0.67 on the cylinder indenter) and 30 times lower at the smaller d, with eps kept at h/E."""
+    import numpy as np
+
+    args = [a for a in problems(outdir)[name] if a not in ("penalty",)]
+    args = [a for i, a in enumerate(args) if not (a == "-contact_method" or (i and args[i - 1] == "-contact_method"))]
+    _, ref = run(args + ["-contact_method", "vi"], "vi", output=os.path.join(outdir, "vi.h5"))
+    u_vi = load(ref)[1]["displacement"]
+    scale = np.max(np.abs(u_vi))
+    dist = {}
+    for k in (4, 6):
+        d = 10.0 ** -k * scale
+        _, out = run(args + ["-contact_method", "al", "-contact_penetration_tol", d], "al", output=os.path.join(outdir, f"al{k}.h5"))
+        attrs, fields = load(out)
+        assert attrs["converged"] == 1 and attrs["method"] == "al" and attrs["penalty_quadrature"] == "nodal"
+        dist[k] = np.max(np.abs(fields["displacement"] - u_vi)) / scale
+        print(f"al: d = 1e-{k} max|u_vi|: distance to SNESVI {dist[k]:.3e} = {dist[k] * 10.0 ** k:.2f} d / max|u_vi|")
+        assert dist[k] <= 30 * 10.0 ** -k, (k, dist)
+    assert dist[6] < dist[4] / 30, dist
 
 
 def test_unreachable_tolerance_fails(outdir):
@@ -69,7 +99,9 @@ def test_unreachable_tolerance_fails(outdir):
     (["-contact_penetration_tol", "0"], "-contact_penetration_tol must be positive, got 0"),
     (["-contact_penetration_tol", "-1e-3"], "-contact_penetration_tol must be positive"),
     (["-contact_penetration_tol", "nan"], "-contact_penetration_tol must be a finite number"),
-    (["-contact_penetration_tol", "1e-6", "-contact_method", "vi"], "-contact_penetration_tol needs -contact_method penalty"),
+    (["-contact_penetration_tol", "1e-6", "-contact_method", "vi"], "-contact_penetration_tol needs -contact_method penalty or al"),
+    (["-contact_method", "al"], "-contact_method al needs -contact_penetration_tol"),
+    (["-contact_method", "al", "-contact_penetration_tol", "1e-6", "-penalty_quadrature", "gauss"], "-contact_method al has its multipliers at the contact nodes"),
     (["-contact_penetration_tol", "1e-6", "-penalty_eps0_sweep", "1,0.1"], "-contact_penetration_tol and -penalty_eps0_sweep"),
     (["-contact_penetration_tol", "1e-6", "-load_steps", "2"], "-contact_penetration_tol and -load_steps and -load_path both solve a sequence"),
 ])

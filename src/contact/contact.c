@@ -23,6 +23,7 @@ static PetscErrorCode ContactRegisterAll(void)
   if (contact_registered) PetscFunctionReturn(PETSC_SUCCESS);
   contact_registered = PETSC_TRUE;
   PetscCall(ContactRegister(CONTACTPENALTY, ContactCreate_Penalty));
+  PetscCall(ContactRegister(CONTACTAL, ContactCreate_AL));
   PetscCall(ContactRegister(CONTACTVI, ContactCreate_VI));
   PetscCall(ContactRegister(CONTACTNONE, ContactCreate_None));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -51,16 +52,18 @@ PetscErrorCode ContactSetFromOptions(Contact ct)
   MPI_Comm        comm              = ct->comm;
   ContactOptions *opts              = &ct->opt;
   PetscErrorCode (*create)(Contact) = NULL;
-  PetscBool eps_set, sweep_set, tol_set;
+  PetscBool eps_set, sweep_set, tol_set, quadrature_set;
 
   PetscFunctionBeginUser;
   PetscOptionsBegin(comm, NULL, "Contact on Gamma_C", "Signorini");
   PetscCall(PetscStrncpy(opts->method, CONTACTPENALTY, sizeof(opts->method)));
-  PetscCall(PetscOptionsFList("-contact_method", "Contact treatment: penalty, vi (SNESVI reference), none (no contact)", "ContactRegister",
-                              contact_list, opts->method, opts->method, sizeof(opts->method), NULL));
+  PetscCall(PetscOptionsFList(
+      "-contact_method",
+      "Contact treatment: penalty, al (augmented Lagrangian, with -contact_penetration_tol), vi (SNESVI reference), none (no contact)",
+      "ContactRegister", contact_list, opts->method, opts->method, sizeof(opts->method), NULL));
   opts->quadrature = PENALTY_QUADRATURE_GAUSS;
   PetscCall(PetscOptionsEnum("-penalty_quadrature", "Quadrature of the penalty term: gauss (L2 product) or nodal (lumped, vertex rule)", NULL,
-                             PenaltyQuadratures, (PetscEnum)opts->quadrature, (PetscEnum *)&opts->quadrature, NULL));
+                             PenaltyQuadratures, (PetscEnum)opts->quadrature, (PetscEnum *)&opts->quadrature, &quadrature_set));
   opts->eps0 = 1.0;
   PetscCall(PetscOptionsReal("-penalty_eps0", "eps = eps0 h^power / M (M: -penalty_eps_modulus, E by default): the factor eps0", NULL, opts->eps0,
                              &opts->eps0, NULL));
@@ -102,7 +105,7 @@ PetscErrorCode ContactSetFromOptions(Contact ct)
     PetscCall(OptionsCheckFiniteArray(comm, "-penalty_eps0_sweep", opts->n_sweep, opts->eps0_sweep));
   }
   PetscCall(PetscFunctionListFind(contact_list, opts->method, &create));
-  PetscCheck(create, comm, PETSC_ERR_USER_INPUT, "Unknown option %s for -contact_method: the registered types are penalty, vi and none",
+  PetscCheck(create, comm, PETSC_ERR_USER_INPUT, "Unknown option %s for -contact_method: the registered types are penalty, al, vi and none",
              opts->method);
   PetscCall(PetscStrncpy(ct->type, opts->method, sizeof(ct->type)));
   PetscCall((*create)(ct));
@@ -115,7 +118,13 @@ PetscErrorCode ContactSetFromOptions(Contact ct)
   PetscCheck(!tol_set || opts->penetration_tol > 0.0, comm, PETSC_ERR_USER_INPUT, "-contact_penetration_tol must be positive, got %g",
              (double)opts->penetration_tol);
   PetscCheck(!tol_set || ct->has_penalty, comm, PETSC_ERR_USER_INPUT,
-             "-contact_penetration_tol needs -contact_method penalty (SNESVI's penetration is zero at the nodes already)");
+             "-contact_penetration_tol needs -contact_method penalty or al (SNESVI's penetration is zero at the nodes already)");
+  if (ct->ops.augment && !quadrature_set) opts->quadrature = PENALTY_QUADRATURE_NODAL; /* the augmented Lagrangian's multipliers are nodal */
+  PetscCheck(!ct->ops.augment || opts->quadrature == PENALTY_QUADRATURE_NODAL, comm, PETSC_ERR_USER_INPUT,
+             "-contact_method al has its multipliers at the contact nodes (the nodal rule): the Gauss rule's points over-constrain P1 elements, "
+             "and Uzawa's updates stall there; give -penalty_quadrature nodal or leave it out");
+  PetscCheck(tol_set || !ct->ops.augment, comm, PETSC_ERR_USER_INPUT,
+             "-contact_method al needs -contact_penetration_tol: the largest penetration its multipliers' updates are to reach");
   PetscCheck(!(tol_set && sweep_set), comm, PETSC_ERR_USER_INPUT,
              "-contact_penetration_tol and -penalty_eps0_sweep both choose the values of eps: give one of them");
   if (opts->n_sweep) opts->eps0 = opts->eps0_sweep[0]; /* the sweep starts with its first value, in place of -penalty_eps0 */
@@ -406,6 +415,19 @@ PetscErrorCode ContactSolverFrame(Contact ct, Vec v, PetscBool to_solver)
 PetscBool ContactHasFrames(Contact ct)
 {
   return ct->has_frames;
+}
+
+PetscBool ContactCanAugment(Contact ct)
+{
+  return (PetscBool)(ct->ops.augment != NULL);
+}
+
+PetscErrorCode ContactAugment(Contact ct, DM dm, Vec u)
+{
+  PetscFunctionBeginUser;
+  PetscCheck(ct->ops.augment, ct->comm, PETSC_ERR_ARG_WRONGSTATE, "the contact type %s has no multipliers to update", ct->type);
+  PetscCall((*ct->ops.augment)(ct, dm, u));
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode ContactSameActivity(Contact ct, DM dm, Vec X, Vec Y, PetscBool *same)

@@ -21,6 +21,7 @@ typedef struct {
   PetscErrorCode (*scale_bounds)(Contact, PetscReal);                   /* the bounds times a factor (NULL: none) */
   PetscErrorCode (*load)(Contact, DM);                                  /* after the set's gaps changed, ContactSetLoad() (NULL: none) */
   PetscErrorCode (*frame)(Contact, Vec, PetscBool to_solver);           /* v <- Q^T v or Q v, the SNES's own frame (NULL: none) */
+  PetscErrorCode (*augment)(Contact, DM, Vec u);                        /* the multipliers' update at u, ContactAugment() (NULL: none) */
   PetscErrorCode (*view)(Contact, PetscViewer);                         /* the type's part of the summary line */
 } ContactOps;
 
@@ -80,5 +81,6 @@ PetscErrorCode ViFramesDestroy(ViFrames *fr);
 
 /* the types */
 PetscErrorCode ContactCreate_Penalty(Contact ct);
+PetscErrorCode ContactCreate_AL(Contact ct);
 PetscErrorCode ContactCreate_VI(Contact ct);
 PetscErrorCode ContactCreate_None(Contact ct);

@@ -3,7 +3,15 @@
    gauss: the face Gauss rule (the paper's L2 product), in closed form on P1 simplices with -assembly p1
           (penalty_faces.c), otherwise by PetscFE's boundary integration of the same kernels;
    nodal: the same term with the vertex rule, node by node with the lumped boundary mass.
-   The Jacobian is made in K itself (bulk_rows.c). */
+   The Jacobian is made in K itself (bulk_rows.c).
+   The Contact type "al", the augmented Lagrangian, is the nodal rule's term with a multiplier lambda >= 0 at each
+   contact node: (1/eps)[u . n - g + eps lambda]_+, updated between solves by Uzawa's rule
+   lambda <- [lambda + (1/eps)(u . n - g)]_+ (ContactAugment(), driven by -contact_penetration_tol,
+   src/solver/penetration_tol.c) with eps kept. The shift s = eps lambda, a length, is what is stored:
+   s <- [u . n - g + s]_+. At a fixed point u . n - g <= 0 wherever lambda > 0 is the pressure, and the penetration
+   goes to zero with the updates while eps, and the conditioning, stay at h/E. Only the nodal rule: the Gauss rule's
+   points over-constrain P1 (two points a face in 2D for one unknown a node), and Uzawa on them stalled at a largest
+   penetration of 4e-5 on the 64 x 64 square where the nodal rule reached 1e-7 (ContactSetFromOptions() refuses it). */
 #include "mesh.h"
 #include "penalty.h"
 #include "penalty_kernels.h"
@@ -11,10 +19,17 @@
 enum { PENALTY_PART_TERM, PENALTY_PART_ENERGY }; /* parts of the penalty weak form */
 
 typedef struct {
+  PetscReal      *shift; /* [set.n]: the type "al": the nodal rule's eps lambda at each contact node (NULL before the first update) */
   PetscWeakForm   wf;    /* the penalty term on Gamma_C, kept out of the bulk weak form (PETSc's integration) */
   PenaltyFaces    faces; /* the same term in closed form (the Gauss rule on P1 simplices with -assembly p1) */
   ContactBulkRows rows;  /* K's own values in the contact rows, while K holds the penalty Jacobian */
 } Contact_Penalty;
+
+/* The argument of the nodal rule's [.]_+ at contact node i: u . n - g, plus the augmented Lagrangian's shift. */
+static inline PetscReal NodeArgument(const Contact_Penalty *pen, const ContactSet *cs, PetscInt dim, PetscInt i, const PetscScalar x[])
+{
+  return ContactNodePenetration(cs, dim, i, x) + (pen->shift ? pen->shift[i] : 0.0);
+}
 
 /* PETSc integrates the Gauss rule (its boundary integration), or the closed form of penalty_faces.c does. */
 static PetscBool UseFE(Contact ct)
@@ -117,6 +132,7 @@ static PetscErrorCode ContactReset_Penalty(Contact ct)
   PetscFunctionBeginUser;
   PetscCall(PetscWeakFormDestroy(&pen->wf));
   PetscCall(PenaltyFacesDestroy(&pen->faces));
+  PetscCall(PetscFree(pen->shift));
   PetscCall(BulkRowsFree(&pen->rows));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -184,7 +200,7 @@ static PetscErrorCode ContactResidual_Penalty(Contact ct, DM dm, Vec X, Vec F)
     PetscCall(VecGetArrayRead(X, &x));
     PetscCall(VecGetArray(F, &f));
     for (PetscInt i = 0; i < cs->n; ++i) {
-      const PetscReal d = ContactNodePenetration(cs, dim, i, x);
+      const PetscReal d = NodeArgument((Contact_Penalty *)ct->data, cs, dim, i, x);
       if (d <= 0.0) continue;
       for (PetscInt c = 0; c < dim; ++c)
         if (cs->dof[i * dim + c] >= 0) f[cs->dof[i * dim + c]] += cs->weight[i] * d / ContactNodeEps(cs, ct->eps, i) * cs->normal[i * dim + c];
@@ -224,7 +240,7 @@ static PetscErrorCode ContactSameActivity_Penalty(Contact ct, DM dm, Vec X, Vec 
     PetscCall(VecGetArrayRead(X, &x));
     PetscCall(VecGetArrayRead(Y, &y));
     for (PetscInt i = 0; i < cs->n && *same; ++i)
-      *same = (PetscBool)((ContactNodePenetration(cs, dim, i, x) > 0.0) == (ContactNodePenetration(cs, dim, i, y) > 0.0));
+      *same = (PetscBool)((NodeArgument(pen, cs, dim, i, x) > 0.0) == (NodeArgument(pen, cs, dim, i, y) > 0.0));
     PetscCall(VecRestoreArrayRead(X, &x));
     PetscCall(VecRestoreArrayRead(Y, &y));
   }
@@ -251,7 +267,7 @@ static PetscErrorCode PenaltyAddJacobian(Contact ct, DM dm, Vec X, Mat J)
     for (PetscInt i = 0; i < cs->n; ++i) {
       PetscInt nfree = 0, comp[3];
 
-      if (ContactNodePenetration(cs, dim, i, x) <= 0.0) continue;
+      if (NodeArgument((Contact_Penalty *)ct->data, cs, dim, i, x) <= 0.0) continue;
       for (PetscInt c = 0; c < dim; ++c)
         if (cs->dof[i * dim + c] >= 0) {
           comp[nfree]   = c;
@@ -350,7 +366,7 @@ static PetscErrorCode ContactEnergy_Penalty(Contact ct, DM dm, Vec X, PetscReal 
 
     PetscCall(VecGetArrayRead(X, &x));
     for (PetscInt i = 0; i < cs->n; ++i) {
-      const PetscReal d = ContactNodePenetration(cs, dim, i, x);
+      const PetscReal d = NodeArgument((Contact_Penalty *)ct->data, cs, dim, i, x);
       if (d > 0.0) e += 0.5 / ContactNodeEps(cs, ct->eps, i) * cs->weight[i] * d * d;
     }
     PetscCall(VecRestoreArrayRead(X, &x));
@@ -500,5 +516,27 @@ PetscErrorCode ContactCreate_Penalty(Contact ct)
   ct->ops.same_activity    = ContactSameActivity_Penalty;
   ct->ops.check            = ContactCheck_Penalty;
   ct->ops.view             = ContactView_Penalty;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Uzawa's update of the augmented Lagrangian at u: s <- [u . n - g + s]_+ at every contact node (s = eps lambda). */
+static PetscErrorCode ContactAugment_AL(Contact ct, DM dm, Vec X)
+{
+  Contact_Penalty   *pen = (Contact_Penalty *)ct->data;
+  const PetscScalar *x;
+
+  PetscFunctionBeginUser;
+  if (!pen->shift) PetscCall(PetscCalloc1(ct->set.n + 1, &pen->shift));
+  PetscCall(VecGetArrayRead(X, &x));
+  for (PetscInt i = 0; i < ct->set.n; ++i) pen->shift[i] = PetscMax(0.0, NodeArgument(pen, &ct->set, ct->dim, i, x));
+  PetscCall(VecRestoreArrayRead(X, &x));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode ContactCreate_AL(Contact ct)
+{
+  PetscFunctionBeginUser;
+  PetscCall(ContactCreate_Penalty(ct));
+  ct->ops.augment = ContactAugment_AL;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

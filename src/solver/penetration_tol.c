@@ -23,6 +23,37 @@
 
 #define PENETRATION_TOL_AIM 0.9
 #define PENETRATION_TOL_MAX_SOLVES 12
+#define PENETRATION_TOL_MAX_UPDATES 60
+#define PENETRATION_TOL_STALL 8
+
+/* The augmented Lagrangian (-contact_method al): Uzawa's updates of the multipliers at the rule's points, each followed
+   by a solve from the last solution at the same eps, until the largest penetration is at most d. Where the active set
+   stays, a solve is one linear solve with the last Jacobian; the penetration falls by a constant factor per update
+   (about eps times the pressure's stiffness, so the factor is that of eps = h/E against the bulk). */
+static PetscErrorCode UzawaSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscReal tol, PetscReal *d_max, PetscInt *solves)
+{
+  MPI_Comm  comm       = PetscObjectComm((PetscObject)dm);
+  PetscReal best       = *d_max;
+  PetscInt  since_best = 0;
+
+  PetscFunctionBeginUser;
+  while (*d_max > tol && user->rec.stats.converged && *solves < PENETRATION_TOL_MAX_UPDATES) {
+    PetscCall(ContactAugment(user->contact, dm, u));
+    PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
+    ++*solves;
+    PetscCall(ContactMaxPenetration(user->contact, dm, u, d_max));
+    PetscCall(PetscInfo(snes, "augmented Lagrangian: update %" PetscInt_FMT ", largest penetration %g\n", *solves - 1, (double)*d_max));
+    if (*d_max < best) {
+      best       = *d_max;
+      since_best = 0;
+    } else if (++since_best == PENETRATION_TOL_STALL) { /* Uzawa's penetration need not fall at every update, but it must fall */
+      PetscCall(PetscPrintf(comm, "  augmented Lagrangian: the largest penetration has not fallen below %g in %d updates\n", (double)best,
+                            PENETRATION_TOL_STALL));
+      break;
+    }
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
 PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 {
@@ -37,7 +68,8 @@ PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
   if (!(copt->penetration_tol > 0.0) || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactMaxPenetration(user->contact, dm, u, &d_max));
   PetscCall(ContactGetEps(user->contact, &eps));
-  while (d_max > copt->penetration_tol && user->rec.stats.converged && solves < PENETRATION_TOL_MAX_SOLVES) {
+  if (ContactCanAugment(user->contact)) PetscCall(UzawaSolve(dm, user, snes, u, copt->penetration_tol, &d_max, &solves));
+  while (!ContactCanAugment(user->contact) && d_max > copt->penetration_tol && user->rec.stats.converged && solves < PENETRATION_TOL_MAX_SOLVES) {
     const PetscReal eps_new = eps * PetscMax(PENETRATION_TOL_AIM * copt->penetration_tol / d_max, copt->continuation_factor);
 
     PetscCall(PetscPrintf(comm, "  penetration tolerance: eps = %g gives the largest penetration %g > %g: eps = %g next\n", (double)eps,
