@@ -121,13 +121,14 @@ def test_ladder_script(outdir):
     from harness import ENV, ROOT
     from signorini.runs import read_run
 
-    r = subprocess.run(["/usr/bin/python3", "scripts/penetration_tol.py", "--small", "--cases", "square512", "--outdir", outdir], cwd=ROOT,
+    r = subprocess.run(["/usr/bin/python3", "scripts/penetration_tol.py", "--small", "--cases", "square512", "--methods", "continuation,al", "--outdir", outdir], cwd=ROOT,
                        env=ENV, capture_output=True, text=True, timeout=600)
     assert r.returncode == 0, r.stdout[-2000:] + r.stderr[-2000:]
     rows = list(csv.DictReader(open(os.path.join(outdir, "penetration_tol.csv"))))
-    assert [x["d_over_h"] for x in rows] == ["1e-2", "1e-4", "1e-6"]
-    for k, x in zip((2, 4, 6), rows):
-        a = read_run(os.path.join(outdir, f"square512_d{k}.h5"))
+    assert [(x["d_over_h"], x["method"]) for x in rows] == [(f"1e-{k}", m) for k in (2, 4, 6) for m in ("continuation", "al")]
+    for x in rows:
+        a = read_run(os.path.join(outdir, f"square512_{x['method']}_d{x['d_over_h'][-1]}.h5"))
+        assert a["method"] == ("al" if x["method"] == "al" else "penalty")
         assert int(x["converged"]) == int(a["converged"]) == 1
         assert float(x["penetration"]) == float(a["penetration_tol_measured"]) <= float(x["d"])
         assert int(x["solves"]) == int(a["penetration_tol_solves"]) >= 2
