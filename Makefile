@@ -108,7 +108,8 @@ hertz-path: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/hertz_path.py --check 0.01
 
-# -contact_penetration_tol on a ladder of tolerances (docs/solvers.md, "A penetration tolerance"): the square at 512 x 512
+# -contact_penetration_tol on a ladder of tolerances, eps continuation and the augmented Lagrangian (docs/solvers.md,
+# "A penetration tolerance instead of an eps"): the square at 512 x 512
 # with GAMG and the 3D sphere indenter, d = 1e-2, 1e-4, 1e-6 h: output/penetration_tol/penetration_tol.{md,csv}
 penetration-tol: deps
 	@$(MAKE) --no-print-directory $(BIN)
