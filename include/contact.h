@@ -92,9 +92,11 @@ PetscErrorCode ContactSameActivity(Contact ct, DM dm, Vec X, Vec Y, PetscBool *s
    v <- Q^T v (to_solver) or v <- Q v; the identity for the other types and where every normal is an axis. */
 PetscErrorCode ContactSolverFrame(Contact ct, Vec v, PetscBool to_solver);
 PetscBool      ContactHasFrames(Contact ct);
-/* The augmented Lagrangian (type al): whether the type has multipliers, and their update at u (Uzawa). */
+/* The augmented Lagrangian (type al): whether the type has multipliers, and their update at u (Uzawa), made if apply;
+   *change is the largest change of eps lambda it makes (a length: the penetration, or the stand-off of a node whose
+   multiplier pushes). */
 PetscBool      ContactCanAugment(Contact ct);
-PetscErrorCode ContactAugment(Contact ct, DM dm, Vec u);
+PetscErrorCode ContactAugment(Contact ct, DM dm, Vec u, PetscBool apply, PetscReal *change);
 
 /* The state of the contact nodes at an iterate (contact_set.c) */
 PetscErrorCode ContactCountActive(Contact ct, Vec X, PetscReal tol_scale, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left);

@@ -422,11 +422,11 @@ PetscBool ContactCanAugment(Contact ct)
   return (PetscBool)(ct->ops.augment != NULL);
 }
 
-PetscErrorCode ContactAugment(Contact ct, DM dm, Vec u)
+PetscErrorCode ContactAugment(Contact ct, DM dm, Vec u, PetscBool apply, PetscReal *change)
 {
   PetscFunctionBeginUser;
   PetscCheck(ct->ops.augment, ct->comm, PETSC_ERR_ARG_WRONGSTATE, "the contact type %s has no multipliers to update", ct->type);
-  PetscCall((*ct->ops.augment)(ct, dm, u));
+  PetscCall((*ct->ops.augment)(ct, dm, u, apply, change));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

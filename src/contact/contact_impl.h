@@ -5,24 +5,24 @@
 #include "obstacle.h"
 
 typedef struct {
-  PetscErrorCode (*setup)(Contact, DM);                                 /* after the contact set is built: the type's own state */
-  PetscErrorCode (*reset)(Contact);                                     /* frees the state of the mesh */
-  PetscErrorCode (*destroy)(Contact);                                   /* frees data (NULL: PetscFree(data)) */
-  PetscErrorCode (*residual)(Contact, DM, Vec u, Vec F);                /* F += the contact term at u (NULL: none) */
-  PetscErrorCode (*jacobian)(Contact, DM, Vec u, Mat K, Mat P);         /* P = K + the contact Jacobian at u (NULL: P = K) */
-  PetscErrorCode (*prepare_operator)(Contact, DM, Mat K);               /* once K is assembled, before the first Jacobian */
-  PetscErrorCode (*bulk_mult)(Contact, Mat K, Vec X, Vec R);            /* R = K X with K's own values (NULL: MatMult) */
-  PetscErrorCode (*bulk_operator)(Contact, Mat K, Mat *Kb);             /* a new matrix equal to the bulk K (NULL: K itself) */
-  PetscErrorCode (*energy)(Contact, DM, Vec u, PetscReal *);            /* the contact term's energy (NULL: 0) */
-  PetscErrorCode (*acts)(Contact, DM, Vec u, PetscBool[], PetscReal *); /* where the force acts (NULL: everywhere) */
-  PetscErrorCode (*same_activity)(Contact, DM, Vec, Vec, PetscBool *);  /* the force acts at the same points (NULL: true) */
-  PetscErrorCode (*setup_snes)(Contact, DM, SNES);                      /* the SNES type and bounds (NULL: Newton, ContactSetUpSNES()) */
-  PetscErrorCode (*check)(Contact, DM, Vec u);                          /* -assembly_check after the solve (NULL: none) */
-  PetscErrorCode (*scale_bounds)(Contact, PetscReal);                   /* the bounds times a factor (NULL: none) */
-  PetscErrorCode (*load)(Contact, DM);                                  /* after the set's gaps changed, ContactSetLoad() (NULL: none) */
-  PetscErrorCode (*frame)(Contact, Vec, PetscBool to_solver);           /* v <- Q^T v or Q v, the SNES's own frame (NULL: none) */
-  PetscErrorCode (*augment)(Contact, DM, Vec u);                        /* the multipliers' update at u, ContactAugment() (NULL: none) */
-  PetscErrorCode (*view)(Contact, PetscViewer);                         /* the type's part of the summary line */
+  PetscErrorCode (*setup)(Contact, DM);                                              /* after the contact set is built: the type's own state */
+  PetscErrorCode (*reset)(Contact);                                                  /* frees the state of the mesh */
+  PetscErrorCode (*destroy)(Contact);                                                /* frees data (NULL: PetscFree(data)) */
+  PetscErrorCode (*residual)(Contact, DM, Vec u, Vec F);                             /* F += the contact term at u (NULL: none) */
+  PetscErrorCode (*jacobian)(Contact, DM, Vec u, Mat K, Mat P);                      /* P = K + the contact Jacobian at u (NULL: P = K) */
+  PetscErrorCode (*prepare_operator)(Contact, DM, Mat K);                            /* once K is assembled, before the first Jacobian */
+  PetscErrorCode (*bulk_mult)(Contact, Mat K, Vec X, Vec R);                         /* R = K X with K's own values (NULL: MatMult) */
+  PetscErrorCode (*bulk_operator)(Contact, Mat K, Mat *Kb);                          /* a new matrix equal to the bulk K (NULL: K itself) */
+  PetscErrorCode (*energy)(Contact, DM, Vec u, PetscReal *);                         /* the contact term's energy (NULL: 0) */
+  PetscErrorCode (*acts)(Contact, DM, Vec u, PetscBool[], PetscReal *);              /* where the force acts (NULL: everywhere) */
+  PetscErrorCode (*same_activity)(Contact, DM, Vec, Vec, PetscBool *);               /* the force acts at the same points (NULL: true) */
+  PetscErrorCode (*setup_snes)(Contact, DM, SNES);                                   /* the SNES type and bounds (NULL: Newton, ContactSetUpSNES()) */
+  PetscErrorCode (*check)(Contact, DM, Vec u);                                       /* -assembly_check after the solve (NULL: none) */
+  PetscErrorCode (*scale_bounds)(Contact, PetscReal);                                /* the bounds times a factor (NULL: none) */
+  PetscErrorCode (*load)(Contact, DM);                                               /* after the set's gaps changed, ContactSetLoad() (NULL: none) */
+  PetscErrorCode (*frame)(Contact, Vec, PetscBool to_solver);                        /* v <- Q^T v or Q v, the SNES's own frame (NULL: none) */
+  PetscErrorCode (*augment)(Contact, DM, Vec u, PetscBool apply, PetscReal *change); /* the multipliers' update at u (NULL: none) */
+  PetscErrorCode (*view)(Contact, PetscViewer);                                      /* the type's part of the summary line */
 } ContactOps;
 
 struct _p_Contact {

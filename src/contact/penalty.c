@@ -519,17 +519,27 @@ PetscErrorCode ContactCreate_Penalty(Contact ct)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Uzawa's update of the augmented Lagrangian at u: s <- [u . n - g + s]_+ at every contact node (s = eps lambda). */
-static PetscErrorCode ContactAugment_AL(Contact ct, DM dm, Vec X)
+/* Uzawa's update of the augmented Lagrangian at u: s <- [u . n - g + s]_+ at every contact node (s = eps lambda), made
+   if apply; *change: the largest |s_new - s| over the ranks, a length. It bounds the penetration (s_new - s = u . n - g
+   wherever that is positive) and the gap where the multiplier pushes (s_new - s = -s where the node left the obstacle
+   by more than s): at most d, the penetration is at most d and no node carrying force stands off by more than d. */
+static PetscErrorCode ContactAugment_AL(Contact ct, DM dm, Vec X, PetscBool apply, PetscReal *change)
 {
   Contact_Penalty   *pen = (Contact_Penalty *)ct->data;
   const PetscScalar *x;
+  PetscReal          local = 0.0;
 
   PetscFunctionBeginUser;
   if (!pen->shift) PetscCall(PetscCalloc1(ct->set.n + 1, &pen->shift));
   PetscCall(VecGetArrayRead(X, &x));
-  for (PetscInt i = 0; i < ct->set.n; ++i) pen->shift[i] = PetscMax(0.0, NodeArgument(pen, &ct->set, ct->dim, i, x));
+  for (PetscInt i = 0; i < ct->set.n; ++i) {
+    const PetscReal next = PetscMax(0.0, NodeArgument(pen, &ct->set, ct->dim, i, x));
+
+    local = PetscMax(local, PetscAbsReal(next - pen->shift[i]));
+    if (apply) pen->shift[i] = next;
+  }
   PetscCall(VecRestoreArrayRead(X, &x));
+  PetscCall(MPIU_Allreduce(&local, change, 1, MPIU_REAL, MPIU_MAX, ct->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

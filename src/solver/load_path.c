@@ -57,8 +57,8 @@ PetscErrorCode LoadPathSetUp(MPI_Comm comm, AppCtx *user)
              "-obstacle_force works with -contact_method penalty (its positions' warm solves and force secant are the penalty's)");
   PetscCheck(!opt->bars, comm, PETSC_ERR_USER_INPUT, "-bars measures one load state: give it without %s", what);
   PetscCheck(copt->n_sweep <= 1, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep and %s both solve a sequence: give one of them", what);
-  PetscCheck(!(copt->penetration_tol > 0.0), comm, PETSC_ERR_USER_INPUT, "-contact_penetration_tol and %s both solve a sequence: give one of them",
-             what);
+  PetscCheck(!(copt->penetration_tol > 0.0 && user->scene.obstacle.force > 0.0), comm, PETSC_ERR_USER_INPUT,
+             "-contact_penetration_tol and -obstacle_force both move a solve's data (eps, the obstacle's position): give one of them");
   PetscCheck(!opt->verify.reference[0], comm, PETSC_ERR_USER_INPUT, "-reference compares one load state: give it without %s", what);
   PetscCall(SceneSetLoadFactor(&user->scene, opt->load_path.n ? opt->load_path.factor[0] : 1.0)); /* keeps the data at the factor 1 */
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -249,7 +249,7 @@ static PetscErrorCode LoadPathRecordStep(DM dm, AppCtx *user, Vec u, PetscReal t
     s->ksp_its += user->rec.records[i].ksp_its;
     s->time += user->rec.records[i].time_solve;
   }
-  s->converged = (PetscBool)(user->rec.records[user->rec.nrecords - 1].converged && ok);
+  s->converged = (PetscBool)(user->rec.records[user->rec.nrecords - 1].converged && ok && user->rec.stats.converged);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -315,6 +315,7 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
       PetscCall(SecantStart(snes, dm, user, u, prev, dir, secant, secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0));
     }
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
+    PetscCall(PenetrationTolSolve(dm, user, snes, u)); /* -contact_penetration_tol at every step, from the last step's eps (or multipliers) */
     PetscCall(LoadPathForce(dm, user, snes, u, &ok));
     PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[k], first, ok));
   }
