@@ -151,3 +151,25 @@ def test_ladder_script(outdir):
         assert int(x["converged"]) == int(a["converged"]) == 1
         assert float(x["penetration"]) == float(a["penetration_tol_measured"]) <= float(x["d"])
         assert int(x["solves"]) == int(a["penetration_tol_solves"]) >= 2
+
+
+@pytest.mark.parametrize("method", ["penalty", "al"])
+def test_penetration_tol_two_ranks(outdir, method):
+    """2 ranks give the serial answer: the same solves (the loop's decisions are reduced over the ranks), the same
+    penetration and the displacement to 1e-9, on the cylinder indenter's graded mesh (local eps)."""
+    import numpy as np
+
+    from harness import sorted_by_position
+
+    args = problems(outdir)["cylinder-indenter"]
+    args = [a for i, a in enumerate(args) if not (a == "-contact_method" or (i and args[i - 1] == "-contact_method"))]
+    extra = ["-contact_method", method, "-contact_penetration_tol", 1e-7] + (["-penalty_quadrature", "nodal"] if method == "al" else [])
+    res = []
+    for ranks in (1, 2):
+        _, out = run(args + extra, f"np{ranks}", np_=ranks, output=os.path.join(outdir, f"np{ranks}.h5"))
+        res.append(load(out))
+    (a1, f1), (a2, f2) = res
+    assert a1["converged"] == a2["converged"] == 1 and a1["penetration_tol_solves"] == a2["penetration_tol_solves"] >= 2
+    assert abs(a1["penetration_tol_measured"] - a2["penetration_tol_measured"]) <= 1e-9 * a1["penetration_tol_measured"] + 1e-15
+    u1, u2 = sorted_by_position(f1, "displacement"), sorted_by_position(f2, "displacement")
+    assert np.max(np.abs(u1 - u2)) <= 1e-9 * np.max(np.abs(u1))
