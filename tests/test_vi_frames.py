@@ -79,12 +79,18 @@ def test_rotated_cantilever_2d(outdir):
     assert np.max(np.abs(f1["contact_pressure"][idx] - f0["contact_pressure"])) <= 1e-8 * np.max(f0["contact_pressure"])
 
 
-def test_rotated_block_3d(outdir):
+def rotation_about_x(t):
+    return [[1.0, 0.0, 0.0], [0.0, math.cos(t), -math.sin(t)], [0.0, math.sin(t), math.cos(t)]]
+
+
+@pytest.mark.parametrize("about", ["axis123", "x"])
+def test_rotated_block_3d(outdir, about):
     """A cube clamped on its top face, pressed down by 0.003 with a sideways shift onto a plane 0.002 under its bottom
     face (frictionless: it slides) and pushed sideways by a body force, which lifts part of the face (partial contact);
-    rotated about (1, 2, 3) by 40 degrees every normal component mixes: the displacement is R u_ref to 1e-9 of its size,
-    the active vertices the same, the contact force R F_ref."""
-    rot = rotation_3d()
+    rotated about (1, 2, 3) by 40 degrees every normal component mixes, rotated about x by 30 degrees the normal is
+    (0, sin, -cos), whose first free component is not on it (the frame's normal unknown must still carry the bound):
+    the displacement is R u_ref to 1e-9 of its size, the active vertices the same, the contact force R F_ref."""
+    rot = rotation_3d() if about == "axis123" else rotation_about_x(THETA)
 
     def args(R):
         return ["-bc_clamp", "2", "-bc_clamp_2_translate", vec(R @ [0.003, -0.002, -0.003]), "-contact_faces", "1",

@@ -13,12 +13,13 @@
 #include "contact_impl.h"
 
 /* The constraint of contact node i as coef * x[dof[i * dim + comp]] <= rhs on the node's own (axis or frame) unknown:
-   comp the first free component whose normal part is not zero, coef the normal's free part along it (axis, signed) or
-   |n_free| (frame); rotate says whether the node needs a frame; comp = -1 when no free component meets the normal. */
+   on an axis, comp the one free component the normal meets and coef the normal's part along it (signed); in a frame,
+   comp the node's first free component, whose place holds the frame's normal unknown w_n (FrameOfNode()), and coef
+   |n_free|; rotate says whether the node needs a frame; comp = -1 when no free component meets the normal. */
 void ViNodeConstraint(const ContactSet *cs, PetscInt dim, PetscInt i, PetscInt *comp, PetscReal *coef, PetscReal *rhs, PetscBool *rotate)
 {
   const PetscReal *n     = &cs->normal[i * dim];
-  PetscInt         count = 0, first = -1;
+  PetscInt         count = 0, first = -1, first_free = -1;
   PetscReal        len2 = 0.0, fixed_n = 0.0;
 
   for (PetscInt c = 0; c < dim; ++c) {
@@ -26,12 +27,13 @@ void ViNodeConstraint(const ContactSet *cs, PetscInt dim, PetscInt i, PetscInt *
       fixed_n += cs->fixed[i * dim + c] * n[c];
       continue;
     }
+    if (first_free < 0) first_free = c;
     if (PetscAbsReal(n[c]) <= 1e-12) continue;
     if (first < 0) first = c;
     ++count;
     len2 += n[c] * n[c];
   }
-  *comp   = first;
+  *comp   = count > 1 ? first_free : first;
   *rotate = (PetscBool)(count > 1);
   *coef   = count > 1 ? PetscSqrtReal(len2) : first >= 0 ? n[first] : 0.0;
   *rhs    = cs->gap[i] - fixed_n;
