@@ -490,7 +490,8 @@ PetscErrorCode ContactRoundoffTerm(Contact ct, Vec u, PetscReal *sum_sq)
   if (!ct->has_penalty) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(VecGetArrayRead(u, &x));
   for (PetscInt i = 0; i < cs->n; ++i)
-    if (ContactNodePenetration(cs, ct->dim, i, x) > 0.0) gap += PetscSqr(cs->weight[i] * cs->gap[i] / ContactNodeEps(cs, ct->eps, i));
+    if (NodeArgument((Contact_Penalty *)ct->data, cs, ct->dim, i, x) > 0.0)
+      gap += PetscSqr(cs->weight[i] * cs->gap[i] / ContactNodeEps(cs, ct->eps, i));
   PetscCall(VecRestoreArrayRead(u, &x));
   PetscCall(MPIU_Allreduce(&gap, sum_sq, 1, MPIU_REAL, MPIU_SUM, ct->comm));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -1,5 +1,5 @@
-/* The start of a solve extrapolated from earlier solutions: the eps sweep's (eps_sweep.c) and the load path's
-   (load_path.c). */
+/* The start of a solve extrapolated from earlier solutions: the eps sweep's (eps_sweep.c), the load path's
+   (load_path.c) and the penetration tolerance's (penetration_tol.c). */
 #include "contact.h"
 #include "solver_impl.h"
 
@@ -29,5 +29,20 @@ PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Ve
     PetscCall(SolverSetStepGuess(user->prob.sctx, dir));
   }
   PetscCall(VecDestroy(&guess));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The start of a solve on the secant of the last two solutions: u <- u + factor (u - prev) where
+   SolverExtrapolatedStart() takes it (use; relaxed as there), and prev <- the old u. Shared by a load path's steps
+   (along the factor), force control's positions (along the position) and the penetration tolerance's values of eps. */
+PetscErrorCode SolverSecantStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor, PetscReal relaxed)
+{
+  PetscFunctionBeginUser;
+  if (use) {
+    PetscCall(VecWAXPY(dir, -1.0, prev, u));
+    PetscCall(VecCopy(u, prev));
+    PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, factor, relaxed, PETSC_TRUE));
+  } else
+    PetscCall(VecCopy(u, prev));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -103,21 +103,6 @@ static void ForceAlong(const AppCtx *user, PetscReal *f, PetscReal *s)
   Along(user, user->rec.stats.contact_force_vector, user->scene.obstacle.translate, f, s);
 }
 
-/* The start of a solve on the secant of the solutions: u <- u + factor (u - prev) where SolverExtrapolatedStart()
-   takes it (use), and prev <- the old u. Shared by the path's steps (along the factor) and force control's positions
-   (along the position). */
-static PetscErrorCode SecantStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor)
-{
-  PetscFunctionBeginUser;
-  if (use) {
-    PetscCall(VecWAXPY(dir, -1.0, prev, u));
-    PetscCall(VecCopy(u, prev));
-    PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, factor, 1.0, PETSC_TRUE));
-  } else
-    PetscCall(VecCopy(u, prev));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 #define FORCE_CONTROL_RTOL 1e-8 /* |F - target| / target at which the position is found */
 #define FORCE_CONTROL_MAX_ITS 60
 #define FORCE_CONTROL_SOLVE_TOL 1e-2 /* each position's Newton residual, relative to FORCE_CONTROL_RTOL times the target */
@@ -207,7 +192,7 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
       s_next = s_lo + (target - f_lo) * (s_hi - s_lo) / (f_hi - f_lo); /* regula falsi in the bracket */
     PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
     PetscCall(ProblemUpdateData(dm, user));
-    PetscCall(SecantStart(snes, dm, user, u, u_prev, dir, (PetscBool)(s != s_prev), s != s_prev ? (s_next - s) / (s - s_prev) : 0.0));
+    PetscCall(SolverSecantStart(snes, dm, user, u, u_prev, dir, (PetscBool)(s != s_prev), s != s_prev ? (s_next - s) / (s - s_prev) : 0.0, 1.0));
     s_prev = s, f_prev = f;
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
     if (!user->rec.stats.converged) /* Newton from the last position's solution can cycle between active sets: from zero, as a direct run */
@@ -312,7 +297,7 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
     {
       const PetscBool secant = (PetscBool)(!force && t_last != t_prev && ContactHasPenalty(user->contact));
 
-      PetscCall(SecantStart(snes, dm, user, u, prev, dir, secant, secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0));
+      PetscCall(SolverSecantStart(snes, dm, user, u, prev, dir, secant, secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0, 1.0));
     }
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
     PetscCall(PenetrationTolSolve(dm, user, snes, u)); /* -contact_penetration_tol at every step, from the last step's eps (or multipliers) */

@@ -33,7 +33,7 @@
    zero, would end the loop with the wrong answer). Where the active set stays, a solve is one linear solve with the
    last Jacobian; the change falls by a constant factor per update (about 0.6 at the edge of the contact zone,
    docs/solvers.md). */
-static PetscErrorCode UzawaSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscReal tol, PetscReal *d_max, PetscInt *solves)
+static PetscErrorCode UzawaSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscReal tol, PetscReal *d_max, PetscInt *solves, PetscBool *reached)
 {
   MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
   PetscReal change, best;
@@ -59,40 +59,35 @@ static PetscErrorCode UzawaSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscRea
       break;
     }
   }
-  if (change > tol && *d_max <= tol) *d_max = change; /* not there: reported with the change that is left */
+  *reached = (PetscBool)(change <= tol);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
+/* eps continuation (-contact_method penalty): eps <- eps 0.9 d / d_max after each solve, by at most the continuation
+   factor, each solve from the secant in eps of the last two solutions (or the last one), and from zero where the warm
+   solve fails. */
+static PetscErrorCode ContinuationSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscReal tol, PetscReal *d_max, PetscInt *solves, PetscBool *reached)
 {
   const ContactOptions *copt;
   MPI_Comm              comm = PetscObjectComm((PetscObject)dm);
   Vec                   prev = NULL, dir = NULL;
-  PetscReal             d_max, eps, eps_prev = 0.0;
-  PetscInt              solves = 1;
+  PetscReal             eps, eps_prev    = 0.0;
 
   PetscFunctionBeginUser;
   PetscCall(ContactGetOptions(user->contact, &copt));
-  if (!(copt->penetration_tol > 0.0) || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(ContactMaxPenetration(user->contact, dm, u, &d_max));
   PetscCall(ContactGetEps(user->contact, &eps));
-  if (ContactCanAugment(user->contact)) PetscCall(UzawaSolve(dm, user, snes, u, copt->penetration_tol, &d_max, &solves));
-  while (!ContactCanAugment(user->contact) && d_max > copt->penetration_tol && user->rec.stats.converged && solves < PENETRATION_TOL_MAX_SOLVES) {
-    const PetscReal eps_new = eps * PetscMax(PENETRATION_TOL_AIM * copt->penetration_tol / d_max, copt->continuation_factor);
+  while (*d_max > tol && user->rec.stats.converged && *solves < PENETRATION_TOL_MAX_SOLVES) {
+    const PetscReal eps_new = eps * PetscMax(PENETRATION_TOL_AIM * tol / *d_max, copt->continuation_factor);
+    const PetscBool secant  = (PetscBool)(prev != NULL);
 
     PetscCall(PetscPrintf(comm, "  penetration tolerance: eps = %g gives the largest penetration %g > %g: eps = %g next\n", (double)eps,
-                          (double)d_max, (double)copt->penetration_tol, (double)eps_new));
-    if (!dir) PetscCall(VecDuplicate(u, &dir));
-    if (prev) { /* the secant in eps of the last two solutions */
-      PetscCall(VecWAXPY(dir, -1.0, prev, u));
-      PetscCall(VecCopy(u, prev));
-      PetscCall(ContactSetEps(user->contact, dm, eps_new));
-      PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, (eps_new - eps) / (eps - eps_prev), 0.0, PETSC_TRUE));
-    } else {
+                          (double)*d_max, (double)tol, (double)eps_new));
+    if (!prev) {
       PetscCall(VecDuplicate(u, &prev));
-      PetscCall(VecCopy(u, prev));
-      PetscCall(ContactSetEps(user->contact, dm, eps_new));
+      PetscCall(VecDuplicate(u, &dir));
     }
+    PetscCall(ContactSetEps(user->contact, dm, eps_new));
+    PetscCall(SolverSecantStart(snes, dm, user, u, prev, dir, secant, secant ? (eps_new - eps) / (eps - eps_prev) : 0.0, 0.0));
     eps_prev = eps;
     eps      = eps_new;
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
@@ -100,20 +95,42 @@ PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
       PetscCall(PetscPrintf(comm, "  penetration tolerance: the warm solve at eps = %g failed; solving again from zero\n", (double)eps));
       PetscCall(SolverSolve(snes, user, u, SOLVER_START_ZERO));
     }
-    ++solves;
-    PetscCall(ContactMaxPenetration(user->contact, dm, u, &d_max));
+    ++*solves;
+    PetscCall(ContactMaxPenetration(user->contact, dm, u, d_max));
   }
+  *reached = (PetscBool)(*d_max <= tol);
+  PetscCall(VecDestroy(&prev));
+  PetscCall(VecDestroy(&dir));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
+{
+  const ContactOptions *copt;
+  MPI_Comm              comm = PetscObjectComm((PetscObject)dm);
+  PetscReal             d_max, eps;
+  PetscInt              solves  = 1;
+  PetscBool             reached = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  PetscCall(ContactGetOptions(user->contact, &copt));
+  if (!(copt->penetration_tol > 0.0) || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactMaxPenetration(user->contact, dm, u, &d_max));
+  if (ContactCanAugment(user->contact))
+    PetscCall(UzawaSolve(dm, user, snes, u, copt->penetration_tol, &d_max, &solves, &reached));
+  else
+    PetscCall(ContinuationSolve(dm, user, snes, u, copt->penetration_tol, &d_max, &solves, &reached));
+  PetscCall(ContactGetEps(user->contact, &eps));
   user->rec.stats.penetration_tol_solves += solves; /* over the steps of a load path */
   user->rec.stats.penetration_tol_measured = d_max;
-  if (user->rec.stats.converged && d_max > copt->penetration_tol) {
-    PetscCall(PetscPrintf(comm,
-                          "  penetration tolerance: the largest penetration %g is above -contact_penetration_tol %g after %" PetscInt_FMT " solves\n",
-                          (double)d_max, (double)copt->penetration_tol, solves));
+  if (user->rec.stats.converged && !reached) {
+    PetscCall(PetscPrintf(
+        comm, "  penetration tolerance: -contact_penetration_tol %g not reached after %" PetscInt_FMT " solves (the largest penetration %g%s)\n",
+        (double)copt->penetration_tol, solves, (double)d_max,
+        ContactCanAugment(user->contact) ? "; the multipliers still move by more than the tolerance" : ""));
     user->rec.stats.converged = PETSC_FALSE;
   } else if (user->rec.stats.converged)
     PetscCall(PetscPrintf(comm, "  penetration tolerance: the largest penetration %g <= %g at eps = %g, in %" PetscInt_FMT " solve(s)\n",
                           (double)d_max, (double)copt->penetration_tol, (double)eps, solves));
-  PetscCall(VecDestroy(&prev));
-  PetscCall(VecDestroy(&dir));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -135,6 +135,7 @@ PetscErrorCode SolverSetStepGuess(SolverCtx sc, Vec du);
 PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, SolverCtx sc);
 PetscErrorCode SolverStepGuessDrop(SolverCtx sc);
 PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscReal factor, PetscReal relaxed, PetscBool step_guess);
+PetscErrorCode SolverSecantStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor, PetscReal relaxed);
 
 /* pc_reuse.c */
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X);
