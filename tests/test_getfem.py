@@ -93,8 +93,8 @@ def test_snesvi_against_getfem_contact_brick(outdir, problem):
     elasticity, load and Dirichlet bricks, its nodal contact brick with the rigid obstacle given as a signed distance,
     its Newton), on the problem without the left slip: the displacements to 1e-8 of their size (measured 3.3e-13) and
     the contact force to 1e-8. (Under the disk the brick differs by 1.1e-5, by an amount that grows with the obstacle's
-    curvature: 2.1e-6 at R = 50, 1.5e-5 at R = 1.5, where the exact normals of solve_exact() agree to 6e-15; GetFEM's
-    brick approximates the curved obstacle's normal or gap.)"""
+    curvature: 2.1e-6 at R = 50, 1.5e-5 at R = 1.5 (python3 tests/getfem_reference.py prints them), where the exact
+    normals of solve_exact() agree to 6e-15; GetFEM's brick approximates the curved obstacle's normal or gap.)"""
     path = problem[0]
     x_ref, u_ref, force_ref = ref.solve_brick(path, obstacle="plane")
     _, h5 = run(["-dm_plex_filename", path] + ref.solver_options("plane", "vi", slip=False), "brick", output=os.path.join(outdir, "brick.h5"))
