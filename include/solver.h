@@ -14,6 +14,9 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user);
    iteration); the last two are warm starts, and the first and last reach a small eps by continuation. */
 typedef enum { SOLVER_START_ZERO, SOLVER_START_NEARBY_EPS, SOLVER_START_COARSER_MESH } SolverStart;
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start);
+/* A solve from the guess u (a load path's step, force control's position, the penetration tolerance's eps) that, where
+   it stalls or fails, is solved again from zero as a direct run: never less reliable than the direct run */
+PetscErrorCode SolverSolveWarm(SNES snes, AppCtx *user, Vec u, const char what[]);
 /* |F| (user's units) that -snes_rtol is relative to in the current solve: its first, or for a warm start the load
    ||F(0)||, so that a warm start ends as tight as a start from zero */
 PetscErrorCode SolverResidualNorm(SNES snes, SolverCtx sc, Vec u, PetscReal *norm);

@@ -77,6 +77,32 @@ def test_the_same_factor_by_any_path(outdir):
 
 
 @pytest.mark.parametrize("np_", [1, 2])
+def test_unloading_the_sphere_indenter(outdir, np_):
+    """The 3D sphere indenter (make hertz's mesh at h_near 0.02, eps = h/100) unloaded from 1 to 0.5 and 0.25, then
+    loaded to 0.6: every step is the direct run at its factor (force and energy to 1e-8), on 1 and 2 ranks. The secant's
+    guess u/2 lifts all but a few nodes off the sphere, whose profile does not scale, and Newton from it stalled (50
+    steps, the critical-point line search at lambda = 6e-4 each, a failed step) until a stalled warm solve was solved
+    again from zero (SolverSolveWarm())."""
+    import sys
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "scripts"))
+    from signorini import hertz
+    mesh = os.path.join(outdir, "sphere.msh")
+    hertz.write_mesh("sphere-indenter", 0.02, mesh)
+    base = hertz.command("sphere-indenter", mesh, "eps=h/100", "unused.h5")[4:-2] + ["-snes_rtol", "1e-12"]  # the options only
+    path = [1.0, 0.5, 0.25, 0.6]
+    _, h5 = run(base + ["-load_path", vec(path)], "unload", np_=np_, output=os.path.join(outdir, "unload.h5"))
+    st = steps(h5)
+    assert list(st["factor"]) == path and st["converged"].all(), st
+    move = np.array(base[base.index("-obstacle_translate") + 1].split(","), dtype=float)
+    for k, t in enumerate(path[1:], start=1):
+        direct = base + ["-obstacle_translate", vec(t * move)]
+        _, d = run(direct, f"unload_direct_{k}", np_=np_, output=os.path.join(outdir, f"unload_direct_{k}.h5"))
+        attrs = load(d)[0]
+        for q in ("contact_force", "energy"):
+            assert abs(st[q][k] - attrs[q]) <= 1e-8 * abs(attrs[q]), (k, q, st[q][k], attrs[q])
+
+
+@pytest.mark.parametrize("np_", [1, 2])
 def test_snesvi_path_follows_the_gap(outdir, np_):
     """SNESVI along a path: the bounds u . n <= g are renewed at each step from the moved obstacle's gaps (a flat
     foundation under a block pressed by its moving clamp, and a plane obstacle moved up into a block held at its

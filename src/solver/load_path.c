@@ -194,9 +194,7 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
     PetscCall(ProblemUpdateData(dm, user));
     PetscCall(SolverSecantStart(snes, dm, user, u, u_prev, dir, (PetscBool)(s != s_prev), s != s_prev ? (s_next - s) / (s - s_prev) : 0.0, 1.0));
     s_prev = s, f_prev = f;
-    PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
-    if (!user->rec.stats.converged) /* Newton from the last position's solution can cycle between active sets: from zero, as a direct run */
-      PetscCall(SolverSolve(snes, user, u, SOLVER_START_ZERO));
+    PetscCall(SolverSolveWarm(snes, user, u, "force control")); /* from zero where Newton stalls at a kink of the penalty */
     PetscCall(PostprocessContact(dm, user, u));
     ForceAlong(user, &f, &s);
     ++*its;
@@ -299,7 +297,7 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 
       PetscCall(SolverSecantStart(snes, dm, user, u, prev, dir, secant, secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0, 1.0));
     }
-    PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
+    PetscCall(SolverSolveWarm(snes, user, u, "load path")); /* from zero where the guess's active set is too far off */
     PetscCall(PenetrationTolSolve(dm, user, snes, u)); /* -contact_penetration_tol at every step, from the last step's eps (or multipliers) */
     PetscCall(LoadPathForce(dm, user, snes, u, &ok));
     PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[k], first, ok));

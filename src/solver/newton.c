@@ -185,6 +185,16 @@ PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscRea
       sc->roundoff_stop = PETSC_TRUE;
     }
   }
+  /* A warm solve that has a way out (SolverSolveWarm()) stops, failed, where SOLVER_STALL_STEPS Newton steps have not
+     halved |F|: converging semismooth Newton does that in one or two steps, while a start whose active set is far off
+     can stall, the critical-point line search taking steps of 1e-3 at every iteration (solver.c). */
+  if (sc->stall_stop && !PetscIsInfOrNanReal(f)) {
+    const PetscInt w = SOLVER_STALL_STEPS + 1;
+
+    if (*reason == SNES_CONVERGED_ITERATING && it >= SOLVER_STALL_STEPS && f > 0.5 * sc->fnorm_window[(it - SOLVER_STALL_STEPS) % w])
+      *reason = SNES_DIVERGED_LINE_SEARCH;
+    sc->fnorm_window[it % w] = f;
+  }
   sc->fnorm_last = f;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

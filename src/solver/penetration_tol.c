@@ -90,11 +90,7 @@ static PetscErrorCode ContinuationSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
     PetscCall(SolverSecantStart(snes, dm, user, u, prev, dir, secant, secant ? (eps_new - eps) / (eps - eps_prev) : 0.0, 0.0));
     eps_prev = eps;
     eps      = eps_new;
-    PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
-    if (!user->rec.stats.converged) { /* stalled at a kink of the penalty (the line search's steps shrink to nothing): from zero, as a direct run */
-      PetscCall(PetscPrintf(comm, "  penetration tolerance: the warm solve at eps = %g failed; solving again from zero\n", (double)eps));
-      PetscCall(SolverSolve(snes, user, u, SOLVER_START_ZERO));
-    }
+    PetscCall(SolverSolveWarm(snes, user, u, "penetration tolerance")); /* from zero where it stalls at a kink of the penalty */
     ++*solves;
     PetscCall(ContactMaxPenetration(user->contact, dm, u, d_max));
   }

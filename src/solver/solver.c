@@ -424,6 +424,32 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* A warm solve with a way out. Semismooth Newton from a guess whose active set is far off can stall: on a path that
+   unloads the 3D sphere indenter from 1 to 0.5 (make hertz-path's mesh, or h_near 0.02), the secant's guess u/2 lifts
+   all but a few contact nodes off the sphere, whose profile does not scale; each Newton step then pushes hundreds of
+   nodes deep into the obstacle, the critical-point line search's one secant step along the energy's derivative, whose
+   slope jumps by 1/eps there, takes lambda = 6e-4, and the active set never grows: 50 Newton steps and a failed step,
+   where the direct run converges in 13. So the warm solve stops once SOLVER_STALL_STEPS Newton steps have not halved
+   |F| (SolverConverged()), or on any failure, and the problem is solved again from zero as a direct run would be; both
+   solves are in /solves and the Newton steps of both count. */
+PetscErrorCode SolverSolveWarm(SNES snes, AppCtx *user, Vec u, const char what[])
+{
+  SNESConvergedReason reason;
+  PetscInt            its;
+
+  PetscFunctionBeginUser;
+  user->prob.sctx->stall_stop = PETSC_TRUE;
+  PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
+  user->prob.sctx->stall_stop = PETSC_FALSE;
+  if (user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(SNESGetConvergedReason(snes, &reason));
+  PetscCall(SNESGetIterationNumber(snes, &its));
+  PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes), "  %s: the warm solve %s (%s, %" PetscInt_FMT " Newton steps); solved again from zero\n", what,
+                        reason == SNES_DIVERGED_LINE_SEARCH ? "stalled" : "failed", SNESConvergedReasons[reason], its));
+  PetscCall(SolverSolve(snes, user, u, SOLVER_START_ZERO));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Hager's estimate of ||J^-1||_1 (Higham, ACM TOMS 14, 1988), with solves by the SNES's own linear solver, times ||J||_1:
    the 1-norm condition number of the Jacobian at the solution (for vi: of K). J is symmetric, so J^-T x is a solve with J.
    SNESVI's linear solver holds the reduced system of the last active set, so vi gets a linear solver of its own for K,

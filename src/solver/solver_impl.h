@@ -7,6 +7,10 @@
 #include "contact.h"
 #include "solver.h"
 
+/* A warm solve with a way out (SolverSolveWarm()) stops, failed, once this many Newton steps have not halved |F|
+   (SolverConverged()): it has stalled, and is solved again from zero. */
+#define SOLVER_STALL_STEPS 6
+
 /* State of the preconditioner reuse (pc_reuse.c). */
 typedef struct {
   PetscBool enabled;         /* penalty method with a Krylov method around the preconditioner */
@@ -96,6 +100,8 @@ struct _n_SolverCtx {
   PetscReal  fnorm_last;                      /* |F| at the last Newton step, in the user's units */
   PetscBool  roundoff_stop;                   /* the last SNESSolve stopped at the round-off of its terms (SolverConverged()) */
   PetscBool  warm;                            /* the last SolverSolve() started from a given guess, not from zero */
+  PetscBool  stall_stop;                      /* the current solve is SolverSolveWarm()'s: it stops where it stalls */
+  PetscReal  fnorm_window[SOLVER_STALL_STEPS + 1]; /* |F| of its last Newton steps (a ring), for that test */
   PetscInt64 active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
   PetscReal  fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */
   /* acceleration */
