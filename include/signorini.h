@@ -155,6 +155,7 @@ typedef struct {
   PetscBool   pc_update_check;    /*   and each update is compared with the full Galerkin products */
   PetscBool   pc_update_esteig;   /*   and the finest smoother estimates its eigenvalues again at each update */
   PetscReal   pc_update_truncate; /*   and the coarse spaces leave out the contact dofs whose penalty exceeds this times K's diagonal (0: none) */
+  PetscInt    pc_update_changes;  /*   and the coarse operators stay while at most this many contact nodes changed since they followed (0: never) */
   PetscInt    grid_sequence;      /* solve on the mesh and on this many uniform refinements of it, each from the last */
   PetscInt    coarse_levels;      /* nested iteration to the mesh: this many coarser boxes solved first (-1: automatic) */
   PetscReal   coarse_rtol;        /*   Newton's relative tolerance there */
@@ -287,6 +288,7 @@ typedef struct {
   PetscInt            active_set_cycles;        /* active-set cycles detected (and damped) in the Newton iterations */
   PetscInt            pc_builds;                /* preconditioner (factorization) builds of the Newton steps */
   PetscInt            pc_updates;               /* updates of a GAMG hierarchy's coarse operators instead of builds (-contact_pc_update) */
+  PetscInt            pc_finest_updates;        /*   and of its finest level only (-contact_pc_update_changes) */
   PetscBool           coarse_mg;                /* the coarser boxes solved with the geometric multigrid of the boxes below, if any */
   PetscInt            pc_breakdowns;            /* preconditioner breakdowns recovered from (pc_recovery.c), */
   char                pc_recovery[512];         /*   and what was done, "; "-separated */

@@ -33,6 +33,7 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
                         "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, %" PetscInt_FMT " preconditioner builds",
                         SNESConvergedReasons[s->reason], s->newton_its, s->ksp_its, s->pc_builds));
   if (s->pc_updates) PetscCall(PetscPrintf(comm, " and %" PetscInt_FMT " coarse-level updates", s->pc_updates));
+  if (s->pc_finest_updates) PetscCall(PetscPrintf(comm, " (and %" PetscInt_FMT " of the finest level only)", s->pc_finest_updates));
   PetscCall(PetscPrintf(comm, ", |F| = %g%s\n", (double)s->residual_norm,
                         s->roundoff_stop ? " (stopped at round-off: -snes_rtol asks for less than double precision can reach)" : ""));
   PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g, contact force %g, energy %.10g\n",

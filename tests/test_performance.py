@@ -152,8 +152,10 @@ def test_gamg_hierarchy_update_is_the_rebuild(np_, eps0):
     operator the Galerkin product of the Jacobian's change (in the contact rows only). -contact_pc_update_check compares
     each updated coarse operator with R^T A_f R computed in full, as a rebuild does; and the answer is the one of a
     rebuild at every changed step. eps = 1e-6 h goes through the continuation's changes of eps, on 2 ranks. Without
-    nesting (-contact_coarse_levels 0): from a zero guess Newton takes enough steps to update several times."""
-    args = SQUARE + ["-dm_plex_box_faces", "64,64", "-penalty_eps0", eps0, "-options_file", "options/solvers/gamg.yaml", "-contact_coarse_levels", 0]
+    nesting (-contact_coarse_levels 0): from a zero guess Newton takes enough steps to update several times. Every
+    Newton step updates every level (-contact_pc_update_changes 0; test_finest_only_updates for the default)."""
+    args = SQUARE + ["-dm_plex_box_faces", "64,64", "-penalty_eps0", eps0, "-options_file", "options/solvers/gamg.yaml", "-contact_coarse_levels", 0,
+                     "-contact_pc_update_changes", 0]
     out, upd = run(args + ["-contact_pc_update_check"], f"pc_update_{np_}_{eps0}", np_=np_)
     _, rebuilt = run(args + ["-contact_pc_update", "0", "-contact_pc_reuse_changes", "0"], f"pc_rebuilt_{np_}_{eps0}", np_=np_)
     a, _ = load(upd)
@@ -164,6 +166,31 @@ def test_gamg_hierarchy_update_is_the_rebuild(np_, eps0):
     assert len(checks) >= 2 * a["pc_updates"], "one line per coarse level and update"
     assert max(checks) < 1e-13, max(checks)
     assert max_diff(upd, rebuilt) < 1e-8
+
+
+@pytest.mark.parametrize("np_", [1, 2])
+def test_finest_only_updates(outdir, np_):
+    """-contact_pc_update_changes 50 (the default): a Newton step that changed the state of at most 50 contact nodes
+    since the coarse operators last followed the Jacobian, at the same eps, updates the finest level only. Along a
+    10-step path on the 3D sphere indenter (h_near 0.02, eps = h/100, GAMG) the rim's Newton steps do so (the last
+    step: all of them), and every step is the one of updates at every level (-contact_pc_update_changes 0) to 1e-8, on
+    1 and 2 ranks."""
+    import sys
+    sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "scripts"))
+    from signorini import hertz
+    mesh = os.path.join(outdir, "sphere.msh")
+    hertz.write_mesh("sphere-indenter", 0.02, mesh)
+    base = hertz.command("sphere-indenter", mesh, "eps=h/100", "unused.h5")[4:-2]  # the options only
+    base += ["-options_file", "options/solvers/gamg.yaml", "-load_steps", 10, "-snes_rtol", "1e-12"]
+    _, lazy = run(base, f"finest_only_{np_}", np_=np_, output=os.path.join(outdir, "lazy.h5"))
+    _, every = run(base + ["-contact_pc_update_changes", 0], f"every_level_{np_}", np_=np_, output=os.path.join(outdir, "every.h5"))
+    a, b = load(lazy)[0], load(every)[0]
+    assert a["pc_finest_updates"] >= 2 and b["pc_finest_updates"] == 0, (a["pc_finest_updates"], b["pc_finest_updates"])
+    with h5py.File(lazy, "r") as fa, h5py.File(every, "r") as fb:
+        assert fa["steps"]["converged"][:].all() and fb["steps"]["converged"][:].all()
+        for q in ("contact_force", "energy", "pressure_max"):
+            x, y = fa["steps"][q][:].ravel(), fb["steps"][q][:].ravel()
+            assert np.all(np.abs(x - y) <= 1e-8 * np.abs(y)), (q, x, y)
 
 
 @pytest.mark.parametrize("np_", [1, 2])
@@ -221,7 +248,8 @@ def test_finest_smoother_interval_is_bounded_not_estimated(np_, extra):
     bound of the penalty term (src/solver/smoother_bound.c), not from a new estimate. -contact_pc_update_check
     estimates afresh on every updated Jacobian: the interval's top stays above 1.1 times that estimate (what PETSc's
     own re-estimate would give, to 1%), and the answer is the one of the re-estimates (-contact_pc_update_esteig).
-    Without nesting: from a zero guess Newton takes enough steps to update several times."""
+    Without nesting: from a zero guess Newton takes enough steps to update several times. The updates of the finest
+    level only (-contact_pc_update_changes) bound the interval too: one check each."""
     args = SQUARE + extra + ["-options_file", "options/solvers/gamg.yaml", "-contact_coarse_levels", 0]
     tag = f"smoother_bound_{np_}_{len(extra)}"
     out, bounded = run(args + ["-contact_pc_update_check"], tag, np_=np_)
@@ -229,8 +257,9 @@ def test_finest_smoother_interval_is_bounded_not_estimated(np_, extra):
     a, _ = load(bounded)
     b, _ = load(estimated)
     ratios = [float(x) for x in re.findall(r"pc update check: finest level: .* interval top / fresh estimate = (\S+)", out)]
-    assert a["converged"] == b["converged"] == 1 and a["pc_updates"] >= 2
-    assert len(ratios) == a["pc_updates"], (len(ratios), a["pc_updates"])
+    updates = a["pc_updates"] + a["pc_finest_updates"]
+    assert a["converged"] == b["converged"] == 1 and updates >= 2
+    assert len(ratios) == updates, (len(ratios), a["pc_updates"], a["pc_finest_updates"])
     assert min(ratios) >= 1.1 * 0.99, ratios
     assert a["newton_its"] == b["newton_its"]
     assert max_diff(bounded, estimated) < 1e-8

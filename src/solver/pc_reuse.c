@@ -7,27 +7,76 @@
    since the last step lives in the contact rows, and each coarse operator A_c = R^T A_f R (R the prolongator)
    changes by R^T D R, a
    Galerkin product of a matrix with a few hundred nonzero rows. The hierarchy then equals a rebuild's (GAMG reuses its
-   prolongators on a rebuild) at the cost of a few sparse products instead of the products of the whole matrix. */
+   prolongators on a rebuild) at the cost of a few sparse products instead of the products of the whole matrix.
+   Those products still cost about as much as the linear solve where the coarse levels are dense (make hertz-path's
+   graded sphere mesh: 2496 coarse rows with 240 nonzeros each, 534 with 462; 62 ms of a 140 ms Newton step). While a
+   Newton step changed the state of few contact nodes since the coarse operators last followed the Jacobian (at most
+   -contact_pc_update_changes, and the last linear solve took at most twice the iterations of the first after that, plus
+   5), only the finest level is updated: its smoother's Jacobi diagonal and Chebyshev bound (smoother_bound.c), while
+   its operator is the Jacobian itself. The coarse operators are then the Galerkin products of an earlier Jacobian, which
+   differs from this one by a term of the rank of those nodes: the preconditioner stays symmetric positive definite,
+   and CG pays a few iterations for the change (the path's steps settle the rim of the contact zone a few nodes per
+   Newton step). On that mesh a 10-step load path took 455 -> 514 linear iterations and 13.4-14.2 s -> 11.5-11.9 s. */
 #include "physics.h"
 #include "solver_impl.h"
 
 /* Number of contact nodes (over all ranks) whose state differs from the state at the last build. */
-static PetscErrorCode CountChanges(SolverCtx sc, PetscInt dim, const PetscScalar x[], PetscBool record, PetscInt *changes)
+static PetscErrorCode CountChangesSince(SolverCtx sc, PetscInt dim, const PetscScalar x[], PetscBool **state, PetscBool record, PetscInt *changes)
 {
-  PcReuse          *r     = &sc->pc_reuse;
   PetscInt          local = 0;
   const ContactSet *cs;
 
   PetscFunctionBeginUser;
   PetscCall(ContactGetSet(sc->contact, &cs));
-  if (!r->built_active) PetscCall(PetscCalloc1(cs->n + 1, &r->built_active)); /* no node penetrated before the first build */
+  if (!*state) PetscCall(PetscCalloc1(cs->n + 1, state)); /* no node penetrated before the first build */
   for (PetscInt i = 0; i < cs->n; ++i) {
     const PetscBool on = (PetscBool)(ContactNodePenetration(cs, dim, i, x) > 0.0);
 
-    local += on != r->built_active[i];
-    if (record) r->built_active[i] = on;
+    local += on != (*state)[i];
+    if (record) (*state)[i] = on;
   }
   PetscCall(MPIU_Allreduce(&local, changes, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)sc->K)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* ... since the last build (record: the current states become the build's). */
+static PetscErrorCode CountChanges(SolverCtx sc, PetscInt dim, const PetscScalar x[], PetscBool record, PetscInt *changes)
+{
+  PetscFunctionBeginUser;
+  PetscCall(CountChangesSince(sc, dim, x, &sc->pc_reuse.built_active, record, changes));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Whether this Newton step updates the finest level only (the header's comment), and if not, the current states become
+   those the coarse operators follow. Collective. */
+static PetscErrorCode DecideFinestOnly(KSP ksp, DM dm, SolverCtx sc, Vec X)
+{
+  PcReuse           *r       = &sc->pc_reuse;
+  PetscInt           changes = 0, its, dim;
+  PetscReal          eps;
+  KSPConvergedReason reason;
+  const PetscScalar *x;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(ContactGetEps(sc->contact, &eps));
+  PetscCall(VecGetArrayRead(X, &x));
+  r->finest_only = PETSC_FALSE;
+  /* only where the coarse operators have followed the Jacobian since the build, at this eps (a new eps changes the
+     penalty at every contact node, not at a few), and the last linear solve converged */
+  if (r->dcoarse && sc->opt->pc_update_changes > 0 && eps == r->carried_eps) {
+    PetscCall(KSPGetIterationNumber(ksp, &its));
+    PetscCall(KSPGetConvergedReason(ksp, &reason));
+    if (r->its_after_carry < 0) r->its_after_carry = its;
+    PetscCall(CountChangesSince(sc, dim, x, &r->carried_active, PETSC_FALSE, &changes));
+    r->finest_only = (PetscBool)(changes <= sc->opt->pc_update_changes && reason >= 0 && its <= 2 * r->its_after_carry + 5);
+  }
+  if (!r->finest_only) {
+    PetscCall(CountChangesSince(sc, dim, x, &r->carried_active, PETSC_TRUE, &changes));
+    r->its_after_carry = -1; /* set by the next call */
+    r->carried_eps     = eps;
+  }
+  PetscCall(VecRestoreArrayRead(X, &x));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -346,6 +395,17 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
   PetscCheck(r->nlevels == nlevels, PetscObjectComm((PetscObject)pc), PETSC_ERR_PLIB, "the multigrid hierarchy changed its levels");
   PetscCall(ContactRowValues(sc, r->dvals));
   PetscCall(PetscArraycpy(r->built_vals, r->dvals, nnz)); /* J now, for the finest smoother's bound */
+  if (r->finest_only) { /* the coarse operators, R's rows Z and eff_vals stay as they are, consistent with each other */
+    KSP smoother;
+    Mat A;
+
+    PetscCall(PCMGGetSmoother(pc, nlevels - 1, &smoother));
+    PetscCall(KSPGetOperators(smoother, &A, NULL));
+    PetscCall(KSPSetOperators(smoother, A, A)); /* its Jacobi diagonal again */
+    if (!sc->opt->pc_update_esteig) PetscCall(SmootherBoundFinest(pc, nlevels, sc, r->built_vals, sc->opt->pc_update_check));
+    r->finest_updates++;
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   PetscCall(EffectiveValues(sc, r->dvals, r->eff_dvals));
   PetscCall(ProlongatorRowsSet(sc, PETSC_FALSE));
   for (PetscInt k = 0; k < nnz + r->nmirror; ++k) {
@@ -420,6 +480,7 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
     PetscCall(HierarchyLevels(snes, sc, &pc, &nlevels));
     if (nlevels > 1 && r->recorded) { /* the hierarchy follows the Jacobian (PcReuseAfterJacobian()): no rebuild */
       r->update = PETSC_TRUE;
+      PetscCall(DecideFinestOnly(ksp, dm, sc, X));
       PetscCall(SNESSetLagPreconditioner(snes, -1));
       PetscFunctionReturn(PETSC_SUCCESS);
     }
@@ -501,6 +562,7 @@ PetscErrorCode PcReuseDestroy(SolverCtx sc)
   PetscCall(VecDestroy(&r->pdiag));
   PetscCall(VecDestroy(&r->pcols));
   PetscCall(PetscFree(r->built_active));
+  PetscCall(PetscFree(r->carried_active));
   PetscCall(PetscMemzero(r, sizeof(*r)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -301,6 +301,7 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
   user->rec.stats.pc_builds = user->prob.sctx->pc_reuse.enabled ? user->prob.sctx->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
   user->rec.stats.pc_updates = user->prob.sctx->pc_reuse.updates;
+  user->rec.stats.pc_finest_updates = user->prob.sctx->pc_reuse.finest_updates;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -403,6 +404,7 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
   PetscCall(PetscTime(&t0));
   user->prob.sctx->pc_reuse.builds    = 0; /* counted per solve */
   user->prob.sctx->pc_reuse.updates   = 0;
+  user->prob.sctx->pc_reuse.finest_updates = 0;
   user->rec.stats.continuation_stages = 0;
   if (start != SOLVER_START_NEARBY_EPS && ContactHasPenalty(user->contact) && copt->continuation && eps_target < eps_start) {
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= copt->continuation_factor) {

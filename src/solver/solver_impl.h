@@ -53,6 +53,12 @@ typedef struct {
   PetscReal  est_min, est_max; /* the build's Chebyshev estimate of the extreme eigenvalues of diag(K)^-1 K */
   PetscInt   est_steps;        /* the steps of its estimator */
   PetscBool *built_active;     /* the contact nodes' penetration when the preconditioner was last built */
+  /* -contact_pc_update_changes: the coarse operators stay while few contact nodes changed since they followed the Jacobian */
+  PetscBool *carried_active;   /* the contact nodes' penetration when the coarse operators last followed the Jacobian */
+  PetscInt   its_after_carry;  /* Krylov iterations of the first solve after that (-1: not yet known) */
+  PetscReal  carried_eps;      /* eps then */
+  PetscBool  finest_only;      /* this Newton step updates the finest level only */
+  PetscInt   finest_updates;   /* such updates so far */
   PetscReal  tform[4];         /* Chebyshev's transform of estimates into its interval (-ksp_chebyshev_esteig) */
   Vec        pdiag, pcols;     /* the penalty term's diagonal, and its values at the contact rows' columns */
 } PcReuse;

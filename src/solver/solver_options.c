@@ -119,6 +119,12 @@ PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts)
                              "With the updates: the coarse operators leave out the contact dofs whose penalty diagonal exceeds this times "
                              "K's diagonal (Jacobi smooths them alone), so that a small eps does not stiffen the coarse spaces; 0: never",
                              NULL, opts->pc_update_truncate, &opts->pc_update_truncate, NULL));
+  opts->pc_update_changes = 50;
+  PetscCall(PetscOptionsInt("-contact_pc_update_changes",
+                            "With the updates: a Newton step at which at most this many contact nodes changed state since the coarse operators "
+                            "last followed the Jacobian (and whose last linear solve stayed cheap) updates the finest level only; 0: every step "
+                            "updates every level",
+                            NULL, opts->pc_update_changes, &opts->pc_update_changes, NULL));
   opts->grid_sequence = 0;
   PetscCall(PetscOptionsInt("-contact_grid_sequence",
                             "Nested iteration: solve on the mesh, then on N uniform refinements of it, each from the interpolated last solution",
@@ -169,6 +175,8 @@ PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts)
              (double)opts->ew_guard);
   PetscCheck(opts->pc_update_truncate >= 0.0, comm, PETSC_ERR_USER_INPUT, "-contact_pc_update_truncate must be >= 0 (0: never), got %g",
              (double)opts->pc_update_truncate);
+  PetscCheck(opts->pc_update_changes >= 0, comm, PETSC_ERR_USER_INPUT, "-contact_pc_update_changes must be >= 0 (0: every step updates every level), got %" PetscInt_FMT,
+             opts->pc_update_changes);
   PetscCheck(opts->pc_reuse_changes >= 0, comm, PETSC_ERR_USER_INPUT, "-contact_pc_reuse_changes must be >= 0, got %" PetscInt_FMT,
              opts->pc_reuse_changes);
   PetscFunctionReturn(PETSC_SUCCESS);
