@@ -170,11 +170,12 @@ def test_gamg_hierarchy_update_is_the_rebuild(np_, eps0):
 
 @pytest.mark.parametrize("np_", [1, 2])
 def test_finest_only_updates(outdir, np_):
-    """-contact_pc_update_changes 50 (the default): a Newton step that changed the state of at most 50 contact nodes
-    since the coarse operators last followed the Jacobian, at the same eps, updates the finest level only. Along a
-    10-step path on the 3D sphere indenter (h_near 0.02, eps = h/100, GAMG) the rim's Newton steps do so (the last
-    step: all of them), and every step is the one of updates at every level (-contact_pc_update_changes 0) to 1e-8, on
-    1 and 2 ranks."""
+    """-contact_pc_update_changes 50 (the default): where a carried update costs more than 2 CG iterations (in flops), a
+    Newton step that changed the state of at most 50 contact nodes since the coarse operators last followed the
+    Jacobian, at the same eps, updates the finest level only. Along a 10-step path on the 3D sphere indenter (h_near
+    0.02, eps = h/100, GAMG; an update costs 3.9 CG iterations) the rim's Newton steps do so, and every step is the one
+    of updates at every level (-contact_pc_update_changes 0) to 1e-8, on 1 and 2 ranks. On the 2D square (64 x 64,
+    without nesting; an update costs 0.5) every update is carried."""
     import sys
     sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "scripts"))
     from signorini import hertz
@@ -186,6 +187,10 @@ def test_finest_only_updates(outdir, np_):
     _, every = run(base + ["-contact_pc_update_changes", 0], f"every_level_{np_}", np_=np_, output=os.path.join(outdir, "every.h5"))
     a, b = load(lazy)[0], load(every)[0]
     assert a["pc_finest_updates"] >= 2 and b["pc_finest_updates"] == 0, (a["pc_finest_updates"], b["pc_finest_updates"])
+    _, square = run(SQUARE + ["-dm_plex_box_faces", "64,64", "-options_file", "options/solvers/gamg.yaml", "-contact_coarse_levels", 0],
+                    f"square_carried_{np_}", np_=np_, output=os.path.join(outdir, "square.h5"))
+    c = load(square)[0]
+    assert c["pc_finest_updates"] == 0 and c["pc_updates"] >= 3, (c["pc_finest_updates"], c["pc_updates"])
     with h5py.File(lazy, "r") as fa, h5py.File(every, "r") as fb:
         assert fa["steps"]["converged"][:].all() and fb["steps"]["converged"][:].all()
         for q in ("contact_force", "energy", "pressure_max"):

@@ -8,17 +8,22 @@
    changes by R^T D R, a
    Galerkin product of a matrix with a few hundred nonzero rows. The hierarchy then equals a rebuild's (GAMG reuses its
    prolongators on a rebuild) at the cost of a few sparse products instead of the products of the whole matrix.
-   Those products still cost about as much as the linear solve where the coarse levels are dense (make hertz-path's
-   graded sphere mesh: 2496 coarse rows with 240 nonzeros each, 534 with 462; 62 ms of a 140 ms Newton step). While a
-   Newton step changed the state of few contact nodes since the coarse operators last followed the Jacobian (at most
-   -contact_pc_update_changes, and the last linear solve took at most twice the iterations of the first after that, plus
-   5), only the finest level is updated: its smoother's Jacobi diagonal and Chebyshev bound (smoother_bound.c), while
-   its operator is the Jacobian itself. The coarse operators are then the Galerkin products of an earlier Jacobian, which
-   differs from this one by a term of the rank of those nodes: the preconditioner stays symmetric positive definite,
-   and CG pays a few iterations for the change (the path's steps settle the rim of the contact zone a few nodes per
-   Newton step). On that mesh a 10-step load path took 455 -> 514 linear iterations and 13.4-14.2 s -> 11.5-11.9 s. */
+   Where the coarse levels are dense those products, and the coarse smoothers' new eigenvalue estimates, cost several
+   linear iterations (make hertz-path's graded sphere mesh: 2496 coarse rows with 240 nonzeros each, 534 with 462; 62 ms
+   of a 140 ms Newton step, about 5 CG iterations' flops). There, while a Newton step changed the state of few contact
+   nodes since the coarse operators last followed the Jacobian (at most -contact_pc_update_changes, at the same eps, the
+   last linear solve converged in at most twice the iterations of the first after that, plus 5), only the finest level
+   is updated: its smoother's Jacobi diagonal and Chebyshev bound (smoother_bound.c), while its operator is the Jacobian
+   itself. The coarse operators are then the Galerkin products of an earlier Jacobian, which differs from this one by a
+   term of the rank of those nodes: the preconditioner stays symmetric positive definite, and CG pays a few iterations
+   for the change (a load path's steps settle the rim of the contact zone a few nodes per Newton step). "There" is where
+   the last carried update cost more than PC_FINEST_ONLY_CYCLES CG iterations, in flops (deterministic, unlike times):
+   on the 2D square at 512 x 512 an update costs less than one, and the finest-only steps cost more CG iterations (50 ->
+   77 in 9 Newton steps) than they saved. */
 #include "physics.h"
 #include "solver_impl.h"
+
+#define PC_FINEST_ONLY_CYCLES 2.0 /* the coarse operators may stay where a carried update costs more CG iterations than this */
 
 /* Number of contact nodes (over all ranks) whose state differs from the state at the last build. */
 static PetscErrorCode CountChangesSince(SolverCtx sc, PetscInt dim, const PetscScalar x[], PetscBool **state, PetscBool record, PetscInt *changes)
@@ -64,7 +69,8 @@ static PetscErrorCode DecideFinestOnly(KSP ksp, DM dm, SolverCtx sc, Vec X)
   r->finest_only = PETSC_FALSE;
   /* only where the coarse operators have followed the Jacobian since the build, at this eps (a new eps changes the
      penalty at every contact node, not at a few), and the last linear solve converged */
-  if (r->dcoarse && sc->opt->pc_update_changes > 0 && eps == r->carried_eps) {
+  if (r->dcoarse && sc->opt->pc_update_changes > 0 && eps == r->carried_eps && r->cycle_cost > 0.0 &&
+      r->carry_cost > PC_FINEST_ONLY_CYCLES * r->cycle_cost) {
     PetscCall(KSPGetIterationNumber(ksp, &its));
     PetscCall(KSPGetConvergedReason(ksp, &reason));
     if (r->its_after_carry < 0) r->its_after_carry = its;
@@ -377,6 +383,35 @@ static PetscErrorCode CheckHierarchy(PC pc, PetscInt nlevels, PcReuse *r)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The flops of a carried update (products, the flops counted on this rank, summed over the ranks, and the coarse
+   smoothers' new eigenvalue estimates: Chebyshev's 10 CG steps, a product with the level's operator each) and of a CG
+   iteration (a product with the finest operator, and a V-cycle: on each level 2 Chebyshev steps down and 2 up and a
+   residual, 5 products with its operator), 2 flops a nonzero. Collective. */
+static PetscErrorCode HierarchyCosts(PC pc, PetscInt nlevels, PetscLogDouble products, PcReuse *r)
+{
+  PetscReal coarse = 0.0, all = 0.0, fine = 0.0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt l = 0; l < nlevels; ++l) {
+    KSP     smoother;
+    Mat     A;
+    MatInfo info;
+
+    PetscCall(PCMGGetSmoother(pc, l, &smoother));
+    PetscCall(KSPGetOperators(smoother, &A, NULL));
+    PetscCall(MatGetInfo(A, MAT_GLOBAL_SUM, &info));
+    all += info.nz_used;
+    if (l < nlevels - 1) coarse += info.nz_used;
+    else fine = info.nz_used;
+  }
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &products, 1, MPI_DOUBLE, MPI_SUM, PetscObjectComm((PetscObject)pc)));
+  r->carry_cost = (PetscReal)products + 2.0 * 10.0 * coarse;
+  r->cycle_cost = 2.0 * (fine + 5.0 * all);
+  PetscCall(PetscInfo(pc, "carried update: %g flops (%g in its products), a CG iteration %g: %.2f iterations\n", (double)r->carry_cost, (double)products,
+                      (double)r->cycle_cost, (double)(r->carry_cost / r->cycle_cost)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The change of the Jacobian since the last build or update, carried down the hierarchy: each coarse operator gets
    R^T D R, D the change on the level above (the first product makes the patterns, the later ones reuse them). */
 static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
@@ -385,6 +420,7 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
   const ContactBulkRows *br   = ContactBulkRowsOf(sc->contact);
   PetscInt               nnz  = br->ptr[br->n];
   PetscReal              dmax = 0.0;
+  PetscLogDouble         flops0, flops1;
 
   PetscFunctionBeginUser;
   if (!r->dcoarse) {
@@ -417,6 +453,7 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
   }
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &dmax, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)pc)));
   if (dmax == 0.0) PetscFunctionReturn(PETSC_SUCCESS); /* the same Jacobian in the contact rows: nothing to carry */
+  PetscCall(PetscGetFlops(&flops0));
   /* the first coarse level: this rank's R_S^T D_S R_S, summed over the ranks */
   PetscCall(MatSetValuesCOO(r->dlocal, r->eff_dvals, INSERT_VALUES));
   PetscCall(MatPtAP(r->dlocal, r->rlocal, MAT_REUSE_MATRIX, PETSC_DEFAULT, &r->clocal));
@@ -439,6 +476,8 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
     PetscCall(KSPGetOperators(smoother, &A, NULL));
     PetscCall(MatAXPY(A, 1.0, r->dcoarse[l - 1], SUBSET_NONZERO_PATTERN));
   }
+  PetscCall(PetscGetFlops(&flops1));
+  PetscCall(HierarchyCosts(pc, nlevels, flops1 - flops0, r));
   if (sc->opt->pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r));
   /* every level's operator is new: its Chebyshev smoother estimates its eigenvalues again, its Jacobi or LU sets up
      again (KSPSetOperators() marks the new matrix, as a rebuild would) */

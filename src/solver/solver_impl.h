@@ -57,6 +57,8 @@ typedef struct {
   PetscBool *carried_active;   /* the contact nodes' penetration when the coarse operators last followed the Jacobian */
   PetscInt   its_after_carry;  /* Krylov iterations of the first solve after that (-1: not yet known) */
   PetscReal  carried_eps;      /* eps then */
+  PetscReal  carry_cost;       /* the flops of the last carried update: its products, and its coarse smoothers' eigenvalue estimates */
+  PetscReal  cycle_cost;       /* the flops of a CG iteration with the hierarchy's V-cycle (0: not yet counted) */
   PetscBool  finest_only;      /* this Newton step updates the finest level only */
   PetscInt   finest_updates;   /* such updates so far */
   PetscReal  tform[4];         /* Chebyshev's transform of estimates into its interval (-ksp_chebyshev_esteig) */
