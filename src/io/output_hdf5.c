@@ -424,10 +424,10 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));
   PetscCall(WriteIntAttr(v, "active_set_cycles", s->active_set_cycles));
   PetscCall(WriteIntAttr(v, "pc_builds", s->pc_builds));
-  PetscCall(WriteIntAttr(v, "pc_updates", s->pc_updates)); /* -contact_pc_update: coarse-operator updates of a GAMG hierarchy */
+  PetscCall(WriteIntAttr(v, "pc_updates", s->pc_updates));               /* -contact_pc_update: coarse-operator updates of a GAMG hierarchy */
   PetscCall(WriteIntAttr(v, "pc_finest_updates", s->pc_finest_updates)); /* -contact_pc_update_changes: updates of its finest level only */
-  PetscCall(WriteIntAttr(v, "ksp_ew", s->ksp_ew));         /* 1: the linear tolerances of Eisenstat-Walker */
-  if (s->bandwidth.measured) {                             /* -perf_bandwidth */
+  PetscCall(WriteIntAttr(v, "ksp_ew", s->ksp_ew));                       /* 1: the linear tolerances of Eisenstat-Walker */
+  if (s->bandwidth.measured) {                                           /* -perf_bandwidth */
     PetscCall(WriteRealAttr(v, "bandwidth_triad_gbs", s->bandwidth.triad_gbs));
     PetscCall(WriteRealAttr(v, "bandwidth_matmult_gbs", s->bandwidth.matmult_gbs));
     PetscCall(WriteRealAttr(v, "bandwidth_vcycle_gbs", s->bandwidth.vcycle_gbs));

@@ -298,7 +298,7 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
       PetscCall(SolverSecantStart(snes, dm, user, u, prev, dir, secant, secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0, 1.0));
     }
     PetscCall(SolverSolveWarm(snes, user, u, "load path")); /* from zero where the guess's active set is too far off */
-    PetscCall(PenetrationTolSolve(dm, user, snes, u)); /* -contact_penetration_tol at every step, from the last step's eps (or multipliers) */
+    PetscCall(PenetrationTolSolve(dm, user, snes, u));      /* -contact_penetration_tol at every step, from the last step's eps (or multipliers) */
     PetscCall(LoadPathForce(dm, user, snes, u, &ok));
     PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[k], first, ok));
   }

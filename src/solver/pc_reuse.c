@@ -401,14 +401,16 @@ static PetscErrorCode HierarchyCosts(PC pc, PetscInt nlevels, PetscLogDouble pro
     PetscCall(KSPGetOperators(smoother, &A, NULL));
     PetscCall(MatGetInfo(A, MAT_GLOBAL_SUM, &info));
     all += info.nz_used;
-    if (l < nlevels - 1) coarse += info.nz_used;
-    else fine = info.nz_used;
+    if (l < nlevels - 1)
+      coarse += info.nz_used;
+    else
+      fine = info.nz_used;
   }
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &products, 1, MPI_DOUBLE, MPI_SUM, PetscObjectComm((PetscObject)pc)));
   r->carry_cost = (PetscReal)products + 2.0 * 10.0 * coarse;
   r->cycle_cost = 2.0 * (fine + 5.0 * all);
-  PetscCall(PetscInfo(pc, "carried update: %g flops (%g in its products), a CG iteration %g: %.2f iterations\n", (double)r->carry_cost, (double)products,
-                      (double)r->cycle_cost, (double)(r->carry_cost / r->cycle_cost)));
+  PetscCall(PetscInfo(pc, "carried update: %g flops (%g in its products), a CG iteration %g: %.2f iterations\n", (double)r->carry_cost,
+                      (double)products, (double)r->cycle_cost, (double)(r->carry_cost / r->cycle_cost)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

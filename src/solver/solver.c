@@ -300,7 +300,7 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   user->rec.stats.converged        = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
   PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
   user->rec.stats.pc_builds = user->prob.sctx->pc_reuse.enabled ? user->prob.sctx->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
-  user->rec.stats.pc_updates = user->prob.sctx->pc_reuse.updates;
+  user->rec.stats.pc_updates        = user->prob.sctx->pc_reuse.updates;
   user->rec.stats.pc_finest_updates = user->prob.sctx->pc_reuse.finest_updates;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -402,10 +402,10 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
   PetscCall(MultigridSetUpPC(snes, user)); /* -pc_type mg: the levels of the meshes solved so far */
   user->prob.sctx->warm = warm;
   PetscCall(PetscTime(&t0));
-  user->prob.sctx->pc_reuse.builds    = 0; /* counted per solve */
-  user->prob.sctx->pc_reuse.updates   = 0;
+  user->prob.sctx->pc_reuse.builds         = 0; /* counted per solve */
+  user->prob.sctx->pc_reuse.updates        = 0;
   user->prob.sctx->pc_reuse.finest_updates = 0;
-  user->rec.stats.continuation_stages = 0;
+  user->rec.stats.continuation_stages      = 0;
   if (start != SOLVER_START_NEARBY_EPS && ContactHasPenalty(user->contact) && copt->continuation && eps_target < eps_start) {
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= copt->continuation_factor) {
       PetscCall(ContactSetEps(user->contact, dm, eps));
@@ -446,8 +446,8 @@ PetscErrorCode SolverSolveWarm(SNES snes, AppCtx *user, Vec u, const char what[]
   if (user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetConvergedReason(snes, &reason));
   PetscCall(SNESGetIterationNumber(snes, &its));
-  PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes), "  %s: the warm solve %s (%s, %" PetscInt_FMT " Newton steps); solved again from zero\n", what,
-                        reason == SNES_DIVERGED_LINE_SEARCH ? "stalled" : "failed", SNESConvergedReasons[reason], its));
+  PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes), "  %s: the warm solve %s (%s, %" PetscInt_FMT " Newton steps); solved again from zero\n",
+                        what, reason == SNES_DIVERGED_LINE_SEARCH ? "stalled" : "failed", SNESConvergedReasons[reason], its));
   PetscCall(SolverSolve(snes, user, u, SOLVER_START_ZERO));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

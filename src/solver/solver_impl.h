@@ -54,15 +54,15 @@ typedef struct {
   PetscInt   est_steps;        /* the steps of its estimator */
   PetscBool *built_active;     /* the contact nodes' penetration when the preconditioner was last built */
   /* -contact_pc_update_changes: the coarse operators stay while few contact nodes changed since they followed the Jacobian */
-  PetscBool *carried_active;   /* the contact nodes' penetration when the coarse operators last followed the Jacobian */
-  PetscInt   its_after_carry;  /* Krylov iterations of the first solve after that (-1: not yet known) */
-  PetscReal  carried_eps;      /* eps then */
-  PetscReal  carry_cost;       /* the flops of the last carried update: its products, and its coarse smoothers' eigenvalue estimates */
-  PetscReal  cycle_cost;       /* the flops of a CG iteration with the hierarchy's V-cycle (0: not yet counted) */
-  PetscBool  finest_only;      /* this Newton step updates the finest level only */
-  PetscInt   finest_updates;   /* such updates so far */
-  PetscReal  tform[4];         /* Chebyshev's transform of estimates into its interval (-ksp_chebyshev_esteig) */
-  Vec        pdiag, pcols;     /* the penalty term's diagonal, and its values at the contact rows' columns */
+  PetscBool *carried_active;  /* the contact nodes' penetration when the coarse operators last followed the Jacobian */
+  PetscInt   its_after_carry; /* Krylov iterations of the first solve after that (-1: not yet known) */
+  PetscReal  carried_eps;     /* eps then */
+  PetscReal  carry_cost;      /* the flops of the last carried update: its products, and its coarse smoothers' eigenvalue estimates */
+  PetscReal  cycle_cost;      /* the flops of a CG iteration with the hierarchy's V-cycle (0: not yet counted) */
+  PetscBool  finest_only;     /* this Newton step updates the finest level only */
+  PetscInt   finest_updates;  /* such updates so far */
+  PetscReal  tform[4];        /* Chebyshev's transform of estimates into its interval (-ksp_chebyshev_esteig) */
+  Vec        pdiag, pcols;    /* the penalty term's diagonal, and its values at the contact rows' columns */
 } PcReuse;
 
 /* State of the recovery from preconditioner breakdowns (pc_recovery.c). */
@@ -102,16 +102,16 @@ struct _n_SolverCtx {
   PetscReal            load_norm;          /* ||F(0)||, the problem's load */
   PetscReal            displacement_scale; /* U: the SNES iterates on u/U */
   /* the Newton iteration */
-  PetscReal  snes_scale;                      /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
-  Vec        work;                            /* U x~: the displacement of the SNES iterate x~ */
-  PetscReal  fnorm0;                          /* |F| at the start of the last SNESSolve, in the user's units */
-  PetscReal  fnorm_last;                      /* |F| at the last Newton step, in the user's units */
-  PetscBool  roundoff_stop;                   /* the last SNESSolve stopped at the round-off of its terms (SolverConverged()) */
-  PetscBool  warm;                            /* the last SolverSolve() started from a given guess, not from zero */
-  PetscBool  stall_stop;                      /* the current solve is SolverSolveWarm()'s: it stops where it stalls */
+  PetscReal  snes_scale;                           /* U inside SolverSolve(), 1 outside it (so -dmsnes_check and the estimates see u itself) */
+  Vec        work;                                 /* U x~: the displacement of the SNES iterate x~ */
+  PetscReal  fnorm0;                               /* |F| at the start of the last SNESSolve, in the user's units */
+  PetscReal  fnorm_last;                           /* |F| at the last Newton step, in the user's units */
+  PetscBool  roundoff_stop;                        /* the last SNESSolve stopped at the round-off of its terms (SolverConverged()) */
+  PetscBool  warm;                                 /* the last SolverSolve() started from a given guess, not from zero */
+  PetscBool  stall_stop;                           /* the current solve is SolverSolveWarm()'s: it stops where it stalls */
   PetscReal  fnorm_window[SOLVER_STALL_STEPS + 1]; /* |F| of its last Newton steps (a ring), for that test */
-  PetscInt64 active_history[CONTACT_HISTORY]; /* active-set hashes of the Newton steps of the current solve, */
-  PetscReal  fnorm_history[CONTACT_HISTORY];  /*   and their residual norms */
+  PetscInt64 active_history[CONTACT_HISTORY];      /* active-set hashes of the Newton steps of the current solve, */
+  PetscReal  fnorm_history[CONTACT_HISTORY];       /*   and their residual norms */
   /* acceleration */
   PcReuse         pc_reuse;
   PcRecovery      pc_recovery;

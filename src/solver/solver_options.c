@@ -175,8 +175,8 @@ PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts)
              (double)opts->ew_guard);
   PetscCheck(opts->pc_update_truncate >= 0.0, comm, PETSC_ERR_USER_INPUT, "-contact_pc_update_truncate must be >= 0 (0: never), got %g",
              (double)opts->pc_update_truncate);
-  PetscCheck(opts->pc_update_changes >= 0, comm, PETSC_ERR_USER_INPUT, "-contact_pc_update_changes must be >= 0 (0: every step updates every level), got %" PetscInt_FMT,
-             opts->pc_update_changes);
+  PetscCheck(opts->pc_update_changes >= 0, comm, PETSC_ERR_USER_INPUT,
+             "-contact_pc_update_changes must be >= 0 (0: every step updates every level), got %" PetscInt_FMT, opts->pc_update_changes);
   PetscCheck(opts->pc_reuse_changes >= 0, comm, PETSC_ERR_USER_INPUT, "-contact_pc_reuse_changes must be >= 0, got %" PetscInt_FMT,
              opts->pc_reuse_changes);
   PetscFunctionReturn(PETSC_SUCCESS);
