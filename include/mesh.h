@@ -3,8 +3,8 @@
 #include "signorini.h"
 
 /* mesh.c, mesh_box_simplex.c */
-PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt coarse_request, PetscInt coarse_min_faces, PetscInt coarse_min_levels,
-                          MeshBox *box, DM *dm);
+PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt coarse_request, const PetscInt coarse_faces[3],
+                          PetscInt coarse_min_levels, MeshBox *box, DM *dm);
 PetscErrorCode MeshIndexCellTypes(DM dm);
 PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[]);
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],

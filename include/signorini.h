@@ -221,7 +221,7 @@ typedef struct {
 
 /* The simplex box of the options, when the mesh is one (MeshCreate()): the grid sequence builds its finer levels directly. */
 typedef struct {
-  PetscBool is_box;        /* a 2D simplex box not refined by -dm_refine, on one rank or in slabs of rows that nest */
+  PetscBool is_box;        /* a simplex box (2D or 3D) not refined by -dm_refine, on one rank or in slabs of rows that nest */
   PetscInt  dim, faces[3]; /* faces: of the mesh built first, the coarsest box when coarse_levels > 0 */
   PetscInt  coarse_levels; /* the mesh of the options is this many box doublings above the one built first */
   PetscReal lower[3], upper[3];

@@ -31,8 +31,17 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
    -contact_coarse_mg) a coarser box costs little and is one more level of the hierarchy (a smaller coarse factorization). */
 #define GRID_SEQUENCE_MIN_FACES 64
 #define GRID_SEQUENCE_MIN_FACES_MG 16
-PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt *min_faces,
-                                         PetscInt *min_levels, PetscBool *coarse_mg);
+/* In 3D the boxes of about as many unknowns: 16^3 (14,739) against 64^2 (8,450); and 4^3 (375), whose factorization is
+   the multigrid's coarse solve, against 16^2 (578). With 16 in 3D the geometric multigrid's coarsest box was 20^3 at
+   40^3 (26,460 unknowns), and its 4 factorizations took 51 s of a 60 s run. */
+#define GRID_SEQUENCE_MIN_FACES_3D 16
+#define GRID_SEQUENCE_MIN_FACES_MG_3D 4
+/* ... and the multigrid's coarsest box in 3D has at most 8 cells per side (2,187 unknowns) where it nests by default:
+   68^3 halves to 17^3 only, whose factorizations (3 of 17,496 unknowns) took 21 s of a 79 s run; such a box does not
+   nest by default (GAMG on each box instead is for a later measurement) */
+#define GRID_SEQUENCE_MAX_COARSEST_MG_3D 8
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt faces[3], PetscInt *min_levels,
+                                         PetscBool *coarse_mg);
 PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts);
 PetscErrorCode SolverGivenIndex(const char prefix[], PetscInt *k);
 PetscErrorCode SolverGivenEsteig(const SolverGiven *g, const char prefix[], PetscInt *n, PetscReal t[]);

@@ -132,7 +132,7 @@ OPTION_CASES = [
     ("coarse_levels_not_divisible", ["-dm_plex_box_faces", "12,20", "-contact_coarse_levels", 3],
      "-contact_coarse_levels 3: -dm_plex_box_faces 12 is not divisible by 2^3"),
     ("coarse_levels_quads", ["-dm_plex_simplex", 0, "-contact_coarse_levels", 1],
-     "-contact_coarse_levels 1 needs the 2D simplex box (-dm_plex_box_faces) without -dm_refine"),
+     "-contact_coarse_levels 1 needs the simplex box (-dm_plex_box_faces) without -dm_refine"),
     ("coarse_levels_p2", ["-displacement_petscspace_degree", 2, "-contact_coarse_levels", 1],
      "-contact_coarse_levels 1 needs P1 displacements, got -displacement_petscspace_degree 2"),
     ("coarse_rtol", ["-contact_coarse_rtol", 0], "-contact_coarse_rtol must lie in (0, 1), got 0"),

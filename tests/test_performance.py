@@ -51,11 +51,33 @@ def test_grid_sequence_with_snesvi_equals_the_direct_solution():
 
 
 def test_grid_sequence_in_parallel_and_3d_equals_serial():
-    args = SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3", "-contact_grid_sequence", "1"]
+    """3D grid sequencing: the 4^3 Kuhn box's finer level is the 8^3 box built directly (it refines the coarse one), on
+    1 and 2 ranks (slabs of rows) alike, and equals the direct 8^3 run; 3^3 on 2 ranks, whose rows do not divide, is
+    refined by PETSc and equals the direct -dm_refine 1 run."""
+    args = SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "4,4,4", "-contact_grid_sequence", "1"]
     _, one = run(args, "gs3d_np1")
     _, two = run(args, "gs3d_np2", np_=2)
-    _, direct = run(SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3", "-dm_refine", "1"], "gs3d_direct")
+    _, direct = run(SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "8,8,8", "-contact_coarse_levels", 0], "gs3d_direct")
     assert max_diff(two, one) < 1e-8 and max_diff(one, direct) < 1e-8
+    _, refined = run(SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3", "-contact_grid_sequence", "1"], "gs3d_refined_np2", np_=2)
+    _, direct = run(SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3", "-dm_refine", "1"], "gs3d_refined_direct")
+    assert max_diff(refined, direct) < 1e-8
+
+
+@pytest.mark.parametrize("np_", [1, 2])
+def test_3d_box_nests_by_default(np_):
+    """The 3D Kuhn box of 2N cells per side refines the box of N (issue 35): the default run on the 16^3 box with GAMG
+    solves first on 4^3 and 8^3 (the geometric multigrid of the boxes below, down to 4 cells per side in 3D), and its
+    answer is the direct solve's (-contact_coarse_levels 0) to 1e-8, with at most 3 Newton steps on the final box where
+    the direct solve takes 6, on 1 and 2 ranks."""
+    args = SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "16,16,16", "-options_file", "options/solvers/gamg.yaml"]
+    _, nested = run(args, f"nest3d_{np_}", np_=np_)
+    _, direct = run(args + ["-contact_coarse_levels", 0], f"nest3d_direct_{np_}", np_=np_)
+    a, b = load(nested)[0], load(direct)[0]
+    assert a["coarse_levels"] == 2 and b["coarse_levels"] == 0, (a["coarse_levels"], b["coarse_levels"])
+    assert a["converged"] == b["converged"] == 1
+    assert solves(nested)["newton_its"][-1] <= 3 < b["newton_its"], (solves(nested)["newton_its"], b["newton_its"])
+    assert max_diff(nested, direct) < 1e-8
 
 
 @pytest.mark.parametrize("dim,faces", ((2, "4,4"), (3, "2,2,2")), ids=("quads", "hexes"))

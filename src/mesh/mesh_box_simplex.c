@@ -185,14 +185,15 @@ PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* With box (the 2D simplex box of the options, not refined by -dm_refine; on several ranks built in slabs of rows, each
+/* With box (the simplex box of the options, not refined by -dm_refine; on several ranks built in slabs of rows, each
    slab boundary a row of the coarsest box, so that a rank's fine slab is the refinement of its coarse slab and every
    local fine vertex has its source among the local coarse points), the next level of a grid sequence
    as the box of twice as many cells per side, built directly (cheaper than PETSc's general regular refinement,
-   DMPlexTransformApply()). In 2D that box is the regular refinement of the coarse one, numbered as a
-   direct run of that many cells numbers it (each triangle split in four at its edges' midpoints gives the fine box's
-   triangles; in 3D PETSc splits a tetrahedron along another diagonal than the fine Kuhn box, so 3D keeps the
-   refinement). Every fine vertex is a coarse vertex or the midpoint of a coarse edge (a side or a diagonal):
+   DMPlexTransformApply()), numbered as a direct run of that many cells numbers it. In 2D that box is the regular
+   refinement of the coarse one (each triangle split in four at its edges' midpoints); in 3D it also refines the coarse
+   Kuhn box (each coarse tetrahedron is a union of 8 fine Kuhn tetrahedra: MeshCreate()), though not as PETSc's
+   regular refinement, which splits a tetrahedron's inner octahedron along another diagonal. Every fine vertex is a
+   coarse vertex or the midpoint of a coarse edge (a side or a diagonal; in 3D the monotone diagonals of the Kuhn split):
    vertex_source[v - vStart] is that coarse point, as MeshRefineRegular() gives it, so MeshInterpolateVertexSources()
    is exact for P1. */
 PetscErrorCode MeshCreateBoxLevel(DM coarse, const MeshBox *box, PetscInt level, DM *fine, PetscInt **vertex_source)

@@ -75,8 +75,8 @@ static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt *min_faces,
-                                         PetscInt *min_levels, PetscBool *coarse_mg)
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt faces[3], PetscInt *min_levels,
+                                         PetscBool *coarse_mg)
 {
   const PetscInt  k       = opt->solver.coarse_levels;
   const char     *pc_type = opt->solver.given.pc_type;
@@ -91,9 +91,12 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOpt
   /* -contact_coarse_mg: with an iterative preconditioner that is not already the boxes' multigrid (without -pc_type, the
      default is MUMPS's factorization, which a coarser box's small matrix does not make expensive); not with SNESVI, whose
      reduced system (vinewtonrsls) no PCMG can follow and whose vinewtonssls Jacobian CG cannot take */
-  *coarse_mg  = (PetscBool)(opt->solver.coarse_mg && given && !is_mg && !is_factor && !ContactHasBounds(ct));
-  *request    = k;
-  *min_faces  = (is_mg || *coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
+  *coarse_mg = (PetscBool)(opt->solver.coarse_mg && given && !is_mg && !is_factor && !ContactHasBounds(ct));
+  *request   = k;
+  /* the coarsest box's least cells per side in 2D and in 3D, and its most in 3D (0: any) */
+  faces[0]    = (is_mg || *coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG : GRID_SEQUENCE_MIN_FACES;
+  faces[1]    = (is_mg || *coarse_mg) ? GRID_SEQUENCE_MIN_FACES_MG_3D : GRID_SEQUENCE_MIN_FACES_3D;
+  faces[2]    = (is_mg || *coarse_mg) ? GRID_SEQUENCE_MAX_COARSEST_MG_3D : 0;
   *min_levels = opt->bars ? BARS_LEVELS - 1 : 0; /* -bars: at least two boxes below the final one, whatever their size */
   /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels) */
   if (k < 0 && (!(ContactHasPenalty(ct) || (ContactIsNone(ct) && is_mg)) || opt->degree != 1)) *request = 0;

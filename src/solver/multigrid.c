@@ -137,7 +137,7 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
   if (!is_mg) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCheck(mg->n > 0 || user->prob.level < user->box.coarse_levels + user->opt->solver.grid_sequence, PetscObjectComm((PetscObject)snes),
              PETSC_ERR_USER_INPUT,
-             "-pc_type mg takes its levels from nested meshes, and this mesh has none: use the 2D simplex box (-dm_plex_box_faces, "
+             "-pc_type mg takes its levels from nested meshes, and this mesh has none: use the simplex box (-dm_plex_box_faces, "
              "-contact_coarse_levels) or -contact_grid_sequence N, or another -pc_type");
   PetscCall(PCGetOptionsPrefix(pc, &prefix));
   PetscCall(SolverGivenIndex(prefix, &k));
