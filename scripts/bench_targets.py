@@ -326,6 +326,28 @@ def measure_load_path(out, s, pairs):
     return rows
 
 
+def measure_default3d(out, s, pairs):
+    """Issue 35: the 3D default run against the elastic solve on the 40^3 box (201,720 unknowns; --small: 5^3), 1 and 2
+    ranks, side by side, with the run without nesting (-contact_coarse_levels 0) as a figure: at most 1.1."""
+    n = max(40 // s, 2)
+    box = ["-dm_plex_dim", "3", "-dm_plex_box_faces", f"{n},{n},{n}"]
+    rows = []
+    for ranks in (1, 2):
+        r = side_by_side({"default3d": (box, ranks), "direct3d": (box + ["-contact_coarse_levels", "0"], ranks),
+                          "elastic3d": (box + ["-contact_method", "none"], ranks)}, pairs, out)
+        p, d, e = r["default3d"], r["direct3d"], r["elastic3d"]
+        rows.append(row(f"3D default penalty run / elastic solve <= 1.1 ({n}^3, {ranks} rank(s), whole process)",
+                        f"{p[0] / e[0]:.3f} ({p[0]:.2f} s / {e[0]:.2f} s; {pair_range(p, e)}; {int(p[2].get('coarse_levels', 0))} coarser boxes, "
+                        f"{int(solves_last_newton(p[2]))} Newton steps on the final box; without nesting {d[0] / e[0]:.3f}, {d[0]:.2f} s)",
+                        p[0] / e[0] <= 1.1, f"{'mpiexec -n 2 ' if ranks == 2 else ''}bin/signorini {' '.join(BASE)} {' '.join(box)} [-contact_coarse_levels 0 | -contact_method none]"))
+    return rows
+
+
+def solves_last_newton(attrs):
+    """Newton steps of the run's final solve: newton_its (the last solve's)."""
+    return attrs.get("newton_its", 0)
+
+
 def measure_vi(out, s, pairs):
     """SNESVI (issue 33) on the 3D sphere indenter of make hertz, whose normals are no axis (its rotated frames), against
     the penalty at eps = h/10 on the same mesh (make hertz's finest, h_near 0.007; --small: 0.02), side by side, each
@@ -355,7 +377,8 @@ def measure_getfem(out, s, pairs):
 
 
 SECTIONS = {"default": measure_default, "mg": measure_mg, "iterations": measure_iterations, "eps": measure_eps, "parallel": measure_parallel, "getfem": measure_getfem,
-            "estimate": measure_estimate, "load_path": measure_load_path, "vi": measure_vi}
+            "estimate": measure_estimate, "load_path": measure_load_path, "vi": measure_vi,
+            "default3d": measure_default3d}
 
 
 def rows_of_table(path):
