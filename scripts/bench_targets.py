@@ -338,14 +338,9 @@ def measure_default3d(out, s, pairs):
         p, d, e = r["default3d"], r["direct3d"], r["elastic3d"]
         rows.append(row(f"3D default penalty run / elastic solve <= 1.1 ({n}^3, {ranks} rank(s), whole process)",
                         f"{p[0] / e[0]:.3f} ({p[0]:.2f} s / {e[0]:.2f} s; {pair_range(p, e)}; {int(p[2].get('coarse_levels', 0))} coarser boxes, "
-                        f"{int(solves_last_newton(p[2]))} Newton steps on the final box; without nesting {d[0] / e[0]:.3f}, {d[0]:.2f} s)",
+                        f"{int(p[2].get('newton_its', 0))} Newton steps on the final box; without nesting {d[0] / e[0]:.3f}, {d[0]:.2f} s)",
                         p[0] / e[0] <= 1.1, f"{'mpiexec -n 2 ' if ranks == 2 else ''}bin/signorini {' '.join(BASE)} {' '.join(box)} [-contact_coarse_levels 0 | -contact_method none]"))
     return rows
-
-
-def solves_last_newton(attrs):
-    """Newton steps of the run's final solve: newton_its (the last solve's)."""
-    return attrs.get("newton_its", 0)
 
 
 def measure_vi(out, s, pairs):

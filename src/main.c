@@ -131,11 +131,11 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   user.opt = &opt;
 
   {
-    PetscInt coarse_request, coarse_min_faces[3], coarse_min_levels;
+    PetscInt coarse_request, coarse_faces[3], coarse_min_levels;
 
-    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, &coarse_request, coarse_min_faces, &coarse_min_levels, &user.rec.stats.coarse_mg));
+    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, &coarse_request, coarse_faces, &coarse_min_levels, &user.rec.stats.coarse_mg));
     PetscCall(MultigridCreate(user.rec.stats.coarse_mg, &user.mg));
-    PetscCall(MeshCreate(comm, opt.solver.grid_sequence, coarse_request, coarse_min_faces, coarse_min_levels, &user.box, &dm));
+    PetscCall(MeshCreate(comm, opt.solver.grid_sequence, coarse_request, coarse_faces, coarse_min_levels, &user.box, &dm));
   }
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));        /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */

@@ -1,6 +1,6 @@
 /* Nested iteration. -contact_grid_sequence N: the problem is solved on the mesh of the options, then on N uniform
    refinements of it, each level from the interpolation of the solution of the level below (exact for nested P1/Q1).
-   -contact_coarse_levels K (by default where the 2D P1 box allows it): the mesh of the options is the last of K box
+   -contact_coarse_levels K (by default where the P1 simplex box allows it, 2D or 3D): the mesh of the options is the last of K box
    doublings from a coarser box, each solved to the looser -contact_coarse_rtol; the final mesh is the direct build's.
    From a zero guess, semismooth Newton needs more steps as h falls (the active set moves about a cell per step);
    from the coarse solution it needs only a few on each level. A failed level of -contact_grid_sequence ends the

@@ -33,7 +33,7 @@ static PetscErrorCode CountChangesSince(SolverCtx sc, PetscInt dim, const PetscS
 
   PetscFunctionBeginUser;
   PetscCall(ContactGetSet(sc->contact, &cs));
-  if (!*state) PetscCall(PetscCalloc1(cs->n + 1, state)); /* no node penetrated before the first build */
+  if (!*state) PetscCall(PetscCalloc1(cs->n + 1, state)); /* no node penetrated before the first record */
   for (PetscInt i = 0; i < cs->n; ++i) {
     const PetscBool on = (PetscBool)(ContactNodePenetration(cs, dim, i, x) > 0.0);
 
@@ -45,6 +45,13 @@ static PetscErrorCode CountChangesSince(SolverCtx sc, PetscInt dim, const PetscS
 }
 
 /* ... since the last build (record: the current states become the build's). */
+/* The last linear solve needed more than twice the iterations of the first one after the preconditioner last changed
+   (a build, or the coarse operators' last update), plus 5: the preconditioner no longer fits the Jacobian. */
+static inline PetscBool LinearSolveGrew(PetscInt its, PetscInt its_first)
+{
+  return (PetscBool)(its_first >= 0 && its > 2 * its_first + 5);
+}
+
 static PetscErrorCode CountChanges(SolverCtx sc, PetscInt dim, const PetscScalar x[], PetscBool record, PetscInt *changes)
 {
   PetscFunctionBeginUser;
@@ -75,7 +82,7 @@ static PetscErrorCode DecideFinestOnly(KSP ksp, DM dm, SolverCtx sc, Vec X)
     PetscCall(KSPGetConvergedReason(ksp, &reason));
     if (r->its_after_carry < 0) r->its_after_carry = its;
     PetscCall(CountChangesSince(sc, dim, x, &r->carried_active, PETSC_FALSE, &changes));
-    r->finest_only = (PetscBool)(changes <= sc->opt->pc_update_changes && reason >= 0 && its <= 2 * r->its_after_carry + 5);
+    r->finest_only = (PetscBool)(changes <= sc->opt->pc_update_changes && reason >= 0 && !LinearSolveGrew(its, r->its_after_carry));
   }
   if (!r->finest_only) {
     PetscCall(CountChangesSince(sc, dim, x, &r->carried_active, PETSC_TRUE, &changes));
@@ -146,9 +153,11 @@ static PetscErrorCode DestroyProducts(PcReuse *r)
   PetscCall(MatDestroy(&r->rfine));
   PetscCall(VecDestroy(&r->zmark));
   PetscCall(VecDestroy(&r->zcols));
-  r->nmirror = 0;
-  r->nz      = 0;
-  r->nlevels = 0;
+  r->nmirror    = 0;
+  r->nz         = 0;
+  r->nlevels    = 0;
+  r->carry_cost = 0.0; /* the costs are the hierarchy's: counted again on the next one */
+  r->cycle_cost = 0.0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -383,11 +392,12 @@ static PetscErrorCode CheckHierarchy(PC pc, PetscInt nlevels, PcReuse *r)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The flops of a carried update (products, the flops counted on this rank, summed over the ranks, and the coarse
-   smoothers' new eigenvalue estimates: Chebyshev's 10 CG steps, a product with the level's operator each) and of a CG
-   iteration (a product with the finest operator, and a V-cycle: on each level 2 Chebyshev steps down and 2 up and a
-   residual, 5 products with its operator), 2 flops a nonzero. Collective. */
-static PetscErrorCode HierarchyCosts(PC pc, PetscInt nlevels, PetscLogDouble products, PcReuse *r)
+/* The hierarchy's nonzeros, counted once per build (the updates keep the operators' patterns): those of the coarse
+   levels, whose smoothers estimate their eigenvalues again at each carried update (Chebyshev's 10 CG steps, a product
+   with the level's operator each), and the flops of a CG iteration (a product with the finest operator, and a V-cycle:
+   on each level 2 Chebyshev steps down and 2 up and a residual, 5 products with its operator), 2 flops a nonzero.
+   Collective. */
+static PetscErrorCode HierarchyNonzeros(PC pc, PetscInt nlevels, PcReuse *r)
 {
   PetscReal coarse = 0.0, all = 0.0, fine = 0.0;
 
@@ -406,9 +416,18 @@ static PetscErrorCode HierarchyCosts(PC pc, PetscInt nlevels, PetscLogDouble pro
     else
       fine = info.nz_used;
   }
-  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &products, 1, MPI_DOUBLE, MPI_SUM, PetscObjectComm((PetscObject)pc)));
-  r->carry_cost = (PetscReal)products + 2.0 * 10.0 * coarse;
+  r->coarse_nnz = coarse;
   r->cycle_cost = 2.0 * (fine + 5.0 * all);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The flops of a carried update: its products (the flops counted on this rank, summed over the ranks) and the coarse
+   smoothers' new eigenvalue estimates (HierarchyNonzeros()). Collective. */
+static PetscErrorCode CarryCost(PC pc, PetscLogDouble products, PcReuse *r)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &products, 1, MPI_DOUBLE, MPI_SUM, PetscObjectComm((PetscObject)pc)));
+  r->carry_cost = (PetscReal)products + 2.0 * 10.0 * r->coarse_nnz;
   PetscCall(PetscInfo(pc, "carried update: %g flops (%g in its products), a CG iteration %g: %.2f iterations\n", (double)r->carry_cost,
                       (double)products, (double)r->cycle_cost, (double)(r->carry_cost / r->cycle_cost)));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -429,6 +448,7 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
     r->nlevels = nlevels;
     PetscCall(PetscCalloc1(nlevels, &r->dcoarse));
     PetscCall(FinestProductSetUp(pc, sc));
+    PetscCall(HierarchyNonzeros(pc, nlevels, r));
   }
   PetscCheck(r->nlevels == nlevels, PetscObjectComm((PetscObject)pc), PETSC_ERR_PLIB, "the multigrid hierarchy changed its levels");
   PetscCall(ContactRowValues(sc, r->dvals));
@@ -479,7 +499,7 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
     PetscCall(MatAXPY(A, 1.0, r->dcoarse[l - 1], SUBSET_NONZERO_PATTERN));
   }
   PetscCall(PetscGetFlops(&flops1));
-  PetscCall(HierarchyCosts(pc, nlevels, flops1 - flops0, r));
+  PetscCall(CarryCost(pc, flops1 - flops0, r));
   if (sc->opt->pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r));
   /* every level's operator is new: its Chebyshev smoother estimates its eigenvalues again, its Jacobi or LU sets up
      again (KSPSetOperators() marks the new matrix, as a rebuild would) */
@@ -534,7 +554,7 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
     PetscCall(KSPGetIterationNumber(ksp, &its));
     PetscCall(KSPGetConvergedReason(ksp, &reason));
     /* rebuild after a failed solve, or when the last solve needed twice the iterations of the first after the build */
-    rebuild = (PetscBool)(changes > sc->opt->pc_reuse_changes || reason < 0 || (r->its_after_build >= 0 && its > 2 * r->its_after_build + 5));
+    rebuild = (PetscBool)(changes > sc->opt->pc_reuse_changes || reason < 0 || LinearSolveGrew(its, r->its_after_build));
   }
   if (rebuild) {
     PetscCall(CountChanges(sc, dim, x, PETSC_TRUE, &changes));

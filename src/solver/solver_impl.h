@@ -59,6 +59,7 @@ typedef struct {
   PetscReal  carried_eps;     /* eps then */
   PetscReal  carry_cost;      /* the flops of the last carried update: its products, and its coarse smoothers' eigenvalue estimates */
   PetscReal  cycle_cost;      /* the flops of a CG iteration with the hierarchy's V-cycle (0: not yet counted) */
+  PetscReal  coarse_nnz;      /* the nonzeros of its coarse operators */
   PetscBool  finest_only;     /* this Newton step updates the finest level only */
   PetscInt   finest_updates;  /* such updates so far */
   PetscReal  tform[4];        /* Chebyshev's transform of estimates into its interval (-ksp_chebyshev_esteig) */
