@@ -29,7 +29,7 @@ all: $(BIN)
 
 deps:
 	@pkg-config --exists petsc && [ -f /usr/include/metis.h ] && [ -f /usr/include/yaml.h ] && command -v mpicc >/dev/null && command -v mpiexec >/dev/null && command -v pvbatch >/dev/null && \
-	  $(PYTHON) -c "import h5py, numpy, matplotlib, yaml, pytest, gmsh, getfem" 2>/dev/null || sh scripts/install-deps.sh
+	  $(PYTHON) -c "import h5py, numpy, matplotlib, yaml, pytest, gmsh, getfem, dolfinx" 2>/dev/null || sh scripts/install-deps.sh
 
 # -MMD -MP: each object depends on the headers it includes (build/*.d), and only those
 build/%.o: src/%.c
@@ -121,11 +121,12 @@ estimates: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/estimates.py --check
 
-# Performance (docs/solvers.md, "Performance"): bench/{bench,getfem,bandwidth,targets}.{md,csv}, runs under bench/runs/
+# Performance (docs/solvers.md, "Performance"): bench/{bench,getfem,fenicsx,bandwidth,targets}.{md,csv}, runs under bench/runs/
 bench: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/bench.py options/bench/bench.yaml
 	$(PYTHON) scripts/bench_getfem.py
+	$(PYTHON) scripts/bench_fenicsx.py
 	$(PYTHON) scripts/bench_bandwidth.py
 	$(PYTHON) scripts/bench_targets.py
 

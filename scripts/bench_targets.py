@@ -2,7 +2,7 @@
 """The performance targets of docs/solvers.md, "Performance" measured in one invocation (make bench): each row is a target,
 the figure measured here, whether it is met, and the command behind it. Whole-process wall times and peak resident
 sets come from /usr/bin/time -v; ratios are of medians of runs alternated side by side in this invocation. The GetFEM
-row reads bench/getfem.csv (scripts/bench_getfem.py). Writes bench/targets.md and bench/targets.csv."""
+row reads bench/getfem.csv (scripts/bench_getfem.py), the FEniCSx row bench/fenicsx.csv (scripts/bench_fenicsx.py). Writes bench/targets.md and bench/targets.csv."""
 import argparse
 import csv
 import json
@@ -371,9 +371,34 @@ def measure_getfem(out, s, pairs):
                 "scripts/bench_getfem.py (bench/getfem.md)")]
 
 
+def measure_fenicsx(out, s, pairs):
+    """Issue 35: the ratio and the contact forces of bench/fenicsx.csv (scripts/bench_fenicsx.py): FEniCSx's best of plain
+    Newton and Eisenstat-Walker over the 3D default run on the 40^3 box, at least 5, with the same contact force to 1e-3.
+    Judged only on the 40^3 box (another box's table is shown as a figure); no table yet: a row saying so."""
+    target = "3D default run at 40^3 at least 5 times faster than FEniCSx on the same problem (contact force to 1e-3)"
+    cmd = "scripts/bench_fenicsx.py (bench/fenicsx.md)"
+    fcsv = os.path.join(os.path.dirname(os.path.dirname(out)), "fenicsx.csv")
+    if not os.path.exists(fcsv):
+        return [row(target, "not measured: no bench/fenicsx.csv (run scripts/bench_fenicsx.py first)", False, cmd)]
+    with open(fcsv) as fh:
+        g = {x["code"]: x for x in csv.DictReader(fh)}
+    ours = next(x for c, x in g.items() if c.startswith("signorini"))
+    fenicsx = {c: x for c, x in g.items() if c.startswith("FEniCSx")}
+    ratio = float(ours["fenicsx_best_over_this"])
+    converged = [x for x in fenicsx.values() if int(x["converged"])]  # the best is over these (bench_fenicsx.py)
+    diff = max([float(x["force_rel_diff"]) for x in converged], default=float("nan"))
+    n = int(ours["faces"])
+    agrees = bool(converged) and diff <= 1e-3
+    measured = (f"{ratio:.2f} (signorini {float(ours['wall_median_s']):.2f} s; "
+                + ", ".join(f"{c} {float(x['wall_median_s']):.2f} s{'' if int(x['converged']) else ' (did not converge)'}" for c, x in fenicsx.items())
+                + f"; {n}^3, {ours['unknowns']} unknowns); contact force {'agrees' if agrees else 'does not agree'}: largest relative difference {diff:.1e}"
+                + ("" if n == 40 else f" (measured at {n}^3, not 40^3)"))
+    return [row(target, measured, (ratio >= 5.0 and agrees) if n == 40 else None, cmd)]
+
+
 SECTIONS = {"default": measure_default, "mg": measure_mg, "iterations": measure_iterations, "eps": measure_eps, "parallel": measure_parallel, "getfem": measure_getfem,
             "estimate": measure_estimate, "load_path": measure_load_path, "vi": measure_vi,
-            "default3d": measure_default3d}
+            "default3d": measure_default3d, "fenicsx": measure_fenicsx}
 
 
 def rows_of_table(path):
