@@ -3,7 +3,7 @@
 #include "signorini.h"
 
 /* mesh.c, mesh_box_simplex.c */
-PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt coarse_request, const PetscInt coarse_faces[3],
+PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const PetscInt coarse_requests[2], const PetscInt coarse_faces[3],
                           PetscInt coarse_min_levels, MeshBox *box, DM *dm);
 PetscErrorCode MeshIndexCellTypes(DM dm);
 PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[]);

@@ -290,6 +290,7 @@ typedef struct {
   PetscInt            pc_updates;               /* updates of a GAMG hierarchy's coarse operators instead of builds (-contact_pc_update) */
   PetscInt            pc_finest_updates;        /*   and of its finest level only (-contact_pc_update_changes) */
   PetscBool           coarse_mg;                /* the coarser boxes solved with the geometric multigrid of the boxes below, if any */
+  PetscBool           default_mg;               /* the linear solver: the boxes' geometric multigrid, by default (no -pc_type; 3D box) */
   PetscInt            pc_breakdowns;            /* preconditioner breakdowns recovered from (pc_recovery.c), */
   char                pc_recovery[512];         /*   and what was done, "; "-separated */
   PetscBool           ksp_ew;                   /* Eisenstat-Walker linear tolerances (-snes_ksp_ew) */

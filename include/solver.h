@@ -36,12 +36,12 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
    40^3 (26,460 unknowns), and its 4 factorizations took 51 s of a 60 s run. */
 #define GRID_SEQUENCE_MIN_FACES_3D 16
 #define GRID_SEQUENCE_MIN_FACES_MG_3D 4
-/* ... and the multigrid's coarsest box in 3D has at most 8 cells per side (2,187 unknowns) where it nests by default:
-   68^3 halves to 17^3 only, whose factorizations (3 of 17,496 unknowns) took 21 s of a 79 s run; such a box does not
-   nest by default (GAMG on each box instead is for a later measurement) */
-#define GRID_SEQUENCE_MAX_COARSEST_MG_3D 8
-PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt *request, PetscInt faces[3], PetscInt *min_levels,
-                                         PetscBool *coarse_mg);
+/* ... and the multigrid's coarsest box in 3D has at most 20 cells per side (27,783 unknowns) where it nests by default: it
+   is factored by MUMPS at each build of the hierarchy (17^3, the coarsest of 68^3: 0.4 s) and solved alone by GAMG
+   (multigrid.c). With PETSc's own LU it was 8: three factorizations of 17^3 took 21 s of a 79 s run. */
+#define GRID_SEQUENCE_MAX_COARSEST_MG_3D 20
+PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt request[2], PetscInt faces[3],
+                                         PetscInt *min_levels, PetscBool *coarse_mg, PetscBool *default_mg);
 PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts);
 PetscErrorCode SolverGivenIndex(const char prefix[], PetscInt *k);
 PetscErrorCode SolverGivenEsteig(const SolverGiven *g, const char prefix[], PetscInt *n, PetscReal t[]);
@@ -62,6 +62,8 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user);
 PetscErrorCode MultigridSetCoarseBoxSolver(KSP ksp, const AppCtx *user);
 PetscErrorCode MultigridCreate(PetscBool coarse_mg, Multigrid *mg);
 PetscErrorCode MultigridDestroy(Multigrid *mg);
+PetscErrorCode MultigridSetDefault(Multigrid mg, PetscBool is_default);
+PetscBool      MultigridIsDefault(const AppCtx *user);
 
 /* fine_smoother.c: -mg_fine_ksp_*, -mg_fine_pc_* */
 PetscErrorCode FineSmootherGiven(KSP ksp, const SolverGiven *g, PetscBool *given);

@@ -29,6 +29,12 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
   PetscCall(ContactView(user->contact, PETSC_VIEWER_STDOUT_(comm))); /* method penalty (gauss quadrature, eps = ...) */
   PetscCall(
       PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, h = %g, %d rank(s)\n", user->opt->degree, ndofs, (double)user->prob.h, size));
+  if (s->default_mg)
+    PetscCall(PetscPrintf(comm,
+                          "  linear solver: CG with the geometric multigrid of the %" PetscInt_FMT
+                          " nested boxes (the default on a 3D box that nests; "
+                          "-pc_type lu for MUMPS)\n",
+                          user->box.coarse_levels + 1));
   PetscCall(PetscPrintf(comm,
                         "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, %" PetscInt_FMT " preconditioner builds",
                         SNESConvergedReasons[s->reason], s->newton_its, s->ksp_its, s->pc_builds));
@@ -131,11 +137,15 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   user.opt = &opt;
 
   {
-    PetscInt coarse_request, coarse_faces[3], coarse_min_levels;
+    PetscInt  coarse_requests[2], coarse_faces[3], coarse_min_levels;
+    PetscBool default_mg;
 
-    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, &coarse_request, coarse_faces, &coarse_min_levels, &user.rec.stats.coarse_mg));
+    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, coarse_requests, coarse_faces, &coarse_min_levels, &user.rec.stats.coarse_mg,
+                                        &default_mg));
     PetscCall(MultigridCreate(user.rec.stats.coarse_mg, &user.mg));
-    PetscCall(MeshCreate(comm, opt.solver.grid_sequence, coarse_request, coarse_faces, coarse_min_levels, &user.box, &dm));
+    PetscCall(MeshCreate(comm, opt.solver.grid_sequence, coarse_requests, coarse_faces, coarse_min_levels, &user.box, &dm));
+    user.rec.stats.default_mg = (PetscBool)(default_mg && user.box.dim == 3 && user.box.coarse_levels > 0);
+    PetscCall(MultigridSetDefault(user.mg, user.rec.stats.default_mg));
   }
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));        /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */

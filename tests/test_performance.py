@@ -80,6 +80,27 @@ def test_3d_box_nests_by_default(np_):
     assert max_diff(nested, direct) < 1e-8
 
 
+@pytest.mark.parametrize("np_", [1, 2])
+def test_3d_box_default_solver_is_the_boxes_multigrid(np_):
+    """Without solver options, a 3D box that nests is solved by CG with the boxes' geometric multigrid (issue 35: MUMPS,
+    the default elsewhere, took 106 s and 4.9 GB on the 40^3 box, the multigrid 4.2 s): on the 16^3 box the penalty run and
+    the elastic solve say so (/run default_mg, the summary line), nest (4^3, 8^3) and equal MUMPS (-pc_type lu, -contact_coarse_levels 0) to 1e-8; a box that does not nest (4^3), a 2D
+    box and a given -pc_type keep their solvers."""
+    box = SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "16,16,16"]
+    for extra, name in (([], "penalty"), (["-contact_method", "none"], "elastic")):
+        out, mg = run(box + extra, f"default_mg_{name}_{np_}", np_=np_)
+        _, lu = run(box + extra + ["-pc_type", "lu", "-contact_coarse_levels", 0], f"default_mg_{name}_lu_{np_}", np_=np_)
+        a, b = load(mg)[0], load(lu)[0]
+        assert a["default_mg"] == 1 and b["default_mg"] == 0, (a["default_mg"], b["default_mg"])
+        assert "geometric multigrid of the" in out, out[-2000:]
+        assert a["coarse_levels"] == 2 and a["converged"] == b["converged"] == 1, a["coarse_levels"]
+        assert max_diff(mg, lu) < 1e-8, max_diff(mg, lu)
+    for extra, name in ((["-dm_plex_dim", 3, "-dm_plex_box_faces", "4,4,4"], "small3d"), (["-dm_plex_box_faces", "64,64"], "box2d"),
+                        (["-dm_plex_dim", 3, "-dm_plex_box_faces", "16,16,16", "-options_file", "options/solvers/mumps.yaml"], "mumps3d")):
+        out, h5 = run(SQUARE + extra, f"default_mg_not_{name}_{np_}", np_=np_)
+        assert load(h5)[0]["default_mg"] == 0 and "geometric multigrid of the" not in out, name
+
+
 @pytest.mark.parametrize("dim,faces", ((2, "4,4"), (3, "2,2,2")), ids=("quads", "hexes"))
 def test_grid_sequence_on_quads_and_hexes_equals_the_direct_solution(dim, faces):
     """Q1: the new vertices are edge midpoints and face or cell centres, interpolated as means of their corners."""

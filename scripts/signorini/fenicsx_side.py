@@ -253,6 +253,11 @@ def same_cells(h5path, n):
     return ours == theirs and len(ours) == len(cells) == 6 * n ** 3
 
 
+def same_cells_cmd(h5path, n):
+    """same_cells() in a process of its own: dolfinx initializes MPI, and a process that did cannot start mpiexec."""
+    return [sys.executable, os.path.abspath(__file__), "--faces", str(n), "--same-cells", h5path]
+
+
 def fenicsx_cmd(n, result, ew=False, extra=()):
     """This program in a process of its own (as a script path: no PYTHONPATH needed), so that it is timed as a whole
     process too."""
@@ -262,7 +267,8 @@ def fenicsx_cmd(n, result, ew=False, extra=()):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--faces", type=int, required=True, help="cells per side of the Kuhn box")
-    ap.add_argument("--result", required=True, help="the result, JSON (and its fields, with --fields, as RESULT.npz beside it)")
+    ap.add_argument("--result", help="the result, JSON (and its fields, with --fields, as RESULT.npz beside it)")
+    ap.add_argument("--same-cells", metavar="H5", help="only check that bin/signorini's output H5 has dolfinx's tetrahedra (same_cells()): exit 0 if so, 1 if not")
     ap.add_argument("--ew", action="store_true", help="Eisenstat-Walker forcing terms (-snes_ksp_ew)")
     ap.add_argument("--eps0", type=float, default=EPS0, help="eps = eps0 h^power / E (default 1)")
     ap.add_argument("--eps-power", type=float, default=EPS_POWER, help="the power of h (default 1)")
@@ -273,6 +279,12 @@ def main(argv=None):
     ap.add_argument("--fields", action="store_true", help="also write the vertex coordinates and displacements (RESULT.npz)")
     ap.add_argument("--monitor", action="store_true", help="print PETSc's Newton and CG convergence")
     args = ap.parse_args(argv)
+    if args.same_cells:
+        same = same_cells(args.same_cells, args.faces)
+        print(f"{args.same_cells}: {'the same' if same else 'not the same'} tetrahedra as dolfinx's create_unit_cube({args.faces})")
+        return 0 if same else 1
+    if not args.result:
+        ap.error("--result is required")
     extra = dict(kv.split("=", 1) if "=" in kv else (kv, "") for kv in args.petsc)
     res = solve(args.faces, ew=args.ew, eps0=args.eps0, eps_power=args.eps_power, quadrature_degree=args.quadrature_degree, quadrature_rule=args.quadrature_rule, petsc_options=extra,
                 monitor=args.monitor, fields=args.fields)

@@ -335,6 +335,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteIntAttr(v, "grid_sequence", user->opt->solver.grid_sequence));
   PetscCall(WriteIntAttr(v, "coarse_levels", user->box.coarse_levels));
   PetscCall(WriteIntAttr(v, "coarse_mg", user->rec.stats.coarse_mg && user->box.coarse_levels > 0 ? 1 : 0)); /* -contact_coarse_mg applied */
+  PetscCall(WriteIntAttr(v, "default_mg", user->rec.stats.default_mg ? 1 : 0)); /* the 3D box's default: the boxes' geometric multigrid */
   PetscCall(WriteIntAttr(v, "n_solves", user->rec.nrecords));
   PetscCall(WriteRealAttr(v, "residual_norm", s->residual_norm));
   PetscCall(WriteIntAttr(v, "residual_reduced", s->residual_reduced ? 1 : 0));

@@ -52,11 +52,11 @@ static PetscErrorCode MeshReadFile(MPI_Comm comm, const char filename[], DM *dm)
 
 /* Creates the mesh from PETSc's own options; simplex boxes, which PETSc 3.18 cannot generate
    without Triangle/CTetGen, come from MeshCreateSimplexBox(). later_refinements: uniform refinements the run will
-   still make (grid sequencing), counted in the size check. coarse_request: nested iteration to the box of the options
+   still make (grid sequencing), counted in the size check. coarse_requests: in 2D and in 3D, nested iteration to the box of the options
    (-1: as many levels as keep coarse_faces[dim - 2] cells per side, and at least coarse_min_levels while the box has 2 cells per
    side to halve, where the box nests, and in 3D none where the coarsest box would keep more than coarse_faces[2] (if > 0); 0: none; k: k levels, or
    an error): the box built is then the coarsest, and box->coarse_levels says how many doublings lead to the one asked for. */
-PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt coarse_request, const PetscInt coarse_faces[3],
+PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const PetscInt coarse_requests[2], const PetscInt coarse_faces[3],
                           PetscInt coarse_min_levels, MeshBox *box, DM *dm)
 {
   PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
@@ -65,7 +65,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
   char                filename[PETSC_MAX_PATH_LEN] = "";
   MeshPartitionerType partitioner;
   PetscMPIInt         size;
-  PetscInt            coarse = 0;
+  PetscInt            coarse = 0, coarse_request;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(comm, &size));
@@ -131,7 +131,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, PetscInt co
      x_i - x_j = const of the coarse grid, which are planes of the fine grid's, so it is a union of fine Kuhn tetrahedra
      (checked on 2^3 against 4^3: each of the 384 fine tetrahedra lies in one coarse tetrahedron), and every fine vertex
      is a coarse vertex or the midpoint of a coarse edge (MeshCreateBoxLevel()) */
-  nests = (PetscBool)(!has_file && simplex && refine == 0 && (dim == 2 || dim == 3) && (size == 1 || partitioner == MESH_PARTITIONER_BOX));
+  coarse_request = coarse_requests[dim - 2];
+  nests          = (PetscBool)(!has_file && simplex && refine == 0 && (dim == 2 || dim == 3) && (size == 1 || partitioner == MESH_PARTITIONER_BOX));
   { /* nested iteration to the box of the options: the box built first has 2^coarse times fewer cells per side. On several
        ranks each box is built in slabs of its rows (-partitioner box), and the boxes nest rank by rank where every slab
        boundary is a row of the coarsest box: its rows divisible by the number of ranks */

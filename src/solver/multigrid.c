@@ -21,6 +21,20 @@ PetscErrorCode MultigridCreate(PetscBool coarse_mg, Multigrid *mg)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* is_default: the run's linear solver is this geometric multigrid, no -pc_type given (GridSequenceCoarseRequest()'s
+   default_mg, on a 3D box that nests). */
+PetscErrorCode MultigridSetDefault(Multigrid mg, PetscBool is_default)
+{
+  PetscFunctionBeginUser;
+  mg->is_default = is_default;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscBool MultigridIsDefault(const AppCtx *user)
+{
+  return user->mg->is_default;
+}
+
 /* Forgets the levels (the meshes no longer nest with the current one). */
 static PetscErrorCode MultigridClear(Multigrid mg)
 {
@@ -124,7 +138,7 @@ PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt v
 /* The solve of the coarsest mesh. Alone (its own Newton steps, before any finer mesh) PCMG's one level would be a
    smoother: it is the coarse solver, under the prefix mg_coarse_ as on more levels. In 2D PETSc's default, LU (on
    several ranks redundant LU). In 3D, where PETSc has MUMPS, MUMPS's factorization: PETSc's own LU orders a box's
-   unknowns with far more fill than MUMPS's METIS ordering (on 10^3, 3,630 unknowns, 2.7e8 flops a factorization, 0.77 s
+   unknowns with far more fill than MUMPS's own orderings (on 10^3, 3,630 unknowns, 2.7e8 flops a factorization, 0.77 s
    of the box's 0.8 s solve against 0.16 s by MUMPS). And a 3D coarsest mesh of more than MULTIGRID_COARSE_LU_ROWS_3D
    unknowns is solved alone by GAMG, not factored at each of its Newton steps (the 17^3 box of 68^3, 16,524 unknowns:
    0.4 s a factorization, 2.1 s for its 5 Newton steps, against 0.4 s by GAMG); below finer meshes it is factored once
@@ -211,7 +225,7 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
   PetscCall(PCMGSetLevels(pc, mg->n + 1, NULL));
   for (PetscInt l = 1; l <= mg->n; ++l) PetscCall(PCMGSetInterpolation(pc, l, mg->interp[l - 1]));
   PetscCall(MultigridSetCoarseSolve(snes, pc, mg->n, prefix));
-  if (MultigridOnCoarseBox(user)) /* the smoothers of mg.yaml; options may change them */
+  if (MultigridOnCoarseBox(user) || user->mg->is_default) /* the smoothers of mg.yaml; options may change them */
     for (PetscInt l = 1; l <= mg->n; ++l) {
       KSP smoother;
       PC  spc;

@@ -91,6 +91,7 @@ struct _n_Multigrid {
   PetscInt  n;
   Mat       interp[MULTIGRID_MAX_LEVELS]; /* [l]: from the global vector of mesh l to that of mesh l + 1 */
   PetscBool coarse_mg;                    /* the coarser boxes are solved with the geometric multigrid of the boxes below */
+  PetscBool is_default;                   /* it is the default linear solver (no -pc_type; the 3D box that nests) */
 };
 
 struct _n_SolverCtx {
