@@ -121,12 +121,13 @@ estimates: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/estimates.py --check
 
-# Performance (docs/solvers.md, "Performance"): bench/{bench,getfem,fenicsx,bandwidth,targets}.{md,csv}, runs under bench/runs/
+# Performance (docs/solvers.md, "Performance"): bench/{bench,getfem,fenicsx,profile3d,bandwidth,targets}.{md,csv}, runs under bench/runs/
 bench: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/bench.py options/bench/bench.yaml
 	$(PYTHON) scripts/bench_getfem.py
 	$(PYTHON) scripts/bench_fenicsx.py
+	$(PYTHON) scripts/profile3d.py
 	$(PYTHON) scripts/bench_bandwidth.py
 	$(PYTHON) scripts/bench_targets.py
 

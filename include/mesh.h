@@ -8,7 +8,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
 PetscErrorCode MeshIndexCellTypes(DM dm);
 PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[]);
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],
-                                    PetscBool distribute, PetscBool petsc_interpolate, PetscBool check, DM *dm);
+                                    PetscBool distribute, PetscInt slab_rows, PetscBool petsc_interpolate, PetscBool check, DM *dm);
 PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[]);
 PetscErrorCode MeshCreateBoxLevel(DM coarse, const MeshBox *box, PetscInt level, DM *fine, PetscInt **vertex_source);
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);

@@ -224,6 +224,7 @@ typedef struct {
   PetscBool is_box;        /* a simplex box (2D or 3D) not refined by -dm_refine, on one rank or in slabs of rows that nest */
   PetscInt  dim, faces[3]; /* faces: of the mesh built first, the coarsest box when coarse_levels > 0 */
   PetscInt  coarse_levels; /* the mesh of the options is this many box doublings above the one built first */
+  PetscInt  slab_rows;     /* several ranks: each box's slabs are whole rows of the box built first, of this many rows (0: one rank) */
   PetscReal lower[3], upper[3];
 } MeshBox;
 

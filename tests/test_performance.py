@@ -447,6 +447,27 @@ def test_targets_script_rows_follow_from_its_runs(outdir):
         assert e + ": " in eps_row["measured"], eps_row["measured"]
 
 
+def test_profile3d_accounts_for_the_solve(outdir):
+    """scripts/profile3d.py on the 8^3 box: both runs use the default geometric multigrid, and PETSc's inclusive events
+    nest as they must (the V-cycles within the linear solves, the Newton solve within the run's solve clock), so that
+    the table's parts are parts of its whole."""
+    p = subprocess.run(["/usr/bin/python3", "scripts/profile3d.py", "--faces", "8", "--out", outdir], cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
+                       stderr=subprocess.STDOUT, text=True, timeout=600)
+    assert p.returncode == 0, p.stdout[-3000:]
+    with open(os.path.join(outdir, "profile3d.csv")) as fh:
+        rows = {r["run"]: r for r in csv.DictReader(fh)}
+    assert set(rows) == {"elastic", "penalty"}
+    for r in rows.values():
+        f = {k: float(v) for k, v in r.items() if k != "run"}
+        assert f["default_mg"] == 1 and f["coarse_levels"] == 1, r
+        assert 0 < f["vcycles"] <= f["ksp_solve"] <= f["snes_solve"] <= f["time_solve"] * 1.05 + 0.01, r
+        assert 0 < f["pc_setup"] <= f["snes_solve"] and f["residual_jacobian"] <= f["snes_solve"], r
+        assert f["time_setup"] + f["time_solve"] <= f["time_total"] + 1e-9, r
+    assert float(rows["penalty"]["newton_total"]) > float(rows["elastic"]["newton_total"])
+    with open(os.path.join(outdir, "profile3d.md")) as fh:
+        assert "of which V-cycles (PCApply)" in fh.read()
+
+
 def test_grid_sequence_builds_2d_box_levels_as_refinements():
     """On one rank the 2D box's finer levels are built directly as boxes of twice the cells (MeshCreateBoxLevel), every
     fine vertex taking a coarse vertex or edge midpoint as its source; on two ranks PETSc refines each level. Both must
@@ -511,7 +532,8 @@ def test_nested_iteration_on_two_ranks_builds_row_slabs_that_nest(solver_file):
     coarsest box (its rows divisible by the ranks), a rank's fine slab refines its coarse slab and the default nests as
     on one rank (MeshCreateBoxLevel, the geometric multigrid's interpolations too): the same levels, the answer of the
     one-rank nested run and of the two-rank direct run to the solver's tolerance, few Newton steps on the final box.
-    Where the rows do not divide (128 on 3 ranks), the default solves directly and an explicit count is refused."""
+    Where the rows do not divide (128 on 3 ranks), the default solves directly in 2D; an explicit count nests in uneven
+    slabs of whole rows, and is refused where the coarsest box has fewer rows than ranks."""
     base = SQUARE + ["-dm_plex_box_faces", "128,128", "-options_file", f"options/solvers/{solver_file}", "-snes_rtol", "1e-9"]
     _, np2 = run(base, f"nested_np2_{solver_file}", np_=2)
     _, np1 = run(base, f"nested_np1_{solver_file}")
@@ -526,8 +548,11 @@ def test_nested_iteration_on_two_ranks_builds_row_slabs_that_nest(solver_file):
         assert a2["newton_its"] <= 4 and a2["newton_its"] < load(direct)[0]["newton_its"]
         _, np3 = run(base, "nested_np3", np_=3)
         assert load(np3)[0]["coarse_levels"] == 0 and max_diff(np3, np1) < 1e-8
-        log, _ = run(base + ["-contact_coarse_levels", 1], "nested_np3_refused", np_=3, expect_rc=None)
-        assert "-contact_coarse_levels 1 on 3 ranks: the coarsest box's 64 rows are not divisible by the number of ranks" in log, log[-2000:]
+        # asked for, a box whose rows do not divide nests in uneven slabs of whole rows (21, 21, 22 of 64)
+        _, np3_asked = run(base + ["-contact_coarse_levels", 1], "nested_np3_asked", np_=3)
+        assert load(np3_asked)[0]["coarse_levels"] == 1 and max_diff(np3_asked, np1) < 1e-8
+        log, _ = run(base + ["-contact_coarse_levels", 6], "nested_np3_refused", np_=3, expect_rc=None)
+        assert "-contact_coarse_levels 6 on 3 ranks: the coarsest box's 2 rows are fewer than the ranks" in log, log[-2000:]
 
 
 @pytest.mark.parametrize("np_", [1, 2])

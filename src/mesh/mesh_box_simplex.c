@@ -87,11 +87,14 @@ static PetscBool BoxFaceOnBoundary(PetscInt nv, const PetscInt gid[], void *ctx)
 }
 
 /* The simplex box: serial (on rank 0, for a partitioner to distribute), or, with distribute, built in parallel: each
-   rank makes a contiguous block of the cell numbering (slabs along the last axis) and the vertices it needs, and its faces
+   rank makes a contiguous block of the cell numbering (slabs along the last axis; with slab_rows > 0 whole rows, rank r
+   those of rows [floor(R r / size), floor(R (r + 1) / size)) of a box of R = slab_rows rows, scaled to this box's: the
+   slabs of the boxes of nested iteration refine one another, whether or not R divides by the ranks; 0: as many cells
+   on each rank, to one) and the vertices it needs, and its faces
    and edges are built directly (src/mesh/mesh_interpolate.c; with petsc_interpolate by PETSc's interpolation); nothing is
    built on one rank and moved. check (one rank): print how the direct build differs from DMPlexInterpolate()'s. */
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],
-                                    PetscBool distribute, PetscBool petsc_interpolate, PetscBool check, DM *dm)
+                                    PetscBool distribute, PetscInt slab_rows, PetscBool petsc_interpolate, PetscBool check, DM *dm)
 {
   const PetscInt n[3] = {faces[0], faces[1], dim == 3 ? faces[2] : 1};
   const PetscInt nc   = dim + 1;
@@ -105,10 +108,17 @@ PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt 
   ncells_total = (dim == 2 ? 2 : 6) * n[0] * n[1] * n[2];
   nverts_total = (n[0] + 1) * (n[1] + 1) * (dim == 3 ? n[2] + 1 : 1);
   if (size == 1) distribute = PETSC_FALSE;
-  if (!distribute) size = 1; /* everything on rank 0 */
-  if (rank < size) {
+  if (!distribute) size = 1;          /* everything on rank 0 */
+  if (rank < size && slab_rows > 0) { /* whole rows: rank r's rows of the box of slab_rows rows, scaled to this box's */
+    const PetscInt rows = n[dim - 1], scale = rows / slab_rows, row_cells = ncells_total / rows;
+
+    c0 = row_cells * scale * (PetscInt)(((PetscInt64)slab_rows * rank) / size);
+    c1 = row_cells * scale * (PetscInt)(((PetscInt64)slab_rows * (rank + 1)) / size);
+  } else if (rank < size) {
     c0 = (PetscInt)(((PetscInt64)ncells_total * rank) / size);
     c1 = (PetscInt)(((PetscInt64)ncells_total * (rank + 1)) / size);
+  }
+  if (rank < size) {
     v0 = (PetscInt)(((PetscInt64)nverts_total * rank) / size);
     v1 = (PetscInt)(((PetscInt64)nverts_total * (rank + 1)) / size);
   }
@@ -212,7 +222,7 @@ PetscErrorCode MeshCreateBoxLevel(DM coarse, const MeshBox *box, PetscInt level,
     ff[d] = 2 * cf[d];
     nlat *= cf[d] + 1;
   }
-  PetscCall(MeshCreateSimplexBox(comm, dim, ff, box->lower, box->upper, PETSC_TRUE, PETSC_FALSE, PETSC_FALSE, fine)); /* in slabs on several ranks */
+  PetscCall(MeshCreateSimplexBox(comm, dim, ff, box->lower, box->upper, PETSC_TRUE, box->slab_rows, PETSC_FALSE, PETSC_FALSE, fine)); /* in slabs */
   PetscCall(DMGetMatType(coarse, &mtype));
   PetscCall(DMSetMatType(*fine, mtype));
   PetscCall(PetscObjectSetName((PetscObject)*fine, "mesh"));
