@@ -34,7 +34,7 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
                           "  linear solver: CG with the geometric multigrid of the %" PetscInt_FMT
                           " nested boxes (the default on a 3D box that nests; "
                           "-pc_type lu for MUMPS)\n",
-                          user->box.coarse_levels + 1));
+                          user->box.coarse_levels + user->opt->solver.grid_sequence + 1));
   PetscCall(PetscPrintf(comm,
                         "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, %" PetscInt_FMT " preconditioner builds",
                         SNESConvergedReasons[s->reason], s->newton_its, s->ksp_its, s->pc_builds));
