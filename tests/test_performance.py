@@ -457,12 +457,15 @@ def test_profile3d_accounts_for_the_solve(outdir):
     with open(os.path.join(outdir, "profile3d.csv")) as fh:
         rows = {r["run"]: r for r in csv.DictReader(fh)}
     assert set(rows) == {"elastic", "penalty"}
+    def within(a, b):  # a part of b, to the clocks' noise (milliseconds on this box; a solve outside the SNES, the estimate's, counts in KSPSolve)
+        return a <= 1.05 * b + 0.01
+
     for r in rows.values():
         f = {k: float(v) for k, v in r.items() if k != "run"}
         assert f["default_mg"] == 1 and f["coarse_levels"] == 1, r
-        assert 0 < f["vcycles"] <= f["ksp_solve"] <= f["snes_solve"] <= f["time_solve"] * 1.05 + 0.01, r
-        assert 0 < f["pc_setup"] <= f["snes_solve"] and f["residual_jacobian"] <= f["snes_solve"], r
-        assert f["time_setup"] + f["time_solve"] <= f["time_total"] + 1e-9, r
+        assert 0 < f["vcycles"] and within(f["vcycles"], f["ksp_solve"]) and within(f["ksp_solve"], f["snes_solve"]), r
+        assert within(f["snes_solve"], f["time_solve"]) and 0 < f["pc_setup"] and within(f["pc_setup"], f["snes_solve"]), r
+        assert within(f["residual_jacobian"], f["snes_solve"]) and f["time_setup"] + f["time_solve"] <= f["time_total"] + 1e-9, r
     assert float(rows["penalty"]["newton_total"]) > float(rows["elastic"]["newton_total"])
     with open(os.path.join(outdir, "profile3d.md")) as fh:
         assert "of which V-cycles (PCApply)" in fh.read()
