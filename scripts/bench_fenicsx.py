@@ -7,7 +7,6 @@ with Eisenstat-Walker, each as a whole process, alternating, PAIRS times; the me
 time, and the relative differences of the contact forces (at most 1e-3). Writes bench/fenicsx.md and bench/fenicsx.csv,
 and the runs under bench/runs/fenicsx/."""
 import argparse
-import csv
 import json
 import os
 import statistics
@@ -19,6 +18,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from signorini import fenicsx_side as fx  # noqa: E402
 from signorini.mpirun import run_timed  # noqa: E402
 from signorini.paths import BIN, ROOT  # noqa: E402
+from signorini.report import dict_csv_text, write_text  # noqa: E402
 
 SIGNORINI = {"signorini (3D default run: the boxes' geometric multigrid)": [], "signorini (GAMG, options/solvers/gamg.yaml)": ["-options_file", "options/solvers/gamg.yaml"]}
 DEFAULT = next(iter(SIGNORINI))  # the row of the target
@@ -85,10 +85,7 @@ def main():
                      "converged": int(all(r["converged"] for r in info[name])), "newton": last["newton"], "krylov": last["krylov"],
                      "solve_s_median": statistics.median(r["time_solve"] for r in info[name]), "contact_force": last["contact_force"],
                      "force_rel_diff": diff, "fenicsx_best_over_this": (med[best] / med[name]) if best else float("nan"), "note": last["note"]})
-    with open(os.path.join(args.out, "fenicsx.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_text(os.path.join(args.out, "fenicsx.csv"), dict_csv_text(list(rows[0]), rows))
     worst = max([r["force_rel_diff"] for r in rows if r["converged"]])  # a variant that did not converge is shown, not compared
     ratio = rows[0]["fenicsx_best_over_this"]
     lines = [f"# FEniCSx side by side (3D, {n}^3 box, {rows[0]['unknowns']} unknowns)", "",
@@ -109,8 +106,7 @@ def main():
                      f"{r['solve_s_median']:.2f} | {r['contact_force']:.8g} | {r['force_rel_diff']:.1e} | {r['fenicsx_best_over_this']:.2f} | {r['note']} |")
     lines += ["", f"FEniCSx's best ({best or 'none converged'}) over the project: {ratio:.2f} (target >= {TARGET_RATIO:g}: "
               f"{'met' if ratio >= TARGET_RATIO else 'not met'}); largest contact-force difference {worst:.1e} (<= {FORCE_RTOL:g}: {'yes' if worst <= FORCE_RTOL else 'no'})."]
-    with open(os.path.join(args.out, "fenicsx.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+    write_text(os.path.join(args.out, "fenicsx.md"), "\n".join(lines) + "\n")
     print("\n".join(lines))
     return 0 if worst <= FORCE_RTOL and best else 1
 

@@ -6,7 +6,6 @@ set-up (mesh, sections, K), the residual and Jacobian evaluations, the precondit
 their V-cycles, and the rest (estimate, output); the V-cycle's bandwidth against the triad's. Writes bench/profile3d.md
 and bench/profile3d.csv, the logs under bench/runs/profile3d/."""
 import argparse
-import csv
 import os
 import re
 import sys
@@ -16,6 +15,7 @@ import h5py
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from signorini.mpirun import run_mpi  # noqa: E402
 from signorini.paths import BIN, ROOT  # noqa: E402
+from signorini.report import dict_csv_text, write_text  # noqa: E402
 
 EVENTS = ["SNESSolve", "SNESFunctionEval", "SNESJacobianEval", "PCSetUp", "KSPSolve", "PCApply", "MatMult", "MatPtAPNumeric", "MatPtAPSymbolic",
           "KSPSetUp", "MatLUFactorNum", "AssemblyP1Prealloc"]
@@ -64,10 +64,7 @@ def main():
         row["rest"] = row["time_total"] - row["time_setup"] - row["time_solve"]
         rows.append(row)
         print(row, flush=True)
-    with open(os.path.join(args.out, "profile3d.csv"), "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0]))
-        w.writeheader()
-        w.writerows(rows)
+    write_text(os.path.join(args.out, "profile3d.csv"), dict_csv_text(list(rows[0]), rows))
     e, p = rows
     lines = [f"# Where the time of the 3D default run goes ({n}^3 box, {e['dofs']} unknowns, one rank)", "",
              f"`/usr/bin/python3 scripts/profile3d.py` (make bench): `bin/signorini -options_file options/square.yaml -dm_plex_dim 3 -dm_plex_box_faces {n},{n},{n} "
@@ -89,8 +86,7 @@ def main():
         lines.append(f"| {label} | {e[k]:.2f} | {p[k]:.2f} | |")
     lines += ["", f"The V-cycle runs at {p['vcycle_gbs'] / p['triad_gbs']:.2f} of the triad's bandwidth (penalty; elastic {e['vcycle_gbs'] / e['triad_gbs']:.2f}), "
               f"MatMult at {p['matmult_gbs'] / p['triad_gbs']:.2f}."]
-    with open(os.path.join(args.out, "profile3d.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+    write_text(os.path.join(args.out, "profile3d.md"), "\n".join(lines) + "\n")
     print("\n".join(lines))
 
 

@@ -106,9 +106,14 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOpt
   faces[1]    = mg_3d ? GRID_SEQUENCE_MIN_FACES_MG_3D : GRID_SEQUENCE_MIN_FACES_3D;
   faces[2]    = mg_3d ? GRID_SEQUENCE_MAX_COARSEST_MG_3D : 0;
   *min_levels = opt->bars ? BARS_LEVELS - 1 : 0; /* -bars: at least two boxes below the final one, whatever their size */
-  /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels) */
-  if (k < 0 && (!(ContactHasPenalty(ct) || (ContactIsNone(ct) && is_mg)) || opt->degree != 1)) request[0] = 0;
-  if (k < 0 && (!(ContactHasPenalty(ct) || (ContactIsNone(ct) && (is_mg || *default_mg))) || opt->degree != 1)) request[1] = 0;
+  /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels: -pc_type mg, and in
+     3D the default's), on P1 */
+  {
+    const PetscBool penalty = (PetscBool)(opt->degree == 1 && ContactHasPenalty(ct)), elastic = (PetscBool)(opt->degree == 1 && ContactIsNone(ct));
+
+    if (k < 0 && !(penalty || (elastic && is_mg))) request[0] = 0;
+    if (k < 0 && !(penalty || (elastic && (is_mg || *default_mg)))) request[1] = 0;
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -160,22 +160,24 @@ static PetscErrorCode MultigridSetCoarseSolve(SNES snes, PC pc, PetscInt nfine, 
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(PetscHasExternalPackage("mumps", &mumps));
+  PetscCall(SNESGetJacobian(snes, &A, NULL, NULL, NULL));
+  PetscCall(MatGetSize(A, &rows, NULL));
   if (!nfine) {
     PetscCall(KSPSetOptionsPrefix(coarse, prefix));
     PetscCall(KSPAppendOptionsPrefix(coarse, "mg_coarse_"));
+  }
+  if (dim == 3 && mumps) {
     PetscCall(KSPSetType(coarse, KSPPREONLY));
-    if (dim != 3 || !mumps) PetscCall(PCSetType(cpc, size > 1 ? PCREDUNDANT : PCLU));
+    if (!nfine && rows > MULTIGRID_COARSE_LU_ROWS_3D)
+      PetscCall(PCSetType(cpc, PCGAMG));
+    else {
+      PetscCall(PCSetType(cpc, PCLU));
+      PetscCall(PCFactorSetMatSolverType(cpc, MATSOLVERMUMPS));
+    }
+  } else if (!nfine) {
+    PetscCall(KSPSetType(coarse, KSPPREONLY));
+    PetscCall(PCSetType(cpc, size > 1 ? PCREDUNDANT : PCLU));
   }
-  if (dim != 3 || !mumps) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(SNESGetJacobian(snes, &A, NULL, NULL, NULL));
-  PetscCall(MatGetSize(A, &rows, NULL));
-  if (!nfine && rows > MULTIGRID_COARSE_LU_ROWS_3D) {
-    PetscCall(PCSetType(cpc, PCGAMG));
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-  PetscCall(KSPSetType(coarse, KSPPREONLY));
-  PetscCall(PCSetType(cpc, PCLU));
-  PetscCall(PCFactorSetMatSolverType(cpc, MATSOLVERMUMPS));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
