@@ -176,6 +176,21 @@ def test_sweep_starts_the_linear_solve_from_a_refused_extrapolation(ranks):
     assert np.all(s["newton_its"][-2:] <= 2) and np.all(s["ksp_its"][-2:] <= 17), (s["newton_its"], s["ksp_its"])
 
 
+def test_sweep_extrapolates_its_start_on_a_parabola_in_eps():
+    """From the fourth value on, a sweep starts on the parabola in eps through the last three solutions
+    (src/solver/eps_sweep.c): u(eps) is smooth in eps while the active set stays, and the secant of two leaves its eps^2
+    term. On the 256 x 256 square with GAMG (eps = h to 1e-7 h) the last three values took 2, 1 and 1 Newton steps and
+    11, 6 and 5 CG iterations from the secant; from the parabola 1, 1 and 0, and 6, 5 and 0. They must take at most 2
+    Newton steps and 16 CG iterations together (the secant fails this), and the sweep end at the direct solution."""
+    sweep = [1, 0.1, 0.01, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7]
+    args = SQUARE + ["-dm_plex_box_faces", "256,256", "-options_file", "options/solvers/gamg.yaml"]
+    _, h5 = run(args + ["-penalty_eps0_sweep", ",".join(map(str, sweep))], "sweep_parabola")
+    _, direct = run(args + ["-penalty_eps0", "1e-7"], "sweep_parabola_direct")
+    s = solves(h5)
+    assert np.all(s["converged"] == 1) and max_diff(h5, direct) < 1e-7
+    assert s["newton_its"][-3:].sum() <= 2 and s["ksp_its"][-3:].sum() <= 16, (s["newton_its"], s["ksp_its"])
+
+
 def test_preconditioner_reuse_changes_the_cost_not_the_answer():
     args = SQUARE + ["-dm_plex_box_faces", "64,64"]
     _, reuse = run(args, "reuse_on")
