@@ -195,16 +195,18 @@ def test_sweep_starts_the_linear_solve_from_a_refused_extrapolation(ranks):
 def test_sweep_extrapolates_its_start_on_a_parabola_in_eps():
     """From the fourth value on, a sweep starts on the parabola in eps through the last three solutions
     (src/solver/eps_sweep.c): u(eps) is smooth in eps while the active set stays, and the secant of two leaves its eps^2
-    term. On the 256 x 256 square with GAMG (eps = h to 1e-7 h) the last three values took 2, 1 and 1 Newton steps and
-    11, 6 and 5 CG iterations from the secant; from the parabola 1, 1 and 0, and 6, 5 and 0. They must take at most 2
-    Newton steps and 16 CG iterations together (the secant fails this), and the sweep end at the direct solution."""
+    term. On the 256 x 256 square with GAMG (eps = h to 1e-7 h) the last four values took 2, 2, 1 and 1 Newton steps and
+    33 or 34 CG iterations from the secant; from the parabola 2, 1, 1 and 0 (or 1), and 22 to 25 CG iterations (the
+    counts move by an iteration or two with OpenBLAS's threads, which change the last bits of the eigenvalue estimates
+    of the Chebyshev smoothers: the last value's start sits at Newton's stop). They must take at most 5 Newton steps and
+    28 CG iterations together (the secant fails both), and the sweep end at the direct solution."""
     sweep = [1, 0.1, 0.01, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7]
     args = SQUARE + ["-dm_plex_box_faces", "256,256", "-options_file", "options/solvers/gamg.yaml"]
     _, h5 = run(args + ["-penalty_eps0_sweep", ",".join(map(str, sweep))], "sweep_parabola")
     _, direct = run(args + ["-penalty_eps0", "1e-7"], "sweep_parabola_direct")
     s = solves(h5)
     assert np.all(s["converged"] == 1) and max_diff(h5, direct) < 1e-7
-    assert s["newton_its"][-3:].sum() <= 2 and s["ksp_its"][-3:].sum() <= 16, (s["newton_its"], s["ksp_its"])
+    assert s["newton_its"][-4:].sum() <= 5 and s["ksp_its"][-4:].sum() <= 28, (s["newton_its"], s["ksp_its"])
 
 
 def test_preconditioner_reuse_changes_the_cost_not_the_answer():

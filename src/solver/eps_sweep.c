@@ -8,7 +8,8 @@
    carried over. The polynomial goes through the last SWEEP_POINTS solutions (fewer at the start): the secant of two
    leaves the eps^2 term, eps_last eps_prev u''(0)/2 about, which the parabola of three removes; at 256 x 256 with
    GAMG (eps = h to 1e-7 h) the last four values then take 2, 1, 1 and 0 Newton steps and 11, 6, 5 and 0 CG iterations
-   instead of 2, 2, 1, 1 and 11, 11, 6, 5 (the fourth point of a cubic saved one more CG iteration there; not kept).
+   instead of 2, 2, 1, 1 and 11, 11, 6, 5 (one OpenBLAS thread; with its threads 2, 1, 1, 1 and 11, 5, 5, 4); the fourth
+   point of a cubic saved one more CG iteration there (not kept).
    The second value starts on the tangent of the solution path at the first (TangentDirection()). */
 #include "contact.h"
 #include "solver_impl.h"
