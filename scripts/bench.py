@@ -28,7 +28,7 @@ import yaml
 SCRIPTS = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, SCRIPTS)
 from signorini.formatting import fmt_sig as fmt  # noqa: E402
-from signorini.mpirun import MPI_ENV, run_mpi, tail  # noqa: E402,F401
+from signorini.mpirun import BENCH_ENV, MPI_ENV, run_mpi, tail  # noqa: E402,F401
 from signorini.paths import BIN, ROOT  # noqa: E402
 from signorini.report import dict_csv_text, write_atomic  # noqa: E402
 from signorini.runs import decoded_attrs, read_solves  # noqa: E402
@@ -115,7 +115,7 @@ def run_case(problem, solver, ranks, kind, bench, outdir, resume=False):
             return read_case(row, name, h5, cmd, returncode, "", problem, kind)
     if os.path.exists(h5):
         os.remove(h5)
-    proc = run_mpi(cmd, timeout=limit, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"})
+    proc = run_mpi(cmd, timeout=limit, env=BENCH_ENV)
     returncode, output = (None if proc.timed_out else proc.returncode), proc.output
     row["wall"] = proc.wall
     with open(log, "w") as fh:

@@ -14,7 +14,7 @@ import time
 import h5py
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from signorini.mpirun import run_timed  # noqa: E402
+from signorini.mpirun import BENCH_ENV, run_timed  # noqa: E402
 from signorini.paths import BIN, ROOT  # noqa: E402
 
 BASE = ["-options_file", "options/square.yaml", "-options_file", "options/solvers/gamg.yaml", "-contact_monitor", "0"]
@@ -26,7 +26,7 @@ def solver(args, name, out, ranks=1, may_fail=False, base=BASE):
     """One whole-process run: (wall s, peak MiB of the largest rank (/usr/bin/time on mpiexec), /run attributes).
     A failed solve (exit 3, converged = 0 in its file) stops the bench unless may_fail: then its attributes say so."""
     h5 = os.path.join(out, name + ".h5")
-    wall, mem, log = run_timed(["mpiexec", "-n", str(ranks), BIN] + base + [str(a) for a in args] + ["-output", h5], ok_codes=(0, 3) if may_fail else (0,))
+    wall, mem, log = run_timed(["mpiexec", "-n", str(ranks), BIN] + base + [str(a) for a in args] + ["-output", h5], env=BENCH_ENV, ok_codes=(0, 3) if may_fail else (0,))
     with h5py.File(h5, "r") as f:
         attrs = dict(f["run"].attrs)
     if int(attrs["converged"]) != 1 and not may_fail:

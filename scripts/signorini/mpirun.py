@@ -13,6 +13,10 @@ from .paths import ROOT
 # mpiexec as root, and more ranks than cores
 MPI_ENV = {"OMPI_ALLOW_RUN_AS_ROOT": "1", "OMPI_ALLOW_RUN_AS_ROOT_CONFIRM": "1",
            "OMPI_MCA_rmaps_base_oversubscribe": "1"}
+# The benches' environment: one BLAS and OpenMP thread per MPI rank (the ranks already use the cores), and the same
+# last bits from run to run: OpenBLAS's threads change those of LAPACK's eigenvalue estimates for the Chebyshev
+# smoothers, and with them a few iteration counts (docs/solvers.md, the eps sweep of issue 35).
+BENCH_ENV = {"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1"}
 LOG_TAIL_LINES = 40  # lines of solver output shown when a run fails without output
 
 
