@@ -11,6 +11,9 @@ PetscErrorCode EstimateReset(ErrorEstimate *est);
 PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u);
 PetscErrorCode EstimateView(MPI_Comm comm, const ErrorEstimate *est, const ErrorNorms *exact);
 
+/* marking.c: the cells an adaptive refinement refines (Doerfler's bulk criterion) */
+PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DMLabel *marked, PetscInt *nmarked);
+
 /* bars.c: -bars, the error bars of the quantities users read */
 PetscErrorCode BarsCheck(MPI_Comm comm, const AppCtx *user);
 PetscErrorCode BarsReset(ErrorBars *b);

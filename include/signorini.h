@@ -345,6 +345,24 @@ typedef struct {
   PetscReal factor[LOAD_PATH_MAX];
 } LoadPathOptions;
 
+/* Adaptive refinement (-adapt_cycles, src/solver/adapt.c): the cycles of estimate, mark, refine and solve after the
+   first solve, and the fraction of the estimate's square the marked cells hold (Doerfler's theta). */
+typedef struct {
+  PetscInt  cycles;   /* 0: no adaptive refinement */
+  PetscReal fraction; /* -adapt_fraction */
+} AdaptOptions;
+
+/* One cycle of the adaptive refinement (/cycles in the output): the mesh, the estimate of its solution and the true
+   energy-norm error where the scene knows the exact solution (NaN otherwise), the cells marked for the next cycle, and
+   the solve on it. */
+typedef struct {
+  PetscInt  n_dofs, n_cells, marked;
+  PetscReal estimate, error_energy;
+  PetscInt  newton_its, ksp_its;
+  PetscReal time_solve;
+  PetscBool converged;
+} CycleRecord;
+
 /* One step of a load path (/steps in the output): its factor, the obstacle's translation, the quantities, the solve. */
 typedef struct {
   PetscReal  factor, obstacle_translate[3];
@@ -379,6 +397,7 @@ typedef struct {
   PetscBool       estimate, estimate_given; /* -estimate: the a posteriori error estimate after the solve (and whether it was given) */
   PetscBool       bars;                     /* -bars: error bars of the quantities from the nested meshes and a second eps */
   LoadPathOptions load_path;                /* -load_steps, -load_path */
+  AdaptOptions    adapt;                    /* -adapt_cycles, -adapt_fraction */
   char            output[PETSC_MAX_PATH_LEN];
   PetscBool       output_dmview; /* -output_dmview: the mesh written by DMView() instead of OutputViewMesh() */
 } RunOptions;
@@ -410,6 +429,8 @@ typedef struct {
   StepRecord   *steps;       /* one per step of a load path solved (the failed one included) */
   Vec          *step_fields; /*   and its state at the vertices, OUTPUT_STATE_FIELDS per step (include/io.h) */
   PetscInt      nsteps;
+  CycleRecord  *cycles; /* one per mesh of the adaptive refinement (-adapt_cycles) */
+  PetscInt      ncycles;
   ErrorNorms    errors;                   /* against the scene's exact solution */
   ErrorNorms    ref_errors;               /* against the -reference solution */
   ErrorEstimate estimate;                 /* the a posteriori estimate of the error */

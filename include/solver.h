@@ -46,8 +46,14 @@ PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts);
 PetscErrorCode SolverGivenIndex(const char prefix[], PetscInt *k);
 PetscErrorCode SolverGivenEsteig(const SolverGiven *g, const char prefix[], PetscInt *n, PetscReal t[]);
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
+PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked);
 PetscErrorCode GridSequenceBarsSizes(DM dm, const AppCtx *user);
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
+/* adapt.c: -adapt_cycles, the adaptive refinement driven by the error estimate */
+PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad);
+PetscErrorCode AdaptCheck(DM dm, const AppCtx *user);
+PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
+PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user);
 PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u); /* penetration_tol.c: -contact_penetration_tol */
 
 /* load_path.c: -load_steps, -load_path */

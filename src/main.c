@@ -65,6 +65,7 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
     }
   }
   PetscCall(LoadPathView(comm, user));
+  PetscCall(AdaptView(comm, user));
   PetscCall(EstimateView(comm, &user->rec.estimate, &user->rec.errors));
   PetscCall(BarsView(comm, &user->rec.bars));
   PetscCall(ContactChecksWarnings(comm, &s->checks, PETSC_TRUE, NULL));
@@ -133,6 +134,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(AssemblyGetOptions(comm, &opt.assembly, &opt.assembly_check));
   PetscCall(OutputGetOptions(comm, &opt));
   PetscCall(LoadPathGetOptions(comm, &opt.load_path));
+  PetscCall(AdaptGetOptions(comm, &opt.adapt));
   PetscCall(BandwidthGetOptions(comm, &opt.perf_bandwidth));
   user.opt = &opt;
 
@@ -155,6 +157,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(ReferenceCheckFile(dm, &user));     /* before the solve, not after it */
   PetscCall(EstimateCheckSupported(dm, &user)); /* -estimate on a discretization it does not cover */
   PetscCall(BarsCheck(comm, &user));            /* -bars without three nested meshes */
+  PetscCall(AdaptCheck(dm, &user));             /* -adapt_cycles where it cannot refine */
   PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(BarsReset(&user.rec.bars));
   PetscCall(ContactChecksGeometry(dm, &user)); /* initial overlap, an obstacle facing away: warnings */
@@ -166,6 +169,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   user.rec.stats.time_setup = t1 - t0;
 
   PetscCall(GridSequenceSolve(&dm, &user, &snes, &u)); /* one solve without nested iteration */
+  PetscCall(AdaptSolve(&dm, &user, &snes, &u));        /* -adapt_cycles: refined where the estimate is largest */
   PetscCall(EpsSweepSolve(dm, &user, snes, u));
   PetscCall(PenetrationTolSolve(dm, &user, snes, u)); /* -contact_penetration_tol: eps lowered until the penetration is reached */
   PetscCall(LoadPathSolve(dm, &user, snes, u));       /* the steps after the first, each from the last */
@@ -224,6 +228,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(ContactFinalizePackage());
   PetscCall(PetscFree(user.rec.records));
   PetscCall(PetscFree(user.rec.steps));
+  PetscCall(PetscFree(user.rec.cycles));
   for (PetscInt k = 0; k < user.rec.nsteps * OUTPUT_STATE_FIELDS; ++k) PetscCall(VecDestroy(&user.rec.step_fields[k]));
   PetscCall(PetscFree(user.rec.step_fields));
   PetscCall(EstimateReset(&user.rec.estimate));

@@ -588,6 +588,37 @@ static PetscErrorCode WriteSteps(MPI_Comm comm, const AppCtx *user, PetscViewer 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* /cycles/<column>: one row per mesh of the adaptive refinement (-adapt_cycles, src/solver/adapt.c). */
+static PetscErrorCode WriteCycles(MPI_Comm comm, const AppCtx *user, PetscViewer v)
+{
+  const PetscInt     n = user->rec.ncycles;
+  const CycleRecord *c = user->rec.cycles;
+  PetscReal         *col;
+
+  PetscFunctionBeginUser;
+  if (!n) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc1(n, &col));
+  PetscCall(PetscViewerHDF5PushGroup(v, "/cycles"));
+#define CYCLE_COLUMN(label, expr)                       \
+  do {                                                  \
+    for (PetscInt i = 0; i < n; ++i) col[i] = (expr);   \
+    PetscCall(WriteStepColumn(comm, v, label, n, col)); \
+  } while (0)
+  CYCLE_COLUMN("n_dofs", (PetscReal)c[i].n_dofs);
+  CYCLE_COLUMN("n_cells", (PetscReal)c[i].n_cells);
+  CYCLE_COLUMN("estimate", c[i].estimate);
+  CYCLE_COLUMN("error_energy", c[i].error_energy);
+  CYCLE_COLUMN("marked", (PetscReal)c[i].marked);
+  CYCLE_COLUMN("newton_its", (PetscReal)c[i].newton_its);
+  CYCLE_COLUMN("ksp_its", (PetscReal)c[i].ksp_its);
+  CYCLE_COLUMN("time_solve", c[i].time_solve);
+  CYCLE_COLUMN("converged", c[i].converged ? 1.0 : 0.0);
+#undef CYCLE_COLUMN
+  PetscCall(PetscViewerHDF5PopGroup(v));
+  PetscCall(PetscFree(col));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* XDMF for ParaView into the file xdmf, pointing into h5name, the final .h5 beside it (rank 0 only). The reals are
    declared 8-byte (XDMF's default precision is 4: ParaView would read them as floats). */
 /* One node or cell attribute of an XDMF grid: the whole dataset /group/name (n values of nc components), or with
@@ -702,6 +733,7 @@ static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, const char h5
   PetscCall(WriteRunMetadata(dm, user, u, viewer, ncells, nverts));
   PetscCall(WriteSolves(comm, user, viewer));
   PetscCall(WriteSteps(comm, user, viewer, dim));
+  PetscCall(WriteCycles(comm, user, viewer));
   PetscCall(PetscViewerDestroy(&viewer));
   if (rank == 0) PetscCall(WriteXdmf(user, xdmftmp, h5name, dim, ncells, ncorners, nverts));
   PetscFunctionReturn(PETSC_SUCCESS);

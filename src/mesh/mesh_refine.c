@@ -137,6 +137,40 @@ PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **pa
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Refines the triangles of dm that `marked` holds with the value DM_ADAPT_REFINE, and those more that keep the mesh
+   conforming: PETSc's skeleton-based refinement (refine_sbr; Plaza and Carey, Appl. Numer. Math. 32, 2000) splits the
+   marked cells' edges at their midpoints, and every cell with a split edge into two to four triangles, so that the new
+   mesh is nested in dm and P1 functions of dm are P1 functions of it. Labels (face sets, Gmsh names) are kept.
+   parent[c - cStart] is the cell of dm that holds fine cell c (PETSc 3.18 finds no source for the new vertices of this
+   transform: DMPlexTransformGetSourcePoint() fails on them, "Replica number ... could be not found"). */
+PetscErrorCode MeshRefineMarked(DM dm, DMLabel marked, DM *fine, PetscInt **parent)
+{
+  DMPlexTransform tr;
+  PetscInt        cStart, cEnd;
+  MatType         mtype;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexTransformCreate(PetscObjectComm((PetscObject)dm), &tr));
+  PetscCall(DMPlexTransformSetType(tr, DMPLEXREFINESBR));
+  PetscCall(DMPlexTransformSetDM(tr, dm));
+  PetscCall(DMPlexTransformSetActive(tr, marked));
+  PetscCall(DMPlexTransformSetUp(tr));
+  PetscCall(DMPlexTransformApply(tr, dm, fine));
+  PetscCall(DMPlexGetHeightStratum(*fine, 0, &cStart, &cEnd));
+  PetscCall(PetscMalloc1(cEnd - cStart, parent));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    DMPolytopeType ct, ctn;
+    PetscInt       r;
+
+    PetscCall(DMPlexTransformGetSourcePoint(tr, c, &ct, &ctn, &(*parent)[c - cStart], &r));
+  }
+  PetscCall(DMPlexTransformDestroy(&tr));
+  PetscCall(DMGetMatType(dm, &mtype));
+  PetscCall(DMSetMatType(*fine, mtype));
+  PetscCall(PetscObjectSetName((PetscObject)*fine, "mesh"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The size each cell of dm would have for eps = eps0 h^power / M if eps were that of its descendants on the mesh refined
    `levels` times: 2^levels (the mean of their diameters^power)^(1/power), and hmax = 2^levels times their largest
    diameter (over all ranks). sizes has one entry per local cell and one more (MeshSetCellSizes()). The refined mesh is

@@ -12,8 +12,9 @@
 #include "physics.h"
 #include "solver.h"
 
-/* Replaces the problem on *dm by the problem on its uniform refinement, with *u interpolated as the initial guess. */
-static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u)
+/* Replaces the problem on *dm by the problem on its uniform refinement, or with marked (the adaptive cycles, adapt.c) on
+   its refinement where marked says, with *u interpolated as the initial guess (exact for nested P1/Q1). */
+PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked)
 {
   DM        fine;
   PetscInt *parent, *vertex_source = NULL;
@@ -25,7 +26,9 @@ static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *
   PetscCall(DMGlobalToLocal(*dm, *u, INSERT_VALUES, loc));
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
-  if (user->box.is_box && user->opt->degree == 1) { /* the box of twice as many cells, built directly */
+  if (marked) /* the cells' parents: no vertex sources from PETSc for this refinement */
+    PetscCall(MeshRefineMarked(*dm, marked, &fine, &parent));
+  else if (user->box.is_box && user->opt->degree == 1) { /* the box of twice as many cells, built directly */
     parent = NULL;
     PetscCall(MeshCreateBoxLevel(*dm, &user->box, user->prob.level, &fine, &vertex_source));
   } else
@@ -33,8 +36,8 @@ static PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *
   user->prob.level++;
   PetscCall(GridSequenceBarsSizes(fine, user)); /* -bars on tetrahedra: the final mesh's eps on this level */
   PetscCall(ProblemSetUp(fine, user, snes));
-  PetscCall(MultigridAddLevel(*snes, *dm, fine, vertex_source, user)); /* with -pc_type mg */
-  if (user->opt->degree == 1)
+  if (vertex_source) PetscCall(MultigridAddLevel(*snes, *dm, fine, vertex_source, user)); /* with -pc_type mg */
+  if (user->opt->degree == 1 && vertex_source)
     PetscCall(MeshInterpolateVertexSources(*dm, fine, vertex_source, loc, &fine_loc)); /* exact and fast */
   else
     PetscCall(MeshInterpolateFromParents(*dm, fine, parent, 1, &loc, &fine_loc));
@@ -266,7 +269,7 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
       PetscCall(PetscPrintf(PetscObjectComm((PetscObject)*dm), "  nested iteration: level %" PetscInt_FMT " failed (%s), the next starts from zero\n",
                             user->prob.level, SNESConvergedReasons[user->rec.stats.reason]));
     PetscCall(PetscTime(&t0));
-    PetscCall(GridSequenceRefine(dm, user, snes, u));
+    PetscCall(GridSequenceRefine(dm, user, snes, u, NULL));
     PetscCall(PetscTime(&t1));
     user->prob.setup_time = t1 - t0; /* refinement, set-up and interpolation */
     user->rec.stats.time_setup += t1 - t0;

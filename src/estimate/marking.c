@@ -1,0 +1,56 @@
+/* Doerfler's marking (SIAM J. Numer. Anal. 33, 1996): the fewest cells whose squared indicators hold the fraction theta
+   of the estimate's square, the cells with the largest indicators first. In parallel the cells are not sorted: the
+   set is {T : eta_T >= t} with t the largest threshold whose set holds that fraction, found by bisection on t with one
+   reduction per step, so that every partition marks the same cells (to the indicators' round-off). */
+#include "estimate.h"
+
+#define MARK_BISECTIONS 60 /* halvings of [0, max eta_T]: t to 1e-18 of the largest indicator */
+
+/* Sum of eta_T^2 over the cells with eta_T >= t, over all ranks. */
+static PetscErrorCode SumAbove(MPI_Comm comm, const ErrorEstimate *est, PetscReal t, PetscReal *sum)
+{
+  PetscReal local = 0.0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt c = 0; c < est->ncells; ++c)
+    if (est->cell[c] >= t) local += est->cell[c] * est->cell[c];
+  PetscCall(MPIU_Allreduce(&local, sum, 1, MPIU_REAL, MPIU_SUM, comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DMLabel *marked, PetscInt *nmarked)
+{
+  MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
+  PetscReal total, emax = 0.0, lo = 0.0, hi, sum;
+  PetscInt  cStart, cEnd, local   = 0;
+
+  PetscFunctionBeginUser;
+  PetscCheck(est->computed && est->cell, comm, PETSC_ERR_ARG_WRONGSTATE, "marking needs the cells' indicators of the error estimate");
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCheck(cEnd - cStart == est->ncells, comm, PETSC_ERR_ARG_WRONGSTATE, "the estimate's cells are not the mesh's");
+  for (PetscInt c = 0; c < est->ncells; ++c) emax = PetscMax(emax, est->cell[c]);
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &emax, 1, MPIU_REAL, MPIU_MAX, comm));
+  PetscCall(SumAbove(comm, est, 0.0, &total));
+  hi = emax; /* SumAbove(lo) >= theta total always; SumAbove(hi) holds at least the largest cell */
+  PetscCall(SumAbove(comm, est, hi, &sum));
+  if (sum < theta * total)
+    for (PetscInt k = 0; k < MARK_BISECTIONS; ++k) {
+      const PetscReal mid = 0.5 * (lo + hi);
+
+      PetscCall(SumAbove(comm, est, mid, &sum));
+      if (sum >= theta * total)
+        lo = mid;
+      else
+        hi = mid;
+    }
+  else
+    lo = hi;
+  PetscCall(DMLabelCreate(PETSC_COMM_SELF, "adapt", marked));
+  for (PetscInt c = 0; c < est->ncells; ++c)
+    if (est->cell[c] >= lo && est->cell[c] > 0.0) {
+      PetscCall(DMLabelSetValue(*marked, cStart + c, DM_ADAPT_REFINE));
+      ++local;
+    }
+  PetscCall(MPIU_Allreduce(&local, nmarked, 1, MPIU_INT, MPIU_SUM, comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
