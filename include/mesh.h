@@ -61,6 +61,7 @@ PetscErrorCode MeshClosureCheck(DM dm, PetscInt *differences, PetscBool *by_dept
 /* mesh_check.c: what the discretization cannot handle, refused before anything is assembled */
 PetscErrorCode MeshCheckFile(DM dm, const char filename[]);
 PetscErrorCode MeshCountInteriorFaces(DM dm, PetscInt n, const PetscInt faces[], PetscInt *ninterior);
+PetscErrorCode MeshCountCurvedRidges(DM dm, PetscInt *count, PetscReal x[3]);
 
 /* mesh_gmsh_names.c */
 PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[]);

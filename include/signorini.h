@@ -226,6 +226,10 @@ typedef struct {
   PetscInt  coarse_levels; /* the mesh of the options is this many box doublings above the one built first */
   PetscInt  slab_rows;     /* several ranks: each box's slabs are whole rows of the box built first, of this many rows (0: one rank) */
   PetscReal lower[3], upper[3];
+  PetscBool from_file;     /* the mesh of the options was read from a file (-dm_plex_filename) */
+  PetscInt  refine;        /*   refined this many times by -dm_refine */
+  PetscInt  curved_ridges; /*   whose boundary turns by a small angle at this many ridges: a curved boundary's chords (MeshCountCurvedRidges()) */
+  PetscReal curved_x[3];   /*   one of them */
 } MeshBox;
 
 /* How the mesh is distributed over the ranks (-partitioner), and the quality of the partition. */
@@ -251,15 +255,19 @@ typedef struct {
 #define CONTACT_CHECK_OVERLAP_RATIO 0.1 /*   and than this part of the overlapped part's width is warned of */
 #define CONTACT_CHECK_ZONE_CELLS_2D 4.0 /* a contact zone spanning fewer cells is warned of (bench/zone_resolution.md) */
 #define CONTACT_CHECK_ZONE_CELLS_3D 6.0 /*   in 3D (bench/zone_resolution_3d.md) */
+#define MESH_CURVED_RIDGES_MIN 3        /* a mesh file's boundary turning by a small angle at this many ridges is curved (MeshCountCurvedRidges()) */
 typedef struct {
   PetscBool geometry_checked, resolution_checked;
-  PetscReal overlap_cells;    /* largest initial overlap -g/h at Gamma_C's vertices, h the diameter of the face's cell */
-  PetscReal overlap_fraction; /* part of Gamma_C's area whose faces start inside the obstacle (g < 0 at the centroid) */
-  PetscReal overlap_ratio;    /* largest initial overlap -g over the width of that part: its length in 2D, 2 sqrt(area / pi) in 3D */
-  PetscReal away_fraction;    /* part of Gamma_C's area where the obstacle's normal points into the body */
-  PetscInt  zone_faces;       /* faces of Gamma_C whose every node carries contact force */
-  PetscReal zone_cells;       /* cells across the contact zone: zone_faces in 2D, sqrt(2 zone_faces / pi) in 3D */
-  PetscReal zone_limit;       /* fewer cells are warned of: CONTACT_CHECK_ZONE_CELLS_2D or _3D */
+  PetscReal overlap_cells;      /* largest initial overlap -g/h at Gamma_C's vertices, h the diameter of the face's cell */
+  PetscReal overlap_fraction;   /* part of Gamma_C's area whose faces start inside the obstacle (g < 0 at the centroid) */
+  PetscReal overlap_ratio;      /* largest initial overlap -g over the width of that part: its length in 2D, 2 sqrt(area / pi) in 3D */
+  PetscReal away_fraction;      /* part of Gamma_C's area where the obstacle's normal points into the body */
+  PetscInt  zone_faces;         /* faces of Gamma_C whose every node carries contact force */
+  PetscReal zone_cells;         /* cells across the contact zone: zone_faces in 2D, sqrt(2 zone_faces / pi) in 3D */
+  PetscReal zone_limit;         /* fewer cells are warned of: CONTACT_CHECK_ZONE_CELLS_2D or _3D */
+  PetscInt  curved_refined;     /* a mesh file's curved boundary (MeshBox.curved_ridges) that the solver refined on its chords: its ridges, */
+  PetscInt  curved_refinements; /*   the refinements (-dm_refine and -contact_grid_sequence), */
+  PetscReal curved_x[3];        /*   and one of the ridges */
 } ContactChecks;
 
 /* The quantities users read of a solution (PostprocessContact()), whose error bars -bars estimates (src/estimate/bars.c). */

@@ -417,6 +417,8 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
       PetscCall(WriteRealAttr(v, "initial_overlap_ratio", s->checks.overlap_ratio));
       PetscCall(WriteRealAttr(v, "obstacle_away_fraction", s->checks.away_fraction));
     }
+    if (user->box.from_file) PetscCall(WriteIntAttr(v, "curved_boundary_ridges", user->box.curved_ridges)); /* MeshCountCurvedRidges() */
+    PetscCall(WriteIntAttr(v, "curved_boundary_refined", s->checks.curved_refined ? 1 : 0)); /* and the solver refined them: a warning */
     if (s->checks.resolution_checked) {
       PetscCall(WriteIntAttr(v, "contact_zone_faces", s->checks.zone_faces));
       PetscCall(WriteRealAttr(v, "contact_zone_cells", s->checks.zone_cells));

@@ -59,7 +59,8 @@ static PetscErrorCode MeshReadFile(MPI_Comm comm, const char filename[], DM *dm)
 PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const PetscInt coarse_requests[2], const PetscInt coarse_faces[3],
                           PetscInt coarse_min_levels, MeshBox *box, DM *dm)
 {
-  PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine;
+  PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine, curved_ridges = 0;
+  PetscReal           curved_x[3] = {0, 0, 0};
   PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
   PetscBool           simplex, has_file, dim_set, nests, parallel_read = PETSC_FALSE, petsc_interpolate, check_interpolation, check_closures;
   char                filename[PETSC_MAX_PATH_LEN] = "";
@@ -194,7 +195,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
                "names of more than 240; use a shorter (for example relative) path",
                filename, (int)strlen(filename));
     PetscCall(MeshReadFile(comm, filename, dm));
-    PetscCall(MeshCheckFile(*dm, filename)); /* one cell type, first order, no cell twice: before anything is assembled */
+    PetscCall(MeshCheckFile(*dm, filename));                         /* one cell type, first order, no cell twice: before anything is assembled */
+    PetscCall(MeshCountCurvedRidges(*dm, &curved_ridges, curved_x)); /* the file's own boundary, before any refinement */
     {
       PetscBool gmsh;
 
@@ -230,6 +232,10 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
     box->slab_rows     = slab_rows;
     box->coarse_levels = coarse;
     box->dim           = dim;
+    box->from_file     = has_file;
+    box->refine        = refine;
+    box->curved_ridges = curved_ridges;
+    for (PetscInt d = 0; d < 3; ++d) box->curved_x[d] = curved_x[d];
     for (PetscInt d = 0; d < dim; ++d) {
       box->faces[d] = faces[d];
       box->lower[d] = lower[d];

@@ -42,6 +42,15 @@ PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
   PetscReal      sums[3] = {0.0, 0.0, 0.0}, overlap[2] = {0.0, 0.0}; /* area, area facing away, area overlapping; -g/h and -g */
 
   PetscFunctionBeginUser;
+  { /* a mesh file's curved boundary refined by the solver on its chords (-adapt_cycles refuses it: AdaptCheck()) */
+    const PetscInt refinements = user->box.refine + user->opt->solver.grid_sequence;
+
+    if (user->box.from_file && refinements > 0 && user->box.curved_ridges >= MESH_CURVED_RIDGES_MIN) {
+      ck->curved_refined     = user->box.curved_ridges;
+      ck->curved_refinements = refinements;
+      for (PetscInt d = 0; d < 3; ++d) ck->curved_x[d] = user->box.curved_x[d];
+    }
+  }
   if (ContactIsNone(user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
@@ -200,6 +209,17 @@ PetscErrorCode ContactChecksWarnings(MPI_Comm comm, const ContactChecks *ck, Pet
                             " faces), fewer than %.0f: the force and the penetration are a discretization artefact there; refine near the "
                             "contact\n",
                             (double)ck->zone_cells, ck->zone_faces, (double)ck->zone_limit));
+  }
+  if (ck->curved_refined) {
+    ++n;
+    if (print)
+      PetscCall(PetscPrintf(comm,
+                            "  WARNING: the mesh file's boundary turns by less than 20 degrees at %" PetscInt_FMT
+                            " of its vertices or edges (one near (%g, %g, %g)): a curved boundary's chords, which the solver's %" PetscInt_FMT
+                            " refinement(s) (-dm_refine, -contact_grid_sequence) split on the chords, so that the answer is the file's polygon's, "
+                            "not the curved body's (the Hertz cylinder meshed at h = 0.05 and refined 3 times: its contact width 25%% short); "
+                            "mesh finer with Gmsh instead\n",
+                            ck->curved_refined, (double)ck->curved_x[0], (double)ck->curved_x[1], (double)ck->curved_x[2], ck->curved_refinements));
   }
   if (nwarnings) *nwarnings = n;
   PetscFunctionReturn(PETSC_SUCCESS);
