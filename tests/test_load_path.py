@@ -116,11 +116,15 @@ def test_snesvi_path_follows_the_gap(outdir, np_):
     _, h5 = run(base + data(1.0) + ["-load_path", "0.3,1.5,1"], "vi_path", np_=np_, output=os.path.join(outdir, "vi_path.h5"))
     st = steps(h5)
     assert list(st["factor"]) == [0.3, 1.5, 1.0] and st["converged"].all()
-    assert st["contact_force"][0] > 0  # in contact from the first step
+    # in contact at the overshoot and at the end; at 0.3 the block does not reach the foundation (the force is round-off,
+    # 1e-18, whose last bits MUMPS's parallel factorization changes from run to run): the forces are compared relative
+    # to the path's largest
+    scale = st["contact_force"].max()
+    assert st["contact_force"][1] > 0 and st["contact_force"][2] > 0, st["contact_force"]
     for k, t in enumerate(st["factor"]):
         _, d = run(base + data(t), f"vi_direct_{k}", np_=np_, output=os.path.join(outdir, f"vi_direct_{k}.h5"))
         attrs, fields = load(d)
-        assert abs(st["contact_force"][k] - attrs["contact_force"]) <= 1e-10 * attrs["contact_force"], (k, st["contact_force"][k], attrs["contact_force"])
+        assert abs(st["contact_force"][k] - attrs["contact_force"]) <= 1e-10 * scale, (k, st["contact_force"][k], attrs["contact_force"])
     last = load(h5)[1]["displacement"]
     assert np.max(np.abs(last - fields["displacement"])) <= 1e-10 * np.max(np.abs(fields["displacement"]))
 

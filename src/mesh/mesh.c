@@ -195,8 +195,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
                "names of more than 240; use a shorter (for example relative) path",
                filename, (int)strlen(filename));
     PetscCall(MeshReadFile(comm, filename, dm));
-    PetscCall(MeshCheckFile(*dm, filename));                         /* one cell type, first order, no cell twice: before anything is assembled */
-    PetscCall(MeshCountCurvedRidges(*dm, &curved_ridges, curved_x)); /* the file's own boundary, before any refinement */
+    PetscCall(MeshCheckFile(*dm, filename)); /* one cell type, first order, no cell twice: before anything is assembled */
     {
       PetscBool gmsh;
 
@@ -221,6 +220,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
         *dm = dist;
       }
     }
+    PetscCall(
+        MeshCountCurvedRidges(*dm, &curved_ridges, curved_x)); /* the file's own boundary before any refinement (a parallel read: once consistent) */
   } else if (simplex)
     PetscCall(MeshCreateSimplexBox(comm, dim, faces, lower, upper, (PetscBool)(partitioner == MESH_PARTITIONER_BOX), slab_rows, petsc_interpolate,
                                    check_interpolation, dm));
