@@ -23,7 +23,7 @@ SRC = $(wildcard src/*.c src/*/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path penetration-tol estimates bench format clean
+.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path penetration-tol estimates adapt-hertz bench format clean
 STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
@@ -120,6 +120,12 @@ penetration-tol: deps
 estimates: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/estimates.py --check
+
+# Adaptive refinement (docs/estimate.md, "Adaptive refinement"): the 2D cylinder indenter from a uniform mesh, a and p0
+# against the closed form after 0 to 10 cycles: output/adapt_hertz/adapt_hertz.{md,csv}
+adapt-hertz: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) scripts/adapt_hertz.py
 
 # Performance (docs/solvers.md, "Performance"): bench/{bench,getfem,fenicsx,profile3d,bandwidth,targets}.{md,csv}, runs under bench/runs/
 bench: deps
