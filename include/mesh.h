@@ -20,8 +20,10 @@ PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id);
 PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count);
 PetscErrorCode MeshOwnedIndex(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt **index, PetscInt *nowned);
 PetscErrorCode MeshGetBoundaryFaces(DM dm, PetscInt id, PetscInt *n, PetscInt **faces);
-PetscErrorCode MeshPointPosition(DM dm, PetscInt p, PetscReal x[]);
 PetscErrorCode MeshPointGlobalIndices(PetscSection lsec, PetscSection gsec, PetscInt p, PetscInt dim, PetscInt idx[]);
+
+/* mesh_point.c */
+PetscErrorCode MeshPointPosition(DM dm, PetscInt p, PetscReal x[]);
 
 /* mesh_interpolate.c */
 /* The local vertices' global numbers, which are shared with other ranks, and whether a face (its vertices' global

@@ -180,32 +180,6 @@ PetscErrorCode MeshCountInteriorFaces(DM dm, PetscInt n, const PetscInt faces[],
    ridges where the outward normals of the two boundary faces turn by more than MESH_FLAT_ANGLE and at most
    MESH_CURVED_ANGLE (a polygon's corners turn by more; the straight pieces by nothing), over all ranks; x, where count
    > 0: one of them. A ridge whose two faces lie on different ranks is not seen (the count is a lower bound). */
-/* The coordinates of point p of dm: a vertex's, or the centroid of an edge, face or cell (MeshPointPosition()'s, which
-   mesh.c holds and which calls this file's checks). */
-static PetscErrorCode PointPosition(DM dm, PetscInt p, PetscReal x[])
-{
-  PetscInt depth, cdim;
-
-  PetscFunctionBeginUser;
-  PetscCall(DMGetCoordinateDim(dm, &cdim));
-  PetscCall(DMPlexGetPointDepth(dm, p, &depth));
-  if (depth == 0) {
-    PetscSection       cs;
-    Vec                coords;
-    PetscInt           off;
-    const PetscScalar *a;
-
-    PetscCall(DMGetCoordinateSection(dm, &cs));
-    PetscCall(DMGetCoordinatesLocal(dm, &coords));
-    PetscCall(PetscSectionGetOffset(cs, p, &off));
-    PetscCall(VecGetArrayRead(coords, &a));
-    for (PetscInt d = 0; d < cdim; ++d) x[d] = PetscRealPart(a[off + d]);
-    PetscCall(VecRestoreArrayRead(coords, &a));
-  } else
-    PetscCall(DMPlexComputeCellGeometryFVM(dm, p, NULL, x, NULL));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 #define MESH_FLAT_ANGLE 1e-6                        /* radians: straight */
 #define MESH_CURVED_ANGLE (20.0 * PETSC_PI / 180.0) /* a chord of a circle of radius R spans h/R, up to 20 degrees */
 PetscErrorCode MeshCountCurvedRidges(DM dm, PetscInt *count, PetscReal x[3])
@@ -239,7 +213,7 @@ PetscErrorCode MeshCountCurvedRidges(DM dm, PetscInt *count, PetscReal x[3])
         PetscInt depth;
 
         PetscCall(DMPlexGetPointDepth(dm, closure[2 * j], &depth));
-        if (depth == 0) PetscCall(PointPosition(dm, closure[2 * j], v[nv++]));
+        if (depth == 0) PetscCall(MeshPointPosition(dm, closure[2 * j], v[nv++]));
       }
       PetscCall(DMPlexRestoreTransitiveClosure(dm, f, PETSC_TRUE, &ncl, &closure));
       if (dim == 2) {
@@ -285,7 +259,7 @@ PetscErrorCode MeshCountCurvedRidges(DM dm, PetscInt *count, PetscReal x[3])
     angle = PetscAcosReal(PetscMin(1.0, PetscMax(-1.0, dot)));
     if (angle > MESH_FLAT_ANGLE && angle <= MESH_CURVED_ANGLE) {
       if (!local) {
-        PetscCall(PointPosition(dm, rStart + r, where)); /* a vertex in 2D; an edge's centroid in 3D */
+        PetscCall(MeshPointPosition(dm, rStart + r, where)); /* a vertex in 2D; an edge's centroid in 3D */
         where[3] = 1.0;
       }
       ++local;
