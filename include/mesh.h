@@ -72,7 +72,7 @@ PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[]);
 PetscErrorCode MeshCellVertices(DM dm, PetscInt c, PetscInt verts[], PetscInt *nv);
 PetscErrorCode MeshCellReferenceCoordinates(DM dm, PetscInt c, PetscInt n, const PetscReal x[], PetscReal xi[]);
 PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **parent, PetscInt **vertex_source);
-PetscErrorCode MeshRefineMarked(DM dm, DMLabel marked, DM *fine, PetscInt **parent);
+PetscErrorCode MeshRefineMarked(DM dm, DMLabel marked, DM *fine, PetscInt **vertex_source);
 PetscErrorCode MeshDescendantSizes(DM dm, PetscInt levels, PetscReal power, PetscReal **sizes, PetscReal *hmax);
 PetscErrorCode MeshSourceVertices(DM dm, const PetscInt vb[2], const PetscInt eb[2], PetscInt src, PetscInt verts[], PetscInt *nv);
 PetscErrorCode MeshInterpolateVertexSources(DM dm, DM fine, const PetscInt vertex_source[], Vec loc, Vec *fine_loc);

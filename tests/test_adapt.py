@@ -30,6 +30,10 @@ def test_adaptive_cycles_beat_uniform_refinement_on_the_manufactured_solution():
     assert np.all(np.diff(c["error_energy"]) < 0) and np.all(np.diff(c["estimate"]) < 0), (c["error_energy"], c["estimate"])
     assert np.all(c["estimate"] > c["error_energy"]), (c["estimate"], c["error_energy"])
     assert np.all(c["marked"][:-1] > 0) and np.all(np.diff(c["n_dofs"]) > 0), (c["marked"], c["n_dofs"])
+    # the last solution carried to the refined mesh is exact (nested P1): each cycle's Newton starts at its answer but
+    # for the new cells' share (1 step each here; with the parents of PETSc 3.18's refine_sbr, wrong for some cells,
+    # the later cycles took 4 and 3)
+    assert np.all(c["newton_its"][1:] <= 2), c["newton_its"]
     a, _ = load(h5)
     assert abs(a["error_energy"] - c["error_energy"][-1]) <= 1e-12 * a["error_energy"], (a["error_energy"], c["error_energy"][-1])
     adaptive = c["error_energy"][-1] * np.sqrt(c["n_dofs"][-1])
@@ -41,17 +45,21 @@ def test_adaptive_cycles_beat_uniform_refinement_on_the_manufactured_solution():
     assert adaptive <= 0.95 * min(uniform), (adaptive, uniform)
 
 
-def test_adaptive_cycles_on_two_ranks_equal_one_rank():
+@pytest.mark.parametrize("scene", ["mms", "square_gamg"])
+def test_adaptive_cycles_on_two_ranks_equal_one_rank(scene):
     """The marking is a threshold found by reductions, and PETSc's refinement splits the edges the ranks share alike:
-    2 ranks refine the same cells and give the same answer."""
-    args = MMS + ["-dm_plex_box_faces", "16,16", "-adapt_cycles", 3]
-    _, one = run(args, "adapt_np1")
-    _, two = run(args, "adapt_np2", np_=2)
+    2 ranks refine the same cells and give the same answer (the square with GAMG on 2 ranks crashed in PETSc's
+    DMPlexTransformGetSourcePoint() before the refined vertices were matched to their sources by position)."""
+    base = MMS if scene == "mms" else SQUARE + ["-options_file", "options/solvers/gamg.yaml"]
+    args = base + ["-dm_plex_box_faces", "16,16", "-adapt_cycles", 3]
+    _, one = run(args, f"adapt_{scene}_np1")
+    _, two = run(args, f"adapt_{scene}_np2", np_=2)
     c1, c2 = cycles(one), cycles(two)
     for k in ("n_dofs", "n_cells", "marked"):
         assert np.array_equal(c1[k], c2[k]), (k, c1[k], c2[k])
-    for k in ("estimate", "error_energy"):
-        np.testing.assert_allclose(c2[k], c1[k], rtol=1e-8)
+    np.testing.assert_allclose(c2["estimate"], c1["estimate"], rtol=1e-8)
+    if scene == "mms":
+        np.testing.assert_allclose(c2["error_energy"], c1["error_energy"], rtol=1e-8)
     _, f1 = load(one)
     _, f2 = load(two)
     u1, u2 = sorted_by_position(f1, "displacement"), sorted_by_position(f2, "displacement")

@@ -1,5 +1,6 @@
 /* Uniform refinement with the parent of every fine cell, and the interpolation of FE functions from the coarse mesh
    to the fine one: used by the grid sequencing (grid_sequence.c) and by -reference (reference.c). */
+#include <stdlib.h>
 #include <petscdmplextransform.h>
 #include "mesh.h"
 
@@ -137,16 +138,82 @@ PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **pa
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* A point of the coarse mesh and its position, sorted by position (VertexSourcesByPosition()). */
+typedef struct {
+  PetscReal x[2];
+  PetscInt  point;
+} PositionKey;
+
+static int ComparePositions(const void *a, const void *b)
+{
+  const PositionKey *p = (const PositionKey *)a, *q = (const PositionKey *)b;
+
+  for (PetscInt d = 0; d < 2; ++d)
+    if (p->x[d] != q->x[d]) return p->x[d] < q->x[d] ? -1 : 1;
+  return 0;
+}
+
+/* vertex_source for a 2D fine mesh nested in dm whose new vertices are midpoints of dm's edges: each fine vertex is
+   matched by its position (exactly: both are computed as the mean of the same two coordinates) to a vertex of dm or
+   to the midpoint of an edge of dm, among the points of this rank (its ghosts included). */
+static PetscErrorCode VertexSourcesByPosition(DM dm, DM fine, PetscInt **vertex_source)
+{
+  PetscInt     vStart, vEnd, eStart, eEnd, fvStart, fvEnd, n = 0;
+  PositionKey *keys;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 1, &eStart, &eEnd));
+  PetscCall(PetscMalloc1(vEnd - vStart + eEnd - eStart, &keys));
+  for (PetscInt v = vStart; v < vEnd; ++v, ++n) {
+    PetscReal x[3];
+
+    PetscCall(MeshPointPosition(dm, v, x));
+    keys[n].x[0]  = x[0];
+    keys[n].x[1]  = x[1];
+    keys[n].point = v;
+  }
+  for (PetscInt e = eStart; e < eEnd; ++e, ++n) {
+    const PetscInt *cone;
+    PetscReal       a[3], b[3];
+
+    PetscCall(DMPlexGetCone(dm, e, &cone));
+    PetscCall(MeshPointPosition(dm, cone[0], a));
+    PetscCall(MeshPointPosition(dm, cone[1], b));
+    keys[n].x[0]  = 0.5 * (a[0] + b[0]);
+    keys[n].x[1]  = 0.5 * (a[1] + b[1]);
+    keys[n].point = e;
+  }
+  qsort(keys, (size_t)n, sizeof(*keys), ComparePositions);
+  PetscCall(DMPlexGetDepthStratum(fine, 0, &fvStart, &fvEnd));
+  PetscCall(PetscMalloc1(fvEnd - fvStart, vertex_source));
+  for (PetscInt v = fvStart; v < fvEnd; ++v) {
+    PositionKey key, *hit;
+    PetscReal   x[3];
+
+    PetscCall(MeshPointPosition(fine, v, x));
+    key.x[0] = x[0];
+    key.x[1] = x[1];
+    hit      = (PositionKey *)bsearch(&key, keys, (size_t)n, sizeof(*keys), ComparePositions);
+    PetscCheck(hit, PETSC_COMM_SELF, PETSC_ERR_PLIB,
+               "the refined mesh's vertex at (%g, %g) is neither a vertex nor an edge midpoint of the mesh it refines", (double)x[0], (double)x[1]);
+    (*vertex_source)[v - fvStart] = hit->point;
+  }
+  PetscCall(PetscFree(keys));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Refines the triangles of dm that `marked` holds with the value DM_ADAPT_REFINE, and those more that keep the mesh
    conforming: PETSc's skeleton-based refinement (refine_sbr; Plaza and Carey, Appl. Numer. Math. 32, 2000) splits the
    marked cells' edges at their midpoints, and every cell with a split edge into two to four triangles, so that the new
    mesh is nested in dm and P1 functions of dm are P1 functions of it. Labels (face sets, Gmsh names) are kept.
-   parent[c - cStart] is the cell of dm that holds fine cell c (PETSc 3.18 finds no source for the new vertices of this
-   transform: DMPlexTransformGetSourcePoint() fails on them, "Replica number ... could be not found"). */
-PetscErrorCode MeshRefineMarked(DM dm, DMLabel marked, DM *fine, PetscInt **parent)
+   As MeshRefineRegular()'s, vertex_source[v - vStart] is the point of dm (a vertex, or the edge it halves) whose centre
+   the new vertex v is; it is found by position, since PETSc 3.18's DMPlexTransformGetSourcePoint() fails on this
+   transform's new points ("Replica number ... could be not found" for its vertices, "Source point ... is not a
+   triangle" for some cells on 2 ranks). */
+PetscErrorCode MeshRefineMarked(DM dm, DMLabel marked, DM *fine, PetscInt **vertex_source)
 {
   DMPlexTransform tr;
-  PetscInt        cStart, cEnd;
   MatType         mtype;
 
   PetscFunctionBeginUser;
@@ -156,15 +223,8 @@ PetscErrorCode MeshRefineMarked(DM dm, DMLabel marked, DM *fine, PetscInt **pare
   PetscCall(DMPlexTransformSetActive(tr, marked));
   PetscCall(DMPlexTransformSetUp(tr));
   PetscCall(DMPlexTransformApply(tr, dm, fine));
-  PetscCall(DMPlexGetHeightStratum(*fine, 0, &cStart, &cEnd));
-  PetscCall(PetscMalloc1(cEnd - cStart, parent));
-  for (PetscInt c = cStart; c < cEnd; ++c) {
-    DMPolytopeType ct, ctn;
-    PetscInt       r;
-
-    PetscCall(DMPlexTransformGetSourcePoint(tr, c, &ct, &ctn, &(*parent)[c - cStart], &r));
-  }
   PetscCall(DMPlexTransformDestroy(&tr));
+  PetscCall(VertexSourcesByPosition(dm, *fine, vertex_source));
   PetscCall(DMGetMatType(dm, &mtype));
   PetscCall(DMSetMatType(*fine, mtype));
   PetscCall(PetscObjectSetName((PetscObject)*fine, "mesh"));

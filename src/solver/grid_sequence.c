@@ -26,9 +26,10 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   PetscCall(DMGlobalToLocal(*dm, *u, INSERT_VALUES, loc));
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
-  if (marked) /* the cells' parents: no vertex sources from PETSc for this refinement */
-    PetscCall(MeshRefineMarked(*dm, marked, &fine, &parent));
-  else if (user->box.is_box && user->opt->degree == 1) { /* the box of twice as many cells, built directly */
+  if (marked) {
+    parent = NULL;
+    PetscCall(MeshRefineMarked(*dm, marked, &fine, &vertex_source));
+  } else if (user->box.is_box && user->opt->degree == 1) { /* the box of twice as many cells, built directly */
     parent = NULL;
     PetscCall(MeshCreateBoxLevel(*dm, &user->box, user->prob.level, &fine, &vertex_source));
   } else
@@ -36,8 +37,8 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   user->prob.level++;
   PetscCall(GridSequenceBarsSizes(fine, user)); /* -bars on tetrahedra: the final mesh's eps on this level */
   PetscCall(ProblemSetUp(fine, user, snes));
-  if (vertex_source) PetscCall(MultigridAddLevel(*snes, *dm, fine, vertex_source, user)); /* with -pc_type mg */
-  if (user->opt->degree == 1 && vertex_source)
+  PetscCall(MultigridAddLevel(*snes, *dm, fine, vertex_source, user)); /* with -pc_type mg */
+  if (user->opt->degree == 1)
     PetscCall(MeshInterpolateVertexSources(*dm, fine, vertex_source, loc, &fine_loc)); /* exact and fast */
   else
     PetscCall(MeshInterpolateFromParents(*dm, fine, parent, 1, &loc, &fine_loc));
