@@ -24,6 +24,7 @@ PetscErrorCode MeshPointGlobalIndices(PetscSection lsec, PetscSection gsec, Pets
 
 /* mesh_point.c */
 PetscErrorCode MeshPointPosition(DM dm, PetscInt p, PetscReal x[]);
+PetscErrorCode MeshFaceOutwardGeometry(DM dm, PetscInt f, PetscInt dim, PetscReal n[], PetscReal xc[], PetscReal *area);
 
 /* mesh_interpolate.c */
 /* The local vertices' global numbers, which are shared with other ranks, and whether a face (its vertices' global

@@ -219,7 +219,8 @@ typedef struct {
   PetscReal  time;
 } ErrorEstimate;
 
-/* The simplex box of the options, when the mesh is one (MeshCreate()): the grid sequence builds its finer levels directly. */
+/* The mesh of the options as MeshCreate() made it: the simplex box, when it is one (the grid sequence builds its finer
+   levels directly), or a file and what its boundary is. */
 typedef struct {
   PetscBool is_box;        /* a simplex box (2D or 3D) not refined by -dm_refine, on one rank or in slabs of rows that nest */
   PetscInt  dim, faces[3]; /* faces: of the mesh built first, the coarsest box when coarse_levels > 0 */

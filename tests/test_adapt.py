@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from harness import load, run, sorted_by_position
+from signorini import hertz
 
 MMS = ["-options_file", "options/mms.yaml", "-contact_monitor", "0"]
 SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "0"]
@@ -113,23 +114,15 @@ def test_adaptive_cycles_refuse_what_they_cannot_do(case):
     assert not os.path.exists(h5)
 
 
-def hertz_case():
-    import sys
-    sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "scripts"))
-    from signorini import hertz
-    return hertz
-
-
 @pytest.fixture(scope="module")
 def coarse_disk(tmp_path_factory):
     """The Hertz cylinder's quarter disk meshed at h = 0.05 throughout (make hertz's geometry, scripts/signorini/geometry.py)."""
     path = str(tmp_path_factory.mktemp("curved") / "disk_h005.msh")
-    hertz_case().write_mesh("cylinder", 0.05, path, h_far=0.05, near=0.06)
+    hertz.write_mesh("cylinder", 0.05, path, h_far=0.05, near=0.06)
     return path
 
 
 def hertz_args(mesh):
-    hertz = hertz_case()
     return hertz.command("cylinder", mesh, "eps=h/10", "unused.h5")[4:-2]  # the options, without mpiexec, the binary and -output
 
 
@@ -139,7 +132,6 @@ def test_refining_a_curved_mesh_file_is_warned_of_and_adaptivity_refuses_it(coar
     than 10% off the closed form (25% after 3 refinements; make hertz's meshes are within 0.5%): the run says so
     (MeshCountCurvedRidges(): the arc turns by h/R at each of its 31 vertices), and -adapt_cycles refuses it. Without
     refinement, and on a polygonal mesh file refined, no warning."""
-    hertz = hertz_case()
     out, h5 = run(hertz_args(coarse_disk) + ["-dm_refine", 2], "curved_refined")
     a, _ = load(h5)
     assert a["curved_boundary_refined"] == 1 and a["curved_boundary_ridges"] >= 20 and a["warnings"] >= 1, a["curved_boundary_ridges"]

@@ -198,48 +198,14 @@ PetscErrorCode MeshCountCurvedRidges(DM dm, PetscInt *count, PetscReal x[3])
   PetscCall(DMPlexMarkBoundaryFaces(dm, 1, bnd));
   PetscCall(PetscCalloc2(rEnd - rStart, &nface, 6 * (rEnd - rStart), &normal));
   for (PetscInt f = fStart; f < fEnd; ++f) {
-    const PetscInt *cone, *support;
-    PetscInt        val, nc, ns;
-    PetscReal       n[3] = {0, 0, 0}, xf[3] = {0, 0, 0}, xc[3] = {0, 0, 0}, nn = 0.0, out = 0.0;
+    const PetscInt *cone;
+    PetscInt        val, nc;
+    PetscReal       n[3] = {0, 0, 0}, xf[3], area;
 
     PetscCall(DMLabelGetValue(bnd, f, &val));
     if (val != 1) continue;
-    { /* the face's normal from its vertices, and its centroid */
-      PetscInt *closure = NULL, ncl, nv = 0;
-      PetscReal v[4][3];
-
-      PetscCall(DMPlexGetTransitiveClosure(dm, f, PETSC_TRUE, &ncl, &closure));
-      for (PetscInt j = 0; j < ncl && nv < 4; ++j) {
-        PetscInt depth;
-
-        PetscCall(DMPlexGetPointDepth(dm, closure[2 * j], &depth));
-        if (depth == 0) PetscCall(MeshPointPosition(dm, closure[2 * j], v[nv++]));
-      }
-      PetscCall(DMPlexRestoreTransitiveClosure(dm, f, PETSC_TRUE, &ncl, &closure));
-      if (dim == 2) {
-        n[0] = v[1][1] - v[0][1];
-        n[1] = v[0][0] - v[1][0];
-      } else if (nv >= 3) {
-        const PetscReal a[3] = {v[1][0] - v[0][0], v[1][1] - v[0][1], v[1][2] - v[0][2]},
-                        b[3] = {v[2][0] - v[0][0], v[2][1] - v[0][1], v[2][2] - v[0][2]};
-
-        n[0] = a[1] * b[2] - a[2] * b[1];
-        n[1] = a[2] * b[0] - a[0] * b[2];
-        n[2] = a[0] * b[1] - a[1] * b[0];
-      }
-      for (PetscInt k = 0; k < nv; ++k)
-        for (PetscInt d = 0; d < dim; ++d) xf[d] += v[k][d] / nv;
-    }
-    PetscCall(DMPlexGetSupportSize(dm, f, &ns));
-    PetscCall(DMPlexGetSupport(dm, f, &support));
-    if (ns < 1) continue;
-    PetscCall(DMPlexComputeCellGeometryFVM(dm, support[0], NULL, xc, NULL));
-    for (PetscInt d = 0; d < dim; ++d) {
-      nn += n[d] * n[d];
-      out += n[d] * (xf[d] - xc[d]);
-    }
-    if (!(nn > 0.0)) continue;
-    for (PetscInt d = 0; d < dim; ++d) n[d] *= (out < 0.0 ? -1.0 : 1.0) / PetscSqrtReal(nn); /* outward, unit */
+    PetscCall(MeshFaceOutwardGeometry(dm, f, dim, n, xf, &area));
+    if (!(area > 0.0)) continue;
     PetscCall(DMPlexGetConeSize(dm, f, &nc));
     PetscCall(DMPlexGetCone(dm, f, &cone));
     for (PetscInt k = 0; k < nc; ++k) {

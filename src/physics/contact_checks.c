@@ -15,25 +15,6 @@
 #include "obstacle.h"
 #include "physics.h"
 
-/* The outward unit normal, centroid and area of boundary face f (its one cell on the inside). */
-static PetscErrorCode FaceOutwardGeometry(DM dm, PetscInt f, PetscInt dim, PetscReal n[], PetscReal xc[], PetscReal *area)
-{
-  const PetscInt *support;
-  PetscReal       cc[3], vol, dot = 0.0, norm = 0.0;
-
-  PetscFunctionBeginUser;
-  PetscCall(DMPlexComputeCellGeometryFVM(dm, f, area, xc, n));
-  PetscCall(DMPlexGetSupport(dm, f, &support));
-  PetscCall(DMPlexComputeCellGeometryFVM(dm, support[0], &vol, cc, NULL));
-  for (PetscInt d = 0; d < dim; ++d) {
-    dot += n[d] * (xc[d] - cc[d]);
-    norm += n[d] * n[d];
-  }
-  norm = PetscSqrtReal(norm);
-  for (PetscInt d = 0; d < dim; ++d) n[d] = (dot < 0.0 ? -n[d] : n[d]) / (norm > 0.0 ? norm : 1.0);
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
 {
   MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
@@ -63,7 +44,7 @@ PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
       PetscInt       *closure = NULL, ncl;
       PetscReal       n[3] = {0, 0, 0}, xc[3] = {0, 0, 0}, area, nob[3], g, dot = 0.0, diam;
 
-      PetscCall(FaceOutwardGeometry(dm, faces[i], dim, n, xc, &area));
+      PetscCall(MeshFaceOutwardGeometry(dm, faces[i], dim, n, xc, &area));
       ObstacleGapNormalAt(&user->scene.obstacle, dim, xc, nob, &g);
       for (PetscInt d = 0; d < dim; ++d) dot += n[d] * nob[d];
       sums[0] += area;

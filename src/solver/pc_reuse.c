@@ -523,24 +523,20 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
    nodes decides): the 10^3 box's MUMPS factorization takes 28 ms, a CG iteration with it 2 ms, and 40^3 on 2 ranks,
    which nests from 10^3, factored it 4 times in its 4 Newton steps there (2 now, with 9 CG iterations instead of 4).
    In 2D the coarsest box (16^2) factors in about a millisecond, and keeping it cost the 64^2 GAMG run one more Newton
-   step and 14 more CG iterations: 2D factors again as before. */
-static PetscErrorCode OneLevelFactorReuse(KSP ksp, PetscInt dim, PetscBool reuse)
+   step and 14 more CG iterations: 2D factors again as before. *coarse: that coarse KSP in 3D, else NULL. */
+static PetscErrorCode OneLevelMG(KSP ksp, PetscInt dim, KSP *coarse)
 {
   PC        pc;
   PetscBool is_mg;
   PetscInt  nlevels = 0;
 
   PetscFunctionBeginUser;
+  *coarse = NULL;
   if (dim != 3) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
   if (is_mg) PetscCall(PCMGGetLevels(pc, &nlevels));
-  if (nlevels == 1) {
-    KSP coarse;
-
-    PetscCall(PCMGGetCoarseSolve(pc, &coarse));
-    PetscCall(KSPSetReusePreconditioner(coarse, reuse));
-  }
+  if (nlevels == 1) PetscCall(PCMGGetCoarseSolve(pc, coarse));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -549,7 +545,7 @@ static PetscErrorCode OneLevelFactorReuse(KSP ksp, PetscInt dim, PetscBool reuse
 PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
 {
   PcReuse           *r = &sc->pc_reuse;
-  KSP                ksp;
+  KSP                ksp, one_level;
   PetscInt           dim, changes = 0, its = 0;
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
   PetscBool          rebuild;
@@ -560,6 +556,7 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
   if (!r->enabled) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(SNESGetKSP(snes, &ksp));
+  PetscCall(OneLevelMG(ksp, dim, &one_level));
   r->update = PETSC_FALSE;
   if (r->built) {
     PC       pc;
@@ -590,16 +587,11 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
        the Jacobian of its build: each changed node costs CG about dim iterations. */
     PetscCall(KSPGetPC(ksp, &pc));
     PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &geometric));
-    if (geometric && dim == 3) { /* with one level its coarse solve factors the Jacobian itself (OneLevelFactorReuse()) */
-      PetscInt nlevels;
-
-      PetscCall(PCMGGetLevels(pc, &nlevels));
-      geometric = (PetscBool)(nlevels > 1);
-    }
+    geometric = (PetscBool)(geometric && !one_level); /* with one level its coarse solve factors the Jacobian itself (OneLevelMG()) */
     /* rebuild after a failed solve, or when the last solve needed twice the iterations of the first after the build */
     rebuild = (PetscBool)((!geometric && changes > sc->opt->pc_reuse_changes) || reason < 0 || LinearSolveGrew(its, r->its_after_build));
   }
-  PetscCall(OneLevelFactorReuse(ksp, dim, (PetscBool)!rebuild));
+  if (one_level) PetscCall(KSPSetReusePreconditioner(one_level, (PetscBool)!rebuild));
   if (rebuild) {
     PetscCall(CountChanges(sc, dim, x, PETSC_TRUE, &changes));
     r->built           = PETSC_TRUE;
