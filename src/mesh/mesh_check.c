@@ -192,6 +192,12 @@ PetscErrorCode MeshCountCurvedRidges(DM dm, PetscInt *count, PetscReal x[3])
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
+  {
+    Vec coords;
+
+    PetscCall(DMGetCoordinatesLocal(
+        dm, &coords)); /* collective: makes the local coordinates the face geometry reads (a mesh read from HDF5 has none yet) */
+  }
   PetscCall(DMPlexGetHeightStratum(dm, 1, &fStart, &fEnd)); /* faces */
   PetscCall(DMPlexGetHeightStratum(dm, 2, &rStart, &rEnd)); /* ridges: vertices in 2D, edges in 3D */
   PetscCall(DMLabelCreate(PETSC_COMM_SELF, "curved_check_boundary", &bnd));
