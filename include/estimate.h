@@ -13,6 +13,9 @@ PetscErrorCode EstimateView(MPI_Comm comm, const ErrorEstimate *est, const Error
 
 /* marking.c: the cells an adaptive refinement refines (Doerfler's bulk criterion) */
 PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DMLabel *marked, PetscInt *nmarked);
+/* cycle_bars.c: the bars of -accuracy's quantities on the adaptive cycles */
+PetscErrorCode CycleBarsCompute(AppCtx *user, PetscInt dim, PetscInt last);
+PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nunseen);
 
 /* bars.c: -bars, the error bars of the quantities users read */
 PetscErrorCode BarsCheck(MPI_Comm comm, const AppCtx *user);

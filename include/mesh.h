@@ -16,6 +16,7 @@ PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam);
 PetscErrorCode MeshCellSize(DM dm, PetscInt c, PetscReal *h);
 PetscErrorCode MeshGetMaxCellSize(DM dm, PetscReal diameter_max, PetscReal *h);
 PetscErrorCode MeshSetCellSizes(DM dm, PetscReal hmax, PetscReal *sizes);
+PetscErrorCode MeshSetContactCellSizes(DM dm, PetscInt nids, const PetscInt ids[]);
 PetscErrorCode MeshCheckContactBoundary(DM dm, PetscInt contact_id);
 PetscErrorCode MeshCountOwned(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt *count);
 PetscErrorCode MeshOwnedIndex(DM dm, PetscInt pStart, PetscInt pEnd, PetscInt **index, PetscInt *nowned);

@@ -213,6 +213,7 @@ typedef struct {
   PetscBool  computed;
   char       unavailable[160]; /* why there is no estimate ("" if computed or not asked for) */
   PetscReal  total, part[ESTIMATE_NUM_PARTS];
+  PetscReal  norm;    /* the energy norm of u_h, a(u_h, u_h)^1/2, the scale of the relative estimate total / norm */
   PetscInt   ncells;  /* the local cells, */
   PetscReal *cell;    /*   the indicator eta_T of each: the square root of the sum of its parts' squares */
   PetscReal *density; /*   and eta_T / |T|^1/2, the error's level per unit volume, comparable across cells of any size */
@@ -356,20 +357,31 @@ typedef struct {
 
 /* Adaptive refinement (-adapt_cycles, src/solver/adapt.c): the cycles of estimate, mark, refine and solve after the
    first solve, and the fraction of the estimate's square the marked cells hold (Doerfler's theta). */
+typedef enum { ACCURACY_ENERGY, ACCURACY_FORCE, ACCURACY_PRESSURE, ACCURACY_SIZE, ACCURACY_NUM } AccuracyQuantity;
+extern const char *const AccuracyQuantities[];
 typedef struct {
-  PetscInt  cycles;   /* 0: no adaptive refinement */
-  PetscReal fraction; /* -adapt_fraction */
+  PetscInt  cycles;               /* 0: no adaptive refinement; with -accuracy, the most cycles */
+  PetscReal fraction;             /* -adapt_fraction */
+  PetscReal accuracy;             /* -accuracy: the relative error asked for (0: none), */
+  PetscBool target[ACCURACY_NUM]; /*   of these quantities (-accuracy_quantity) */
 } AdaptOptions;
 
 /* One cycle of the adaptive refinement (/cycles in the output): the mesh, the estimate of its solution and the true
    energy-norm error where the scene knows the exact solution (NaN otherwise), the cells marked for the next cycle, and
    the solve on it. */
 typedef struct {
-  PetscInt  n_dofs, n_cells, marked;
-  PetscReal estimate, error_energy;
-  PetscInt  newton_its, ksp_its;
-  PetscReal time_solve;
-  PetscBool converged;
+  PetscInt   n_dofs, n_cells, marked;
+  PetscReal  estimate, estimate_penalty; /* the estimate and its penalty part, */
+  PetscReal  norm;                       /*   and the energy norm of the solution, its scale */
+  PetscReal  error_energy;
+  Quantities q;                   /* the quantities users read on the cycle's mesh */
+  PetscReal  value[ACCURACY_NUM]; /* -accuracy's quantities (the energy: the solution's energy norm; the force: its magnitude) */
+  PetscReal  bar[ACCURACY_NUM];   /*   and their error bars (the energy: the estimate), NaN where there is none */
+  PetscInt   unseen;              /* contact nodes the rule does not see (EstimateMarkUnseenContact()) */
+  PetscBool  accurate;            /* every quantity asked for within -accuracy */
+  PetscInt   newton_its, ksp_its;
+  PetscReal  time_solve;
+  PetscBool  converged;
 } CycleRecord;
 
 /* One step of a load path (/steps in the output): its factor, the obstacle's translation, the quantities, the solve. */

@@ -75,6 +75,7 @@ PetscErrorCode EstimateReset(ErrorEstimate *est)
   est->computed       = PETSC_FALSE;
   est->unavailable[0] = '\0';
   est->total          = PETSC_NAN;
+  est->norm           = PETSC_NAN;
   for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k) est->part[k] = PETSC_NAN;
   est->ncells = 0;
   est->time   = 0.0;
@@ -213,7 +214,9 @@ PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
     est->part[k] = PetscSqrtReal(gsums[k]);
     total += gsums[k];
   }
-  est->total    = PetscSqrtReal(total);
+  est->total = PetscSqrtReal(total);
+  PetscCall(MPIU_Allreduce(&w.norm2, &est->norm, 1, MPIU_REAL, MPIU_SUM, comm));
+  est->norm     = PetscSqrtReal(est->norm);
   est->computed = PETSC_TRUE;
 
   PetscCall(PetscFree(w.face_kind));

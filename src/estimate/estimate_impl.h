@@ -41,6 +41,7 @@ typedef struct {
   EstimateRule       face_rule; /* for the boundary terms */
   PetscReal         *eta2;      /* [ncells][ESTIMATE_NUM_PARTS] the squared indicators */
   PetscReal         *volume;    /* [ncells] */
+  PetscReal          norm2;     /* the local cells' sum of sigma(u_h) : grad u_h |T|, the square of u_h's energy norm */
   PetscInt          *face_kind; /* [fEnd - fStart]: ESTIMATE_FACE_* or the index of the face's clamp/slip/load in the scene */
   PetscReal         *face_sum;  /* [chart][dim + 1]: sum over a face's cells of sigma n_out, and their number */
   PetscReal         *face_geom; /* [fEnd - fStart][dim + 2]: each face's measure, diameter and unit normal */

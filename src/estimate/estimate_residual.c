@@ -87,6 +87,7 @@ static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
 
     PetscCall(EstimateCellLoad(w, c, &cell));
     w->volume[c - w->cStart] = cell.volume;
+    for (PetscInt i = 0; i < dim * dim; ++i) w->norm2 += cell.volume * cell.sigma[i] * cell.grad[i]; /* sigma : eps(u_h), sigma symmetric */
     if (has_load) {
       PetscReal ff = 0.0;
 

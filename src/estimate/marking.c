@@ -2,6 +2,7 @@
    of the estimate's square, the cells with the largest indicators first. In parallel the cells are not sorted: the
    set is {T : eta_T >= t} with t the largest threshold whose set holds that fraction, found by bisection on t with one
    reduction per step, so that every partition marks the same cells (to the indicators' round-off). */
+#include "contact.h"
 #include "estimate.h"
 
 #define MARK_BISECTIONS 60 /* halvings of [0, max eta_T]: t to 1e-18 of the largest indicator */
@@ -52,5 +53,48 @@ PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DM
       ++local;
     }
   PetscCall(MPIU_Allreduce(&local, nmarked, 1, MPIU_INT, MPIU_SUM, comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The contact the mesh does not see: a node of Gamma_C that penetrates the obstacle while the rule exerts (almost) no
+   force on it. On a mesh coarse against the contact zone the Gauss rule's points fall outside the zone (a rigid
+   cylinder indenting a block meshed at h = 0.5 by 0.001: a zone 0.017 wide, the nearest point 0.1 from the axis), the
+   discrete problem has no contact at all, its solution is zero and so is the estimate: the residual estimator cannot
+   see what the rule does not impose. Such a node has the penalty's pressure d / eps_i at its penetration d, or more,
+   where the rule sees it; here its pressure is below UNSEEN_FRACTION of that. Its cells are marked (added to *marked,
+   created if NULL), and *nunseen counts the nodes over all ranks: while there are any, the run's answer does not hold
+   the contact and no accuracy can be claimed (src/solver/adapt.c). SNESVI and no contact have none. */
+#define UNSEEN_FRACTION 1e-2
+
+PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nunseen)
+{
+  const ContactSet  *cs;
+  const PetscScalar *x;
+  PetscReal          eps;
+  PetscInt           dim, local = 0, cStart, cEnd;
+
+  PetscFunctionBeginUser;
+  *nunseen = 0;
+  if (!ContactHasPenalty(user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(ContactGetEps(user->contact, &eps));
+  PetscCall(VecGetArrayRead(u, &x));
+  for (PetscInt i = 0; i < cs->n; ++i) {
+    const PetscReal d    = ContactNodePenetration(cs, dim, i, x);
+    PetscInt       *star = NULL, nstar;
+
+    if (!(d > 0.0) || cs->pressure[i] >= UNSEEN_FRACTION * d / (eps * cs->eps_factor[i])) continue;
+    ++local;
+    if (!marked) continue;
+    if (!*marked) PetscCall(DMLabelCreate(PETSC_COMM_SELF, "adapt", marked));
+    PetscCall(DMPlexGetTransitiveClosure(dm, cs->point[i], PETSC_FALSE, &nstar, &star));
+    for (PetscInt k = 0; k < nstar; ++k)
+      if (star[2 * k] >= cStart && star[2 * k] < cEnd) PetscCall(DMLabelSetValue(*marked, star[2 * k], DM_ADAPT_REFINE));
+    PetscCall(DMPlexRestoreTransitiveClosure(dm, cs->point[i], PETSC_FALSE, &nstar, &star));
+  }
+  PetscCall(VecRestoreArrayRead(u, &x));
+  PetscCall(MPIU_Allreduce(&local, nunseen, 1, MPIU_INT, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

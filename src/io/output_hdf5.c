@@ -458,6 +458,21 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     PetscCall(WriteRealAttr(v, "time_estimate", user->rec.estimate.time));
   } else if (user->rec.estimate.unavailable[0])
     PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "estimate_unavailable", PETSC_STRING, user->rec.estimate.unavailable));
+  if (user->opt->adapt.accuracy > 0.0 && user->rec.ncycles) { /* -accuracy: asked for, reached, and the last cycle's bars */
+    const CycleRecord *c = &user->rec.cycles[user->rec.ncycles - 1];
+
+    PetscCall(WriteRealAttr(v, "accuracy", user->opt->adapt.accuracy));
+    PetscCall(WriteIntAttr(v, "accuracy_reached", c->accurate));
+    for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
+      char name[64];
+
+      if (!user->opt->adapt.target[k]) continue;
+      PetscCall(PetscSNPrintf(name, sizeof(name), "accuracy_%s_value", AccuracyQuantities[k]));
+      PetscCall(WriteRealAttr(v, name, c->value[k]));
+      PetscCall(PetscSNPrintf(name, sizeof(name), "accuracy_%s_bar", AccuracyQuantities[k]));
+      PetscCall(WriteRealAttr(v, name, c->bar[k]));
+    }
+  }
   for (PetscInt k = 0; k < user->rec.bars.n; ++k) { /* -bars: qoi_NAME, its bar and parts and order, or why there is no bar */
     const ErrorBars *b        = &user->rec.bars;
     const char      *suffix[] = {"", "_bar", "_bar_mesh", "_bar_eps", "_order"};
@@ -591,7 +606,7 @@ static PetscErrorCode WriteSteps(MPI_Comm comm, const AppCtx *user, PetscViewer 
 }
 
 /* /cycles/<column>: one row per mesh of the adaptive refinement (-adapt_cycles, src/solver/adapt.c). */
-static PetscErrorCode WriteCycles(MPI_Comm comm, const AppCtx *user, PetscViewer v)
+static PetscErrorCode WriteCycles(MPI_Comm comm, const AppCtx *user, PetscViewer v, PetscInt dim)
 {
   const PetscInt     n = user->rec.ncycles;
   const CycleRecord *c = user->rec.cycles;
@@ -609,6 +624,27 @@ static PetscErrorCode WriteCycles(MPI_Comm comm, const AppCtx *user, PetscViewer
   CYCLE_COLUMN("n_dofs", (PetscReal)c[i].n_dofs);
   CYCLE_COLUMN("n_cells", (PetscReal)c[i].n_cells);
   CYCLE_COLUMN("estimate", c[i].estimate);
+  CYCLE_COLUMN("estimate_penalty", c[i].estimate_penalty);
+  CYCLE_COLUMN("norm", c[i].norm);
+  for (PetscInt d = 0; d < dim; ++d) {
+    char label[32];
+
+    PetscCall(PetscSNPrintf(label, sizeof(label), "contact_force_%c", "xyz"[d]));
+    CYCLE_COLUMN(label, c[i].q.force[d]);
+  }
+  CYCLE_COLUMN("pressure_max", c[i].q.pressure_max);
+  CYCLE_COLUMN("contact_size", c[i].q.contact_size);
+  CYCLE_COLUMN("contact_size_band", c[i].q.contact_size_band);
+  for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
+    char label[64];
+
+    PetscCall(PetscSNPrintf(label, sizeof(label), "%s_value", AccuracyQuantities[k]));
+    CYCLE_COLUMN(label, c[i].value[k]);
+    PetscCall(PetscSNPrintf(label, sizeof(label), "%s_bar", AccuracyQuantities[k]));
+    CYCLE_COLUMN(label, c[i].bar[k]);
+  }
+  CYCLE_COLUMN("unseen_contact", (PetscReal)c[i].unseen);
+  CYCLE_COLUMN("accurate", c[i].accurate ? 1.0 : 0.0);
   CYCLE_COLUMN("error_energy", c[i].error_energy);
   CYCLE_COLUMN("marked", (PetscReal)c[i].marked);
   CYCLE_COLUMN("newton_its", (PetscReal)c[i].newton_its);
@@ -735,7 +771,7 @@ static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, const char h5
   PetscCall(WriteRunMetadata(dm, user, u, viewer, ncells, nverts));
   PetscCall(WriteSolves(comm, user, viewer));
   PetscCall(WriteSteps(comm, user, viewer, dim));
-  PetscCall(WriteCycles(comm, user, viewer));
+  PetscCall(WriteCycles(comm, user, viewer, dim));
   PetscCall(PetscViewerDestroy(&viewer));
   if (rank == 0) PetscCall(WriteXdmf(user, xdmftmp, h5name, dim, ncells, ncorners, nverts));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -10,23 +10,49 @@
 #include "contact.h"
 #include "estimate.h"
 #include "mesh.h"
+#include "physics.h"
 #include "solver.h"
 #include "verify.h"
 
+#define ADAPT_ACCURACY_CYCLES 40 /* -accuracy's most cycles unless -adapt_cycles says */
+
 PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
 {
+  PetscEnum quantities[ACCURACY_NUM];
+  PetscInt  nq = ACCURACY_NUM;
+  PetscBool cycles_given, quantities_given;
+
   PetscFunctionBeginUser;
   ad->cycles   = 0;
   ad->fraction = 0.5;
+  ad->accuracy = 0.0;
   PetscOptionsBegin(comm, NULL, "Adaptive refinement", "Signorini");
-  PetscCall(PetscOptionsInt("-adapt_cycles", "Refine where the error estimate is largest and solve again, this many times (2D triangles, P1)", NULL,
-                            ad->cycles, &ad->cycles, NULL));
+  PetscCall(PetscOptionsInt(
+      "-adapt_cycles",
+      "Refine where the error estimate is largest and solve again, this many times (2D triangles, P1); with -accuracy, at most this many", NULL,
+      ad->cycles, &ad->cycles, &cycles_given));
   PetscCall(PetscOptionsReal("-adapt_fraction", "The fraction of the estimate's square that the cells refined at each cycle hold (Doerfler's theta)",
                              NULL, ad->fraction, &ad->fraction, NULL));
+  PetscCall(PetscOptionsReal("-accuracy", "Refine adaptively until the error bars of the quantities are below this fraction of their values", NULL,
+                             ad->accuracy, &ad->accuracy, NULL));
+  PetscCall(PetscOptionsEnumArray("-accuracy_quantity",
+                                  "The quantities -accuracy asks for (energy: the energy-norm estimate against the solution's energy norm)", NULL,
+                                  AccuracyQuantities, quantities, &nq, &quantities_given));
   PetscOptionsEnd();
   PetscCheck(ad->cycles >= 0, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles must be >= 0, got %" PetscInt_FMT, ad->cycles);
   PetscCheck(ad->fraction > 0.0 && ad->fraction <= 1.0, comm, PETSC_ERR_USER_INPUT, "-adapt_fraction must lie in (0, 1], got %g",
              (double)ad->fraction);
+  PetscCheck(ad->accuracy >= 0.0 && ad->accuracy < 1.0, comm, PETSC_ERR_USER_INPUT, "-accuracy is a relative error in (0, 1), got %g",
+             (double)ad->accuracy);
+  PetscCheck(!quantities_given || ad->accuracy > 0.0, comm, PETSC_ERR_USER_INPUT, "-accuracy_quantity needs -accuracy TOL");
+  PetscCheck(!quantities_given || nq > 0, comm, PETSC_ERR_USER_INPUT,
+             "-accuracy_quantity needs at least one of energy, contact_force, pressure_max, contact_size");
+  for (PetscInt k = 0; k < ACCURACY_NUM; ++k) ad->target[k] = (PetscBool)!quantities_given;
+  for (PetscInt k = 0; k < nq && quantities_given; ++k) ad->target[quantities[k]] = PETSC_TRUE;
+  if (ad->accuracy > 0.0) {
+    PetscCheck(!cycles_given || ad->cycles > 0, comm, PETSC_ERR_USER_INPUT, "-accuracy refines adaptively: -adapt_cycles 0 leaves it no cycle");
+    if (!cycles_given) ad->cycles = ADAPT_ACCURACY_CYCLES;
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -84,12 +110,16 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   local = cEnd - cStart;
   PetscCall(MPIU_Allreduce(&local, &c->n_cells, 1, MPIU_INT, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
-  c->n_dofs       = r->n_dofs;
-  c->newton_its   = r->newton_its;
-  c->ksp_its      = r->ksp_its;
-  c->time_solve   = r->time_solve;
-  c->converged    = r->converged;
-  c->estimate     = user->rec.estimate.total;
+  c->n_dofs           = r->n_dofs;
+  c->newton_its       = r->newton_its;
+  c->ksp_its          = r->ksp_its;
+  c->time_solve       = r->time_solve;
+  c->converged        = r->converged;
+  c->estimate         = user->rec.estimate.total;
+  c->estimate_penalty = user->rec.estimate.part[ESTIMATE_PENALTY];
+  c->norm             = user->rec.estimate.norm;
+  PetscCall(PostprocessContact(dm, user, u));
+  PostprocessGetQuantities(user, &c->q);
   c->marked       = 0;
   c->error_energy = PETSC_NAN;
   if (user->scene.exact) {
@@ -100,19 +130,40 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Whether the last cycle reached -accuracy: a converged solve that sees its contact, and each quantity asked for with
+   a bar below the tolerance times its value. */
+static PetscBool Accurate(const AdaptOptions *ad, const CycleRecord *c)
+{
+  if (!(ad->accuracy > 0.0) || !c->converged || c->unseen) return PETSC_FALSE;
+  for (PetscInt k = 0; k < ACCURACY_NUM; ++k)
+    if (ad->target[k] && !(c->bar[k] <= ad->accuracy * PetscAbsReal(c->value[k]))) return PETSC_FALSE; /* NaN: not yet */
+  return PETSC_TRUE;
+}
+
 PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
 {
   const AdaptOptions *ad = &user->opt->adapt;
+  PetscInt            dim;
 
   PetscFunctionBeginUser;
   if (!ad->cycles) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(DMGetDimension(*dm, &dim));
   PetscCall(PetscCalloc1(ad->cycles + 1, &user->rec.cycles));
   for (PetscInt k = 0;; ++k) {
-    DMLabel marked;
+    CycleRecord *c      = &user->rec.cycles[k];
+    DMLabel      marked = NULL;
 
     PetscCall(AdaptRecord(*dm, user, *u, k));
-    if (k == ad->cycles || !user->rec.stats.converged) break;
-    PetscCall(EstimateMark(*dm, &user->rec.estimate, ad->fraction, &marked, &user->rec.cycles[k].marked));
+    PetscCall(CycleBarsCompute(user, dim, k));
+    PetscCall(EstimateMarkUnseenContact(*dm, user, *u, NULL, &c->unseen));
+    c->accurate = Accurate(ad, c);
+    if (c->accurate || k == ad->cycles || !user->rec.stats.converged) break;
+    PetscCall(EstimateMark(*dm, &user->rec.estimate, ad->fraction, &marked, &c->marked));
+    PetscCall(EstimateMarkUnseenContact(*dm, user, *u, &marked, &c->unseen));
+    if (!c->marked && !c->unseen) { /* a zero estimate: nothing to refine */
+      PetscCall(DMLabelDestroy(&marked));
+      break;
+    }
     PetscCall(GridSequenceRefine(dm, user, snes, u, marked));
     PetscCall(DMLabelDestroy(&marked));
     PetscCall(SolverSolve(*snes, user, *u, SOLVER_START_COARSER_MESH));
@@ -122,13 +173,15 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The cycles in the summary, one line each. */
+/* The cycles in the summary, one line each, and -accuracy's outcome: the last cycle's quantities with their bars. */
 PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
 {
+  const AdaptOptions *ad = &user->opt->adapt;
+
   PetscFunctionBeginUser;
   if (!user->rec.ncycles) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscPrintf(comm, "  adaptive cycles (-adapt_fraction %g): cycle  dofs        cells       estimate    %s  marked  Newton  Krylov\n",
-                        (double)user->opt->adapt.fraction, user->scene.exact ? "error      " : ""));
+                        (double)ad->fraction, user->scene.exact ? "error      " : ""));
   for (PetscInt k = 0; k < user->rec.ncycles; ++k) {
     const CycleRecord *c       = &user->rec.cycles[k];
     char               err[32] = "";
@@ -138,6 +191,28 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
                           "                                           %5" PetscInt_FMT "  %-10" PetscInt_FMT "  %-10" PetscInt_FMT
                           "  %.4e  %s%6" PetscInt_FMT "  %6" PetscInt_FMT "  %6" PetscInt_FMT "\n",
                           k, c->n_dofs, c->n_cells, (double)c->estimate, err, c->marked, c->newton_its, c->ksp_its));
+  }
+  if (ad->accuracy > 0.0) {
+    const CycleRecord *c = &user->rec.cycles[user->rec.ncycles - 1];
+
+    if (c->accurate)
+      PetscCall(PetscPrintf(comm, "  accuracy %g reached at cycle %" PetscInt_FMT " (%" PetscInt_FMT " dofs):\n", (double)ad->accuracy,
+                            user->rec.ncycles - 1, c->n_dofs));
+    else
+      PetscCall(PetscPrintf(
+          comm, "  WARNING: accuracy %g not reached after %" PetscInt_FMT " cycles (%" PetscInt_FMT " dofs)%s%s; the last cycle's bars:\n",
+          (double)ad->accuracy, user->rec.ncycles - 1, c->n_dofs, c->unseen ? ": the mesh does not see the contact at some nodes" : "",
+          !c->converged ? ": the last solve failed" : ""));
+    for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
+      if (!ad->target[k]) continue;
+      if (PetscIsNanReal(c->bar[k]))
+        PetscCall(PetscPrintf(comm, "    %-14s %.6g, no bar yet (no earlier cycle twice as coarse: N^(-1/dim) twice the last one's)\n",
+                              AccuracyQuantities[k], (double)c->value[k]));
+      else
+        PetscCall(PetscPrintf(comm, "    %-14s %.6g +- %.2g (%.2g%%)%s\n", AccuracyQuantities[k], (double)c->value[k], (double)c->bar[k],
+                              (double)(100.0 * c->bar[k] / PetscAbsReal(c->value[k])),
+                              k == ACCURACY_ENERGY ? " (the energy norm and the error estimate)" : ""));
+    }
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
