@@ -23,7 +23,7 @@ SRC = $(wildcard src/*.c src/*/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path penetration-tol estimates adapt-hertz bench format clean
+.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path penetration-tol estimates adapt-hertz accuracy-ladder bench format clean
 STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
@@ -126,6 +126,12 @@ estimates: deps
 adapt-hertz: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/adapt_hertz.py
+
+# -accuracy on the 2D Hertz cylinder indenter from a coarse uniform mesh (3% and 1%), against the closed form and
+# against make hertz's grading on the same block, timed side by side: output/accuracy_ladder/accuracy_ladder.{md,csv}
+accuracy-ladder: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) scripts/accuracy_ladder.py
 
 # Performance (docs/solvers.md, "Performance"): bench/{bench,getfem,fenicsx,profile3d,bandwidth,targets}.{md,csv}, runs under bench/runs/
 bench: deps
