@@ -29,7 +29,7 @@ PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *siz
 
 /* contact_checks.c */
 PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user);
-PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user);
+PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user, Vec u);
 PetscErrorCode ContactChecksWarnings(MPI_Comm comm, const ContactChecks *ck, PetscBool print, PetscInt *nwarnings);
 
 /* elasticity.c: sigma(grad u) = lambda tr(eps) I + 2 mu eps, grad[i*dim+j] = du_i/dx_j */

@@ -267,6 +267,7 @@ typedef struct {
   PetscInt  zone_faces;         /* faces of Gamma_C whose every node carries contact force */
   PetscReal zone_cells;         /* cells across the contact zone: zone_faces in 2D, sqrt(2 zone_faces / pi) in 3D */
   PetscReal zone_limit;         /* fewer cells are warned of: CONTACT_CHECK_ZONE_CELLS_2D or _3D */
+  PetscInt  unseen_nodes;       /* contact nodes that penetrate while the rule exerts no force on them (ContactUnseenNodes()) */
   PetscInt  curved_refined;     /* a mesh file's curved boundary (MeshBox.curved_ridges) that the solver refined on its chords: its ridges, */
   PetscInt  curved_refinements; /*   the refinements (-dm_refine and -contact_grid_sequence), */
   PetscReal curved_x[3];        /*   and one of the ridges */

@@ -6,12 +6,17 @@ the block's own gap to the half-space of the closed form is 0.02%, docs/estimate
 For each TOL the run starts from the block meshed uniformly at h = 0.5 (the contact zone, a = 0.017, is 30 times
 smaller than a cell) and refines until the bars of the force, the largest pressure and the contact width are below
 TOL. Each is compared with the closed form at the run's force (the width and the largest pressure) and with the force
-of the finest run (the force has no closed form in 2D). Then the hand-graded meshes (make hertz's grading on the same
-block, h_near = 0.004, 0.002, 0.001, 0.0005) are solved once each, and for each TOL the cheapest one whose true errors
-are below TOL is timed side by side with the adaptive run (--pairs alternated pairs, medians). Writes
-output/accuracy_ladder/accuracy_ladder.md and .csv.
+of the finest run (the force has no closed form in 2D). Then hand-graded meshes of the same block are solved once
+each: the size h_near + G r grows with the distance r from the contact point up to h_far = 0.5 (scripts/make_mesh.py
+block --grade G; make hertz's grading, h_near up to 0.06 and then 0.5 within 0.3, leaves a force error of 5% on this
+block), and for each TOL the one with the fewest unknowns whose true errors are below TOL is timed side by side with
+the adaptive run (--pairs alternated pairs, medians). Writes output/accuracy_ladder/accuracy_ladder.md and .csv.
 
-    /usr/bin/python3 scripts/accuracy_ladder.py [--tols 0.03,0.01] [--pairs 3]
+Then the bars' coverage over every cycle (--coverage, on by default): the manufactured solution from 8 x 8, 11 cycles
+at eps = h and at eps = h/10, against its closed form, and this indenter, 16 cycles, against the closed form (the width
+and the largest pressure) and the force of a 17th cycle; each cycle's bar of each quantity against its true error.
+
+    /usr/bin/python3 scripts/accuracy_ladder.py [--tols 0.03,0.01] [--pairs 3] [--no-coverage]
 """
 import argparse
 import os
@@ -29,8 +34,9 @@ from signorini.report import csv_text, write_text  # noqa: E402
 from signorini.runs import read_run  # noqa: E402
 
 CASE = "cylinder-indenter"
+MMS_EXACT = {"contact_force": 0.0720182, "pressure_max": 0.402594, "contact_size": 0.447214}  # docs/estimate.md
 QUANTITIES = "contact_force,pressure_max,contact_size"
-HAND = [0.004, 0.002, 0.001, 0.0005]
+HAND = [(0.002, 0.1), (0.001, 0.1), (0.001, 0.05), (0.0005, 0.05), (0.0005, 0.02), (0.00025, 0.02)]  # (h_near, grade G)
 
 
 def solve(cmd):
@@ -46,8 +52,43 @@ def errors(attrs, force_ref):
     against force_ref."""
     force = abs(float(attrs["contact_force_y"]))
     a, p0 = hertz.closed_form(2, 2 * force)
-    return {"contact_size": float(attrs["contact_size"]) / a - 1, "pressure_max": float(attrs["pressure_max"]) / p0 - 1,
-            "contact_force": force / force_ref - 1}
+    return {"contact_force": force / force_ref - 1, "pressure_max": float(attrs["pressure_max"]) / p0 - 1,
+            "contact_size": float(attrs["contact_size"]) / a - 1}
+
+
+def cycles(path):
+    import h5py
+    import numpy as np
+    with h5py.File(path, "r") as f:
+        return {k: np.asarray(f["cycles"][k][:]).ravel() for k in f["cycles"]}
+
+
+def coverage(outdir, coarse):
+    """Each cycle's bars against the true errors: rows (run, quantity, cycles with a bar, covered, min and median of
+    bar / error)."""
+    import numpy as np
+    runs = []
+    for label, eps0 in (("mms eps=h", "1"), ("mms eps=h/10", "0.1")):
+        out = os.path.join(outdir, f"coverage_mms_{eps0}.h5")
+        solve([os.path.join(ROOT, "bin", "signorini"), "-options_file", "options/mms.yaml", "-dm_plex_box_faces", "8,8", "-adapt_cycles", "11",
+               "-penalty_eps0", eps0, "-output", out])
+        c = cycles(out)
+        runs.append((label, c, {q: np.full(len(c["n_dofs"]), v) for q, v in MMS_EXACT.items()}))
+    out = os.path.join(outdir, "coverage_hertz.h5")
+    solve(hertz.command(CASE, coarse, "eps=h/10", out)[3:] + ["-adapt_cycles", "17", "-options_file", "options/solvers/gamg.yaml"])
+    c = {k: v[:-1] for k, v in cycles(out).items()}
+    force_ref = abs(cycles(out)["contact_force_value"][-1])
+    closed = [hertz.closed_form(2, 2 * f) for f in c["contact_force_value"]]
+    runs.append(("hertz indenter", c, {"contact_force": np.full(len(closed), force_ref), "pressure_max": np.array([p for _, p in closed]),
+                                       "contact_size": np.array([a for a, _ in closed])}))
+    rows = []
+    for label, c, exact in runs:
+        for q, ex in exact.items():
+            bar, err = c[f"{q}_bar"], np.abs(c[f"{q}_value"] - ex)
+            has = ~np.isnan(bar)
+            ratio = bar[has] / np.maximum(err[has], 1e-300)
+            rows.append([label, q, int(has.sum()), int(np.sum(err[has] <= bar[has])), float(ratio.min()), float(np.median(ratio))])
+    return rows
 
 
 def main():
@@ -55,6 +96,7 @@ def main():
     ap.add_argument("--tols", default="0.03,0.01")
     ap.add_argument("--pairs", type=int, default=3, help="alternated timing pairs of the adaptive and the hand-graded run")
     ap.add_argument("--outdir", default=os.path.join(ROOT, "output", "accuracy_ladder"))
+    ap.add_argument("--no-coverage", dest="coverage", action="store_false", help="skip the bars' coverage over every cycle")
     args = ap.parse_args()
     os.makedirs(args.outdir, exist_ok=True)
     tols = sorted((float(t) for t in args.tols.split(",")), reverse=True)
@@ -69,14 +111,16 @@ def main():
         print(f"-accuracy {tol:g}: {adaptive[tol][1]['n_dofs']} unknowns, reached {adaptive[tol][1]['accuracy_reached']}", flush=True)
     force_ref = abs(float(adaptive[tols[-1]][1]["contact_force_y"]))
     hand = []
-    for h_near in HAND:
-        mesh = os.path.join(args.outdir, f"block10_graded_{h_near:g}.msh")
-        st.write_block_mesh(CASE, h_near, mesh)
-        out = os.path.join(args.outdir, f"graded_{h_near:g}.h5")
+    for h_near, grade in HAND:
+        mesh = os.path.join(args.outdir, f"block10_h{h_near:g}_grade{grade:g}.msh")
+        near = min(0.98 * (0.5 - h_near) / grade, 0.9 * st.BLOCK)
+        geometry.block(mesh, radius=st.BLOCK, h_far=0.5, h_near=h_near, grade=grade, near=near, width=min(2.0, 0.95 * st.BLOCK - near))
+        out = os.path.join(args.outdir, f"graded_h{h_near:g}_grade{grade:g}.h5")
         cmd = hertz.command(CASE, mesh, "eps=h/10", out)[3:]
         solve(cmd)
-        hand.append((h_near, cmd, read_run(out)))
-        print(f"hand-graded h_near {h_near:g}: {hand[-1][2]['n_dofs']} unknowns", flush=True)
+        hand.append((f"{h_near:g}, G {grade:g}", cmd, read_run(out)))
+        print(f"hand-graded h_near {h_near:g} grade {grade:g}: {hand[-1][2]['n_dofs']} unknowns", flush=True)
+    hand.sort(key=lambda t: int(t[2]["n_dofs"]))
     rows, md = [], []
     for tol in tols:
         cmd, a = adaptive[tol]
@@ -91,22 +135,29 @@ def main():
         ratio = statistics.median(t_ad) / statistics.median(t_hd) if best else float("nan")
         row = [tol, int(a["n_dofs"]), int(a["accuracy_reached"]), statistics.median(t_ad)]
         row += [err[q] for q in QUANTITIES.split(",")] + [bars[q] for q in QUANTITIES.split(",")]
-        row += [best[0] if best else float("nan"), int(best[2]["n_dofs"]) if best else 0, statistics.median(t_hd) if best else float("nan"), ratio]
+        row += [best[0] if best else "", int(best[2]["n_dofs"]) if best else 0, statistics.median(t_hd) if best else float("nan"), ratio]
         rows.append(row)
         covered = all(abs(err[q]) <= bars[q] for q in bars)
         md.append(f"| {tol:g} | {row[1]} | {'yes' if row[2] else 'no'} | " + " | ".join(f"{err[q]:+.3%} ({bars[q]:.2%})" for q in bars)
-                  + f" | {'yes' if covered else 'NO'} | {row[3]:.2f} | " + (f"{best[0]:g}: {row[-3]} | {row[-2]:.2f} | {ratio:.2f} |" if best else "none | | |"))
+                  + f" | {'yes' if covered else 'NO'} | {row[3]:.2f} | " + (f"{best[0]}: {row[-3]} | {row[-2]:.2f} | {ratio:.2f} |" if best else "none | | |"))
     header = ["tol", "n_dofs", "reached", "time", "err_force", "err_pressure_max", "err_contact_size", "bar_force", "bar_pressure_max",
               "bar_contact_size", "hand_h_near", "hand_n_dofs", "hand_time", "time_ratio"]
     write_text(os.path.join(args.outdir, "accuracy_ladder.csv"), csv_text(header, rows))
-    hand_md = [f"| {h:g} | {b['n_dofs']} | " + " | ".join(f"{e:+.3%}" for e in errors(b, force_ref).values()) + " |" for h, _, b in hand]
+    hand_md = [f"| {h} | {b['n_dofs']} | " + " | ".join(f"{e:+.3%}" for e in errors(b, force_ref).values()) + " |" for h, _, b in hand]
     text = [f"# -accuracy on the 2D Hertz cylinder indenter (block {st.BLOCK:g} x {st.BLOCK:g}, eps = h/10, from h = 0.5 uniform)", "",
             f"`/usr/bin/python3 scripts/accuracy_ladder.py --tols {args.tols} --pairs {args.pairs}`. Errors: the width and the largest "
             "pressure against the closed form at the run's force, the force against the finest run's; in brackets the run's bar "
             f"(relative). Times: medians of {args.pairs} alternated pairs, whole processes.", "",
-            "| TOL | unknowns | reached | force | largest pressure | width | covered | time (s) | cheapest hand-graded within TOL: h_near: unknowns | its time (s) | adaptive / hand-graded |",
-            "|---|---|---|---|---|---|---|---|---|---|---|"] + md + ["", "Hand-graded meshes (make hertz's grading on the same block), one solve each:", "",
-                                                                     "| h_near | unknowns | force | largest pressure | width |", "|---|---|---|---|---|"] + hand_md
+            "| TOL | unknowns | reached | force | largest pressure | width | covered | time (s) | fewest hand-graded unknowns within TOL (h_near, G: unknowns) | its time (s) | adaptive / hand-graded |",
+            "|---|---|---|---|---|---|---|---|---|---|---|"] + md + ["", "Hand-graded meshes (size h_near + G r up to 0.5), one solve each:", "",
+                                                                     "| h_near, G | unknowns | force | largest pressure | width |", "|---|---|---|---|---|"] + hand_md
+    if args.coverage:
+        cov = coverage(args.outdir, coarse)
+        write_text(os.path.join(args.outdir, "coverage.csv"), csv_text(["run", "quantity", "cycles_with_bar", "covered", "min_bar_over_error",
+                                                                         "median_bar_over_error"], cov))
+        text += ["", "The bars over every cycle (their true errors: the closed forms; the indenter's force against a 17th cycle's):", "",
+                 "| run | quantity | cycles with a bar | covered | bar / error: least | median |", "|---|---|---|---|---|---|"]
+        text += [f"| {r[0]} | {r[1]} | {r[2]} | {r[3]} | {r[4]:.2f} | {r[5]:.2f} |" for r in cov]
     write_text(os.path.join(args.outdir, "accuracy_ladder.md"), "\n".join(text) + "\n")
     print("\n".join(text))
 

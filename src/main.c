@@ -176,8 +176,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(LoadPathSolve(dm, &user, snes, u));       /* the steps after the first, each from the last */
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
-  PetscCall(BarsCompute(dm, &user));             /* -bars: from the levels' quantities and this mesh's */
-  PetscCall(ContactChecksResolution(dm, &user)); /* cells across the contact zone: a warning */
+  PetscCall(BarsCompute(dm, &user));                /* -bars: from the levels' quantities and this mesh's */
+  PetscCall(ContactChecksResolution(dm, &user, u)); /* cells across the contact zone, contact the mesh does not see: warnings */
   { /* diagnostics: a failure there is reported and the output written without them, never the solve lost */
     char failed[512];
 

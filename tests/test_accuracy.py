@@ -60,13 +60,20 @@ def indenter(mesh):
 
 def test_a_mesh_that_does_not_see_the_contact_is_refined_where_it_penetrates(big_block):
     """On the uniform h = 0.5 block the Gauss rule's points miss the zone: no force, a zero solution and a zero estimate,
-    with the node on the axis 0.001 inside the cylinder. The cycles refine at that node (EstimateMarkUnseenContact())
-    until the rule sees the contact, and -accuracy never stops while a node is unseen."""
+    with the node on the axis 0.001 inside the cylinder. A single run says so (a warning, /run contact_unseen_nodes); the
+    cycles refine at that node (EstimateMarkUnseenContact()) until the rule sees the contact, and -accuracy never stops
+    while a node is unseen."""
+    out, h5 = run(indenter(big_block), "accuracy_unseen_single")
+    a, _ = load(h5)
+    assert a["contact_unseen_nodes"] == 1 and a["contact_force_y"] == 0.0 and a["warnings"] >= 1, (a["contact_unseen_nodes"], a["warnings"])
+    assert "penetrate the obstacle while the penalty rule exerts no force on them" in out
     _, h5 = run(indenter(big_block) + ["-adapt_cycles", 4], "accuracy_unseen")
     c = cycles(h5)
     assert c["unseen_contact"][0] >= 1 and c["contact_force_y"][0] == 0.0 and c["estimate"][0] == 0.0, c
     assert c["unseen_contact"][-1] == 0 and c["contact_force_y"][-1] < 0.0, c
     assert np.all(c["accurate"] == 0)
+    a, _ = load(h5)
+    assert a["contact_unseen_nodes"] == 0
 
 
 def test_accuracy_ladder_on_the_hertz_indenter(big_block):

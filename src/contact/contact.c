@@ -527,3 +527,35 @@ PetscErrorCode ContactPostProcess(Contact ct, DM dm, Vec R, Vec u, PetscReal tol
   if (ct->ops.check) PetscCall((*ct->ops.check)(ct, dm, u));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The contact the mesh does not see: the nodes of Gamma_C that penetrate the obstacle while the rule exerts (almost) no
+   force on them, after ContactPostProcess(). On a mesh coarse against the contact zone the Gauss rule's points fall
+   outside the zone (a rigid cylinder indenting a block meshed at h = 0.5 by 0.001: a zone 0.017 wide, the nearest
+   point 0.1 from the axis): the discrete problem has no contact there, its solution and its error estimate are zero.
+   A node the rule sees has the penalty's pressure d / eps_i at its penetration d, or more; an unseen one has less than
+   CONTACT_UNSEEN_FRACTION of it. unseen[i] (NULL: not asked) flags this rank's nodes, *count is over all ranks.
+   SNESVI and no contact see every node: none. */
+#define CONTACT_UNSEEN_FRACTION 1e-2
+
+PetscErrorCode ContactUnseenNodes(Contact ct, Vec u, PetscBool unseen[], PetscInt *count)
+{
+  const ContactSet  *cs = &ct->set;
+  const PetscScalar *x;
+  PetscInt           local = 0;
+
+  PetscFunctionBeginUser;
+  for (PetscInt i = 0; i < cs->n && unseen; ++i) unseen[i] = PETSC_FALSE;
+  if (ct->has_penalty) {
+    PetscCall(VecGetArrayRead(u, &x));
+    for (PetscInt i = 0; i < cs->n; ++i) {
+      const PetscReal d = ContactNodePenetration(cs, ct->dim, i, x);
+
+      if (!(d > 0.0) || cs->pressure[i] >= CONTACT_UNSEEN_FRACTION * d / ContactNodeEps(cs, ct->eps, i)) continue;
+      ++local;
+      if (unseen) unseen[i] = PETSC_TRUE;
+    }
+    PetscCall(VecRestoreArrayRead(u, &x));
+  }
+  PetscCall(MPIU_Allreduce(&local, count, 1, MPIU_INT, MPI_SUM, ct->comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -56,45 +56,31 @@ PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DM
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The contact the mesh does not see: a node of Gamma_C that penetrates the obstacle while the rule exerts (almost) no
-   force on it. On a mesh coarse against the contact zone the Gauss rule's points fall outside the zone (a rigid
-   cylinder indenting a block meshed at h = 0.5 by 0.001: a zone 0.017 wide, the nearest point 0.1 from the axis), the
-   discrete problem has no contact at all, its solution is zero and so is the estimate: the residual estimator cannot
-   see what the rule does not impose. Such a node has the penalty's pressure d / eps_i at its penetration d, or more,
-   where the rule sees it; here its pressure is below UNSEEN_FRACTION of that. Its cells are marked (added to *marked,
-   created if NULL), and *nunseen counts the nodes over all ranks: while there are any, the run's answer does not hold
-   the contact and no accuracy can be claimed (src/solver/adapt.c). SNESVI and no contact have none. */
-#define UNSEEN_FRACTION 1e-2
-
+/* The cells around each contact node the mesh does not see (ContactUnseenNodes(): it penetrates the obstacle while the
+   rule exerts no force on it, as on a mesh whose Gauss points all miss the contact zone, where the solution and the
+   estimate are zero) are marked too (added to *marked, created if NULL), so that the cycles refine until the rule sees
+   the contact; *nunseen counts the nodes over all ranks. */
 PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nunseen)
 {
-  const ContactSet  *cs;
-  const PetscScalar *x;
-  PetscReal          eps;
-  PetscInt           dim, local = 0, cStart, cEnd;
+  const ContactSet *cs;
+  PetscBool        *unseen;
+  PetscInt          cStart, cEnd;
 
   PetscFunctionBeginUser;
-  *nunseen = 0;
-  if (!ContactHasPenalty(user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(ContactGetSet(user->contact, &cs));
-  PetscCall(ContactGetEps(user->contact, &eps));
-  PetscCall(VecGetArrayRead(u, &x));
-  for (PetscInt i = 0; i < cs->n; ++i) {
-    const PetscReal d    = ContactNodePenetration(cs, dim, i, x);
-    PetscInt       *star = NULL, nstar;
+  PetscCall(PetscMalloc1(cs->n + 1, &unseen));
+  PetscCall(ContactUnseenNodes(user->contact, u, unseen, nunseen));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  for (PetscInt i = 0; i < cs->n && marked; ++i) {
+    PetscInt *star = NULL, nstar;
 
-    if (!(d > 0.0) || cs->pressure[i] >= UNSEEN_FRACTION * d / (eps * cs->eps_factor[i])) continue;
-    ++local;
-    if (!marked) continue;
+    if (!unseen[i]) continue;
     if (!*marked) PetscCall(DMLabelCreate(PETSC_COMM_SELF, "adapt", marked));
     PetscCall(DMPlexGetTransitiveClosure(dm, cs->point[i], PETSC_FALSE, &nstar, &star));
     for (PetscInt k = 0; k < nstar; ++k)
       if (star[2 * k] >= cStart && star[2 * k] < cEnd) PetscCall(DMLabelSetValue(*marked, star[2 * k], DM_ADAPT_REFINE));
     PetscCall(DMPlexRestoreTransitiveClosure(dm, cs->point[i], PETSC_FALSE, &nstar, &star));
   }
-  PetscCall(VecRestoreArrayRead(u, &x));
-  PetscCall(MPIU_Allreduce(&local, nunseen, 1, MPIU_INT, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
+  PetscCall(PetscFree(unseen));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -422,6 +422,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     if (s->checks.resolution_checked) {
       PetscCall(WriteIntAttr(v, "contact_zone_faces", s->checks.zone_faces));
       PetscCall(WriteRealAttr(v, "contact_zone_cells", s->checks.zone_cells));
+      PetscCall(WriteIntAttr(v, "contact_unseen_nodes", s->checks.unseen_nodes)); /* penetrating with no force from the rule: a warning */
     }
   }
   PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));

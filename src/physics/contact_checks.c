@@ -97,7 +97,7 @@ static int ComparePoints(const void *a, const void *b)
    SNESVI's pressure is the reaction at every node, round-off (1e-16 of the largest) at the free ones: a node carries
    force there above 1e-10 times the largest pressure, the tolerance of its active set. Without it the count changed
    with the round-off, 4 or 6 faces between two identical runs of the square on 2 ranks. */
-PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user)
+PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user, Vec u)
 {
   MPI_Comm          comm = PetscObjectComm((PetscObject)dm);
   ContactChecks    *ck   = &user->rec.stats.checks;
@@ -157,6 +157,7 @@ PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user)
   ck->zone_cells         = dim == 2 ? (PetscReal)ck->zone_faces : PetscSqrtReal(2.0 * (PetscReal)ck->zone_faces / PETSC_PI);
   ck->zone_limit         = dim == 2 ? CONTACT_CHECK_ZONE_CELLS_2D : CONTACT_CHECK_ZONE_CELLS_3D;
   ck->resolution_checked = PETSC_TRUE;
+  PetscCall(ContactUnseenNodes(user->contact, u, NULL, &ck->unseen_nodes));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -190,6 +191,15 @@ PetscErrorCode ContactChecksWarnings(MPI_Comm comm, const ContactChecks *ck, Pet
                             " faces), fewer than %.0f: the force and the penetration are a discretization artefact there; refine near the "
                             "contact\n",
                             (double)ck->zone_cells, ck->zone_faces, (double)ck->zone_limit));
+  }
+  if (ck->resolution_checked && ck->unseen_nodes > 0) {
+    ++n;
+    if (print)
+      PetscCall(PetscPrintf(comm,
+                            "  WARNING: %" PetscInt_FMT " node(s) of Gamma_C penetrate the obstacle while the penalty rule exerts no force on them: "
+                            "the contact zone there is smaller than the faces, and the rule's points miss it (the force and the estimate see "
+                            "no contact); refine near the contact, or let -adapt_cycles or -accuracy refine there\n",
+                            ck->unseen_nodes));
   }
   if (ck->curved_refined) {
     ++n;
