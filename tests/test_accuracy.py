@@ -144,3 +144,15 @@ def test_accuracy_refuses_what_it_cannot_do(case):
     out, h5 = run(args, f"accuracy_bad_{case}", expect_rc=None)
     assert message in out, f"'{message}' not in the output of {args}:\n{out[-1500:]}"
     assert not os.path.exists(h5)
+
+
+def test_accuracy_takes_eps_h_over_10_unless_eps0_is_given():
+    """-accuracy's default eps0 is 0.1 (the cheapest of 1, 0.1 and 0.01 for a tolerance, docs/estimate.md); a given
+    -penalty_eps0 wins (options/mms.yaml gives 1, so the scene is named here alone), and without -accuracy it is 1."""
+    base = ["-scene", "mms", "-contact_monitor", "0", "-dm_plex_box_faces", "8,8", "-adapt_cycles", 1]
+    eps = {}
+    for k, extra in {"default": ["-accuracy", 0.5], "0.1": ["-accuracy", 0.5, "-penalty_eps0", 0.1], "1": ["-accuracy", 0.5, "-penalty_eps0", 1],
+                     "none": []}.items():
+        _, h5 = run(base + extra, f"accuracy_eps0_{k}")
+        eps[k] = load(h5)[0]["eps"]
+    assert eps["default"] == eps["0.1"] and abs(eps["1"] / eps["0.1"] - 10) < 1e-9 and eps["none"] == eps["1"], eps

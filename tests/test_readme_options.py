@@ -8,7 +8,7 @@ import re
 from harness import OUT, ROOT, solve
 
 PROJECT = re.compile(r"^-(contact_|penalty_|bc_|obstacle|scene|young_modulus|poisson_ratio|body_force|partitioner|assembly|output|reference|"
-                     r"verify_|perf_|box_|mesh_|section_|square_|patch_|mms_|dual_|mg_fine_|error_|estimate|bars|load_|adapt_)")
+                     r"verify_|perf_|box_|mesh_|section_|square_|patch_|mms_|dual_|mg_fine_|error_|estimate|bars|load_|adapt_|accuracy)")
 # the runs whose -help, together, shows every option of the project
 RUNS = [
     ["-dm_plex_box_faces", "4,4"],
