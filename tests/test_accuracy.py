@@ -2,7 +2,7 @@
 quantities asked for are below TOL times their values. The bars come from the cycles themselves (Roache's two-level
 index with the safety factor 3 and the order 1, 1/2 for the zone's size, against the last two cycles with 4 and more
 times fewer unknowns); the energy's bar is the error estimate. Checked against the manufactured solution's exact values, the Hertz closed form on
-a block large enough for it (a 10 x 10 block: its gap to the half-space is 0.02%, docs/estimate.md), on 2 ranks
+a 10 x 10 block (where the closed form is a reference to about 0.2%, docs/estimate.md), on 2 ranks
 against 1, on a mesh that does not see the contact, and on the refusals."""
 import math
 import os
