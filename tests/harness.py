@@ -48,6 +48,13 @@ def run(args, name, np_=1, expect_rc=0, output=None):
     return text, out
 
 
+def refused(args, name, message):
+    """Runs the solver on input it must refuse: the message in its output, and no output file written."""
+    out, h5 = run(args, name, expect_rc=None)
+    assert message in out, f"'{message}' not in the output of {args}:\n{out[-1500:]}"
+    assert not os.path.exists(h5)
+
+
 def load(path):
     """(attrs, fields) of an output: /run with bytes decoded, the vertex fields in the file's order and "x", the vertex
     coordinates (signorini.runs.read_output)."""

@@ -50,41 +50,34 @@ static PetscReal Size(const CycleRecord *c, PetscInt dim)
   return PetscPowReal((PetscReal)c->n_dofs, -1.0 / dim);
 }
 
-/* The bar of one quantity Q (q[m] over the cycles 0..last) of order r on the last cycle, NaN before the cycle twice as
-   coarse and the one before it exist. */
-static PetscReal Bar(const CycleRecord c[], const PetscReal q[], PetscInt last, PetscInt dim, PetscReal r)
+/* The bar of quantity k on the last cycle, NaN before the cycle twice as coarse and the one before it exist; r its order. */
+static PetscReal Bar(const CycleRecord c[], PetscInt k, PetscInt last, PetscInt dim, PetscReal r)
 {
   const PetscInt j   = Coarser(c, last, dim);
   PetscReal      bar = 0.0;
 
   if (j < 1) return PETSC_NAN;
   for (PetscInt m = j; m >= j - 1; --m)
-    bar = PetscMax(bar, CYCLE_SAFETY * PetscAbsReal(q[m] - q[last]) / (PetscPowReal(Size(&c[m], dim) / Size(&c[last], dim), r) - 1.0));
+    bar = PetscMax(bar,
+                   CYCLE_SAFETY * PetscAbsReal(c[m].value[k] - c[last].value[k]) / (PetscPowReal(Size(&c[m], dim) / Size(&c[last], dim), r) - 1.0));
   return bar;
 }
 
+/* The last cycle's values and bars; the earlier cycles' values are those of the earlier calls, one per cycle. */
 PetscErrorCode CycleBarsCompute(AppCtx *user, PetscInt dim, PetscInt last)
 {
-  CycleRecord *c = user->rec.cycles;
-  PetscReal   *q;
+  CycleRecord *c = &user->rec.cycles[last];
+  PetscReal    f = 0.0;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMalloc1(last + 1, &q));
-  for (PetscInt m = 0; m <= last; ++m) {
-    PetscReal f = 0.0;
-
-    for (PetscInt d = 0; d < dim; ++d) f += PetscSqr(c[m].q.force[d]);
-    c[m].value[ACCURACY_ENERGY]   = c[m].norm;
-    c[m].value[ACCURACY_FORCE]    = PetscSqrtReal(f);
-    c[m].value[ACCURACY_PRESSURE] = c[m].q.pressure_max;
-    c[m].value[ACCURACY_SIZE]     = c[m].q.contact_size;
-  }
-  c[last].bar[ACCURACY_ENERGY] = c[last].estimate;
-  for (PetscInt k = ACCURACY_FORCE; k < ACCURACY_NUM; ++k) {
-    for (PetscInt m = 0; m <= last; ++m) q[m] = c[m].value[k];
-    c[last].bar[k] = Bar(c, q, last, dim, k == ACCURACY_SIZE ? CYCLE_ORDER_SIZE : CYCLE_ORDER);
-  }
-  if (!PetscIsNanReal(c[last].bar[ACCURACY_SIZE])) c[last].bar[ACCURACY_SIZE] = PetscMax(c[last].bar[ACCURACY_SIZE], c[last].q.contact_size_band);
-  PetscCall(PetscFree(q));
+  for (PetscInt d = 0; d < dim; ++d) f += PetscSqr(c->q.force[d]);
+  c->value[ACCURACY_ENERGY]   = c->norm;
+  c->value[ACCURACY_FORCE]    = PetscSqrtReal(f);
+  c->value[ACCURACY_PRESSURE] = c->q.pressure_max;
+  c->value[ACCURACY_SIZE]     = c->q.contact_size;
+  c->bar[ACCURACY_ENERGY]     = c->estimate;
+  for (PetscInt k = ACCURACY_FORCE; k < ACCURACY_NUM; ++k)
+    c->bar[k] = Bar(user->rec.cycles, k, last, dim, k == ACCURACY_SIZE ? CYCLE_ORDER_SIZE : CYCLE_ORDER);
+  if (!PetscIsNanReal(c->bar[ACCURACY_SIZE])) c->bar[ACCURACY_SIZE] = PetscMax(c->bar[ACCURACY_SIZE], c->q.contact_size_band);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -1,7 +1,8 @@
 /* Doerfler's marking (SIAM J. Numer. Anal. 33, 1996): the fewest cells whose squared indicators hold the fraction theta
    of the estimate's square, the cells with the largest indicators first. In parallel the cells are not sorted: the
    set is {T : eta_T >= t} with t the largest threshold whose set holds that fraction, found by bisection on t with one
-   reduction per step, so that every partition marks the same cells (to the indicators' round-off). */
+   reduction per step, so that every partition marks the same cells (to the indicators' round-off). The cells are added
+   to *marked, created if NULL; *nmarked counts them over all ranks. */
 #include "contact.h"
 #include "estimate.h"
 
@@ -46,7 +47,7 @@ PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DM
     }
   else
     lo = hi;
-  PetscCall(DMLabelCreate(PETSC_COMM_SELF, "adapt", marked));
+  if (!*marked) PetscCall(DMLabelCreate(PETSC_COMM_SELF, "adapt", marked));
   for (PetscInt c = 0; c < est->ncells; ++c)
     if (est->cell[c] >= lo && est->cell[c] > 0.0) {
       PetscCall(DMLabelSetValue(*marked, cStart + c, DM_ADAPT_REFINE));
@@ -58,8 +59,8 @@ PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DM
 
 /* The cells around each contact node the mesh does not see (ContactUnseenNodes(): it penetrates the obstacle while the
    rule exerts no force on it, as on a mesh whose Gauss points all miss the contact zone, where the solution and the
-   estimate are zero) are marked too (added to *marked, created if NULL), so that the cycles refine until the rule sees
-   the contact; *nunseen counts the nodes over all ranks. */
+   estimate are zero) are marked too (added to *marked, created if NULL and there is one), so that the cycles refine
+   until the rule sees the contact; *nunseen counts the nodes over all ranks. */
 PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nunseen)
 {
   const ContactSet *cs;
@@ -71,7 +72,7 @@ PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *ma
   PetscCall(PetscMalloc1(cs->n + 1, &unseen));
   PetscCall(ContactUnseenNodes(user->contact, u, unseen, nunseen));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
-  for (PetscInt i = 0; i < cs->n && marked; ++i) {
+  for (PetscInt i = 0; i < cs->n; ++i) {
     PetscInt *star = NULL, nstar;
 
     if (!unseen[i]) continue;

@@ -155,12 +155,12 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
 
     PetscCall(AdaptRecord(*dm, user, *u, k));
     PetscCall(CycleBarsCompute(user, dim, k));
-    PetscCall(EstimateMarkUnseenContact(*dm, user, *u, NULL, &c->unseen));
+    PetscCall(EstimateMarkUnseenContact(*dm, user, *u, &marked, &c->unseen)); /* the cells around the contact the mesh misses */
     c->accurate = Accurate(ad, c);
-    if (c->accurate || k == ad->cycles || !user->rec.stats.converged) break;
-    PetscCall(EstimateMark(*dm, &user->rec.estimate, ad->fraction, &marked, &c->marked));
-    PetscCall(EstimateMarkUnseenContact(*dm, user, *u, &marked, &c->unseen));
-    if (!c->marked && !c->unseen) { /* a zero estimate: nothing to refine */
+    if (!c->accurate && k < ad->cycles && user->rec.stats.converged)
+      PetscCall(EstimateMark(*dm, &user->rec.estimate, ad->fraction, &marked, &c->marked));
+    if (c->accurate || k == ad->cycles || !user->rec.stats.converged ||
+        (!c->marked && !c->unseen)) { /* done, or a zero estimate: nothing to refine */
       PetscCall(DMLabelDestroy(&marked));
       break;
     }
