@@ -17,7 +17,7 @@ else
 endif
 CFLAGS  ?= -O2 -g
 CFLAGS  += -std=c99 -Wall -Wextra -Wno-unused-parameter -Iinclude -Ibuild
-LDLIBS  += $(PETSC_LIBS) -lyaml -lmetis -lm
+LDLIBS  += $(PETSC_LIBS) -lgmsh -lyaml -lmetis -lm
 
 SRC = $(wildcard src/*.c src/*/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
@@ -28,7 +28,7 @@ STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
 deps:
-	@pkg-config --exists petsc && [ -f /usr/include/metis.h ] && [ -f /usr/include/yaml.h ] && command -v mpicc >/dev/null && command -v mpiexec >/dev/null && command -v pvbatch >/dev/null && \
+	@pkg-config --exists petsc && [ -f /usr/include/metis.h ] && [ -f /usr/include/gmshc.h ] && [ -f /usr/include/yaml.h ] && command -v mpicc >/dev/null && command -v mpiexec >/dev/null && command -v pvbatch >/dev/null && \
 	  $(PYTHON) -c "import h5py, numpy, matplotlib, yaml, pytest, gmsh, getfem, dolfinx" 2>/dev/null || sh scripts/install-deps.sh
 
 # -MMD -MP: each object depends on the headers it includes (build/*.d), and only those

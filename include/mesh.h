@@ -6,6 +6,7 @@
 PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const PetscInt coarse_requests[2], const PetscInt coarse_faces[3],
                           PetscInt coarse_min_levels, MeshBox *box, DM *dm);
 PetscErrorCode MeshIndexCellTypes(DM dm);
+PetscErrorCode MeshReadRemeshed(MPI_Comm comm, const char filename[], DM *dm);
 PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[]);
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],
                                     PetscBool distribute, PetscInt slab_rows, PetscBool petsc_interpolate, PetscBool check, DM *dm);
@@ -81,6 +82,9 @@ PetscErrorCode MeshInterpolateVertexSources(DM dm, DM fine, const PetscInt verte
 PetscErrorCode MeshInterpolateVertexArrays(DM dm, DM fine, const PetscInt vertex_source[], PetscInt nc, PetscReal *const coarse[],
                                            PetscReal *fine_values[]);
 PetscErrorCode MeshInterpolateFromParents(DM dm, DM fine, const PetscInt parent[], PetscInt nvec, Vec loc[], Vec fine_loc[]);
+
+/* mesh_remesh.c: the Gmsh model meshed again with a size per cell of dm (-adapt_model) */
+PetscErrorCode MeshRemesh(DM dm, const char model[], const PetscReal size[], DM *remeshed);
 
 /* mesh_partition.c */
 PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm);

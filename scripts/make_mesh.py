@@ -8,6 +8,8 @@
   make_mesh.py block          -o FILE.msh [--radius R] ...   (2D: [0,R] x [-R,0], indented at the origin from above)
   make_mesh.py quarter-block  -o FILE.msh [--radius R] ...   (3D: [0,R]^2 x [-R,0])
 
+With --model FILE.geo the geometry is written too (FILE.geo and FILE.brep): the model the solver remeshes with
+-adapt_model when it refines a curved body or a 3D mesh (docs/estimate.md).
 The mesh size is h_near at the origin and h_near + G r up to the distance --near from it (--grade G, default 0: the
 size is h_near there), then grows linearly to h_far over the distance W (default R/2). A grade keeps the cells across
 a contact zone that grows, as along a load path, about as many at every size of it (docs/hertz.md).
@@ -36,15 +38,17 @@ def main(argv=None):
     parser.add_argument("--width", type=float, help="distance over which the size grows from h-near to h-far (default radius/2)")
     parser.add_argument("--near", type=float, default=0.0, help="distance from the origin up to which the size is h-near + grade r (default 0)")
     parser.add_argument("--grade", type=float, default=0.0, help="growth of the size with the distance r inside --near (default 0)")
+    parser.add_argument("--model", help="also write the geometry as a Gmsh model (a .geo and its .brep), for -adapt_model")
     args = parser.parse_args(argv)
     h_far = args.h_far if args.h_far is not None else DEFAULTS[args.shape][0] * args.radius
     h_near = args.h_near if args.h_near is not None else DEFAULTS[args.shape][1] * args.radius
     try:
-        SHAPES[args.shape](args.output, radius=args.radius, h_far=h_far, h_near=h_near, width=args.width, near=args.near, grade=args.grade)
+        SHAPES[args.shape](args.output, radius=args.radius, h_far=h_far, h_near=h_near, width=args.width, near=args.near, grade=args.grade,
+                            model=args.model)
     except ValueError as exc:
         print(f"make_mesh.py: {exc}", file=sys.stderr)
         return 2
-    print(f"written {args.output}")
+    print(f"written {args.output}" + (f", {args.model}" if args.model else ""))
     return 0
 
 

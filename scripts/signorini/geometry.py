@@ -8,6 +8,7 @@ linearly to h_far over the distance width. A grade makes the cells across a cont
 every a inside near: what a load path, whose zone grows from small, needs at every step.
 """
 import contextlib
+import os
 
 import gmsh
 
@@ -58,12 +59,50 @@ def _model(name):
         gmsh.finalize()
 
 
-def _write(path, dim, h_near, h_far, width, near=0.0, grade=0.0):
-    """The body's physical group, the size field, the mesh, and the file."""
+def _groups():
+    """Each physical group's dimension, tag and name, and the bounding boxes of its entities (sorted)."""
+    out = {}
+    for d, tag in gmsh.model.getPhysicalGroups():
+        boxes = sorted(tuple(round(v, 9) for v in gmsh.model.getBoundingBox(d, e)) for e in gmsh.model.getEntitiesForPhysicalGroup(d, tag))
+        out[(d, tag)] = (gmsh.model.getPhysicalName(d, tag), boxes)
+    return out
+
+
+def _write_model(model):
+    """The geometry as a Gmsh model the solver remeshes (-adapt_model): the OpenCASCADE shape in model's .brep, and
+    model, a .geo that merges it and names the physical groups, without any mesh size (the solver gives its own). A
+    .brep read back numbers its entities anew, so the groups' entities are found again in it by their bounding boxes;
+    the .geo is then read back and checked: the same groups of the same entities."""
+    brep = os.path.splitext(model)[0] + ".brep"
+    kind = {0: "Point", 1: "Curve", 2: "Surface", 3: "Volume"}
+    groups = _groups()
+    gmsh.write(brep)
+    gmsh.clear()
+    gmsh.merge(brep)
+    lines = ["// The geometry of a mesh written by scripts/make_mesh.py, for the solver's remeshing (-adapt_model)",
+             'SetFactory("OpenCASCADE");', f'Merge "{os.path.basename(brep)}";']
+    for (d, tag), (name, boxes) in sorted(groups.items()):
+        found = {tuple(round(v, 9) for v in gmsh.model.getBoundingBox(d, e)): e for _, e in gmsh.model.getEntities(d)}
+        if any(b not in found for b in boxes):
+            raise ValueError(f"the model {brep} read back lacks entities of the physical group {name}")
+        entities = ", ".join(str(found[b]) for b in boxes)
+        lines.append(f'Physical {kind[d]}("{name}", {tag}) = {{{entities}}};')
+    with open(model, "w") as f:
+        f.write("\n".join(lines) + "\n")
+    gmsh.clear()
+    gmsh.open(model)
+    if _groups() != groups:
+        raise ValueError(f"the model {model} read back does not give the same physical groups")
+
+
+def _write(path, dim, h_near, h_far, width, near=0.0, grade=0.0, model=None):
+    """The body's physical group, the size field, the mesh, and the file; with model, the geometry too."""
     _physical(dim, [tag for _, tag in gmsh.model.getEntities(dim)], BODY_GROUP, "body")
     _size_field(h_near, h_far, width, dim, near, grade)
     gmsh.model.mesh.generate(dim)
     gmsh.write(path)
+    if model:
+        _write_model(model)
 
 
 def _check(radius, h_far, h_near, width, near=0.0, grade=0.0):
@@ -80,7 +119,7 @@ def _check(radius, h_far, h_near, width, near=0.0, grade=0.0):
         raise ValueError(f"the size at near, h_near + grade near ({h_near + grade * near:g}), must not exceed h_far ({h_far})")
 
 
-def half_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0, grade=0.0):
+def half_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0, grade=0.0, model=None):
     """The lower half of the disk of the given radius centred at (0, radius): the arc (Gamma_C, "contact") touches the
     plane y = 0 at the origin, the flat top y = radius is "top". Triangles; writes a Gmsh .msh file at path."""
     width = radius / 2 if width is None else width
@@ -95,10 +134,10 @@ def half_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0, gr
         curves = [tag for _, tag in gmsh.model.getEntities(1)]
         _physical(1, [c for c in curves if c not in top], HALF_DISK_GROUPS["contact"], "contact")
         _physical(1, top, HALF_DISK_GROUPS["top"], "top")
-        _write(path, 2, h_near, h_far, width, near, grade)
+        _write(path, 2, h_near, h_far, width, near, grade, model)
 
 
-def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.0, grade=0.0):
+def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.0, grade=0.0, model=None):
     """The quarter of the lower half of the ball of the given radius centred at (0, 0, radius) with x >= 0 and y >= 0:
     the curved surface ("contact") touches the plane z = 0 at the origin, the flat top z = radius is "top", and the
     planes x = 0 and y = 0 are "symmetry_x" and "symmetry_y". Tetrahedra; writes a Gmsh .msh file at path."""
@@ -118,10 +157,10 @@ def quarter_sphere(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.
         _physical(2, top, QUARTER_SPHERE_GROUPS["top"], "top")
         _physical(2, sym_y, QUARTER_SPHERE_GROUPS["symmetry_y"], "symmetry_y")
         _physical(2, sym_x, QUARTER_SPHERE_GROUPS["symmetry_x"], "symmetry_x")
-        _write(path, 3, h_near, h_far, width, near, grade)
+        _write(path, 3, h_near, h_far, width, near, grade, model)
 
 
-def quarter_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0, grade=0.0):
+def quarter_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0, grade=0.0, model=None):
     """The half of the half-disk with x >= 0: the arc ("contact") touches the plane y = 0 at the origin, the flat top
     y = radius is "top", the plane x = 0 is "symmetry_x". Triangles; writes a Gmsh .msh file at path."""
     width = radius / 2 if width is None else width
@@ -138,10 +177,10 @@ def quarter_disk(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0,
         _physical(1, [c for c in curves if c not in top + sym_x], QUARTER_DISK_GROUPS["contact"], "contact")
         _physical(1, top, QUARTER_DISK_GROUPS["top"], "top")
         _physical(1, sym_x, QUARTER_DISK_GROUPS["symmetry_x"], "symmetry_x")
-        _write(path, 2, h_near, h_far, width, near, grade)
+        _write(path, 2, h_near, h_far, width, near, grade, model)
 
 
-def block(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0, grade=0.0):
+def block(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0, grade=0.0, model=None):
     """The rectangle [0, radius] x [-radius, 0], to be indented at the origin from above: its top y = 0 is "contact",
     its bottom "bottom", x = 0 "symmetry_x", x = radius "side". Triangles; writes a Gmsh .msh file at path."""
     width = radius / 2 if width is None else width
@@ -156,10 +195,10 @@ def block(path, radius=1.0, h_far=0.1, h_near=0.02, width=None, near=0.0, grade=
                   "side": _entities_in_box(1, (radius, -radius, 0), (radius, 0, 0), eps)}
         for name, tags in groups.items():
             _physical(1, tags, BLOCK_GROUPS[name], name)
-        _write(path, 2, h_near, h_far, width, near, grade)
+        _write(path, 2, h_near, h_far, width, near, grade, model)
 
 
-def quarter_block(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.0, grade=0.0):
+def quarter_block(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.0, grade=0.0, model=None):
     """The box [0, radius]^2 x [-radius, 0], to be indented at the origin from above: its top z = 0 is "contact", its
     bottom "bottom", x = 0 "symmetry_x", y = 0 "symmetry_y", the faces x = radius and y = radius "side". Tetrahedra."""
     width = radius / 2 if width is None else width
@@ -176,7 +215,7 @@ def quarter_block(path, radius=1.0, h_far=0.2, h_near=0.05, width=None, near=0.0
                   "side": _entities_in_box(2, (r, 0, -r), (r, r, 0), eps) + _entities_in_box(2, (0, r, -r), (r, r, 0), eps)}
         for name, tags in groups.items():
             _physical(2, tags, QUARTER_BLOCK_GROUPS[name], name)
-        _write(path, 3, h_near, h_far, width, near, grade)
+        _write(path, 3, h_near, h_far, width, near, grade, model)
 
 
 SHAPES = {"half-disk": half_disk, "quarter-disk": quarter_disk, "quarter-sphere": quarter_sphere, "block": block, "quarter-block": quarter_block}

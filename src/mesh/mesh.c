@@ -265,6 +265,20 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* A mesh Gmsh wrote for the run (mesh_remesh.c), read as a mesh file is: checked, its physical groups' names, and
+   distributed by METIS. */
+PetscErrorCode MeshReadRemeshed(MPI_Comm comm, const char filename[], DM *dm)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MeshReadFile(comm, filename, dm));
+  PetscCall(MeshCheckFile(*dm, filename));
+  PetscCall(MeshLabelGmshNames(*dm, filename));
+  PetscCall(MeshPartitionDistribute(MESH_PARTITIONER_METIS, dm));
+  PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
+  PetscCall(PetscObjectSetName((PetscObject)*dm, "mesh"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* PETSc 3.18 looks a point's cell type up in the "celltype" label (DMPlexGetCellType(), called for every point of every
    DMPlexGetTransitiveClosure()). Its DMPlexGetGhostCellStratum(), which the section's creation and the insertion of
    Dirichlet values call, turns every stratum of that label into a hash set after reading it: a lookup then queries a

@@ -38,7 +38,17 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
   PetscCall(PetscOptionsEnumArray("-accuracy_quantity",
                                   "The quantities -accuracy asks for (energy: the energy-norm estimate against the solution's energy norm)", NULL,
                                   AccuracyQuantities, quantities, &nq, &quantities_given));
+  ad->model[0] = '\0';
+  PetscCall(PetscOptionsString("-adapt_model",
+                               "A Gmsh model (.geo) of the body, meshed again by Gmsh at each cycle with the sizes the marking asks for (3D, curved boundaries)",
+                               "MeshRemesh", ad->model, ad->model, sizeof(ad->model), NULL));
   PetscOptionsEnd();
+  if (ad->model[0]) {
+    PetscBool exists;
+
+    PetscCall(PetscTestFile(ad->model, 'r', &exists));
+    PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "-adapt_model: the Gmsh model '%s' does not exist or cannot be read", ad->model);
+  }
   PetscCheck(ad->cycles >= 0, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles must be >= 0, got %" PetscInt_FMT, ad->cycles);
   PetscCheck(ad->fraction > 0.0 && ad->fraction <= 1.0, comm, PETSC_ERR_USER_INPUT, "-adapt_fraction must lie in (0, 1], got %g",
              (double)ad->fraction);
@@ -71,9 +81,12 @@ PetscErrorCode AdaptCheck(DM dm, const AppCtx *user)
   PetscCall(DMPlexIsSimplex(dm, &simplex));
   PetscCall(ContactGetOptions(user->contact, &copt));
   PetscCall(PetscStrcmp(opt->solver.given.pc_type, PCMG, &is_mg));
-  PetscCheck(dim == 2 && simplex, comm, PETSC_ERR_USER_INPUT,
-             "-adapt_cycles refines triangles only (2D): PETSc 3.18 as Debian builds it has no conforming local refinement of %s",
-             dim == 3 ? "tetrahedra" : "quadrilaterals");
+  PetscCheck(simplex, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles refines triangles and tetrahedra only, not %s",
+             dim == 3 ? "hexahedra" : "quadrilaterals");
+  PetscCheck(dim == 2 || opt->adapt.model[0], comm, PETSC_ERR_USER_INPUT,
+             "-adapt_cycles in 3D needs the Gmsh model of the body (-adapt_model FILE.geo), which Gmsh meshes again at each cycle: PETSc 3.18 "
+             "as Debian builds it has no conforming local refinement of tetrahedra (scripts/make_mesh.py --model FILE.geo writes the model of "
+             "its meshes)");
   PetscCheck(opt->degree == 1, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles needs P1 displacements, got -displacement_petscspace_degree %" PetscInt_FMT,
              opt->degree);
   PetscCheck(opt->estimate, comm, PETSC_ERR_USER_INPUT,
@@ -86,12 +99,12 @@ PetscErrorCode AdaptCheck(DM dm, const AppCtx *user)
              "-adapt_cycles with -reference is not supported: the reference is on another mesh");
   PetscCheck(!is_mg, comm, PETSC_ERR_USER_INPUT,
              "-adapt_cycles with -pc_type mg is not supported yet: use GAMG (options/solvers/gamg.yaml) or MUMPS");
-  PetscCheck(!user->box.from_file || user->box.curved_ridges < MESH_CURVED_RIDGES_MIN, comm, PETSC_ERR_USER_INPUT,
+  PetscCheck(opt->adapt.model[0] || !user->box.from_file || user->box.curved_ridges < MESH_CURVED_RIDGES_MIN, comm, PETSC_ERR_USER_INPUT,
              "-adapt_cycles: the mesh file's boundary turns by less than 20 degrees at %" PetscInt_FMT
              " of its vertices (one at %g, %g), a curved boundary's chords: the refinement would split them on the chords, and the "
              "answer would be the file's polygon's, not the curved body's (the Hertz cylinder meshed at h = 0.05: its contact width 27%% short "
-             "after 10 cycles); refinement that follows the Gmsh model is not there yet (issue 34): mesh finer with Gmsh, or refine a "
-             "polygonal body",
+             "after 10 cycles): give the body's Gmsh model (-adapt_model FILE.geo; scripts/make_mesh.py --model FILE.geo writes it), "
+             "which Gmsh meshes again at each cycle, its boundary exact",
              user->box.curved_ridges, (double)user->box.curved_x[0], (double)user->box.curved_x[1]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -164,9 +177,10 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
       PetscCall(DMLabelDestroy(&marked));
       break;
     }
-    PetscCall(GridSequenceRefine(dm, user, snes, u, marked));
+    if (ad->model[0]) PetscCall(GridSequenceRemesh(dm, user, snes, u, marked));
+    else PetscCall(GridSequenceRefine(dm, user, snes, u, marked));
     PetscCall(DMLabelDestroy(&marked));
-    PetscCall(SolverSolve(*snes, user, *u, SOLVER_START_COARSER_MESH));
+    PetscCall(SolverSolve(*snes, user, *u, ad->model[0] ? SOLVER_START_ZERO : SOLVER_START_COARSER_MESH));
   }
   PetscCall(EstimateReset(&user->rec.estimate)); /* the run's own, after the last solve, as without cycles */
   PetscCall(ErrorNormsReset(&user->rec.errors));

@@ -64,6 +64,44 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The next mesh of the adaptive cycles from the Gmsh model (-adapt_model, MeshRemesh()): each cell asks for its mean
+   edge length, halved where marked, and Gmsh meshes the model with these sizes. The meshes do not nest: the solve
+   starts from zero, and the last solution is dropped. */
+PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked)
+{
+  DM         fine;
+  PetscReal *size;
+  PetscInt   cStart, cEnd;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMPlexGetHeightStratum(*dm, 0, &cStart, &cEnd));
+  PetscCall(PetscMalloc1(cEnd - cStart + 1, &size));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    PetscInt verts[4], nv, value = -1, nedges = 0;
+    PetscReal x[4][3] = {{0.0}}, sum = 0.0;
+
+    PetscCall(MeshCellVertices(*dm, c, verts, &nv));
+    for (PetscInt k = 0; k < nv; ++k) PetscCall(MeshPointPosition(*dm, verts[k], x[k]));
+    for (PetscInt i = 0; i < nv; ++i)
+      for (PetscInt j = i + 1; j < nv; ++j, ++nedges) sum += PetscSqrtReal(PetscSqr(x[i][0] - x[j][0]) + PetscSqr(x[i][1] - x[j][1]) + PetscSqr(x[i][2] - x[j][2]));
+    if (marked) PetscCall(DMLabelGetValue(marked, c, &value));
+    size[c - cStart] = (sum / nedges) * (value == DM_ADAPT_REFINE ? 0.5 : 1.0);
+  }
+  PetscCall(VecDestroy(u));
+  PetscCall(ProblemDestroy(user, snes));
+  PetscCall(MeshRemesh(*dm, user->opt->adapt.model, size, &fine));
+  PetscCall(PetscFree(size));
+  user->prob.level++;
+  PetscCall(MeshSetContactCellSizes(fine, user->scene.bcs.ncontact, user->scene.bcs.contact_ids)); /* one eps on Gamma_C */
+  PetscCall(ProblemSetUp(fine, user, snes));
+  PetscCall(DMDestroy(dm));
+  *dm = fine;
+  PetscCall(DMCreateGlobalVector(fine, u));
+  PetscCall(PetscObjectSetName((PetscObject)*u, "displacement"));
+  PetscCall(VecZeroEntries(*u));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Newton's relative tolerance on a box below the one of the options (-contact_coarse_levels): -contact_coarse_rtol where
    looser than -snes_rtol. Its solution is only the next level's initial guess, whose own error is of the order of h. */
 static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
