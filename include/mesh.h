@@ -11,6 +11,7 @@ PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, cons
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],
                                     PetscBool distribute, PetscInt slab_rows, PetscBool petsc_interpolate, PetscBool check, DM *dm);
 PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[]);
+PetscInt       MeshBoxFaceId(PetscInt dim, PetscInt d, PetscInt s);
 PetscErrorCode MeshCreateBoxLevel(DM coarse, const MeshBox *box, PetscInt level, DM *fine, PetscInt **vertex_source);
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
 PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam);
@@ -83,8 +84,9 @@ PetscErrorCode MeshInterpolateVertexArrays(DM dm, DM fine, const PetscInt vertex
                                            PetscReal *fine_values[]);
 PetscErrorCode MeshInterpolateFromParents(DM dm, DM fine, const PetscInt parent[], PetscInt nvec, Vec loc[], Vec fine_loc[]);
 
-/* mesh_remesh.c: the Gmsh model meshed again with a size per cell of dm (-adapt_model) */
-PetscErrorCode MeshRemesh(DM dm, const char model[], const PetscReal size[], DM *remeshed);
+/* mesh_remesh.c: the Gmsh model meshed again with a size per cell of dm (-adapt_model), or the box of the options
+   (model "" and box) */
+PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const PetscReal size[], DM *remeshed);
 
 /* mesh_partition.c */
 PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm);

@@ -361,10 +361,10 @@ typedef struct {
 typedef enum { ACCURACY_ENERGY, ACCURACY_FORCE, ACCURACY_PRESSURE, ACCURACY_SIZE, ACCURACY_NUM } AccuracyQuantity;
 extern const char *const AccuracyQuantities[];
 typedef struct {
-  PetscInt  cycles;               /* 0: no adaptive refinement; with -accuracy, the most cycles */
-  PetscReal fraction;             /* -adapt_fraction */
-  PetscReal accuracy;             /* -accuracy: the relative error asked for (0: none), */
-  PetscBool target[ACCURACY_NUM]; /*   of these quantities (-accuracy_quantity) */
+  PetscInt  cycles;                    /* 0: no adaptive refinement; with -accuracy, the most cycles */
+  PetscReal fraction;                  /* -adapt_fraction */
+  PetscReal accuracy;                  /* -accuracy: the relative error asked for (0: none), */
+  PetscBool target[ACCURACY_NUM];      /*   of these quantities (-accuracy_quantity) */
   char      model[PETSC_MAX_PATH_LEN]; /* -adapt_model: the Gmsh model remeshed at each cycle ("": the mesh refined) */
 } AdaptOptions;
 

@@ -133,7 +133,7 @@ BAD = {"zero": (MMS + ["-accuracy", 0, "-accuracy_quantity", "energy"], "-accura
        "one": (MMS + ["-accuracy", 1.5], "-accuracy is a relative error in (0, 1)"),
        "no_cycles": (MMS + ["-accuracy", 0.1, "-adapt_cycles", 0], "-adapt_cycles 0 leaves it no cycle"),
        "name": (MMS + ["-accuracy", 0.1, "-accuracy_quantity", "force"], "Unknown enum value 'force' for -accuracy_quantity"),
-       "3d": (MMS + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "4,4,4", "-accuracy", 0.1], "-adapt_cycles in 3D needs the Gmsh model of the body")}
+       "quads": (MMS + ["-dm_plex_simplex", 0, "-accuracy", 0.1], "-adapt_cycles refines triangles and tetrahedra only, not quadrilaterals")}
 
 
 @pytest.mark.parametrize("case", BAD)

@@ -97,7 +97,7 @@ def test_refining_every_cell_is_the_uniform_box():
         assert abs(a[k] - b[k]) <= 1e-9 * abs(b[k]), (k, a[k], b[k])
 
 
-BAD_ADAPT = {"3d": (SQUARE + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "4,4,4", "-adapt_cycles", 1], "-adapt_cycles in 3D needs the Gmsh model of the body"),
+BAD_ADAPT = {"quads": (SQUARE + ["-dm_plex_simplex", 0, "-adapt_cycles", 1], "-adapt_cycles refines triangles and tetrahedra only, not quadrilaterals"),
              "bars": (MMS + ["-dm_plex_box_faces", "16,16", "-bars", "-adapt_cycles", 1], "-adapt_cycles with -bars"),
              "sweep": (SQUARE + ["-penalty_eps0_sweep", "1,0.1", "-adapt_cycles", 1], "-adapt_cycles with -penalty_eps0_sweep"),
              "no_estimate": (SQUARE + ["-estimate", "false", "-adapt_cycles", 1], "cannot run with -estimate false"),

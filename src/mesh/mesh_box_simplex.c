@@ -153,16 +153,23 @@ PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* "Face Sets" with PETSc's box numbering (2D: bottom 1, right 2, top 3, left 4;
-   3D: bottom z=0 1, top 2, front y=0 3, back 4, right x=1 5, left x=0 6), and "marker" = 1 on the boundary. A face is on
-   the boundary when its centroid lies on a side of the box: on a distributed mesh, a face at a rank's border also has
-   one cell on that rank. */
-PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[])
+/* PETSc's box numbering of the sides (2D: bottom 1, right 2, top 3, left 4; 3D: bottom z=0 1, top 2, front y=0 3,
+   back 4, right x=1 5, left x=0 6): the "Face Sets" value of the side x_d = lower (s = 0) or upper (s = 1). */
+PetscInt MeshBoxFaceId(PetscInt dim, PetscInt d, PetscInt s)
 {
   const PetscInt ids2[2][2] = {{4, 2}, {1, 3}};
   const PetscInt ids3[3][2] = {{6, 5}, {3, 4}, {1, 2}};
-  PetscInt       dim, fStart, fEnd;
-  DMLabel        face_sets, marker;
+
+  return dim == 2 ? ids2[d][s] : ids3[d][s];
+}
+
+/* "Face Sets" with PETSc's box numbering (MeshBoxFaceId()), and "marker" = 1 on the boundary. A face is on the
+   boundary when its centroid lies on a side of the box: on a distributed mesh, a face at a rank's border also has one
+   cell on that rank. */
+PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[])
+{
+  PetscInt dim, fStart, fEnd;
+  DMLabel  face_sets, marker;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
@@ -185,7 +192,7 @@ PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal
       for (PetscInt s = 0; s < 2; ++s) {
         const PetscReal side = s ? upper[d] : lower[d];
         if (PetscAbsReal(centroid[d] - side) < tol) {
-          PetscCall(DMLabelSetValue(face_sets, f, dim == 2 ? ids2[d][s] : ids3[d][s]));
+          PetscCall(DMLabelSetValue(face_sets, f, MeshBoxFaceId(dim, d, s)));
           on_side = PETSC_TRUE;
         }
       }

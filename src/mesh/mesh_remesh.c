@@ -15,7 +15,8 @@
      shrank. The smallest spreads a mark to the cells around it: 314 to 55,255 unknowns in 7 cycles.
    Gmsh runs on rank 0 on the gathered cells, sorted by their centroids so that the view is the same on any number of
    ranks (Gmsh's search of a point's cell depends on their order where the values jump); the mesh it writes is read by
-   all ranks and distributed as a mesh file is (METIS). */
+   all ranks and distributed as a mesh file is (METIS).
+   Without a model, the box of the options (-dm_plex_box_*) is the model: a 3D box adapts so. */
 #include <gmshc.h>
 #include <petscsf.h>
 #include <stdlib.h>
@@ -23,21 +24,59 @@
 #include "mesh.h"
 
 /* A Gmsh call's error as a PETSc error, with Gmsh's last message. */
-#define GmshCall(call, what) \
-  do { \
-    int ierr_gmsh = 0; \
-    call; \
-    if (ierr_gmsh) { \
-      char *msg = NULL; \
-      int   e2  = 0; \
-      gmshLoggerGetLastError(&msg, &e2); \
-      SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "Gmsh failed to %s: %s", what, msg && msg[0] ? msg : "(no message)"); \
-    } \
+#define GmshCall(call, what)                                                                                       \
+  do {                                                                                                             \
+    int ierr_gmsh = 0;                                                                                             \
+    call;                                                                                                          \
+    if (ierr_gmsh) {                                                                                               \
+      char *msg = NULL;                                                                                            \
+      int   e2  = 0;                                                                                               \
+      gmshLoggerGetLastError(&msg, &e2);                                                                           \
+      SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "Gmsh failed to %s: %s", what, msg &&msg[0] ? msg : "(no message)"); \
+    }                                                                                                              \
   } while (0)
 
-/* Rank 0's part: the model opened, the cells' sizes as its background mesh, the mesh generated and written. data:
-   ncells cells of nv vertices, each as Gmsh's list data (x of the vertices, then y, then z, then the size at each). */
-static PetscErrorCode GmshRemesh(const char model[], PetscInt dim, PetscInt ncells, PetscInt nv, double data[], const char out[])
+/* The box of the options as a Gmsh model: an OpenCASCADE box (rectangle in 2D), its sides' physical groups numbered
+   as PETSc numbers them (MeshBoxFaceId(), found by their bounding boxes), the body 10. */
+static PetscErrorCode GmshBoxModel(const MeshBox *box)
+{
+  const PetscInt dim = box->dim;
+  const double  *lo = box->lower, *hi = box->upper;
+  int           *dimtags = NULL, body;
+  size_t         n       = 0;
+
+  PetscFunctionBeginUser;
+  GmshCall(gmshModelAdd("box", &ierr_gmsh), "add the box model");
+  if (dim == 3)
+    GmshCall(body = gmshModelOccAddBox(lo[0], lo[1], lo[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], -1, &ierr_gmsh), "add the box");
+  else
+    GmshCall(body = gmshModelOccAddRectangle(lo[0], lo[1], 0.0, hi[0] - lo[0], hi[1] - lo[1], -1, 0.0, &ierr_gmsh), "add the rectangle");
+  GmshCall(gmshModelOccSynchronize(&ierr_gmsh), "synchronize the box");
+  GmshCall(gmshModelGetEntities(&dimtags, &n, (int)dim - 1, &ierr_gmsh), "list the box's sides");
+  for (size_t i = 0; i < n / 2; ++i) {
+    double   bb[6];
+    int      side = dimtags[2 * i + 1];
+    PetscInt id   = -1;
+
+    GmshCall(gmshModelGetBoundingBox((int)dim - 1, side, &bb[0], &bb[1], &bb[2], &bb[3], &bb[4], &bb[5], &ierr_gmsh), "bound a side");
+    for (PetscInt d = 0; d < dim; ++d) {
+      const double tol = 1e-6 * (hi[d] - lo[d]);
+
+      if (bb[3 + d] - bb[d] > 2 * tol) continue; /* the side is flat across d */
+      id = MeshBoxFaceId(dim, d, PetscAbsReal(bb[d] - lo[d]) < PetscAbsReal(bb[d] - hi[d]) ? 0 : 1);
+    }
+    PetscCheck(id > 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "a side of the Gmsh box is on no side of the box");
+    GmshCall(gmshModelAddPhysicalGroup((int)dim - 1, &side, 1, (int)id, &ierr_gmsh), "name a side");
+  }
+  gmshFree(dimtags);
+  GmshCall(gmshModelAddPhysicalGroup((int)dim, &body, 1, 10, &ierr_gmsh), "name the body");
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Rank 0's part: the model opened (or the box built), the cells' sizes as its background mesh, the mesh generated and
+   written. data: ncells cells of nv vertices, each as Gmsh's list data (x of the vertices, then y, then z, then the
+   size at each). */
+static PetscErrorCode GmshRemesh(const char model[], const MeshBox *box, PetscInt dim, PetscInt ncells, PetscInt nv, double data[], const char out[])
 {
   int view, field;
 
@@ -45,7 +84,10 @@ static PetscErrorCode GmshRemesh(const char model[], PetscInt dim, PetscInt ncel
   GmshCall(gmshInitialize(0, NULL, 0, &ierr_gmsh), "start");
   GmshCall(gmshOptionSetNumber("General.Terminal", 0, &ierr_gmsh), "set General.Terminal");
   GmshCall(gmshOptionSetNumber("General.NumThreads", 1, &ierr_gmsh), "set General.NumThreads");
-  GmshCall(gmshOpen(model, &ierr_gmsh), "open the model (-adapt_model)");
+  if (model[0])
+    GmshCall(gmshOpen(model, &ierr_gmsh), "open the model (-adapt_model)");
+  else
+    PetscCall(GmshBoxModel(box));
   /* the size is the background mesh's alone: not the model's points', not extended from the boundary, not the
      curvature's */
   GmshCall(gmshOptionSetNumber("Mesh.MeshSizeExtendFromBoundary", 0, &ierr_gmsh), "set Mesh.MeshSizeExtendFromBoundary");
@@ -95,9 +137,9 @@ static PetscErrorCode VertexSizes(DM dm, const PetscReal size[], PetscReal **vsi
 }
 
 /* The cells' list data in the order of their centroids (lexicographic in x, y, z): the same on any partition. */
-static PetscInt sort_per, sort_nv;
+static PetscInt      sort_per, sort_nv;
 static const double *sort_data;
-static int CompareCentroids(const void *a, const void *b)
+static int           CompareCentroids(const void *a, const void *b)
 {
   const double *da = &sort_data[*(const PetscInt *)a * sort_per], *db = &sort_data[*(const PetscInt *)b * sort_per];
 
@@ -115,8 +157,8 @@ static int CompareCentroids(const void *a, const void *b)
 
 static PetscErrorCode SortCells(PetscInt ncells, PetscInt nv, double data[])
 {
-  PetscInt *order;
-  double   *copy;
+  PetscInt      *order;
+  double        *copy;
   const PetscInt per = 4 * nv;
 
   PetscFunctionBeginUser;
@@ -132,7 +174,7 @@ static PetscErrorCode SortCells(PetscInt ncells, PetscInt nv, double data[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode MeshRemesh(DM dm, const char model[], const PetscReal size[], DM *remeshed)
+PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const PetscReal size[], DM *remeshed)
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
   PetscMPIInt        rank, nranks, count, *counts = NULL, *displs = NULL;
@@ -193,7 +235,7 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const PetscReal size[], DM 
     PetscCall(PetscGetTmp(PETSC_COMM_SELF, tmp, sizeof(tmp)));
     PetscCall(PetscSNPrintf(out, sizeof(out), "%s/signorini-remesh-%d.msh", tmp, (int)getpid()));
     PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-    failed = GmshRemesh(model, dim, total / per, nv, all, out);
+    failed = GmshRemesh(model, box, dim, total / per, nv, all, out);
     PetscCall(PetscPopErrorHandler());
     if (failed) {
       const char *text     = NULL;
@@ -210,7 +252,7 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const PetscReal size[], DM 
   }
   PetscCallMPI(MPI_Bcast(&failed, 1, MPI_INT, 0, comm));
   PetscCallMPI(MPI_Bcast(why, sizeof(why), MPI_CHAR, 0, comm));
-  PetscCheck(!failed, comm, PETSC_ERR_LIB, "-adapt_model %s: %s", model, why);
+  PetscCheck(!failed, comm, PETSC_ERR_LIB, "-adapt_model %s: %s", model[0] ? model : "(the box of the options)", why);
   PetscCallMPI(MPI_Bcast(out, sizeof(out), MPI_CHAR, 0, comm));
   PetscCall(MeshReadRemeshed(comm, out, remeshed));
   PetscCallMPI(MPI_Barrier(comm));

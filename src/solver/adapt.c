@@ -39,9 +39,10 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
                                   "The quantities -accuracy asks for (energy: the energy-norm estimate against the solution's energy norm)", NULL,
                                   AccuracyQuantities, quantities, &nq, &quantities_given));
   ad->model[0] = '\0';
-  PetscCall(PetscOptionsString("-adapt_model",
-                               "A Gmsh model (.geo) of the body, meshed again by Gmsh at each cycle with the sizes the marking asks for (3D, curved boundaries)",
-                               "MeshRemesh", ad->model, ad->model, sizeof(ad->model), NULL));
+  PetscCall(PetscOptionsString(
+      "-adapt_model",
+      "A Gmsh model (.geo) of the body, meshed again by Gmsh at each cycle with the sizes the marking asks for (3D, curved boundaries)", "MeshRemesh",
+      ad->model, ad->model, sizeof(ad->model), NULL));
   PetscOptionsEnd();
   if (ad->model[0]) {
     PetscBool exists;
@@ -83,10 +84,10 @@ PetscErrorCode AdaptCheck(DM dm, const AppCtx *user)
   PetscCall(PetscStrcmp(opt->solver.given.pc_type, PCMG, &is_mg));
   PetscCheck(simplex, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles refines triangles and tetrahedra only, not %s",
              dim == 3 ? "hexahedra" : "quadrilaterals");
-  PetscCheck(dim == 2 || opt->adapt.model[0], comm, PETSC_ERR_USER_INPUT,
-             "-adapt_cycles in 3D needs the Gmsh model of the body (-adapt_model FILE.geo), which Gmsh meshes again at each cycle: PETSc 3.18 "
-             "as Debian builds it has no conforming local refinement of tetrahedra (scripts/make_mesh.py --model FILE.geo writes the model of "
-             "its meshes)");
+  PetscCheck(dim == 2 || opt->adapt.model[0] || !user->box.from_file, comm, PETSC_ERR_USER_INPUT,
+             "-adapt_cycles on a 3D mesh file needs the Gmsh model of the body (-adapt_model FILE.geo), which Gmsh meshes again at each cycle: "
+             "PETSc 3.18 as Debian builds it has no conforming local refinement of tetrahedra (scripts/make_mesh.py --model FILE.geo writes the "
+             "model of its meshes)");
   PetscCheck(opt->degree == 1, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles needs P1 displacements, got -displacement_petscspace_degree %" PetscInt_FMT,
              opt->degree);
   PetscCheck(opt->estimate, comm, PETSC_ERR_USER_INPUT,
@@ -157,10 +158,12 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
 {
   const AdaptOptions *ad = &user->opt->adapt;
   PetscInt            dim;
+  PetscBool           remesh;
 
   PetscFunctionBeginUser;
   if (!ad->cycles) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(*dm, &dim));
+  remesh = (PetscBool)(ad->model[0] || dim == 3); /* Gmsh meshes the model, or the 3D box of the options, again (MeshRemesh()) */
   PetscCall(PetscCalloc1(ad->cycles + 1, &user->rec.cycles));
   for (PetscInt k = 0;; ++k) {
     CycleRecord *c      = &user->rec.cycles[k];
@@ -177,10 +180,12 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
       PetscCall(DMLabelDestroy(&marked));
       break;
     }
-    if (ad->model[0]) PetscCall(GridSequenceRemesh(dm, user, snes, u, marked));
-    else PetscCall(GridSequenceRefine(dm, user, snes, u, marked));
+    if (remesh)
+      PetscCall(GridSequenceRemesh(dm, user, snes, u, marked));
+    else
+      PetscCall(GridSequenceRefine(dm, user, snes, u, marked));
     PetscCall(DMLabelDestroy(&marked));
-    PetscCall(SolverSolve(*snes, user, *u, ad->model[0] ? SOLVER_START_ZERO : SOLVER_START_COARSER_MESH));
+    PetscCall(SolverSolve(*snes, user, *u, remesh ? SOLVER_START_ZERO : SOLVER_START_COARSER_MESH));
   }
   PetscCall(EstimateReset(&user->rec.estimate)); /* the run's own, after the last solve, as without cycles */
   PetscCall(ErrorNormsReset(&user->rec.errors));

@@ -64,7 +64,8 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The next mesh of the adaptive cycles from the Gmsh model (-adapt_model, MeshRemesh()): each cell asks for its mean
+/* The next mesh of the adaptive cycles from the Gmsh model (-adapt_model; the 3D box of the options without it;
+   MeshRemesh()): each cell asks for its mean
    edge length, halved where marked, and Gmsh meshes the model with these sizes. The meshes do not nest: the solve
    starts from zero, and the last solution is dropped. */
 PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked)
@@ -77,19 +78,20 @@ PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   PetscCall(DMPlexGetHeightStratum(*dm, 0, &cStart, &cEnd));
   PetscCall(PetscMalloc1(cEnd - cStart + 1, &size));
   for (PetscInt c = cStart; c < cEnd; ++c) {
-    PetscInt verts[4], nv, value = -1, nedges = 0;
+    PetscInt  verts[4], nv, value = -1, nedges = 0;
     PetscReal x[4][3] = {{0.0}}, sum = 0.0;
 
     PetscCall(MeshCellVertices(*dm, c, verts, &nv));
     for (PetscInt k = 0; k < nv; ++k) PetscCall(MeshPointPosition(*dm, verts[k], x[k]));
     for (PetscInt i = 0; i < nv; ++i)
-      for (PetscInt j = i + 1; j < nv; ++j, ++nedges) sum += PetscSqrtReal(PetscSqr(x[i][0] - x[j][0]) + PetscSqr(x[i][1] - x[j][1]) + PetscSqr(x[i][2] - x[j][2]));
+      for (PetscInt j = i + 1; j < nv; ++j, ++nedges)
+        sum += PetscSqrtReal(PetscSqr(x[i][0] - x[j][0]) + PetscSqr(x[i][1] - x[j][1]) + PetscSqr(x[i][2] - x[j][2]));
     if (marked) PetscCall(DMLabelGetValue(marked, c, &value));
     size[c - cStart] = (sum / nedges) * (value == DM_ADAPT_REFINE ? 0.5 : 1.0);
   }
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
-  PetscCall(MeshRemesh(*dm, user->opt->adapt.model, size, &fine));
+  PetscCall(MeshRemesh(*dm, user->opt->adapt.model, &user->box, size, &fine));
   PetscCall(PetscFree(size));
   user->prob.level++;
   PetscCall(MeshSetContactCellSizes(fine, user->scene.bcs.ncontact, user->scene.bcs.contact_ids)); /* one eps on Gamma_C */
