@@ -17,13 +17,13 @@ else
 endif
 CFLAGS  ?= -O2 -g
 CFLAGS  += -std=c99 -Wall -Wextra -Wno-unused-parameter -Iinclude -Ibuild
-LDLIBS  += $(PETSC_LIBS) -lgmsh -lyaml -lmetis -lm
+LDLIBS  += $(PETSC_LIBS) -lyaml -lmetis -lm -ldl
 
 SRC = $(wildcard src/*.c src/*/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path penetration-tol estimates adapt-hertz accuracy-ladder bench format clean
+.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path penetration-tol estimates adapt-hertz accuracy-ladder accuracy-remesh bench format clean
 STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
@@ -132,6 +132,10 @@ adapt-hertz: deps
 accuracy-ladder: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/accuracy_ladder.py
+
+accuracy-remesh: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) scripts/accuracy_remesh.py
 
 # Performance (docs/solvers.md, "Performance"): bench/{bench,getfem,fenicsx,profile3d,bandwidth,targets}.{md,csv}, runs under bench/runs/
 bench: deps

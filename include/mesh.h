@@ -84,9 +84,15 @@ PetscErrorCode MeshInterpolateVertexArrays(DM dm, DM fine, const PetscInt vertex
                                            PetscReal *fine_values[]);
 PetscErrorCode MeshInterpolateFromParents(DM dm, DM fine, const PetscInt parent[], PetscInt nvec, Vec loc[], Vec fine_loc[]);
 
+/* mesh_transfer.c: a P1 field carried from a mesh to its remeshing (the old cells on rank 0) */
+typedef struct _n_MeshTransfer *MeshTransfer;
+PetscErrorCode                  MeshTransferCreate(MPI_Comm comm, PetscInt dim, PetscInt ncells, PetscReal x[], PetscReal u[], MeshTransfer *tr);
+PetscErrorCode                  MeshTransferApply(MeshTransfer tr, DM fine, Vec fine_loc);
+PetscErrorCode                  MeshTransferDestroy(MeshTransfer *tr);
+
 /* mesh_remesh.c: the Gmsh model meshed again with a size per cell of dm (-adapt_model), or the box of the options
-   (model "" and box) */
-PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const PetscReal size[], DM *remeshed);
+   (model "" and box); with loc (dm's local field), *tr carries it to the new mesh */
+PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const PetscReal size[], Vec loc, DM *remeshed, MeshTransfer *tr);
 
 /* mesh_partition.c */
 PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm);

@@ -383,6 +383,8 @@ typedef struct {
   PetscBool  accurate;            /* every quantity asked for within -accuracy */
   PetscInt   newton_its, ksp_its;
   PetscReal  time_solve;
+  PetscReal  time_mesh;  /* s: this cycle's mesh from the last (refined or remeshed) and its problem's set-up (0 for the first) */
+  PetscReal  time_cycle; /* s: the whole cycle, its mesh, solve, estimate and marking (cycle 0: the first solve on) */
   PetscBool  converged;
 } CycleRecord;
 

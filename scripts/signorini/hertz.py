@@ -143,6 +143,15 @@ def measure(case, path, step=None):
             "radius_sq": r2[boundary], "pressure": traction}
 
 
+def quantity_exact(case, force):
+    """The closed form of -accuracy's contact quantities at the force the run's modelled part takes: the largest
+    pressure p0 and the contact zone's size, its half-width a in 2D (the modelled half of the zone) and the area of the
+    zone's quarter, pi a^2 / 4, in 3D."""
+    c = CASES[case]
+    a, p0 = closed_form(c["dim"], c["parts"] * abs(force))
+    return {"pressure_max": p0, "contact_size": a if c["dim"] == 2 else math.pi * a * a / 4}
+
+
 def fit_profile(radius_sq, traction, a_h, inner=0.8):
     """(p0, a) of the Hertz profile fitted to the nodal tractions inside r < inner a_h: p^2 = p0^2 - (p0 / a)^2 r^2 is
     linear in r^2, so the fit is a linear least-squares one; it averages the node-to-node scatter of the tractions."""

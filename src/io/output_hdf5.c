@@ -651,6 +651,8 @@ static PetscErrorCode WriteCycles(MPI_Comm comm, const AppCtx *user, PetscViewer
   CYCLE_COLUMN("newton_its", (PetscReal)c[i].newton_its);
   CYCLE_COLUMN("ksp_its", (PetscReal)c[i].ksp_its);
   CYCLE_COLUMN("time_solve", c[i].time_solve);
+  CYCLE_COLUMN("time_mesh", c[i].time_mesh);
+  CYCLE_COLUMN("time_cycle", c[i].time_cycle);
   CYCLE_COLUMN("converged", c[i].converged ? 1.0 : 0.0);
 #undef CYCLE_COLUMN
   PetscCall(PetscViewerHDF5PopGroup(v));

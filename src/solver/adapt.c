@@ -159,22 +159,29 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
   const AdaptOptions *ad = &user->opt->adapt;
   PetscInt            dim;
   PetscBool           remesh;
+  PetscLogDouble      t_last, time_mesh = 0.0;
 
   PetscFunctionBeginUser;
   if (!ad->cycles) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(*dm, &dim));
   remesh = (PetscBool)(ad->model[0] || dim == 3); /* Gmsh meshes the model, or the 3D box of the options, again (MeshRemesh()) */
   PetscCall(PetscCalloc1(ad->cycles + 1, &user->rec.cycles));
+  PetscCall(PetscTime(&t_last));
   for (PetscInt k = 0;; ++k) {
-    CycleRecord *c      = &user->rec.cycles[k];
-    DMLabel      marked = NULL;
+    CycleRecord   *c      = &user->rec.cycles[k];
+    DMLabel        marked = NULL;
+    PetscLogDouble t0, t1;
 
     PetscCall(AdaptRecord(*dm, user, *u, k));
+    c->time_mesh = time_mesh;
     PetscCall(CycleBarsCompute(user, dim, k));
     PetscCall(EstimateMarkUnseenContact(*dm, user, *u, &marked, &c->unseen)); /* the cells around the contact the mesh misses */
     c->accurate = Accurate(ad, c);
     if (!c->accurate && k < ad->cycles && user->rec.stats.converged)
       PetscCall(EstimateMark(*dm, &user->rec.estimate, ad->fraction, &marked, &c->marked));
+    PetscCall(PetscTime(&t0)); /* the cycle: its mesh, its solve (the first solve for cycle 0), estimate and marking */
+    c->time_cycle = (t0 - t_last) + (k == 0 ? c->time_solve : 0.0);
+    t_last        = t0;
     if (c->accurate || k == ad->cycles || !user->rec.stats.converged ||
         (!c->marked && !c->unseen)) { /* done, or a zero estimate: nothing to refine */
       PetscCall(DMLabelDestroy(&marked));
@@ -184,8 +191,10 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
       PetscCall(GridSequenceRemesh(dm, user, snes, u, marked));
     else
       PetscCall(GridSequenceRefine(dm, user, snes, u, marked));
+    PetscCall(PetscTime(&t1));
+    time_mesh = t1 - t0; /* the next cycle's mesh and its problem's set-up */
     PetscCall(DMLabelDestroy(&marked));
-    PetscCall(SolverSolve(*snes, user, *u, remesh ? SOLVER_START_ZERO : SOLVER_START_COARSER_MESH));
+    PetscCall(SolverSolve(*snes, user, *u, SOLVER_START_COARSER_MESH));
   }
   PetscCall(EstimateReset(&user->rec.estimate)); /* the run's own, after the last solve, as without cycles */
   PetscCall(ErrorNormsReset(&user->rec.errors));

@@ -66,13 +66,16 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
 
 /* The next mesh of the adaptive cycles from the Gmsh model (-adapt_model; the 3D box of the options without it;
    MeshRemesh()): each cell asks for its mean
-   edge length, halved where marked, and Gmsh meshes the model with these sizes. The meshes do not nest: the solve
-   starts from zero, and the last solution is dropped. */
+   edge length, halved where marked, and Gmsh meshes the model with these sizes. The meshes do not nest: the last
+   solution is carried to the new mesh by locating each new vertex in the old mesh (MeshTransferApply()), the next
+   solve's start. */
 PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked)
 {
-  DM         fine;
-  PetscReal *size;
-  PetscInt   cStart, cEnd;
+  DM           fine;
+  PetscReal   *size;
+  PetscInt     cStart, cEnd;
+  Vec          loc;
+  MeshTransfer tr = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(DMPlexGetHeightStratum(*dm, 0, &cStart, &cEnd));
@@ -89,9 +92,13 @@ PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
     if (marked) PetscCall(DMLabelGetValue(marked, c, &value));
     size[c - cStart] = (sum / nedges) * (value == DM_ADAPT_REFINE ? 0.5 : 1.0);
   }
+  PetscCall(DMCreateLocalVector(*dm, &loc));
+  PetscCall(VecCopy(user->prob.loc_bc, loc)); /* the Dirichlet values, inserted by ProblemSetUp() */
+  PetscCall(DMGlobalToLocal(*dm, *u, INSERT_VALUES, loc));
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
-  PetscCall(MeshRemesh(*dm, user->opt->adapt.model, &user->box, size, &fine));
+  PetscCall(MeshRemesh(*dm, user->opt->adapt.model, &user->box, size, loc, &fine, &tr));
+  PetscCall(VecDestroy(&loc));
   PetscCall(PetscFree(size));
   user->prob.level++;
   PetscCall(MeshSetContactCellSizes(fine, user->scene.bcs.ncontact, user->scene.bcs.contact_ids)); /* one eps on Gamma_C */
@@ -100,7 +107,11 @@ PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   *dm = fine;
   PetscCall(DMCreateGlobalVector(fine, u));
   PetscCall(PetscObjectSetName((PetscObject)*u, "displacement"));
-  PetscCall(VecZeroEntries(*u));
+  PetscCall(DMCreateLocalVector(fine, &loc));
+  PetscCall(MeshTransferApply(tr, fine, loc));
+  PetscCall(DMLocalToGlobal(fine, loc, INSERT_VALUES, *u)); /* the fixed components are not in u: their values are the problem's */
+  PetscCall(VecDestroy(&loc));
+  PetscCall(MeshTransferDestroy(&tr));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

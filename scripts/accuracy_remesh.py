@@ -1,0 +1,134 @@
+#!/usr/bin/env python3
+"""-accuracy TOL by remeshing the body's Gmsh model (-adapt_model, issue 34) on make hertz's curved bodies: the elastic
+cylinder (quarter disk, 2D) from a uniform h = 0.1 and the elastic sphere (quarter sphere, 3D) from a uniform h = 0.2,
+eps = h/10. For each TOL: the cycles, unknowns and time, and at the stop the errors of the largest pressure and of the
+zone's size (the half-width in 2D, the quarter zone's area in 3D) against the closed form at the run's force, and of
+the force against the finest run's, each with the run's bar; and the moments' a and the fitted p0 of make hertz
+(signorini.hertz.measure). Then make hertz's hand-graded meshes of the case, one solve each at the same eps, for the
+fewest unknowns within TOL, timed side by side with the adaptive run (--pairs alternated pairs, medians). Writes
+output/accuracy_remesh/accuracy_remesh.md and .csv.
+
+    /usr/bin/python3 scripts/accuracy_remesh.py [--cases cylinder,sphere] [--tols 0.03,0.01] [--tols-3d 0.03] [--pairs 3]
+"""
+import argparse
+import os
+import statistics
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from signorini import geometry, hertz  # noqa: E402
+from signorini.mpirun import BENCH_ENV, MPI_ENV  # noqa: E402
+from signorini.paths import ROOT  # noqa: E402
+from signorini.report import csv_text, write_text  # noqa: E402
+from signorini.runs import read_run  # noqa: E402
+
+QUANTITIES = ("contact_force", "pressure_max", "contact_size")
+COARSE = {"cylinder": (geometry.quarter_disk, 0.1), "sphere": (geometry.quarter_sphere, 0.2)}
+SOLVER = {"cylinder": [], "sphere": ["-options_file", "options/solvers/gamg.yaml"]}
+
+
+def solve(cmd):
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, cwd=ROOT, env={**os.environ, **MPI_ENV, **BENCH_ENV}, capture_output=True, text=True)
+    if p.returncode:
+        sys.exit(f"{' '.join(cmd)} failed:\n{p.stdout[-2000:]}")
+    return time.perf_counter() - t0
+
+
+def cycles(path):
+    with h5py.File(path, "r") as f:
+        return {k: np.asarray(f["cycles"][k][:]).ravel() for k in f["cycles"]}
+
+
+def errors(case, attrs, force_ref):
+    """Relative errors of the largest pressure and the size against the closed form at the run's force, and of the
+    force against force_ref."""
+    axis = "xyz"[hertz.CASES[case]["dim"] - 1]
+    force = abs(float(attrs[f"contact_force_{axis}"]))
+    exact = hertz.quantity_exact(case, force)
+    return {"contact_force": force / force_ref - 1, "pressure_max": float(attrs["pressure_max"]) / exact["pressure_max"] - 1,
+            "contact_size": float(attrs["contact_size"]) / exact["contact_size"] - 1}
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--cases", default="cylinder,sphere")
+    ap.add_argument("--tols", default="0.03,0.01", help="the tolerances in 2D")
+    ap.add_argument("--tols-3d", default="0.03", help="the tolerances in 3D (1% would take millions of unknowns: docs/estimate.md)")
+    ap.add_argument("--pairs", type=int, default=3, help="alternated timing pairs of the adaptive and the hand-graded run")
+    ap.add_argument("--outdir", default=os.path.join(ROOT, "output", "accuracy_remesh"))
+    args = ap.parse_args()
+    os.makedirs(args.outdir, exist_ok=True)
+    rows, md = [], []
+    for case in args.cases.split(","):
+        tols = sorted((float(t) for t in (args.tols if hertz.CASES[case]["dim"] == 2 else args.tols_3d).split(",")), reverse=True)
+        shape, h = COARSE[case]
+        mesh, model = os.path.join(args.outdir, f"{case}_h{h:g}.msh"), os.path.join(args.outdir, f"{case}.geo")
+        shape(mesh, radius=hertz.RADIUS, h_far=h, h_near=h, width=0.5, model=model)
+        adaptive = {}
+        for tol in tols:
+            out = os.path.join(args.outdir, f"{case}_accuracy_{tol:g}.h5")
+            cmd = hertz.command(case, mesh, "eps=h/10", out)[3:] + SOLVER[case] + ["-adapt_model", model, "-accuracy", str(tol),
+                                                                                     "-accuracy_quantity", ",".join(QUANTITIES)]
+            solve(cmd)
+            adaptive[tol] = (cmd, read_run(out), cycles(out), hertz.measure(case, out))
+            print(f"{case} -accuracy {tol:g}: {adaptive[tol][1]['n_dofs']} unknowns", flush=True)
+        axis = "xyz"[hertz.CASES[case]["dim"] - 1]
+        force_ref = abs(float(adaptive[tols[-1]][1][f"contact_force_{axis}"]))
+        hand = []
+        for h_near in hertz.CASES[case]["h_near"]:
+            hmesh = os.path.join(args.outdir, f"{case}_graded_{h_near:g}.msh")
+            hertz.write_mesh(case, h_near, hmesh)
+            out = os.path.join(args.outdir, f"{case}_graded_{h_near:g}.h5")
+            hcmd = hertz.command(case, hmesh, "eps=h/10", out)[3:] + SOLVER[case]
+            solve(hcmd)
+            hand.append((h_near, hcmd, read_run(out), hertz.measure(case, out)))
+            print(f"{case} hand-graded h_near {h_near:g}: {hand[-1][2]['n_dofs']} unknowns", flush=True)
+        hand.sort(key=lambda t: int(t[2]["n_dofs"]))
+        for tol in tols:
+            cmd, a, c, m = adaptive[tol]
+            err = errors(case, a, force_ref)
+            bars = {q: float(a[f"accuracy_{q}_bar"]) / abs(float(a[f"accuracy_{q}_value"])) for q in QUANTITIES}
+            within = [t for t in hand if all(abs(e) <= tol for e in errors(case, t[2], force_ref).values())]
+            best = within[0] if within else None
+            t_ad, t_hd = [], []
+            for _ in range(args.pairs):
+                t_ad.append(solve(cmd))
+                if best:
+                    t_hd.append(solve(best[1]))
+            ratio = statistics.median(t_ad) / statistics.median(t_hd) if best else float("nan")
+            covered = all(abs(err[q]) <= bars[q] for q in QUANTITIES)
+            rows.append([case, tol, len(c["n_dofs"]) - 1, int(a["n_dofs"]), int(a["accuracy_reached"]), statistics.median(t_ad)]
+                        + [err[q] for q in QUANTITIES] + [bars[q] for q in QUANTITIES] + [m["a_error"], m["p0_error"], int(covered)]
+                        + [best[0] if best else float("nan"), int(best[2]["n_dofs"]) if best else 0,
+                           statistics.median(t_hd) if best else float("nan"), ratio])
+            md.append(f"| {case} | {tol:g} | {len(c['n_dofs']) - 1} | {int(a['n_dofs'])} | {'yes' if a['accuracy_reached'] else 'no'} | "
+                      + " | ".join(f"{err[q]:+.3%} ({bars[q]:.2%})" for q in QUANTITIES)
+                      + f" | {m['a_error']:+.3%}, {m['p0_error']:+.3%} | {'yes' if covered else 'NO'} | {statistics.median(t_ad):.2f} | "
+                      + (f"{best[0]:g}: {int(best[2]['n_dofs'])} | {statistics.median(t_hd):.2f} | {ratio:.2f} |" if best else "none | | |"))
+        for h_near, _, b, m in hand:
+            e = errors(case, b, force_ref)
+            md.append(f"| {case} hand-graded h_near {h_near:g} | | | {int(b['n_dofs'])} | | " + " | ".join(f"{e[q]:+.3%}" for q in QUANTITIES)
+                      + f" | {m['a_error']:+.3%}, {m['p0_error']:+.3%} | | | | | |")
+    header = ["case", "tol", "cycles", "n_dofs", "reached", "time", "err_force", "err_pressure_max", "err_contact_size", "bar_force",
+              "bar_pressure_max", "bar_contact_size", "a_error", "p0_error", "covered", "hand_h_near", "hand_n_dofs", "hand_time", "time_ratio"]
+    write_text(os.path.join(args.outdir, "accuracy_remesh.csv"), csv_text(header, rows))
+    text = ["# -accuracy by remeshing the Gmsh model on make hertz's curved bodies (eps = h/10)", "",
+            f"`/usr/bin/python3 scripts/accuracy_remesh.py --cases {args.cases} --tols {args.tols} --tols-3d {args.tols_3d} --pairs {args.pairs}`. The cylinder starts "
+            "from a uniform h = 0.1, the sphere from 0.2. Errors: the largest pressure and the size (2D half-width, 3D quarter area) against "
+            "the closed form at the run's force, the force against the finest run's; in brackets the run's bar (relative); make hertz's "
+            f"moments' a and fitted p0. Times: medians of {args.pairs} alternated pairs, whole processes.", "",
+            "| case | TOL | cycles | unknowns | reached | force | largest pressure | size | a, p0 (make hertz) | covered | time (s) | "
+            "fewest hand-graded within TOL (h_near: unknowns) | its time (s) | adaptive / hand-graded |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"] + md
+    write_text(os.path.join(args.outdir, "accuracy_remesh.md"), "\n".join(text) + "\n")
+    print("\n".join(text))
+
+
+if __name__ == "__main__":
+    main()
