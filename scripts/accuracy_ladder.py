@@ -23,16 +23,15 @@ and the largest pressure) and the force of a 17th cycle; each cycle's bar of eac
 import argparse
 import os
 import statistics
-import subprocess
 import sys
-import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from signorini import estimates as st  # noqa: E402
 from signorini import geometry, hertz  # noqa: E402
-from signorini.mpirun import BENCH_ENV, MPI_ENV  # noqa: E402
+from signorini.mpirun import timed_or_exit as solve  # noqa: E402
 from signorini.paths import ROOT  # noqa: E402
 from signorini.report import csv_text, write_text  # noqa: E402
+from signorini.runs import read_cycles as cycles  # noqa: E402
 from signorini.runs import read_run  # noqa: E402
 
 CASE = "cylinder-indenter"
@@ -41,12 +40,6 @@ QUANTITIES = "contact_force,pressure_max,contact_size"
 HAND = [(0.002, 0.1), (0.001, 0.1), (0.001, 0.05), (0.0005, 0.05), (0.0005, 0.02), (0.00025, 0.02)]  # (h_near, grade G)
 
 
-def solve(cmd):
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, cwd=ROOT, env={**os.environ, **MPI_ENV, **BENCH_ENV}, capture_output=True, text=True)
-    if p.returncode:
-        sys.exit(f"{' '.join(cmd)} failed:\n{p.stdout[-2000:]}")
-    return time.perf_counter() - t0
 
 
 def errors(attrs, force_ref):
@@ -58,11 +51,6 @@ def errors(attrs, force_ref):
             "contact_size": float(attrs["contact_size"]) / a - 1}
 
 
-def cycles(path):
-    import h5py
-    import numpy as np
-    with h5py.File(path, "r") as f:
-        return {k: np.asarray(f["cycles"][k][:]).ravel() for k in f["cycles"]}
 
 
 def coverage(outdir, coarse):

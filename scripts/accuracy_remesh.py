@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """-accuracy TOL by remeshing the body's Gmsh model (-adapt_model, issue 34) on make hertz's curved bodies: the elastic
-cylinder (quarter disk, 2D) from a uniform h = 0.1 and the elastic sphere (quarter sphere, 3D) from a uniform h = 0.2,
-eps = h/10. For each TOL: the cycles, unknowns and time, and at the stop the errors of the largest pressure and of the
+cylinder (quarter disk, 2D) from a uniform h = 0.1, the elastic sphere (quarter sphere, 3D) from a uniform h = 0.2, and
+(--cases sphere-indenter) the rigid sphere indenting the unit block (its quarter, 3D) from a uniform h = 0.2, eps = h/10. For each TOL: the cycles, unknowns and time, and at the stop the errors of the largest pressure and of the
 zone's size (the half-width in 2D, the quarter zone's area in 3D) against the closed form at the run's force, and of
 the force against the finest run's, each with the run's bar; and the moments' a and the fitted p0 of make hertz
 (signorini.hertz.measure). Then make hertz's hand-graded meshes of the case, one solve each at the same eps, for the
@@ -13,36 +13,23 @@ output/accuracy_remesh/accuracy_remesh.md and .csv.
 import argparse
 import os
 import statistics
-import subprocess
 import sys
-import time
-
-import h5py
-import numpy as np
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from signorini import geometry, hertz  # noqa: E402
-from signorini.mpirun import BENCH_ENV, MPI_ENV  # noqa: E402
+from signorini.mpirun import timed_or_exit as solve  # noqa: E402
 from signorini.paths import ROOT  # noqa: E402
 from signorini.report import csv_text, write_text  # noqa: E402
+from signorini.runs import read_cycles as cycles  # noqa: E402
 from signorini.runs import read_run  # noqa: E402
 
 QUANTITIES = ("contact_force", "pressure_max", "contact_size")
-COARSE = {"cylinder": (geometry.quarter_disk, 0.1), "sphere": (geometry.quarter_sphere, 0.2)}
-SOLVER = {"cylinder": [], "sphere": ["-options_file", "options/solvers/gamg.yaml"]}
+COARSE = {"cylinder": (geometry.quarter_disk, 0.1), "sphere": (geometry.quarter_sphere, 0.2), "sphere-indenter": (geometry.quarter_block, 0.2)}
+SOLVER = {"cylinder": [], "sphere": ["-options_file", "options/solvers/gamg.yaml"], "sphere-indenter": ["-options_file", "options/solvers/gamg.yaml"]}
 
 
-def solve(cmd):
-    t0 = time.perf_counter()
-    p = subprocess.run(cmd, cwd=ROOT, env={**os.environ, **MPI_ENV, **BENCH_ENV}, capture_output=True, text=True)
-    if p.returncode:
-        sys.exit(f"{' '.join(cmd)} failed:\n{p.stdout[-2000:]}")
-    return time.perf_counter() - t0
 
 
-def cycles(path):
-    with h5py.File(path, "r") as f:
-        return {k: np.asarray(f["cycles"][k][:]).ravel() for k in f["cycles"]}
 
 
 def errors(case, attrs, force_ref):

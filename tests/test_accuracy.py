@@ -5,21 +5,18 @@ times fewer unknowns); the energy's bar is the error estimate. Checked against t
 a 10 x 10 block (where the closed form is a reference to about 0.2%, docs/estimate.md), on 2 ranks
 against 1, on a mesh that does not see the contact, and on the refusals."""
 
-import h5py
 import numpy as np
 import pytest
 
 from harness import load, refused, run, sorted_by_position
 from signorini import geometry, hertz
+from signorini.runs import read_cycles as cycles
 
 MMS = ["-options_file", "options/mms.yaml", "-contact_monitor", "0"]
 MMS_EXACT = {"contact_force": 0.0720182, "pressure_max": 0.402594, "contact_size": 0.447214}  # docs/estimate.md
 QUANTITIES = ("energy", "contact_force", "pressure_max", "contact_size")
 
 
-def cycles(h5):
-    with h5py.File(h5, "r") as f:
-        return {k: np.asarray(f["cycles"][k][:]).ravel() for k in f["cycles"]}
 
 
 def test_accuracy_on_the_manufactured_solution_ends_within_the_tolerance():

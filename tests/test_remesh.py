@@ -13,11 +13,9 @@ import pytest
 
 from harness import load, refused, run
 from signorini import geometry, hertz
+from signorini.runs import read_cycles as cycles
 
 
-def cycles(h5):
-    with h5py.File(h5, "r") as f:
-        return {k: np.asarray(f["cycles"][k][:]).ravel() for k in f["cycles"]}
 
 
 def contact_vertices(h5):

@@ -71,6 +71,16 @@ def run_mpi(cmd, log=None, timeout=None, env=None, header=""):
     return MpiResult(proc.returncode, text, wall, timed_out)
 
 
+def timed_or_exit(cmd):
+    """Runs cmd from the project's root in the benches' environment and returns its wall time; exits with its output's
+    tail if it fails (the studies' runs, which must all succeed)."""
+    t0 = time.perf_counter()
+    p = subprocess.run(cmd, cwd=ROOT, env={**os.environ, **MPI_ENV, **BENCH_ENV}, capture_output=True, text=True)
+    if p.returncode:
+        raise SystemExit(f"{' '.join(cmd)} failed:\n{p.stdout[-2000:]}")
+    return time.perf_counter() - t0
+
+
 def tail(text, n=LOG_TAIL_LINES):
     """The last `n` lines of `text` (trailing blank space removed)."""
     return "\n".join(text.rstrip().splitlines()[-n:])

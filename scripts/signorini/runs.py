@@ -98,6 +98,12 @@ def read_steps(path):
     return steps, series
 
 
+def read_cycles(path):
+    """The adaptive cycles' table /cycles (-adapt_cycles, -accuracy): one array per column."""
+    with h5py.File(path, "r") as f:
+        return {k: np.asarray(f["cycles"][k][:]).ravel() for k in f["cycles"]}
+
+
 def read_output(path):
     """(attrs, fields) of the output `path`: the /run attributes with bytes decoded (numbers stay numpy scalars), and
     {name: array} of /vertex_fields in the file's vertex order (a load path's: its last step), plus "x":
