@@ -159,3 +159,13 @@ def test_remeshing_the_3d_box_on_two_ranks_gives_the_one_rank_cycles():
     c1, c2 = cycles(h1), cycles(h2)
     assert np.array_equal(c1["n_dofs"], c2["n_dofs"]) and np.array_equal(c1["n_cells"], c2["n_cells"]), (c1["n_dofs"], c2["n_dofs"])
     assert np.allclose(c1["error_energy"], c2["error_energy"], rtol=1e-6, atol=0), (c1["error_energy"], c2["error_energy"])
+
+
+def test_a_model_that_is_not_the_meshs_is_refused(disk, tmp_path):
+    """The block's model given for the disk's mesh: the remeshed mesh lacks the disk's face set "top" (3), and the run
+    stops at the first remesh with an error naming the model and the face set, before any solve on it."""
+    mesh, _ = disk
+    block_model = str(tmp_path / "block.geo")
+    geometry.block(str(tmp_path / "block.msh"), radius=1.0, h_far=0.2, h_near=0.2, width=0.5, model=block_model)
+    refused(case_args("cylinder", mesh) + ["-adapt_model", block_model, "-adapt_cycles", 1], "remesh_bad_model",
+            f"-adapt_model {block_model}: the mesh Gmsh made of the model has no face in the face set 3")

@@ -219,6 +219,58 @@ static PetscErrorCode SortCells(PetscInt ncells, PetscInt nv, double data[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The "Face Sets" values the faces of dm carry, over all ranks: present[v] for v < *n (free with PetscFree). */
+static PetscErrorCode FaceSetValues(DM dm, PetscInt *n, PetscBool **present)
+{
+  DMLabel         label;
+  IS              is = NULL;
+  PetscInt        nv = 0, vmax = -1;
+  const PetscInt *v  = NULL;
+  PetscInt       *flag;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetLabel(dm, "Face Sets", &label));
+  if (label) {
+    PetscCall(DMLabelGetNonEmptyStratumValuesIS(label, &is));
+    PetscCall(ISGetLocalSize(is, &nv));
+    PetscCall(ISGetIndices(is, &v));
+  }
+  for (PetscInt i = 0; i < nv; ++i) vmax = PetscMax(vmax, v[i]);
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &vmax, 1, MPIU_INT, MPI_MAX, PetscObjectComm((PetscObject)dm)));
+  *n = vmax + 1;
+  PetscCall(PetscCalloc1(*n + 1, &flag));
+  for (PetscInt i = 0; i < nv; ++i)
+    if (v[i] >= 0) flag[v[i]] = 1;
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, flag, *n, MPIU_INT, MPI_MAX, PetscObjectComm((PetscObject)dm)));
+  PetscCall(PetscMalloc1(*n + 1, present));
+  for (PetscInt i = 0; i < *n; ++i) (*present)[i] = (PetscBool)(flag[i] != 0);
+  PetscCall(PetscFree(flag));
+  if (is) {
+    PetscCall(ISRestoreIndices(is, &v));
+    PetscCall(ISDestroy(&is));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Every face set of the old mesh on the new one: a model that is not the mesh's would lose the boundary conditions. */
+static PetscErrorCode CheckFaceSets(DM dm, DM remeshed, const char model[])
+{
+  PetscInt   n_old, n_new;
+  PetscBool *old_sets, *new_sets;
+
+  PetscFunctionBeginUser;
+  PetscCall(FaceSetValues(dm, &n_old, &old_sets));
+  PetscCall(FaceSetValues(remeshed, &n_new, &new_sets));
+  for (PetscInt i = 0; i < n_old; ++i)
+    PetscCheck(!old_sets[i] || (i < n_new && new_sets[i]), PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT,
+               "-adapt_model %s: the mesh Gmsh made of the model has no face in the face set %" PetscInt_FMT
+               " (\"Face Sets\" value, a physical group's number) that the mesh had: is it the model of the mesh?",
+               model[0] ? model : "(the box of the options)", i);
+  PetscCall(PetscFree(old_sets));
+  PetscCall(PetscFree(new_sets));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const PetscReal size[], Vec loc, DM *remeshed, MeshTransfer *tr)
 {
   const PetscScalar *lu     = NULL;
@@ -336,6 +388,7 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
   PetscCheck(!failed, comm, PETSC_ERR_LIB, "-adapt_model %s: %s", model[0] ? model : "(the box of the options)", why);
   PetscCallMPI(MPI_Bcast(out, sizeof(out), MPI_CHAR, 0, comm));
   PetscCall(MeshReadRemeshed(comm, out, remeshed));
+  PetscCall(CheckFaceSets(dm, *remeshed, model));
   if (loc) PetscCall(MeshTransferCreate(comm, dim, total / per, all_x, all_u, tr)); /* which owns all_x and all_u (rank 0) */
   PetscCallMPI(MPI_Barrier(comm));
   if (rank == 0) (void)unlink(out);
