@@ -225,7 +225,7 @@ static PetscErrorCode FaceSetValues(DM dm, PetscInt *n, PetscBool **present)
   DMLabel         label;
   IS              is = NULL;
   PetscInt        nv = 0, vmax = -1;
-  const PetscInt *v  = NULL;
+  const PetscInt *v = NULL;
   PetscInt       *flag;
 
   PetscFunctionBeginUser;
