@@ -104,7 +104,7 @@ static PetscErrorCode GmshBoxModel(const MeshBox *box)
 
     GmshCall(G.gmshModelGetBoundingBox((int)dim - 1, side, &bb[0], &bb[1], &bb[2], &bb[3], &bb[4], &bb[5], &ierr_gmsh), "bound a side");
     for (PetscInt d = 0; d < dim; ++d) {
-      const double tol = 1e-6 * (hi[d] - lo[d]);
+      const double tol = 1e-6 * (hi[d] - lo[d]) + 1e-6; /* OpenCASCADE pads its bounding boxes by about 1e-7 */
 
       if (bb[3 + d] - bb[d] > 2 * tol) continue; /* the side is flat across d */
       id = MeshBoxFaceId(dim, d, PetscAbsReal(bb[d] - lo[d]) < PetscAbsReal(bb[d] - hi[d]) ? 0 : 1);
