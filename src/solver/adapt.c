@@ -1,12 +1,16 @@
-/* -adapt_cycles N: adaptive refinement driven by the error estimate (issue 34, its first part: 2D). After the first
-   solve, each cycle estimates the error of the solution (src/estimate/), marks the fewest cells whose indicators hold
-   the fraction -adapt_fraction of the estimate's square (Doerfler, src/estimate/marking.c), refines them and as many
-   more as keep the mesh conforming (PETSc's skeleton-based refinement, MeshRefineMarked()), and solves again from the
-   last solution interpolated (the meshes are nested: exact for P1), as nested iteration does (GridSequenceRefine()).
-   The face sets and Gmsh names follow the refinement, and eps follows each contact face's size (eps = eps0 h^power /
-   M with the local h), so that the penalty's error shrinks with the cells where they shrink. /cycles records each
-   mesh: unknowns, cells, the estimate, the true energy-norm error where the scene knows the exact solution, the marked
-   cells and the solve. */
+/* -adapt_cycles N: adaptive refinement driven by the error estimate (issue 34). After the first solve, each cycle
+   estimates the error of the solution (src/estimate/), marks the fewest cells whose indicators hold the fraction
+   -adapt_fraction of the estimate's square (Doerfler, src/estimate/marking.c), and makes the next mesh:
+   - 2D, a polygonal body: PETSc's skeleton-based refinement of the marked cells and as many more as keep the mesh
+     conforming (MeshRefineMarked()); the last solution is interpolated (the meshes are nested: exact for P1), as
+     nested iteration does (GridSequenceRefine()); the face sets and Gmsh names follow the refinement;
+   - a curved body or 3D: Gmsh meshes the body's model (-adapt_model), or the 3D box of the options, again with the
+     marked cells' sizes halved (GridSequenceRemesh(), MeshRemesh()), and the last solution is carried to it by
+     locating the new vertices in the old cells (MeshTransferApply()).
+   Then it solves again. eps is one value on Gamma_C from its smallest cell (MeshSetContactCellSizes()), so that the
+   penalty's error shrinks with the contact zone's cells. /cycles records each mesh: unknowns, cells, the estimate, the
+   true energy-norm error where the scene knows the exact solution, the quantities and their bars, the marked cells,
+   the solve and the times. */
 #include "contact.h"
 #include "estimate.h"
 #include "mesh.h"
