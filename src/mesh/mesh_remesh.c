@@ -181,7 +181,9 @@ static PetscErrorCode VertexSizes(DM dm, const PetscReal size[], PetscReal **vsi
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The cells' list data in the order of their centroids (lexicographic in x, y, z): the same on any partition. */
+/* The cells' list data in the order of their centroids (lexicographic in x, y, z): the same on any partition. C's
+   qsort() passes no context to its comparison: the data it compares are these file-scope variables, set by
+   SortCells() on rank 0 just before the sort. */
 static PetscInt      sort_per, sort_nv;
 static const double *sort_data;
 static int           CompareCentroids(const void *a, const void *b)
