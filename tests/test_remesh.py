@@ -169,3 +169,16 @@ def test_a_model_that_is_not_the_meshs_is_refused(disk, tmp_path):
     geometry.block(str(tmp_path / "block.msh"), radius=1.0, h_far=0.2, h_near=0.2, width=0.5, model=block_model)
     refused(case_args("cylinder", mesh) + ["-adapt_model", block_model, "-adapt_cycles", 1], "remesh_bad_model",
             f"-adapt_model {block_model}: the mesh Gmsh made of the model has no face in the face set 3")
+
+
+@pytest.mark.parametrize("np_", [1, 2])
+def test_the_carried_solution_is_exact_for_a_linear_field(np_):
+    """The patch test's exact solution is linear, which P1 holds exactly on any mesh: carried to each remeshed 3D box by
+    locating the new vertices in the old cells (MeshTransferApply()), it is already the solution there, so every cycle
+    after the first takes no Newton step and its error stays at round-off (a vertex located in a wrong cell, or a wrong
+    barycentric weight, would give a start off the solution; from zero each cycle took a step)."""
+    _, h5 = run(["-scene", "patch", "-dm_plex_dim", 3, "-dm_plex_box_faces", "3,3,3", "-adapt_cycles", 2], f"remesh_patch_np{np_}", np_=np_)
+    c = cycles(h5)
+    assert len(c["n_dofs"]) == 3 and np.all(np.diff(c["n_dofs"]) > 0), c["n_dofs"]
+    assert np.all(c["newton_its"][1:] == 0), c["newton_its"]
+    assert np.all(c["error_energy"] < 1e-12), c["error_energy"]
