@@ -15,6 +15,7 @@ PetscInt       MeshBoxFaceId(PetscInt dim, PetscInt d, PetscInt s);
 PetscErrorCode MeshCreateBoxLevel(DM coarse, const MeshBox *box, PetscInt level, DM *fine, PetscInt **vertex_source);
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
 PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam);
+PetscErrorCode MeshCellMeanEdge(DM dm, PetscInt c, PetscReal *mean);
 PetscErrorCode MeshCellSize(DM dm, PetscInt c, PetscReal *h);
 PetscErrorCode MeshGetMaxCellSize(DM dm, PetscReal diameter_max, PetscReal *h);
 PetscErrorCode MeshSetCellSizes(DM dm, PetscReal hmax, PetscReal *sizes);

@@ -22,15 +22,16 @@ and the largest pressure) and the force of a 17th cycle; each cycle's bar of eac
 """
 import argparse
 import os
-import statistics
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from signorini import estimates as st  # noqa: E402
 from signorini import geometry, hertz  # noqa: E402
+from signorini.mpirun import paired_medians  # noqa: E402
 from signorini.mpirun import timed_or_exit as solve  # noqa: E402
 from signorini.paths import ROOT  # noqa: E402
 from signorini.report import csv_text, write_text  # noqa: E402
+from signorini.runs import accuracy_bars  # noqa: E402
 from signorini.runs import read_cycles as cycles  # noqa: E402
 from signorini.runs import read_run  # noqa: E402
 
@@ -42,13 +43,6 @@ HAND = [(0.002, 0.1), (0.001, 0.1), (0.001, 0.05), (0.0005, 0.05), (0.0005, 0.02
 
 
 
-def errors(attrs, force_ref):
-    """Relative errors of the width and largest pressure against the closed form at the run's force, and of the force
-    against force_ref."""
-    force = abs(float(attrs["contact_force_y"]))
-    a, p0 = hertz.closed_form(2, 2 * force)
-    return {"contact_force": force / force_ref - 1, "pressure_max": float(attrs["pressure_max"]) / p0 - 1,
-            "contact_size": float(attrs["contact_size"]) / a - 1}
 
 
 
@@ -114,18 +108,14 @@ def main():
     rows, md = [], []
     for tol in tols:
         cmd, a = adaptive[tol]
-        err = errors(a, force_ref)
-        bars = {q: float(a[f"accuracy_{q}_bar"]) / abs(float(a[f"accuracy_{q}_value"])) for q in QUANTITIES.split(",")}
-        best = next(((h, c, b) for h, c, b in hand if all(abs(e) <= tol for e in errors(b, force_ref).values())), None)
-        t_ad, t_hd = [], []
-        for _ in range(args.pairs):
-            t_ad.append(solve(cmd))
-            if best:
-                t_hd.append(solve(best[1]))
-        ratio = statistics.median(t_ad) / statistics.median(t_hd) if best else float("nan")
-        row = [tol, int(a["n_dofs"]), int(a["accuracy_reached"]), statistics.median(t_ad)]
+        err = hertz.quantity_errors(CASE, a, force_ref)
+        bars = accuracy_bars(a, QUANTITIES.split(","))
+        best = next(((h, c, b) for h, c, b in hand if all(abs(e) <= tol for e in hertz.quantity_errors(CASE, b, force_ref).values())), None)
+        t_ad, t_hd = paired_medians(cmd, best[1] if best else None, args.pairs)
+        ratio = t_ad / t_hd if best else float("nan")
+        row = [tol, int(a["n_dofs"]), int(a["accuracy_reached"]), t_ad]
         row += [err[q] for q in QUANTITIES.split(",")] + [bars[q] for q in QUANTITIES.split(",")]
-        row += [best[0] if best else "", int(best[2]["n_dofs"]) if best else 0, statistics.median(t_hd) if best else float("nan"), ratio]
+        row += [best[0] if best else "", int(best[2]["n_dofs"]) if best else 0, t_hd, ratio]
         rows.append(row)
         covered = all(abs(err[q]) <= bars[q] for q in bars)
         md.append(f"| {tol:g} | {row[1]} | {'yes' if row[2] else 'no'} | " + " | ".join(f"{err[q]:+.3%} ({bars[q]:.2%})" for q in bars)
@@ -133,7 +123,7 @@ def main():
     header = ["tol", "n_dofs", "reached", "time", "err_force", "err_pressure_max", "err_contact_size", "bar_force", "bar_pressure_max",
               "bar_contact_size", "hand_h_near", "hand_n_dofs", "hand_time", "time_ratio"]
     write_text(os.path.join(args.outdir, "accuracy_ladder.csv"), csv_text(header, rows))
-    hand_md = [f"| {h} | {b['n_dofs']} | " + " | ".join(f"{e:+.3%}" for e in errors(b, force_ref).values()) + " |" for h, _, b in hand]
+    hand_md = [f"| {h} | {b['n_dofs']} | " + " | ".join(f"{e:+.3%}" for e in hertz.quantity_errors(CASE, b, force_ref).values()) + " |" for h, _, b in hand]
     text = [f"# -accuracy on the 2D Hertz cylinder indenter (block {st.BLOCK:g} x {st.BLOCK:g}, eps = h/10, from h = 0.5 uniform)", "",
             f"`/usr/bin/python3 scripts/accuracy_ladder.py --tols {args.tols} --pairs {args.pairs}`. Errors: the width and the largest "
             "pressure against the closed form at the run's force, the force against the finest run's; in brackets the run's bar "

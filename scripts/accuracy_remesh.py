@@ -12,14 +12,15 @@ output/accuracy_remesh/accuracy_remesh.md and .csv.
 """
 import argparse
 import os
-import statistics
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from signorini import geometry, hertz  # noqa: E402
+from signorini.mpirun import paired_medians  # noqa: E402
 from signorini.mpirun import timed_or_exit as solve  # noqa: E402
 from signorini.paths import ROOT  # noqa: E402
 from signorini.report import csv_text, write_text  # noqa: E402
+from signorini.runs import accuracy_bars  # noqa: E402
 from signorini.runs import read_cycles as cycles  # noqa: E402
 from signorini.runs import read_run  # noqa: E402
 
@@ -32,14 +33,6 @@ SOLVER = {"cylinder": [], "sphere": ["-options_file", "options/solvers/gamg.yaml
 
 
 
-def errors(case, attrs, force_ref):
-    """Relative errors of the largest pressure and the size against the closed form at the run's force, and of the
-    force against force_ref."""
-    axis = "xyz"[hertz.CASES[case]["dim"] - 1]
-    force = abs(float(attrs[f"contact_force_{axis}"]))
-    exact = hertz.quantity_exact(case, force)
-    return {"contact_force": force / force_ref - 1, "pressure_max": float(attrs["pressure_max"]) / exact["pressure_max"] - 1,
-            "contact_size": float(attrs["contact_size"]) / exact["contact_size"] - 1}
 
 
 def main():
@@ -79,28 +72,24 @@ def main():
         hand.sort(key=lambda t: int(t[2]["n_dofs"]))
         for tol in tols:
             cmd, a, c, m = adaptive[tol]
-            err = errors(case, a, force_ref)
-            bars = {q: float(a[f"accuracy_{q}_bar"]) / abs(float(a[f"accuracy_{q}_value"])) for q in QUANTITIES}
-            within = [t for t in hand if all(abs(e) <= tol for e in errors(case, t[2], force_ref).values())]
+            err = hertz.quantity_errors(case, a, force_ref)
+            bars = accuracy_bars(a, QUANTITIES)
+            within = [t for t in hand if all(abs(e) <= tol for e in hertz.quantity_errors(case, t[2], force_ref).values())]
             best = within[0] if within else None
-            t_ad, t_hd = [], []
-            for _ in range(args.pairs):
-                t_ad.append(solve(cmd))
-                if best:
-                    t_hd.append(solve(best[1]))
-            ratio = statistics.median(t_ad) / statistics.median(t_hd) if best else float("nan")
+            t_ad, t_hd = paired_medians(cmd, best[1] if best else None, args.pairs)
+            ratio = t_ad / t_hd if best else float("nan")
             covered = all(abs(err[q]) <= bars[q] for q in QUANTITIES)
-            rows.append([case, tol, len(c["n_dofs"]) - 1, int(a["n_dofs"]), int(a["accuracy_reached"]), statistics.median(t_ad)]
+            rows.append([case, tol, len(c["n_dofs"]) - 1, int(a["n_dofs"]), int(a["accuracy_reached"]), t_ad]
                         + [err[q] for q in QUANTITIES] + [bars[q] for q in QUANTITIES] + [m["a_error"], m["p0_error"], int(covered)]
                         + [best[0] if best else float("nan"), int(best[2]["n_dofs"]) if best else 0,
-                           statistics.median(t_hd) if best else float("nan"), ratio])
+                           t_hd, ratio])
             md.append(f"| {case} | {tol:g} | {len(c['n_dofs']) - 1} | {int(a['n_dofs'])} | {'yes' if a['accuracy_reached'] else 'no'} | "
                       + " | ".join(("reference" if q == "contact_force" and tol == tols[-1] else f"{err[q]:+.3%}") + f" ({bars[q]:.2%})"
                                    for q in QUANTITIES)
-                      + f" | {m['a_error']:+.3%}, {m['p0_error']:+.3%} | {'yes' if covered else 'NO'} | {statistics.median(t_ad):.2f} | "
-                      + (f"{best[0]:g}: {int(best[2]['n_dofs'])} | {statistics.median(t_hd):.2f} | {ratio:.2f} |" if best else "none | | |"))
+                      + f" | {m['a_error']:+.3%}, {m['p0_error']:+.3%} | {'yes' if covered else 'NO'} | {t_ad:.2f} | "
+                      + (f"{best[0]:g}: {int(best[2]['n_dofs'])} | {t_hd:.2f} | {ratio:.2f} |" if best else "none | | |"))
         for h_near, _, b, m in hand:
-            e = errors(case, b, force_ref)
+            e = hertz.quantity_errors(case, b, force_ref)
             md.append(f"| {case} hand-graded h_near {h_near:g} | | | {int(b['n_dofs'])} | | " + " | ".join(f"{e[q]:+.3%}" for q in QUANTITIES)
                       + f" | {m['a_error']:+.3%}, {m['p0_error']:+.3%} | | | | | |")
     header = ["case", "tol", "cycles", "n_dofs", "reached", "time", "err_force", "err_pressure_max", "err_contact_size", "bar_force",

@@ -26,22 +26,24 @@ def contact_vertices(h5):
     return x[on]
 
 
+def uniform_with_model(tmp_path_factory, shape, name, h):
+    """A make_mesh shape of radius 1 meshed uniformly at h, and its model: (mesh, model)."""
+    d = tmp_path_factory.mktemp(f"remesh_{name}")
+    mesh, model = str(d / f"{name}.msh"), str(d / f"{name}.geo")
+    shape(mesh, radius=1.0, h_far=h, h_near=h, width=0.5, model=model)
+    return mesh, model
+
+
 @pytest.fixture(scope="module")
 def disk(tmp_path_factory):
     """The Hertz cylinder's quarter disk (radius 1), meshed uniformly at h = 0.1, and its model."""
-    d = tmp_path_factory.mktemp("remesh_disk")
-    mesh, model = str(d / "disk.msh"), str(d / "disk.geo")
-    geometry.quarter_disk(mesh, radius=1.0, h_far=0.1, h_near=0.1, width=0.5, model=model)
-    return mesh, model
+    return uniform_with_model(tmp_path_factory, geometry.quarter_disk, "disk", 0.1)
 
 
 @pytest.fixture(scope="module")
 def sphere(tmp_path_factory):
     """The Hertz sphere's quarter (radius 1), meshed uniformly at h = 0.2, and its model."""
-    d = tmp_path_factory.mktemp("remesh_sphere")
-    mesh, model = str(d / "sphere.msh"), str(d / "sphere.geo")
-    geometry.quarter_sphere(mesh, radius=1.0, h_far=0.2, h_near=0.2, width=0.5, model=model)
-    return mesh, model
+    return uniform_with_model(tmp_path_factory, geometry.quarter_sphere, "sphere", 0.2)
 
 
 def case_args(case, mesh):

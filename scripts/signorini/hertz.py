@@ -152,6 +152,16 @@ def quantity_exact(case, force):
     return {"pressure_max": p0, "contact_size": a if c["dim"] == 2 else math.pi * a * a / 4}
 
 
+def quantity_errors(case, attrs, force_ref):
+    """Relative errors of a run's -accuracy quantities (its /run attributes): the largest pressure and the size against
+    the closed form at the run's force (quantity_exact()), and the force against force_ref."""
+    axis = "xyz"[CASES[case]["dim"] - 1]
+    force = abs(float(attrs[f"contact_force_{axis}"]))
+    exact = quantity_exact(case, force)
+    return {"contact_force": force / force_ref - 1, "pressure_max": float(attrs["pressure_max"]) / exact["pressure_max"] - 1,
+            "contact_size": float(attrs["contact_size"]) / exact["contact_size"] - 1}
+
+
 def fit_profile(radius_sq, traction, a_h, inner=0.8):
     """(p0, a) of the Hertz profile fitted to the nodal tractions inside r < inner a_h: p^2 = p0^2 - (p0 / a)^2 r^2 is
     linear in r^2, so the fit is a linear least-squares one; it averages the node-to-node scatter of the tractions."""

@@ -3,6 +3,7 @@ tail or the telling line of a failed run's output."""
 import os
 import re
 import signal
+import statistics
 import subprocess
 import time
 from dataclasses import dataclass
@@ -79,6 +80,17 @@ def timed_or_exit(cmd):
     if p.returncode:
         raise SystemExit(f"{' '.join(cmd)} failed:\n{p.stdout[-2000:]}")
     return time.perf_counter() - t0
+
+
+def paired_medians(cmd, other, pairs):
+    """The median wall times of cmd and of other (None: none) over `pairs` alternated runs, side by side so that the
+    machine's noise falls on both; NaN for a missing other."""
+    t, t_other = [], []
+    for _ in range(pairs):
+        t.append(timed_or_exit(cmd))
+        if other:
+            t_other.append(timed_or_exit(other))
+    return statistics.median(t), statistics.median(t_other) if other else float("nan")
 
 
 def tail(text, n=LOG_TAIL_LINES):

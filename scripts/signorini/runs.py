@@ -104,6 +104,11 @@ def read_cycles(path):
         return {k: np.asarray(f["cycles"][k][:]).ravel() for k in f["cycles"]}
 
 
+def accuracy_bars(attrs, quantities):
+    """-accuracy's bars relative to their values, from a run's /run attributes."""
+    return {q: float(attrs[f"accuracy_{q}_bar"]) / abs(float(attrs[f"accuracy_{q}_value"])) for q in quantities}
+
+
 def read_output(path):
     """(attrs, fields) of the output `path`: the /run attributes with bytes decoded (numbers stay numpy scalars), and
     {name: array} of /vertex_fields in the file's vertex order (a load path's: its last step), plus "x":

@@ -307,29 +307,52 @@ PetscErrorCode MeshIndexCellTypes(DM dm)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The diameter of cell c: the largest distance between two of its vertices. */
-PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam)
+/* The largest and the mean distance between two vertices of cell c (its diameter, and for a simplex its mean edge). */
+static PetscErrorCode VertexDistances(DM dm, PetscInt c, PetscReal *largest, PetscReal *mean)
 {
   DM           cdm;
   PetscSection csection;
   Vec          coords;
-  PetscInt     cdim, n;
-  PetscScalar *x = NULL;
+  PetscInt     cdim, n, npairs = 0;
+  PetscScalar *x   = NULL;
+  PetscReal    sum = 0.0;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetCoordinateDim(dm, &cdim));
   PetscCall(DMGetCoordinateDM(dm, &cdm));
   PetscCall(DMGetLocalSection(cdm, &csection));
   PetscCall(DMGetCoordinatesLocal(dm, &coords));
-  *diam = 0.0;
+  *largest = 0.0;
   PetscCall(DMPlexVecGetClosure(cdm, csection, coords, c, &n, &x));
   for (PetscInt i = 0; i < n / cdim; ++i)
-    for (PetscInt j = i + 1; j < n / cdim; ++j) {
+    for (PetscInt j = i + 1; j < n / cdim; ++j, ++npairs) {
       PetscReal d2 = 0.0;
       for (PetscInt d = 0; d < cdim; ++d) d2 += PetscSqr(PetscRealPart(x[i * cdim + d] - x[j * cdim + d]));
-      *diam = PetscMax(*diam, PetscSqrtReal(d2));
+      *largest = PetscMax(*largest, PetscSqrtReal(d2));
+      sum += PetscSqrtReal(d2);
     }
   PetscCall(DMPlexVecRestoreClosure(cdm, csection, coords, c, &n, &x));
+  *mean = npairs ? sum / npairs : 0.0;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The diameter of cell c: the largest distance between two of its vertices. */
+PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam)
+{
+  PetscReal mean;
+
+  PetscFunctionBeginUser;
+  PetscCall(VertexDistances(dm, c, diam, &mean));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The mean edge length of simplex c (the size Gmsh is asked for, MeshRemesh()). */
+PetscErrorCode MeshCellMeanEdge(DM dm, PetscInt c, PetscReal *mean)
+{
+  PetscReal largest;
+
+  PetscFunctionBeginUser;
+  PetscCall(VertexDistances(dm, c, &largest, mean));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -40,7 +40,6 @@
   X(gmshModelMeshFieldSetNumber)           \
   X(gmshModelMeshGenerate)                 \
   X(gmshModelOccAddBox)                    \
-  X(gmshModelOccAddRectangle)              \
   X(gmshModelOccSynchronize)               \
   X(gmshOpen)                              \
   X(gmshOptionSetNumber)                   \
@@ -80,8 +79,8 @@ static PetscErrorCode GmshLoad(void)
     }                                                                                                              \
   } while (0)
 
-/* The box of the options as a Gmsh model: an OpenCASCADE box (rectangle in 2D), its sides' physical groups numbered
-   as PETSc numbers them (MeshBoxFaceId(), found by their bounding boxes), the body 10. */
+/* The 3D box of the options as a Gmsh model (a 2D box is refined by PETSc, AdaptSolve()): an OpenCASCADE box, its
+   sides' physical groups numbered as PETSc numbers them (MeshBoxFaceId(), found by their bounding boxes), the body 10. */
 static PetscErrorCode GmshBoxModel(const MeshBox *box)
 {
   const PetscInt dim = box->dim;
@@ -91,10 +90,8 @@ static PetscErrorCode GmshBoxModel(const MeshBox *box)
 
   PetscFunctionBeginUser;
   GmshCall(G.gmshModelAdd("box", &ierr_gmsh), "add the box model");
-  if (dim == 3)
-    GmshCall(body = G.gmshModelOccAddBox(lo[0], lo[1], lo[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], -1, &ierr_gmsh), "add the box");
-  else
-    GmshCall(body = G.gmshModelOccAddRectangle(lo[0], lo[1], 0.0, hi[0] - lo[0], hi[1] - lo[1], -1, 0.0, &ierr_gmsh), "add the rectangle");
+  PetscCheck(dim == 3, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the box's Gmsh model is 3D");
+  GmshCall(body = G.gmshModelOccAddBox(lo[0], lo[1], lo[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], -1, &ierr_gmsh), "add the box");
   GmshCall(G.gmshModelOccSynchronize(&ierr_gmsh), "synchronize the box");
   GmshCall(G.gmshModelGetEntities(&dimtags, &n, (int)dim - 1, &ierr_gmsh), "list the box's sides");
   for (size_t i = 0; i < n / 2; ++i) {

@@ -14,6 +14,29 @@
 
 /* Replaces the problem on *dm by the problem on its uniform refinement, or with marked (the adaptive cycles, adapt.c) on
    its refinement where marked says, with *u interpolated as the initial guess (exact for nested P1/Q1). */
+/* The solution u on dm as a local vector, with the Dirichlet values (inserted by ProblemSetUp()). */
+static PetscErrorCode LocalSolution(DM dm, const AppCtx *user, Vec u, Vec *loc)
+{
+  PetscFunctionBeginUser;
+  PetscCall(DMCreateLocalVector(dm, loc));
+  PetscCall(VecCopy(user->prob.loc_bc, *loc));
+  PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, *loc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The new mesh in place of the old, and u its global vector from the local fine_loc (which is destroyed). */
+static PetscErrorCode TakeMesh(DM *dm, DM fine, Vec *fine_loc, Vec *u)
+{
+  PetscFunctionBeginUser;
+  PetscCall(DMDestroy(dm));
+  *dm = fine;
+  PetscCall(DMCreateGlobalVector(fine, u));
+  PetscCall(PetscObjectSetName((PetscObject)*u, "displacement"));
+  PetscCall(DMLocalToGlobal(fine, *fine_loc, INSERT_VALUES, *u)); /* the fixed components are not in u: their values are the problem's */
+  PetscCall(VecDestroy(fine_loc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked)
 {
   DM        fine;
@@ -21,9 +44,7 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   Vec       loc, fine_loc;
 
   PetscFunctionBeginUser;
-  PetscCall(DMCreateLocalVector(*dm, &loc));
-  PetscCall(VecCopy(user->prob.loc_bc, loc)); /* the Dirichlet values, inserted by ProblemSetUp() */
-  PetscCall(DMGlobalToLocal(*dm, *u, INSERT_VALUES, loc));
+  PetscCall(LocalSolution(*dm, user, *u, &loc));
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
   if (marked) {
@@ -55,12 +76,7 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   PetscCall(PetscFree(parent));
   PetscCall(PetscFree(vertex_source));
   PetscCall(VecDestroy(&loc));
-  PetscCall(DMDestroy(dm));
-  *dm = fine;
-  PetscCall(DMCreateGlobalVector(fine, u));
-  PetscCall(PetscObjectSetName((PetscObject)*u, "displacement"));
-  PetscCall(DMLocalToGlobal(fine, fine_loc, INSERT_VALUES, *u));
-  PetscCall(VecDestroy(&fine_loc));
+  PetscCall(TakeMesh(dm, fine, &fine_loc, u));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -81,20 +97,13 @@ PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   PetscCall(DMPlexGetHeightStratum(*dm, 0, &cStart, &cEnd));
   PetscCall(PetscMalloc1(cEnd - cStart + 1, &size));
   for (PetscInt c = cStart; c < cEnd; ++c) {
-    PetscInt  verts[4], nv, value = -1, nedges = 0;
-    PetscReal x[4][3] = {{0.0}}, sum = 0.0;
+    PetscInt value = -1;
 
-    PetscCall(MeshCellVertices(*dm, c, verts, &nv));
-    for (PetscInt k = 0; k < nv; ++k) PetscCall(MeshPointPosition(*dm, verts[k], x[k]));
-    for (PetscInt i = 0; i < nv; ++i)
-      for (PetscInt j = i + 1; j < nv; ++j, ++nedges)
-        sum += PetscSqrtReal(PetscSqr(x[i][0] - x[j][0]) + PetscSqr(x[i][1] - x[j][1]) + PetscSqr(x[i][2] - x[j][2]));
+    PetscCall(MeshCellMeanEdge(*dm, c, &size[c - cStart]));
     if (marked) PetscCall(DMLabelGetValue(marked, c, &value));
-    size[c - cStart] = (sum / nedges) * (value == DM_ADAPT_REFINE ? 0.5 : 1.0);
+    if (value == DM_ADAPT_REFINE) size[c - cStart] *= 0.5;
   }
-  PetscCall(DMCreateLocalVector(*dm, &loc));
-  PetscCall(VecCopy(user->prob.loc_bc, loc)); /* the Dirichlet values, inserted by ProblemSetUp() */
-  PetscCall(DMGlobalToLocal(*dm, *u, INSERT_VALUES, loc));
+  PetscCall(LocalSolution(*dm, user, *u, &loc));
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
   PetscCall(MeshRemesh(*dm, user->opt->adapt.model, &user->box, size, loc, &fine, &tr));
@@ -103,15 +112,10 @@ PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   user->prob.level++;
   PetscCall(MeshSetContactCellSizes(fine, user->scene.bcs.ncontact, user->scene.bcs.contact_ids)); /* one eps on Gamma_C */
   PetscCall(ProblemSetUp(fine, user, snes));
-  PetscCall(DMDestroy(dm));
-  *dm = fine;
-  PetscCall(DMCreateGlobalVector(fine, u));
-  PetscCall(PetscObjectSetName((PetscObject)*u, "displacement"));
   PetscCall(DMCreateLocalVector(fine, &loc));
   PetscCall(MeshTransferApply(tr, fine, loc));
-  PetscCall(DMLocalToGlobal(fine, loc, INSERT_VALUES, *u)); /* the fixed components are not in u: their values are the problem's */
-  PetscCall(VecDestroy(&loc));
   PetscCall(MeshTransferDestroy(&tr));
+  PetscCall(TakeMesh(dm, fine, &loc, u));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
