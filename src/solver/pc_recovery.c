@@ -8,10 +8,17 @@
      1. a fresh build of the preconditioner on the current Jacobian, and builds only from then on (no more updates of a
         GAMG hierarchy's coarse operators, whose finest smoother is bounded rather than estimated again): new smoother
         estimates at every build;
-     2. for a multigrid, safer smoother bounds: GAMG built anew with its Chebyshev smoothers bounded by an estimate on
-        each level's own operator (-pc_gamg_use_sa_esteig 0, not the smoothed aggregation's estimate, which PETSc 3.18
-        uses by default and which the penalty rows of a small eps exceed); a geometric multigrid's Chebyshev intervals
-        stretched to SAFER_EMAX times the top estimate (PETSc's default is 1.1);
+     2. for a multigrid, safer smoother bounds and aggregates: GAMG built anew with its Chebyshev smoothers bounded by
+        an estimate on each level's own operator (-pc_gamg_use_sa_esteig 0, not the smoothed aggregation's estimate,
+        which PETSc 3.18 uses by default and which the penalty rows of a small eps exceed), and its aggregates made on
+        the whole graph of the matrix (-pc_gamg_threshold 0); a geometric multigrid's Chebyshev intervals stretched to
+        SAFER_EMAX times the top estimate (PETSc's default is 1.1). The penalty couples the normal components of the
+        contact nodes by 1/eps; where it dwarfs their elastic couplings, options/solvers/gamg.yaml's threshold 0.01
+        drops the links into the body, and aggregates of contact nodes alone, nearly coplanar, carry the rigid-body
+        modes badly: on the Hertz sphere remeshed by -adapt_model (the first Jacobian of a carried solution holds the
+        penalty rows of its contact), CG broke down at its second iteration on every build, the own estimates and
+        intervals widened to 1.5 times or estimated over 40 iterations alike, and the cycles of 5,910 and 58,233
+        unknowns went on to the direct solve (20 s of the second's 22 s); with threshold 0 none broke down;
      3. a direct solve: LU (Cholesky for SBAIJ) by MUMPS, exact for any eps.
    Each step is taken once per run, counted in /run pc_breakdowns and described in pc_recovery; -contact_pc_recovery 0
    leaves the breakdown a failed solve. A breakdown is never turned into a converged result without the Newton
@@ -127,14 +134,19 @@ PetscErrorCode PcRecoveryTry(SNES snes, SolverCtx sc, PetscBool *retry)
     if (is_gamg) {                      /* a new hierarchy whose smoothers estimate on their own operators, not from the aggregation's */
       PetscCall(PCSetType(pc, PCNONE)); /* the old hierarchy destroyed with its smoothers, whose SA estimates would stay */
       PetscCall(PCSetType(pc, PCGAMG));
+      PetscReal unfiltered = 0.0;
+
       PetscCall(PCSetFromOptions(pc)); /* the options given for GAMG, as at the first set-up */
       PetscCall(PCGAMGSetUseSAEstEig(pc, PETSC_FALSE));
+      PetscCall(PCGAMGSetThreshold(pc, &unfiltered, 1)); /* every level's graph whole: aggregates reach into the body */
     } else
       PetscCall(SaferChebyshev(pc)); /* the levels of the nested meshes stay */
-    PetscCall(Record(sc, is_gamg ? "GAMG rebuilt with each level's own eigenvalue estimate" : "Chebyshev intervals widened", kreason));
-    PetscCall(PetscPrintf(
-        comm, "  preconditioner breakdown (%s) again: %s, from the last iterate\n", KSPConvergedReasons[kreason],
-        is_gamg ? "GAMG rebuilt, each level's smoother bounded by its own eigenvalue estimate" : "the smoothers' Chebyshev intervals widened"));
+    PetscCall(
+        Record(sc, is_gamg ? "GAMG rebuilt with each level's own eigenvalue estimate and unfiltered graph" : "Chebyshev intervals widened", kreason));
+    PetscCall(PetscPrintf(comm, "  preconditioner breakdown (%s) again: %s, from the last iterate\n", KSPConvergedReasons[kreason],
+                          is_gamg
+                              ? "GAMG rebuilt, each level's smoother bounded by its own eigenvalue estimate, its aggregates on the unfiltered graph"
+                              : "the smoothers' Chebyshev intervals widened"));
   } else { /* 3. a direct solve */
     rec->stage = 3;
     PetscCall(UseDirectSolve(snes, pc));
