@@ -23,7 +23,7 @@ SRC = $(wildcard src/*.c src/*/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path penetration-tol estimates adapt-hertz accuracy-ladder accuracy-remesh bench format clean
+.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path penetration-tol estimates adapt-hertz accuracy-ladder accuracy-remesh work-precision bench format clean
 STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
@@ -138,6 +138,13 @@ accuracy-ladder: deps
 accuracy-remesh: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/accuracy_remesh.py
+
+# Error against unknowns and time (docs/estimate.md, "Adaptive, uniform and hand-graded meshes"): adaptive cycles, uniform
+# and hand-graded meshes on the 2D cylinder indenter, the elastic cylinder and the manufactured solution:
+# output/work_precision/work_precision.{md,csv} and docs/accuracy_work_precision.png
+work-precision: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) scripts/work_precision.py
 
 # Performance (docs/solvers.md, "Performance"): bench/{bench,getfem,fenicsx,profile3d,bandwidth,targets}.{md,csv}, runs under bench/runs/
 bench: deps
