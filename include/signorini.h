@@ -366,6 +366,7 @@ typedef struct {
   PetscReal accuracy;                  /* -accuracy: the relative error asked for (0: none), */
   PetscBool target[ACCURACY_NUM];      /*   of these quantities (-accuracy_quantity) */
   char      model[PETSC_MAX_PATH_LEN]; /* -adapt_model: the Gmsh model remeshed at each cycle ("": the mesh refined) */
+  PetscReal newton_fraction;           /* -accuracy_newton_fraction: Newton stops at this fraction of the error (0: never) */
 } AdaptOptions;
 
 /* One cycle of the adaptive refinement (/cycles in the output): the mesh, the estimate of its solution and the true

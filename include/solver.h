@@ -17,6 +17,8 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start);
 /* A solve from the guess u (a load path's step, force control's position, the penetration tolerance's eps) that, where
    it stalls or fails, is solved again from zero as a direct run: never less reliable than the direct run */
 PetscErrorCode SolverSolveWarm(SNES snes, AppCtx *user, Vec u, const char what[]);
+/* The next solves of the problem stop once a Newton step's energy norm is below energy (0: at -snes_rtol only) */
+PetscErrorCode SolverSetStepEnergyStop(AppCtx *user, PetscReal energy);
 /* |F| (user's units) that -snes_rtol is relative to in the current solve: its first, or for a warm start the load
    ||F(0)||, so that a warm start ends as tight as a start from zero */
 PetscErrorCode SolverResidualNorm(SNES snes, SolverCtx sc, Vec u, PetscReal *norm);

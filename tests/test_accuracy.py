@@ -149,3 +149,23 @@ def test_accuracy_takes_eps_h_over_10_unless_eps0_is_given():
         _, h5 = run(base + extra, f"accuracy_eps0_{k}")
         eps[k] = load(h5)[0]["eps"]
     assert eps["default"] == eps["0.1"] and abs(eps["1"] / eps["0.1"] - 10) < 1e-9 and eps["none"] == eps["1"], eps
+
+
+def test_the_newton_stop_on_the_steps_energy_norm_stays_within_its_fraction_of_the_estimate():
+    """-accuracy_newton_fraction 0.3 on the 3D manufactured solution (the box remeshed, the solution carried: Newton
+    takes 3 steps on the first new mesh to -snes_rtol): the first new mesh is the same (its marking comes from the first
+    solve, solved to -snes_rtol), Newton stops once a step's energy norm is below 0.3 times the estimate expected there,
+    after fewer steps, converged, and the true energy-norm errors differ by at most that (triangle inequality)."""
+    args = MMS + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "6,6,6", "-adapt_cycles", 1]
+    _, tight = run(args, "newton_stop_tight")
+    _, loose = run(args + ["-accuracy_newton_fraction", 0.3], "newton_stop_loose")
+    ct, cl = cycles(tight), cycles(loose)
+    assert np.array_equal(ct["n_dofs"], cl["n_dofs"]) and cl["converged"][-1] == 1
+    assert cl["newton_its"][-1] < ct["newton_its"][-1], (cl["newton_its"], ct["newton_its"])
+    expected = ct["estimate"][0] * (ct["n_dofs"][0] / ct["n_dofs"][1]) ** (1 / 3)
+    assert 0 < abs(cl["error_energy"][-1] - ct["error_energy"][-1]) <= 0.3 * expected, (cl["error_energy"], ct["error_energy"], expected)
+
+
+def test_a_newton_fraction_outside_zero_one_is_refused():
+    refused(MMS + ["-accuracy", 0.1, "-accuracy_newton_fraction", 1.5], "newton_fraction_bad",
+            "-accuracy_newton_fraction is a fraction of the error estimate in [0, 1), got 1.5")

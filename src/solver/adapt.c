@@ -27,9 +27,10 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
   PetscBool cycles_given, quantities_given;
 
   PetscFunctionBeginUser;
-  ad->cycles   = 0;
-  ad->fraction = 0.5;
-  ad->accuracy = 0.0;
+  ad->cycles          = 0;
+  ad->fraction        = 0.5;
+  ad->accuracy        = 0.0;
+  ad->newton_fraction = 0.0;
   PetscOptionsBegin(comm, NULL, "Adaptive refinement", "Signorini");
   PetscCall(PetscOptionsInt(
       "-adapt_cycles",
@@ -42,6 +43,10 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
   PetscCall(PetscOptionsEnumArray("-accuracy_quantity",
                                   "The quantities -accuracy asks for (energy: the energy-norm estimate against the solution's energy norm)", NULL,
                                   AccuracyQuantities, quantities, &nq, &quantities_given));
+  PetscCall(PetscOptionsReal("-accuracy_newton_fraction",
+                             "Each cycle's Newton stops once its step's energy norm is below this fraction of the error estimate expected on the "
+                             "cycle's mesh (0: at -snes_rtol)",
+                             NULL, ad->newton_fraction, &ad->newton_fraction, NULL));
   ad->model[0] = '\0';
   PetscCall(PetscOptionsString(
       "-adapt_model",
@@ -59,6 +64,8 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
              (double)ad->fraction);
   PetscCheck(ad->accuracy >= 0.0 && ad->accuracy < 1.0, comm, PETSC_ERR_USER_INPUT, "-accuracy is a relative error in (0, 1), got %g",
              (double)ad->accuracy);
+  PetscCheck(ad->newton_fraction >= 0.0 && ad->newton_fraction < 1.0, comm, PETSC_ERR_USER_INPUT,
+             "-accuracy_newton_fraction is a fraction of the error estimate in [0, 1), got %g", (double)ad->newton_fraction);
   PetscCheck(!quantities_given || ad->accuracy > 0.0, comm, PETSC_ERR_USER_INPUT, "-accuracy_quantity needs -accuracy TOL");
   PetscCheck(!quantities_given || nq > 0, comm, PETSC_ERR_USER_INPUT,
              "-accuracy_quantity needs at least one of energy, contact_force, pressure_max, contact_size");
@@ -198,6 +205,13 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     PetscCall(PetscTime(&t1));
     time_mesh = t1 - t0; /* the next cycle's mesh and its problem's set-up */
     PetscCall(DMLabelDestroy(&marked));
+    /* the next mesh's estimate as an adapted mesh's falls, like N^(-1/dim) */
+    if (ad->newton_fraction > 0.0) {
+      PetscInt n_next;
+
+      PetscCall(VecGetSize(*u, &n_next));
+      PetscCall(SolverSetStepEnergyStop(user, ad->newton_fraction * c->estimate * PetscPowReal((PetscReal)c->n_dofs / n_next, 1.0 / dim)));
+    }
     PetscCall(SolverSolve(*snes, user, *u, SOLVER_START_COARSER_MESH));
   }
   PetscCall(EstimateReset(&user->rec.estimate)); /* the run's own, after the last solve, as without cycles */

@@ -153,6 +153,30 @@ static PetscErrorCode SolverRoundoffFloor(SNES snes, SolverCtx sc, PetscReal *fl
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The energy norm of the last Newton step, (du^T J du)^(1/2) with du = U lambda Y the displacement's change (Y the
+   Newton direction, lambda the line search's length): J is the Jacobian of F in u (SolverRoundoffFloor()), the
+   elasticity's stiffness plus the penalty's, so that this is at least the step's a(du, du)^(1/2), the estimate's norm. */
+static PetscErrorCode SolverStepEnergy(SNES snes, SolverCtx sc, PetscReal *energy)
+{
+  SNESLineSearch ls;
+  Vec            Y, du, Jdu;
+  Mat            J;
+  PetscReal      lambda, dot;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESGetSolutionUpdate(snes, &Y));
+  PetscCall(SNESGetLineSearch(snes, &ls));
+  PetscCall(SNESLineSearchGetLambda(ls, &lambda));
+  PetscCall(SolverIterateDisplacement(sc, Y, &du));
+  PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
+  PetscCall(VecDuplicate(du, &Jdu));
+  PetscCall(MatMult(J, du, Jdu));
+  PetscCall(VecDot(du, Jdu, &dot));
+  PetscCall(VecDestroy(&Jdu));
+  *energy = PetscAbsReal(lambda) * PetscSqrtReal(PetscMax(dot, 0.0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm, SNESConvergedReason *reason, void *ctx)
 {
   SolverCtx       sc = (SolverCtx)ctx;
@@ -176,6 +200,7 @@ PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscRea
      instead of running to the iteration limit; /run says so (stopped_at_roundoff). A step that still makes progress is
      never stopped here. */
   if (it == 0) sc->roundoff_stop = PETSC_FALSE;
+  if (it == 0) sc->energy_stop = PETSC_FALSE;
   if (*reason <= 0 && it > 0 && !PetscIsInfOrNanReal(f) && f > 0.5 * sc->fnorm_last) {
     PetscReal floor = 0.0;
 
@@ -194,6 +219,18 @@ PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscRea
     if (*reason == SNES_CONVERGED_ITERATING && it >= SOLVER_STALL_STEPS && f > 0.5 * sc->fnorm_window[(it - SOLVER_STALL_STEPS) % w])
       *reason = SNES_DIVERGED_LINE_SEARCH;
     sc->fnorm_window[it % w] = f;
+  }
+  /* The accuracy's stop (-accuracy_newton_fraction, adapt.c): Newton stops once its step is below a fraction of the
+     discretization's error in the energy norm. Semismooth Newton converges superlinearly near the solution, so that
+     the error left after a step is far below the step, and the step's energy norm bounds it. */
+  if (*reason == SNES_CONVERGED_ITERATING && it > 0 && sc->step_energy_stop > 0.0) {
+    PetscReal e = 0.0;
+
+    PetscCall(SolverStepEnergy(snes, sc, &e));
+    if (e <= sc->step_energy_stop) {
+      *reason         = SNES_CONVERGED_SNORM_RELATIVE;
+      sc->energy_stop = PETSC_TRUE;
+    }
   }
   sc->fnorm_last = f;
   PetscFunctionReturn(PETSC_SUCCESS);

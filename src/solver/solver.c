@@ -304,7 +304,7 @@ static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, Pet
   ref                              = SolverStopReference(user->prob.sctx);
   user->rec.stats.residual_reduced = (PetscBool)(user->rec.stats.residual_norm <= rtol * ref ||
                                                  user->rec.stats.residual_norm <= user->opt->solver.load_rtol * user->prob.load_norm ||
-                                                 fnorm <= atol || user->prob.sctx->roundoff_stop);
+                                                 fnorm <= atol || user->prob.sctx->roundoff_stop || user->prob.sctx->energy_stop);
   user->rec.stats.roundoff_stop    = user->prob.sctx->roundoff_stop;
   user->rec.stats.converged        = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
   PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
@@ -432,6 +432,13 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
   user->rec.stats.newton_its_total += newton;
   user->rec.stats.ksp_its_total += ksp;
   PetscCall(SolverAddRecord(snes, user, u, t1 - t0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode SolverSetStepEnergyStop(AppCtx *user, PetscReal energy)
+{
+  PetscFunctionBeginUser;
+  user->prob.sctx->step_energy_stop = energy;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -111,6 +111,8 @@ struct _n_SolverCtx {
   PetscBool  roundoff_stop;                        /* the last SNESSolve stopped at the round-off of its terms (SolverConverged()) */
   PetscBool  warm;                                 /* the last SolverSolve() started from a given guess, not from zero */
   PetscBool  stall_stop;                           /* the current solve is SolverSolveWarm()'s: it stops where it stalls */
+  PetscReal  step_energy_stop;                     /* Newton stops once a step's energy norm is below this (0: never; adapt.c), */
+  PetscBool  energy_stop;                          /*   and the last SNESSolve did (SolverConverged()) */
   PetscReal  fnorm_window[SOLVER_STALL_STEPS + 1]; /* |F| of its last Newton steps (a ring), for that test */
   PetscInt64 active_history[CONTACT_HISTORY];      /* active-set hashes of the Newton steps of the current solve, */
   PetscReal  fnorm_history[CONTACT_HISTORY];       /*   and their residual norms */
