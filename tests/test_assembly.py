@@ -22,8 +22,8 @@ PENALTY_CHECK = re.compile(r"penalty check: \|F_p1 - F_fe\|/\|F_fe\| = (\S+) \(\
 MESH = {2: ["-dm_plex_dim", 2, "-dm_plex_box_faces", "12,12"], 3: ["-dm_plex_dim", 3, "-dm_plex_box_faces", "4,4,4"]}
 
 
-def check_matrices(out, dim, mat_type=None):
-    """Parses the -assembly_check line and asserts that the two matrices are the same."""
+def check_matrices(out, dim, mat_type=None, bs=None):
+    """Parses the -assembly_check line and asserts that the two matrices are the same (block size bs, by default dim)."""
     m = CHECK.search(out)
     assert m, f"no assembly check line in:\n{out[-2000:]}"
     rel = float(m.group(1))
@@ -35,7 +35,7 @@ def check_matrices(out, dim, mat_type=None):
     assert size_p1 == size_fe, (size_p1, size_fe)
     assert type_p1 == type_fe, (type_p1, type_fe)
     assert mat_type is None or type_p1.endswith(mat_type) and type_p1 in ("seq" + mat_type, "mpi" + mat_type), (type_p1, mat_type)
-    assert bs_p1 == bs_fe == dim, (bs_p1, bs_fe, dim)
+    assert bs_p1 == bs_fe == (bs or dim), (bs_p1, bs_fe, bs or dim)
     assert nz_p1 == nz_fe > 0, (nz_p1, nz_fe)  # same nonzero pattern size: no entry missing or extra
     assert alloc_p1 == nz_p1, f"preallocation not exact: {alloc_p1} allocated for {nz_p1} nonzeros"
     return rel
@@ -91,6 +91,26 @@ def test_penalty_gauss_closed_form_equals_petsc(name, args, tmp_path):
     assert a["converged"] == 1 and a["assembly"] == "p1"
     if name == "graded_local_eps":
         assert a["eps_min"] < 0.5 * a["eps_max"], (a["eps_min"], a["eps_max"])
+
+
+@pytest.mark.parametrize("mat_type", ("aij", "sbaij"))
+@pytest.mark.parametrize("dim", (2, 3), ids=("2d", "3d"))
+def test_partly_constrained_vertices_are_preallocated_exactly(dim, mat_type, tmp_path):
+    """A slip face fixes one component of its vertices, so K has a row per dof (block size 1): on one rank its
+    preallocation is counted from the mesh's edges (AssemblyP1PreallocateScalar()), exact for aij and for sbaij's upper
+    triangle, and K is the FE one. The Hertz cylinder's quarter disk (2D) and the sphere indenter's quarter block (3D)."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    from signorini import hertz
+    case = "cylinder" if dim == 2 else "sphere-indenter"
+    mesh = str(tmp_path / f"{case}.msh")
+    hertz.write_mesh(case, 0.05 if dim == 2 else 0.1, mesh)
+    args = hertz.command(case, mesh, "eps=h/10", "unused.h5")[4:-2] + ["-contact_monitor", 0, "-assembly_check", "-dm_mat_type", mat_type]
+    if mat_type == "sbaij":
+        args += ["-ksp_type", "cg", "-pc_type", "jacobi", "-ksp_rtol", 1e-12]
+    out, h5 = run(args, f"assembly_scalar_{dim}d_{mat_type}")
+    check_matrices(out, dim, mat_type, bs=1)
+    assert load(h5)[0]["converged"] == 1
 
 
 @pytest.mark.parametrize("mat_type,scene,dim,np_", (("baij", "mms", 3, 2), ("sbaij", "square", 2, 1)), ids=("baij", "sbaij"))

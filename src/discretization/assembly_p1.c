@@ -1,8 +1,8 @@
-/* The bulk elastic matrix K for P1 on simplices, without PetscFE: the preallocation from the mesh's edges (one rank, a
-   block per vertex) or by a MATPREALLOCATOR dry run of the cell loop (DMPlex's adjacency-based preallocation is slow in
-   3.18), and closed-form element matrices B^T D B |T|.
-   The result is the matrix of DMCreateMatrix() + DMPlexSNESComputeJacobianFEM(): same type, sizes, block size,
-   local-to-global mapping, nonzero pattern and values; the rows and columns of constrained dofs are absent. */
+/* The bulk elastic matrix K for P1 on simplices, without PetscFE: the preallocation from the mesh's edges (one rank: a
+   block per vertex, or a row per dof where a vertex is partly constrained) or by a MATPREALLOCATOR dry run of the cell loop (DMPlex's adjacency-based
+   preallocation is slow in 3.18), and closed-form element matrices B^T D B |T|. The result is the matrix of DMCreateMatrix() +
+   DMPlexSNESComputeJacobianFEM(): same type, sizes, block size, local-to-global mapping, nonzero pattern and values; the rows and columns of
+   constrained dofs are absent. */
 #include "mesh.h"
 #include "discretization.h"
 #include "physics.h"
@@ -221,10 +221,60 @@ static PetscErrorCode AssemblyP1PreallocateFromEdges(DM dm, PetscInt bs, PetscIn
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The exact preallocation of K on one rank with a row per dof (bs = 1: some vertex is partly constrained, as on a slip
+   face): the row of a free component of vertex v holds the free components of v and of its neighbours along the edges,
+   counted edge by edge, in and on or above the diagonal (for sbaij). */
+static PetscErrorCode AssemblyP1PreallocateScalar(DM dm, PetscInt nlocal, const PetscInt vidx[], Mat K, PetscBool *done)
+{
+  PetscMPIInt size;
+  PetscInt    dim, depth, vStart, vEnd, eStart, eEnd, *dnz, *dnzu, *onz;
+
+  PetscFunctionBeginUser;
+  *done = PETSC_FALSE;
+  PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)dm), &size));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetDepth(dm, &depth));
+  if (size > 1 || depth != dim) PetscFunctionReturn(PETSC_SUCCESS); /* MATPREALLOCATOR then */
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 1, &eStart, &eEnd));
+  PetscCall(PetscCalloc3(nlocal, &dnz, nlocal, &dnzu, nlocal, &onz));
+  for (PetscInt v = vStart; v < vEnd; ++v) { /* the vertex's own block */
+    const PetscInt *g = &vidx[(v - vStart) * dim];
+
+    for (PetscInt a = 0; a < dim; ++a)
+      for (PetscInt b = 0; b < dim && g[a] >= 0; ++b) {
+        if (g[b] < 0) continue;
+        PetscCheck(g[a] < nlocal && g[b] < nlocal, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Vertex %" PetscInt_FMT " has a dof outside the rows", v);
+        ++dnz[g[a]];
+        dnzu[g[a]] += g[b] >= g[a];
+      }
+  }
+  for (PetscInt e = eStart; e < eEnd; ++e) { /* the blocks of the edge's two vertices, both ways */
+    const PetscInt *cone, *ga, *gb;
+
+    PetscCall(DMPlexGetCone(dm, e, &cone));
+    ga = &vidx[(cone[0] - vStart) * dim];
+    gb = &vidx[(cone[1] - vStart) * dim];
+    for (PetscInt a = 0; a < dim; ++a)
+      for (PetscInt b = 0; b < dim; ++b) {
+        if (ga[a] < 0 || gb[b] < 0) continue;
+        ++dnz[ga[a]];
+        ++dnz[gb[b]];
+        dnzu[ga[a]] += gb[b] >= ga[a];
+        dnzu[gb[b]] += ga[a] >= gb[b];
+      }
+  }
+  PetscCall(MatXAIJSetPreallocation(K, 1, dnz, onz, dnzu, onz));
+  PetscCall(MatSetOption(K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
+  PetscCall(PetscFree3(dnz, dnzu, onz));
+  *done = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Preallocates K by a dry run of the cell loop into a MATPREALLOCATOR whose rows and columns are blocks of bs dofs (one
    per vertex when bs = dim), which also counts the entries of rows owned by other ranks. Its pattern, filled into a
    helper matrix of blocks, gives the exact counts of blocks per block row, in and off the diagonal part and on and above
-   the diagonal (for sbaij); AssemblyP1PreallocateFromEdges() is tried first. */
+   the diagonal (for sbaij); AssemblyP1PreallocateFromEdges() and AssemblyP1PreallocateScalar() are tried first. */
 static PetscErrorCode AssemblyP1Preallocate(DM dm, PetscInt bs, PetscInt nlocal, const PetscInt vidx[], const PetscInt cverts[], Mat K)
 {
   MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
@@ -234,6 +284,7 @@ static PetscErrorCode AssemblyP1Preallocate(DM dm, PetscInt bs, PetscInt nlocal,
 
   PetscFunctionBeginUser;
   PetscCall(AssemblyP1PreallocateFromEdges(dm, bs, nlocal, vidx, K, &done));
+  if (!done && bs == 1) PetscCall(AssemblyP1PreallocateScalar(dm, nlocal, vidx, K, &done));
   if (done) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
