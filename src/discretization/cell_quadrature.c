@@ -5,6 +5,14 @@
 #include "mesh.h"
 #include "discretization.h"
 
+/* Whether two arrays of reals differ in any bit-for-bit comparison of their values. */
+static PetscBool RealsDiffer(const PetscReal a[], const PetscReal b[], PetscInt n)
+{
+  for (PetscInt i = 0; i < n; ++i)
+    if (a[i] != b[i]) return PETSC_TRUE;
+  return PETSC_FALSE;
+}
+
 /* Gauss rule with npoints per direction (Stroud conical on simplices), repeated on the subcells of the reference cell refined `refine` times. */
 static PetscErrorCode RuleCreate(DMPolytopeType ct, PetscInt npoints, PetscInt refine, PetscQuadrature *q)
 {
@@ -113,6 +121,13 @@ PetscErrorCode CellQuadratureCreate(DM dm, const Scene *scene, const VerifyOptio
       PetscCall(PetscQuadratureGetData(cq->cell_rule[r], NULL, NULL, NULL, &pts, NULL));
       PetscCall(PetscFECreateTabulation(cq->fe, 1, Nq, pts, 1, &cq->cell_tab[r]));
     }
+    {
+      const PetscInt   n  = cq->Nb * cq->Nc * cq->dim;
+      const PetscReal *T1 = cq->cell_tab[r]->T[1];
+
+      cq->grad_const[r] = PETSC_TRUE;
+      for (PetscInt q = 1; q < Nq && cq->grad_const[r]; ++q) cq->grad_const[r] = (PetscBool)!RealsDiffer(&T1[q * n], T1, n);
+    }
     PetscCall(PetscQuadratureGetData(cq->face_rule[r], NULL, NULL, &Nq, NULL, NULL));
     maxq = PetscMax(maxq, Nq);
   }
@@ -151,10 +166,17 @@ PetscErrorCode CellQuadratureSetCell(CellQuadrature *cq, PetscInt c)
   T1 = cq->cell_tab[r]->T[1];
   for (PetscInt q = 0; q < cq->Nq; ++q) {
     const PetscReal *invJ = &cq->invJ[q * dim * dim];
+    const PetscInt   n    = Nb * Nc * dim;
 
     PetscCheck(cq->detJ[q] > 0.0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Cell %" PetscInt_FMT " is inverted or degenerate (det J = %g)", c,
                (double)cq->detJ[q]);
     cq->wbuf[q] = qw[q] * cq->detJ[q];
+    /* the same reference gradients and the same inverse Jacobian as at the first point (P1 on an affine cell): the same
+       products, copied */
+    if (q > 0 && cq->grad_const[r] && !RealsDiffer(invJ, cq->invJ, dim * dim)) {
+      PetscCall(PetscArraycpy(&cq->dbuf[q * n], cq->dbuf, n));
+      continue;
+    }
     for (PetscInt b = 0; b < Nb; ++b)
       for (PetscInt k = 0; k < Nc; ++k) {
         const PetscReal *ref  = &T1[((q * Nb + b) * Nc + k) * dim];
