@@ -47,7 +47,8 @@ typedef struct {
   const Scene    *scene;
   PetscQuadrature cell_rule[2], face_rule[2]; /* plain and refined */
   PetscTabulation cell_tab[2], face_tab;
-  PetscBool       grad_const[2]; /* the rule's reference gradients the same at every point (P1): one product per affine cell */
+  PetscBool       grad_const[2]; /* the rule's reference gradients the same at every point (P1): one product per affine cell, */
+  PetscBool       D_uniform;     /*   and the current cell's physical gradients D the same at every point */
   PetscReal      *xbuf, *wbuf, *dbuf, *J, *invJ, *detJ, *refbuf;
 } CellQuadrature;
 PetscErrorCode CellQuadratureCreate(DM dm, const Scene *scene, const VerifyOptions *opts, CellQuadrature *cq);

@@ -163,7 +163,8 @@ PetscErrorCode CellQuadratureSetCell(CellQuadrature *cq, PetscInt c)
   r = cut ? 1 : 0;
   PetscCall(PetscQuadratureGetData(cq->cell_rule[r], NULL, NULL, &cq->Nq, NULL, &qw));
   PetscCall(DMPlexComputeCellGeometryFEM(cq->dm, c, cq->cell_rule[r], cq->xbuf, cq->J, cq->invJ, cq->detJ));
-  T1 = cq->cell_tab[r]->T[1];
+  T1            = cq->cell_tab[r]->T[1];
+  cq->D_uniform = PETSC_TRUE;
   for (PetscInt q = 0; q < cq->Nq; ++q) {
     const PetscReal *invJ = &cq->invJ[q * dim * dim];
     const PetscInt   n    = Nb * Nc * dim;
@@ -177,6 +178,7 @@ PetscErrorCode CellQuadratureSetCell(CellQuadrature *cq, PetscInt c)
       PetscCall(PetscArraycpy(&cq->dbuf[q * n], cq->dbuf, n));
       continue;
     }
+    if (q > 0) cq->D_uniform = PETSC_FALSE;
     for (PetscInt b = 0; b < Nb; ++b)
       for (PetscInt k = 0; k < Nc; ++k) {
         const PetscReal *ref  = &T1[((q * Nb + b) * Nc + k) * dim];

@@ -55,10 +55,18 @@ static PetscErrorCode IntegrateBulk(DM dm, AppCtx *user, CellQuadrature *cq, Vec
     PetscCall(CellQuadratureSetCell(cq, c));
     PetscCall(DMPlexVecGetClosure(dm, NULL, loc_uh, c, NULL, &uh));
     if (!t->scene) PetscCall(DMPlexVecGetClosure(dm, NULL, t->loc_u, c, NULL, &ur));
+    PetscReal g0[9]; /* u_h's gradient at the first point: at every point where D is the same there (P1, affine cell) */
+
     for (PetscInt q = 0; q < cq->Nq; ++q) {
       PetscReal u[3], g[9], ut[3], gt[9], sigma[9], s0 = 0.0, s1 = 0.0, s2 = 0.0;
 
-      PetscCall(CellQuadratureInterpolate(cq, uh, q, u, g));
+      if (q == 0 || !cq->D_uniform) {
+        PetscCall(CellQuadratureInterpolate(cq, uh, q, u, g));
+        if (q == 0) PetscCall(PetscArraycpy(g0, g, dim * dim));
+      } else {
+        PetscCall(CellQuadratureInterpolate(cq, uh, q, u, NULL));
+        PetscCall(PetscArraycpy(g, g0, dim * dim));
+      }
       if (t->scene) {
         PetscScalar us[3], gs[9];
 
