@@ -39,7 +39,8 @@ typedef struct {
   const PetscReal *x;           /* [Nq][dim] physical points */
   const PetscReal *w;           /* [Nq] weights times the Jacobian determinant */
   const PetscReal *B;           /* [Nq][Nb][Nc] basis values */
-  const PetscReal *D;           /* [Nq][Nb][Nc][dim] physical basis gradients (cells only) */
+  const PetscReal *D;           /* [Nq][Nb][Nc][dim] physical basis gradients (cells only): point q's at CellQuadratureGradientPoint(q) */
+  PetscBool        D_uniform;   /* the cell's physical gradients the same at every point (P1, affine): D holds the first's alone */
   PetscInt         cell;        /* the cell whose basis is tabulated (the support cell of a face) */
   /* private */
   DM              dm;
@@ -47,8 +48,7 @@ typedef struct {
   const Scene    *scene;
   PetscQuadrature cell_rule[2], face_rule[2]; /* plain and refined */
   PetscTabulation cell_tab[2], face_tab;
-  PetscBool       grad_const[2]; /* the rule's reference gradients the same at every point (P1): one product per affine cell, */
-  PetscBool       D_uniform;     /*   and the current cell's physical gradients D the same at every point */
+  PetscBool       grad_const[2]; /* the rule's reference gradients the same at every point (P1): one product per affine cell */
   PetscReal      *xbuf, *wbuf, *dbuf, *J, *invJ, *detJ, *refbuf;
 } CellQuadrature;
 PetscErrorCode CellQuadratureCreate(DM dm, const Scene *scene, const VerifyOptions *opts, CellQuadrature *cq);
@@ -56,3 +56,8 @@ PetscErrorCode CellQuadratureSetCell(CellQuadrature *cq, PetscInt cell);
 PetscErrorCode CellQuadratureSetFace(CellQuadrature *cq, PetscInt face);
 PetscErrorCode CellQuadratureDestroy(CellQuadrature *cq);
 PetscErrorCode CellQuadratureInterpolate(const CellQuadrature *cq, const PetscScalar closure[], PetscInt q, PetscReal u[], PetscReal grad[]);
+/* The row of D that holds point q's physical gradients */
+static inline PetscInt CellQuadratureGradientPoint(const CellQuadrature *cq, PetscInt q)
+{
+  return cq->D_uniform ? 0 : q;
+}

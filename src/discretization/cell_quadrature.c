@@ -163,22 +163,18 @@ PetscErrorCode CellQuadratureSetCell(CellQuadrature *cq, PetscInt c)
   r = cut ? 1 : 0;
   PetscCall(PetscQuadratureGetData(cq->cell_rule[r], NULL, NULL, &cq->Nq, NULL, &qw));
   PetscCall(DMPlexComputeCellGeometryFEM(cq->dm, c, cq->cell_rule[r], cq->xbuf, cq->J, cq->invJ, cq->detJ));
-  T1            = cq->cell_tab[r]->T[1];
-  cq->D_uniform = PETSC_TRUE;
+  T1 = cq->cell_tab[r]->T[1];
+  /* P1 on an affine cell: the same reference gradients and the same inverse Jacobian at every point, so the physical
+     gradients are those of the first point (D_uniform: D holds that point's alone, and D's users read it for all) */
+  cq->D_uniform = cq->grad_const[r];
+  for (PetscInt q = 1; q < cq->Nq && cq->D_uniform; ++q) cq->D_uniform = (PetscBool)!RealsDiffer(&cq->invJ[q * dim * dim], cq->invJ, dim * dim);
   for (PetscInt q = 0; q < cq->Nq; ++q) {
     const PetscReal *invJ = &cq->invJ[q * dim * dim];
-    const PetscInt   n    = Nb * Nc * dim;
 
     PetscCheck(cq->detJ[q] > 0.0, PETSC_COMM_SELF, PETSC_ERR_ARG_WRONG, "Cell %" PetscInt_FMT " is inverted or degenerate (det J = %g)", c,
                (double)cq->detJ[q]);
     cq->wbuf[q] = qw[q] * cq->detJ[q];
-    /* the same reference gradients and the same inverse Jacobian as at the first point (P1 on an affine cell): the same
-       products, copied */
-    if (q > 0 && cq->grad_const[r] && !RealsDiffer(invJ, cq->invJ, dim * dim)) {
-      PetscCall(PetscArraycpy(&cq->dbuf[q * n], cq->dbuf, n));
-      continue;
-    }
-    if (q > 0) cq->D_uniform = PETSC_FALSE;
+    if (q > 0 && cq->D_uniform) continue;
     for (PetscInt b = 0; b < Nb; ++b)
       for (PetscInt k = 0; k < Nc; ++k) {
         const PetscReal *ref  = &T1[((q * Nb + b) * Nc + k) * dim];
@@ -286,7 +282,7 @@ PetscErrorCode CellQuadratureSetFace(CellQuadrature *cq, PetscInt f)
 /* The FE function with the given closure values at point q: u[Nc] and, on cells, grad[Nc*dim] (grad may be NULL). */
 PetscErrorCode CellQuadratureInterpolate(const CellQuadrature *cq, const PetscScalar closure[], PetscInt q, PetscReal u[], PetscReal grad[])
 {
-  const PetscInt dim = cq->dim, Nb = cq->Nb, Nc = cq->Nc;
+  const PetscInt dim = cq->dim, Nb = cq->Nb, Nc = cq->Nc, qd = CellQuadratureGradientPoint(cq, q);
 
   PetscFunctionBeginUser;
   for (PetscInt k = 0; k < Nc; ++k) u[k] = 0.0;
@@ -299,7 +295,7 @@ PetscErrorCode CellQuadratureInterpolate(const CellQuadrature *cq, const PetscSc
     for (PetscInt k = 0; k < Nc; ++k) {
       u[k] += c * cq->B[(q * Nb + b) * Nc + k];
       if (grad)
-        for (PetscInt e = 0; e < dim; ++e) grad[k * dim + e] += c * cq->D[((q * Nb + b) * Nc + k) * dim + e];
+        for (PetscInt e = 0; e < dim; ++e) grad[k * dim + e] += c * cq->D[((qd * Nb + b) * Nc + k) * dim + e];
     }
   }
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -58,7 +58,8 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0, PetscReal *lif
         PetscReal s = 0.0;
 
         for (PetscInt k = 0; k < cq.Nc; ++k)
-          for (PetscInt e = 0; e < dim; ++e) s += sigma[k * dim + e] * cq.D[((q * cq.Nb + b) * cq.Nc + k) * dim + e];
+          for (PetscInt e = 0; e < dim; ++e)
+            s += sigma[k * dim + e] * cq.D[((CellQuadratureGradientPoint(&cq, q) * cq.Nb + b) * cq.Nc + k) * dim + e];
         elem[b] += cq.w[q] * s;
       }
     }
