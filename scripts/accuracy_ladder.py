@@ -38,7 +38,6 @@ from signorini.runs import read_run  # noqa: E402
 CASE = "cylinder-indenter"
 MMS_EXACT = {"contact_force": 0.0720182, "pressure_max": 0.402594, "contact_size": 0.447214}  # docs/estimate.md
 QUANTITIES = "contact_force,pressure_max,contact_size"
-HAND = [(0.002, 0.1), (0.001, 0.1), (0.001, 0.05), (0.0005, 0.05), (0.0005, 0.02), (0.00025, 0.02)]  # (h_near, grade G)
 
 
 
@@ -95,10 +94,9 @@ def main():
         print(f"-accuracy {tol:g}: {adaptive[tol][1]['n_dofs']} unknowns, reached {adaptive[tol][1]['accuracy_reached']}", flush=True)
     force_ref = abs(float(adaptive[tols[-1]][1]["contact_force_y"]))
     hand = []
-    for h_near, grade in HAND:
+    for h_near, grade in st.INDENTER_GRADES:
         mesh = os.path.join(args.outdir, f"block10_h{h_near:g}_grade{grade:g}.msh")
-        near = min(0.98 * (0.5 - h_near) / grade, 0.9 * st.BLOCK)
-        geometry.block(mesh, radius=st.BLOCK, h_far=0.5, h_near=h_near, grade=grade, near=near, width=min(2.0, 0.95 * st.BLOCK - near))
+        st.write_graded_block(mesh, h_near, grade)
         out = os.path.join(args.outdir, f"graded_h{h_near:g}_grade{grade:g}.h5")
         cmd = hertz.command(CASE, mesh, "eps=h/10", out)[3:]
         solve(cmd)

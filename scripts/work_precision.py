@@ -38,7 +38,6 @@ QUANTITIES = ("contact_force", "pressure_max", "contact_size")
 MMS_EXACT = {"contact_force": 0.0720182, "pressure_max": 0.402594, "contact_size": 0.447214}  # docs/estimate.md
 ERRORS = (0.03, 0.01, 0.003)
 BIN = os.path.join(ROOT, "bin", "signorini")
-INDENTER_HAND = [(0.002, 0.1), (0.001, 0.1), (0.001, 0.05), (0.0005, 0.05), (0.0005, 0.02), (0.00025, 0.02)]  # make accuracy-ladder's
 CYLINDER_HAND = [0.004, 0.002, 0.001, 0.0005]
 
 
@@ -56,15 +55,11 @@ def errors(case, force, pressure_max, size, force_ref):
         return np.max([np.abs(values[q] / exact[q] - 1) for q in QUANTITIES], axis=0)
 
 
-def force_of(attrs, dim):
-    return abs(float(attrs[f"contact_force_{'xyz'[dim - 1]}"]))
-
-
-def single(case, cmd, out, dim):
-    """Solve once; (unknowns, time, force, largest pressure, size)."""
+def single(cmd, out):
+    """Solve once (2D); (unknowns, time, force, largest pressure, size)."""
     solve(cmd + ["-output", out])
     a = read_run(out)
-    return int(a["n_dofs"]), float(a["time_total"]), force_of(a, dim), float(a["pressure_max"]), float(a["contact_size"])
+    return int(a["n_dofs"]), float(a["time_total"]), abs(float(a["contact_force_y"])), float(a["pressure_max"]), float(a["contact_size"])
 
 
 def hertz_cmd(case, mesh):
@@ -79,29 +74,28 @@ def runs_of(case, outdir, cycles):
         mms = [BIN, "-options_file", "options/mms.yaml", "-penalty_eps0", "0.1"]
         adaptive = mms + ["-dm_plex_box_faces", "8,8", "-adapt_cycles", str(cycles)]
         for n in (8, 16, 32, 64, 128, 256):
-            fam["uniform"].append(single(case, mms + ["-dm_plex_box_faces", f"{n},{n}"], os.path.join(outdir, f"mms_uniform_{n}.h5"), 2))
+            fam["uniform"].append(single(mms + ["-dm_plex_box_faces", f"{n},{n}"], os.path.join(outdir, f"mms_uniform_{n}.h5")))
     elif case == "cylinder-indenter":
         coarse = os.path.join(outdir, "block10_h0.5.msh")
         for h in (0.5, 0.25, 0.125, 0.0625, 0.03125):
             mesh = os.path.join(outdir, f"block10_h{h:g}.msh")
             geometry.block(mesh, radius=st.BLOCK, h_far=h, h_near=h, width=3.0, near=0.6)
-            fam["uniform"].append(single(case, hertz_cmd(case, mesh), os.path.join(outdir, f"indenter_uniform_{h:g}.h5"), 2))
-        for h_near, grade in INDENTER_HAND:
+            fam["uniform"].append(single(hertz_cmd(case, mesh), os.path.join(outdir, f"indenter_uniform_{h:g}.h5")))
+        for h_near, grade in st.INDENTER_GRADES:
             mesh = os.path.join(outdir, f"block10_h{h_near:g}_grade{grade:g}.msh")
-            near = min(0.98 * (0.5 - h_near) / grade, 0.9 * st.BLOCK)
-            geometry.block(mesh, radius=st.BLOCK, h_far=0.5, h_near=h_near, grade=grade, near=near, width=min(2.0, 0.95 * st.BLOCK - near))
-            fam["hand-graded"].append(single(case, hertz_cmd(case, mesh), os.path.join(outdir, f"indenter_graded_{h_near:g}_{grade:g}.h5"), 2))
+            st.write_graded_block(mesh, h_near, grade)
+            fam["hand-graded"].append(single(hertz_cmd(case, mesh), os.path.join(outdir, f"indenter_graded_{h_near:g}_{grade:g}.h5")))
         adaptive = hertz_cmd(case, coarse) + ["-adapt_cycles", str(cycles), "-options_file", "options/solvers/gamg.yaml"]
     else:  # the elastic cylinder: uniform meshes of the quarter disk, make hertz's grading, the model remeshed
         model = os.path.join(outdir, "disk.geo")
         for h in (0.1, 0.05, 0.025, 0.0125, 0.00625):
             mesh = os.path.join(outdir, f"disk_h{h:g}.msh")
             geometry.quarter_disk(mesh, radius=hertz.RADIUS, h_far=h, h_near=h, width=0.5, model=model if h == 0.1 else None)
-            fam["uniform"].append(single(case, hertz_cmd(case, mesh), os.path.join(outdir, f"cylinder_uniform_{h:g}.h5"), 2))
+            fam["uniform"].append(single(hertz_cmd(case, mesh), os.path.join(outdir, f"cylinder_uniform_{h:g}.h5")))
         for h_near in CYLINDER_HAND:
             mesh = os.path.join(outdir, f"cylinder_graded_{h_near:g}.msh")
             hertz.write_mesh(case, h_near, mesh)
-            fam["hand-graded"].append(single(case, hertz_cmd(case, mesh), os.path.join(outdir, f"cylinder_graded_{h_near:g}.h5"), 2))
+            fam["hand-graded"].append(single(hertz_cmd(case, mesh), os.path.join(outdir, f"cylinder_graded_{h_near:g}.h5")))
         adaptive = hertz_cmd(case, os.path.join(outdir, "disk_h0.1.msh")) + ["-adapt_model", model, "-adapt_cycles", str(cycles)]
     out = os.path.join(outdir, f"{case}_adaptive.h5")
     solve(adaptive + ["-output", out])

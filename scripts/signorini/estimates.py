@@ -5,7 +5,7 @@ import math
 import h5py
 import numpy as np
 
-from . import hertz
+from . import geometry, hertz
 from .runs import decoded_attrs
 
 # Refinement series on the manufactured solution: (label, dim, solver arguments, mesh sizes)
@@ -108,6 +108,17 @@ def write_block_mesh(case, h_near, path, size=BLOCK):
     """The Hertz indenter's block of the given size, graded as make hertz's from h_near at the contact to size x h_far."""
     spec = hertz.CASES[case]
     spec["shape"](path, radius=size, h_far=spec["h_far"] * size, h_near=h_near, width=spec["width"], near=spec["near"])
+
+
+# The 2D indenter's block graded by hand (make accuracy-ladder, make work-precision): (h_near, grade G) of the size
+# h_near + G r around the contact point, up to 0.5
+INDENTER_GRADES = [(0.002, 0.1), (0.001, 0.1), (0.001, 0.05), (0.0005, 0.05), (0.0005, 0.02), (0.00025, 0.02)]
+
+
+def write_graded_block(path, h_near, grade, h_far=0.5):
+    """The 2D block of size BLOCK graded from h_near at the contact point by G r up to h_far."""
+    near = min(0.98 * (h_far - h_near) / grade, 0.9 * BLOCK)
+    geometry.block(path, radius=BLOCK, h_far=h_far, h_near=h_near, grade=grade, near=near, width=min(2.0, 0.95 * BLOCK - near))
 
 
 def pressure_band_coverage(path):

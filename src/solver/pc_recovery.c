@@ -15,10 +15,8 @@
         SAFER_EMAX times the top estimate (PETSc's default is 1.1). The penalty couples the normal components of the
         contact nodes by 1/eps; where it dwarfs their elastic couplings, options/solvers/gamg.yaml's threshold 0.01
         drops the links into the body, and aggregates of contact nodes alone, nearly coplanar, carry the rigid-body
-        modes badly: on the Hertz sphere remeshed by -adapt_model (the first Jacobian of a carried solution holds the
-        penalty rows of its contact), CG broke down at its second iteration on every build, the own estimates and
-        intervals widened to 1.5 times or estimated over 40 iterations alike, and the cycles of 5,910 and 58,233
-        unknowns went on to the direct solve (20 s of the second's 22 s); with threshold 0 none broke down;
+        modes badly, so that CG breaks down whatever the smoothers' bounds (the Hertz sphere remeshed by -adapt_model,
+        whose carried solutions bring the penalty rows into the first Jacobian: docs/estimate.md);
      3. a direct solve: LU (Cholesky for SBAIJ) by MUMPS, exact for any eps.
    Each step is taken once per run, counted in /run pc_breakdowns and described in pc_recovery; -contact_pc_recovery 0
    leaves the breakdown a failed solve. A breakdown is never turned into a converged result without the Newton
@@ -131,11 +129,11 @@ PetscErrorCode PcRecoveryTry(SNES snes, SolverCtx sc, PetscBool *retry)
                           KSPConvergedReasons[kreason]));
   } else if (rec->stage == 1 && (is_gamg || is_mg)) { /* 2. safer smoother bounds */
     rec->stage = 2;
-    if (is_gamg) {                      /* a new hierarchy whose smoothers estimate on their own operators, not from the aggregation's */
-      PetscCall(PCSetType(pc, PCNONE)); /* the old hierarchy destroyed with its smoothers, whose SA estimates would stay */
-      PetscCall(PCSetType(pc, PCGAMG));
+    if (is_gamg) { /* a new hierarchy whose smoothers estimate on their own operators, not from the aggregation's */
       PetscReal unfiltered = 0.0;
 
+      PetscCall(PCSetType(pc, PCNONE)); /* the old hierarchy destroyed with its smoothers, whose SA estimates would stay */
+      PetscCall(PCSetType(pc, PCGAMG));
       PetscCall(PCSetFromOptions(pc)); /* the options given for GAMG, as at the first set-up */
       PetscCall(PCGAMGSetUseSAEstEig(pc, PETSC_FALSE));
       PetscCall(PCGAMGSetThreshold(pc, &unfiltered, 1)); /* every level's graph whole: aggregates reach into the body */

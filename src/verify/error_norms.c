@@ -51,12 +51,11 @@ static PetscErrorCode IntegrateBulk(DM dm, AppCtx *user, CellQuadrature *cq, Vec
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   for (PetscInt c = cStart; c < cEnd; ++c) {
     PetscScalar *uh = NULL, *ur = NULL;
+    PetscReal    g0[9]; /* u_h's gradient at the first point: at every point where D is the same there (P1, affine cell) */
 
     PetscCall(CellQuadratureSetCell(cq, c));
     PetscCall(DMPlexVecGetClosure(dm, NULL, loc_uh, c, NULL, &uh));
     if (!t->scene) PetscCall(DMPlexVecGetClosure(dm, NULL, t->loc_u, c, NULL, &ur));
-    PetscReal g0[9]; /* u_h's gradient at the first point: at every point where D is the same there (P1, affine cell) */
-
     for (PetscInt q = 0; q < cq->Nq; ++q) {
       PetscReal u[3], g[9], ut[3], gt[9], sigma[9], s0 = 0.0, s1 = 0.0, s2 = 0.0;
 
