@@ -1,6 +1,7 @@
 /* Meshes: creation, size checks, face sets, refinement with interpolation, distribution (src/mesh/). */
 #pragma once
 #include "signorini.h"
+#include <petscdmplextransform.h>
 
 /* mesh.c, mesh_box_simplex.c */
 PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const PetscInt coarse_requests[2], const PetscInt coarse_faces[3],
@@ -78,6 +79,7 @@ PetscErrorCode MeshCellVertices(DM dm, PetscInt c, PetscInt verts[], PetscInt *n
 PetscErrorCode MeshCellReferenceCoordinates(DM dm, PetscInt c, PetscInt n, const PetscReal x[], PetscReal xi[]);
 PetscErrorCode MeshRefineRegular(DM dm, PetscInt levels, DM *fine, PetscInt **parent, PetscInt **vertex_source);
 PetscErrorCode MeshRefineMarked(DM dm, DMLabel marked, DM *fine, PetscInt **vertex_source);
+PetscErrorCode MeshRefineSBRLookups(DMPlexTransform tr);
 PetscErrorCode MeshDescendantSizes(DM dm, PetscInt levels, PetscReal power, PetscReal **sizes, PetscReal *hmax);
 PetscErrorCode MeshSourceVertices(DM dm, const PetscInt vb[2], const PetscInt eb[2], PetscInt src, PetscInt verts[], PetscInt *nv);
 PetscErrorCode MeshInterpolateVertexSources(DM dm, DM fine, const PetscInt vertex_source[], Vec loc, Vec *fine_loc);

@@ -267,6 +267,7 @@ PetscErrorCode MeshRefineMarked(DM dm, DMLabel marked, DM *fine, PetscInt **vert
   PetscCall(DMPlexTransformSetActive(tr, marked));
   PetscCall(DMPlexTransformSetUp(tr));
   PetscCall(TransformTypesGeneral(tr));
+  PetscCall(MeshRefineSBRLookups(tr));
   PetscCall(DMPlexTransformApply(tr, dm, fine));
   PetscCall(DMPlexTransformDestroy(&tr));
   PetscCall(VertexSourcesByPosition(dm, *fine, vertex_source));
