@@ -14,6 +14,7 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user);
    iteration); the last two are warm starts, and the first and last reach a small eps by continuation. */
 typedef enum { SOLVER_START_ZERO, SOLVER_START_NEARBY_EPS, SOLVER_START_COARSER_MESH } SolverStart;
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start);
+PetscErrorCode SolverStartFromCoarser(const AppCtx *user, SolverStart *start);
 /* A solve from the guess u (a load path's step, force control's position, the penetration tolerance's eps) that, where
    it stalls or fails, is solved again from zero as a direct run: never less reliable than the direct run */
 PetscErrorCode SolverSolveWarm(SNES snes, AppCtx *user, Vec u, const char what[]);

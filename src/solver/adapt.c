@@ -7,7 +7,8 @@
    - a curved body or 3D: Gmsh meshes the body's model (-adapt_model), or the 3D box of the options, again with the
      marked cells' sizes halved (GridSequenceRemesh(), MeshRemesh()), and the last solution is carried to it by
      locating the new vertices in the old cells (MeshTransferApply()).
-   Then it solves again. eps is one value on Gamma_C from its smallest cell (MeshSetContactCellSizes()), so that the
+   Then it solves again, from the carried solution, without the eps continuation where it would be one stage
+   (SolverStartFromCoarser()). eps is one value on Gamma_C from its smallest cell (MeshSetContactCellSizes()), so that the
    penalty's error shrinks with the contact zone's cells. /cycles records each mesh: unknowns, cells, the estimate, the
    true energy-norm error where the scene knows the exact solution, the quantities and their bars, the marked cells,
    the solve and the times. */
@@ -182,6 +183,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     CycleRecord   *c      = &user->rec.cycles[k];
     DMLabel        marked = NULL;
     PetscLogDouble t0, t1;
+    SolverStart    start;
 
     PetscCall(AdaptRecord(*dm, user, *u, k));
     c->time_mesh = time_mesh;
@@ -212,7 +214,8 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
       PetscCall(VecGetSize(*u, &n_next));
       PetscCall(SolverSetStepEnergyStop(user, ad->newton_fraction * c->estimate * PetscPowReal((PetscReal)c->n_dofs / n_next, 1.0 / dim)));
     }
-    PetscCall(SolverSolve(*snes, user, *u, SOLVER_START_COARSER_MESH));
+    PetscCall(SolverStartFromCoarser(user, &start));
+    PetscCall(SolverSolve(*snes, user, *u, start));
   }
   PetscCall(EstimateReset(&user->rec.estimate)); /* the run's own, after the last solve, as without cycles */
   PetscCall(ErrorNormsReset(&user->rec.errors));

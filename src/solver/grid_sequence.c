@@ -287,21 +287,14 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* How a level starts from the coarser one's solution: like the sweep's start from a nearby eps (no continuation) when
-   -bars has solved both at the same eps and the continuation would make one stage only (eps >= f h / M, f the
-   continuation factor: a stage at h / M and back, for nothing); otherwise as nested iteration does. */
+/* How a level starts from the coarser one's solution: as SolverStartFromCoarser() decides when -bars has solved both at
+   the same eps; otherwise as nested iteration does. */
 static PetscErrorCode GridSequenceStart(const AppCtx *user, PetscInt nlevels, SolverStart *start)
 {
-  const ContactOptions *copt;
-  PetscReal             eps, eps_start;
-
   PetscFunctionBeginUser;
   *start = SOLVER_START_COARSER_MESH;
   if (!user->opt->bars || !ContactHasPenalty(user->contact) || user->prob.level <= nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(ContactGetOptions(user->contact, &copt));
-  PetscCall(ContactGetEps(user->contact, &eps));
-  PetscCall(ContactGetPenaltyScale(user->contact, &eps_start));
-  if (eps >= copt->continuation_factor * eps_start) *start = SOLVER_START_NEARBY_EPS;
+  PetscCall(SolverStartFromCoarser(user, start));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -386,6 +386,27 @@ static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* How a solve starts from a coarser mesh's converged solution at its own eps, interpolated to this mesh: like the
+   sweep's start from a nearby eps (no continuation) when the continuation would make one stage only, eps >= f h / M
+   (f the continuation factor): that stage solves at h / M, 1/(eps0) times softer, and returns, for nothing, since the
+   coarser solution already holds this problem's contact set to within the refinement. Otherwise as nested iteration
+   does (SolverSolve()): below f h / M the new contact nodes, between an active and a free coarse one, start far off
+   on the 1/eps scale. */
+PetscErrorCode SolverStartFromCoarser(const AppCtx *user, SolverStart *start)
+{
+  const ContactOptions *copt;
+  PetscReal             eps, eps_start;
+
+  PetscFunctionBeginUser;
+  *start = SOLVER_START_COARSER_MESH;
+  if (!ContactHasPenalty(user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetOptions(user->contact, &copt));
+  PetscCall(ContactGetEps(user->contact, &eps));
+  PetscCall(ContactGetPenaltyScale(user->contact, &eps_start));
+  if (eps >= copt->continuation_factor * eps_start) *start = SOLVER_START_NEARBY_EPS;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Solves from a zero initial guess (or from u, start) and records the outcome; a failed solve is recorded, not raised.
    An eps below h/M is reached by continuation: the penalty problems for eps = h/M, h/M f, h/M f^2, ... are solved in turn,
    each from the solution of the previous one, so that Newton starts near the active set and the 1/eps scale of the
