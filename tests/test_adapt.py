@@ -67,6 +67,28 @@ def test_adaptive_cycles_on_two_ranks_equal_one_rank(scene):
     assert np.abs(u1 - u2).max() <= 1e-8 * np.abs(u1).max()
 
 
+INDENT = ["-scene", "general", "-contact_monitor", "0", "-dm_plex_box_faces", "16,8", "-contact_faces", "3", "-bc_clamp", "1", "-obstacle", "cylinder",
+          "-obstacle_center", "0.5,1.5", "-obstacle_radius", "0.5", "-obstacle_translate", "0,-0.02"]
+
+
+@pytest.mark.parametrize("eps0", ["0.1", "0.001"])
+def test_adaptive_cycles_start_from_the_carried_solution_without_a_one_stage_continuation(eps0):
+    """A cycle's solve starts from the last cycle's solution, at an eps at most twice smaller: at eps0 = 0.1, above the
+    continuation's factor 0.01, the continuation would be one stage at h/M (10 times softer) and back, and is skipped
+    (SolverStartFromCoarser()): each cycle after the first converges in at most 3 Newton steps (measured 1 to 2; with
+    the stage, 4 to 6). At eps0 = 0.001 the new contact nodes start far off on the 1/eps scale, and the continuation
+    runs from the coarser solution, as nested iteration's does."""
+    _, h5 = run(INDENT + ["-penalty_eps0", eps0, "-adapt_cycles", 3], f"adapt_start_{eps0}")
+    c = cycles(h5)
+    a, _ = load(h5)
+    assert np.all(c["converged"] == 1), c["converged"]
+    if eps0 == "0.1":
+        assert a["continuation_stages"] == 0, a["continuation_stages"]
+        assert np.all(c["newton_its"][1:] <= 3), c["newton_its"]
+    else:
+        assert a["continuation_stages"] >= 1, a["continuation_stages"]
+
+
 def test_adaptive_cycles_keep_the_refined_faces_boundary_conditions():
     """The face sets follow the refinement: on the default square the clamped top (y = 1) stays at zero displacement
     at every vertex, the new ones included, and the contact face keeps the contact (its vertices touch the obstacle
