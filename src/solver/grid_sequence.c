@@ -12,8 +12,6 @@
 #include "physics.h"
 #include "solver.h"
 
-/* Replaces the problem on *dm by the problem on its uniform refinement, or with marked (the adaptive cycles, adapt.c) on
-   its refinement where marked says, with *u interpolated as the initial guess (exact for nested P1/Q1). */
 /* The solution u on dm as a local vector, with the Dirichlet values (inserted by ProblemSetUp()). */
 static PetscErrorCode LocalSolution(DM dm, const AppCtx *user, Vec u, Vec *loc)
 {
@@ -37,6 +35,8 @@ static PetscErrorCode TakeMesh(DM *dm, DM fine, Vec *fine_loc, Vec *u)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Replaces the problem on *dm by the problem on its uniform refinement, or with marked (the adaptive cycles, adapt.c) on
+   its refinement where marked says, with *u interpolated as the initial guess (exact for nested P1/Q1). */
 PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked)
 {
   DM        fine;
