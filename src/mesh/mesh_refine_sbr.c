@@ -10,7 +10,8 @@
    - the orientation is a function of the refinement type and of the other arguments (the switch below).
    So the types are read into an array indexed by point once, after DMPlexTransformSetUp(); the cell transform is asked
    once per (cell type, refinement type) and its tables kept; and the orientation is the transform's own switch with
-   the type read from the array. The new mesh is the same point for point. */
+   the type read from the array. The new mesh is the same point for point. The types and the switch are PETSc 3.18's
+   (plexrefsbr.c, BSD-2-Clause); another version keeps its own transform. */
 #include <petscdmplextransform.h>
 #include <petsc/private/dmplextransformimpl.h>
 #include "mesh.h"
@@ -192,7 +193,7 @@ PetscErrorCode MeshRefineSBRLookups(DMPlexTransform tr)
   PetscInt        nv;
 
   PetscFunctionBeginUser;
-  if (!types) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!types || !PETSC_VERSION_EQ(3, 18, PETSC_VERSION_SUBMINOR)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscNew(&l));
   PetscCall(DMPlexGetChart(tr->dm, &l->pStart, &l->pEnd));
   PetscCall(PetscMalloc1(l->pEnd - l->pStart, &l->type));
