@@ -40,12 +40,6 @@ MMS_EXACT = {"contact_force": 0.0720182, "pressure_max": 0.402594, "contact_size
 QUANTITIES = "contact_force,pressure_max,contact_size"
 
 
-
-
-
-
-
-
 def coverage(outdir, coarse):
     """Each cycle's bars against the true errors: rows (run, quantity, cycles with a bar, covered, min and median of
     bar / error)."""
