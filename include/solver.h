@@ -53,6 +53,7 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
 PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked);
 PetscErrorCode GridSequenceBarsSizes(DM dm, const AppCtx *user);
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
+PetscErrorCode EpsSweepTangent(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscBool *ok);
 /* adapt.c: -adapt_cycles, the adaptive refinement driven by the error estimate */
 PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad);
 PetscErrorCode AdaptCheck(DM dm, const AppCtx *user);

@@ -147,12 +147,65 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
   PetscCall(PostprocessContact(dm, user, u));
   PostprocessGetQuantities(user, &c->q);
   c->marked       = 0;
+  c->force_eps    = PETSC_NAN;
   c->error_energy = PETSC_NAN;
   if (user->scene.exact) {
     PetscCall(ErrorNormsCompute(dm, user, u));
     c->error_energy = user->rec.errors.energy;
   }
   user->rec.ncycles = k + 1;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The force's penalty part (src/estimate/cycle_bars.c): with -accuracy on the force and the penalty method, a second
+   solve on the cycle's mesh at eps / CYCLE_EPS_RATIO from its solution, whose force magnitude the cycle records; as
+   -bars' second solve, it leaves the cycle's solution, eps, contact state and record of the outcome as they were, and
+   counts in the run's totals. No value if it fails. */
+static PetscErrorCode AdaptForceAtSmallerEps(DM dm, AppCtx *user, SNES snes, Vec u, CycleRecord *c)
+{
+  const AdaptOptions *ad    = &user->opt->adapt;
+  const RunStats      saved = user->rec.stats;
+  PetscReal           eps, f = 0.0;
+  Vec                 u0;
+  Quantities          q;
+
+  PetscFunctionBeginUser;
+  if (!(ad->accuracy > 0.0) || !ad->target[ACCURACY_FORCE] || !ContactHasPenalty(user->contact) || !c->converged) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetEps(user->contact, &eps));
+  PetscCall(VecDuplicate(u, &u0));
+  PetscCall(VecCopy(u, u0));
+  PetscCall(ContactSetEps(user->contact, dm, eps / CYCLE_EPS_RATIO));
+  {
+    const PetscReal eps_new = eps / CYCLE_EPS_RATIO;
+    PetscBool       ok      = PETSC_FALSE;
+    Vec             dir;
+
+    PetscCall(VecDuplicate(u, &dir));
+    PetscCall(EpsSweepTangent(snes, dm, user, u, dir, &ok));
+    if (ok) {
+      PetscInt dim;
+
+      PetscCall(VecAXPY(u, (eps_new - eps) * eps_new / (eps * eps), dir));
+      PetscCall(DMGetDimension(dm, &dim));
+      PetscCall(PostprocessContact(dm, user, u));
+      PostprocessGetQuantities(user, &q);
+      for (PetscInt d = 0; d < dim; ++d) f += PetscSqr(q.force[d]);
+      c->force_eps = PetscSqrtReal(f);
+    }
+    PetscCall(VecDestroy(&dir));
+  }
+  PetscCall(ContactSetEps(user->contact, dm, eps));
+  PetscCall(VecCopy(u0, u));
+  PetscCall(VecDestroy(&u0));
+  PetscCall(PostprocessContact(dm, user, u)); /* the contact state of the cycle's solution again */
+  {
+    const RunStats now = user->rec.stats;
+
+    user->rec.stats                  = saved;
+    user->rec.stats.newton_its_total = now.newton_its_total;
+    user->rec.stats.ksp_its_total    = now.ksp_its_total;
+    user->rec.stats.time_solve       = now.time_solve;
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -186,6 +239,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     SolverStart    start;
 
     PetscCall(AdaptRecord(*dm, user, *u, k));
+    PetscCall(AdaptForceAtSmallerEps(*dm, user, *snes, *u, c));
     c->time_mesh = time_mesh;
     PetscCall(CycleBarsCompute(user, dim, k));
     PetscCall(EstimateMarkUnseenContact(*dm, user, *u, &marked, &c->unseen)); /* the cells around the contact the mesh misses */

@@ -10,7 +10,7 @@
    GAMG (eps = h to 1e-7 h) the last four values then take 2, 1, 1 and 0 Newton steps and 11, 6, 5 and 0 CG iterations
    instead of 2, 2, 1, 1 and 11, 11, 6, 5 (one OpenBLAS thread; with its threads 2, 1, 1, 1 and 11, 5, 5, 4); the fourth
    point of a cubic saved one more CG iteration there (not kept).
-   The second value starts on the tangent of the solution path at the first (TangentDirection()). */
+   The second value starts on the tangent of the solution path at the first (EpsSweepTangent()). */
 #include "contact.h"
 #include "solver_impl.h"
 
@@ -24,7 +24,7 @@
    if CG did not converge. A few Gauss points at the edge of the contact zone may flip on the tangent, so its guess is
    taken where its residual is 100 times lower than the last solution's, whatever its active points; the secant's rule
    (the same active points) would refuse it. */
-static PetscErrorCode TangentDirection(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscBool *ok)
+PetscErrorCode EpsSweepTangent(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscBool *ok)
 {
   KSP                ksp, tangent;
   PC                 pc;
@@ -107,7 +107,7 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
     } else if (k == 1 && ContactHasPenalty(user->contact) && eps != eps_last) { /* the tangent */
       PetscBool ok = PETSC_FALSE;
 
-      PetscCall(TangentDirection(snes, dm, user, u, dir, &ok));
+      PetscCall(EpsSweepTangent(snes, dm, user, u, dir, &ok));
       if (ok) PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, (eps - eps_last) * eps / (eps_last * eps_last), 1e-2, PETSC_FALSE));
     }
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
