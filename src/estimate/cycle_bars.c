@@ -31,10 +31,12 @@
    (src/estimate/bars.c), d = F(eps) - F(eps / R) and bar_eps = |d| (1 + 3 / (R - 1)) at the order 1 in eps; the
    mesh's part compares the cycles' forces extrapolated to eps = 0, F0 = (R F(eps / R) - F(eps)) / (R - 1), at the
    order 2 of the force's mesh error (a functional of the displacement; -bars observes 2.02 on the manufactured
-   solution), with the same two cycles and safety factor 3; the bar is the sum. With the order 1 on the sum, the
-   penalty's order, the force's bars were 15 to 19 times its error on the Hertz indenter, where the penalty's part is a
-   tenth of the error or less; with the parts apart, 4.5 to 4.7 times, and 1.4 to 2.5 (eps = h) and 3.5 to 14
-   (eps = h/10) on the manufactured solution, every cycle covered (docs/estimate.md).
+   solution), with the same two cycles and safety factor 3; the bar is the sum. F(eps / R) is the tangent's prediction
+   (one linear solve; within 0.91 to 1.04 of a solve at eps / R over the cycles of the series below). With the order 1
+   on the sum, the penalty's order, the force's bars were at least 15.5 times its error on the Hertz indenter, where the
+   penalty's part is a tenth of the error or less; with the parts apart, at least 4.74 times (median 5.03) there, and
+   1.43 (1.92) at eps = h and 3.53 (10.3) at eps = h/10 on the manufactured solution, every cycle covered
+   (make accuracy-ladder, docs/estimate.md).
    The zone's size is resolved to a cell: its bar is at least the one-cell band along its edge (contact_size_band).
    The energy's bar is the error estimate itself, against the solution's energy norm (src/estimate/estimate.c). */
 #include "estimate.h"
