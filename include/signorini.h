@@ -380,7 +380,7 @@ typedef struct {
   Quantities q;                   /* the quantities users read on the cycle's mesh */
   PetscReal  value[ACCURACY_NUM]; /* -accuracy's quantities (the energy: the solution's energy norm; the force: its magnitude) */
   PetscReal  bar[ACCURACY_NUM];   /*   and their error bars (the energy: the estimate), NaN where there is none */
-  PetscReal  force_eps;           /* the force's magnitude at eps / CYCLE_EPS_RATIO on the same mesh, NaN without that solve */
+  PetscReal  force_eps;           /* the force's magnitude at eps / CYCLE_EPS_RATIO on the same mesh (the tangent's), NaN without it */
   PetscInt   unseen;              /* contact nodes the rule does not see (EstimateMarkUnseenContact()) */
   PetscBool  accurate;            /* every quantity asked for within -accuracy */
   PetscInt   newton_its, ksp_its;

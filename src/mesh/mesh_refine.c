@@ -2,7 +2,6 @@
    to the fine one: used by the grid sequencing (grid_sequence.c) and by -reference (reference.c). */
 #include <stdlib.h>
 #include <petscdmplextransform.h>
-#include <petsc/private/dmplextransformimpl.h> /* the transform's point types, for TransformTypesGeneral() */
 #include "mesh.h"
 
 /* Reference coordinates xi[n][dim] of the physical points x[n][dim] in cell c, by Newton on the cell map (one step for
@@ -204,49 +203,6 @@ static PetscErrorCode VertexSourcesByPosition(DM dm, DM fine, PetscInt **vertex_
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* PETSc 3.18 keeps each stratum of a label whose points are contiguous as a stride index set, and finds a point's
-   index in its stratum (DMLabelGetStratumPointIndex()) through ISGetIndices(), which expands a stride into a new array
-   at every call. The transform asks that of every new point's source (DMPlexTransformGetTargetPoint()), and the
-   refinement's point types hold whole contiguous ranges (the vertices, the unrefined edges): the refinement took a time
-   quadratic in the mesh's size (a profile of the Hertz indenter adapted to 73,027 unknowns: 24% of the samples in
-   ISGetIndices_Stride(), 19% in PetscFindInt(); adapted to 504,295 unknowns the run took 165 s, and 58 s with this).
-   The strata made general index sets once, with the same sorted points, make each lookup a binary search. */
-static PetscErrorCode TransformTypesGeneral(DMPlexTransform tr)
-{
-  DMLabel         types = tr->trType;
-  IS              values;
-  const PetscInt *vals;
-  PetscInt        nv;
-
-  PetscFunctionBeginUser;
-  if (!types) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(DMLabelGetValueIS(types, &values));
-  PetscCall(ISGetLocalSize(values, &nv));
-  PetscCall(ISGetIndices(values, &vals));
-  for (PetscInt k = 0; k < nv; ++k) {
-    IS              is, general;
-    PetscBool       stride;
-    PetscInt        n;
-    const PetscInt *pts;
-
-    PetscCall(DMLabelGetStratumIS(types, vals[k], &is));
-    if (!is) continue;
-    PetscCall(PetscObjectTypeCompare((PetscObject)is, ISSTRIDE, &stride));
-    if (stride) {
-      PetscCall(ISGetLocalSize(is, &n));
-      PetscCall(ISGetIndices(is, &pts));
-      PetscCall(ISCreateGeneral(PETSC_COMM_SELF, n, pts, PETSC_COPY_VALUES, &general));
-      PetscCall(ISRestoreIndices(is, &pts));
-      PetscCall(DMLabelSetStratumIS(types, vals[k], general));
-      PetscCall(ISDestroy(&general));
-    }
-    PetscCall(ISDestroy(&is));
-  }
-  PetscCall(ISRestoreIndices(values, &vals));
-  PetscCall(ISDestroy(&values));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* Refines the triangles of dm that `marked` holds with the value DM_ADAPT_REFINE, and those more that keep the mesh
    conforming: PETSc's skeleton-based refinement (refine_sbr; Plaza and Carey, Appl. Numer. Math. 32, 2000) splits the
    marked cells' edges at their midpoints, and every cell with a split edge into two to four triangles, so that the new
@@ -266,7 +222,6 @@ PetscErrorCode MeshRefineMarked(DM dm, DMLabel marked, DM *fine, PetscInt **vert
   PetscCall(DMPlexTransformSetDM(tr, dm));
   PetscCall(DMPlexTransformSetActive(tr, marked));
   PetscCall(DMPlexTransformSetUp(tr));
-  PetscCall(TransformTypesGeneral(tr));
   PetscCall(MeshRefineSBRLookups(tr));
   PetscCall(DMPlexTransformApply(tr, dm, fine));
   PetscCall(DMPlexTransformDestroy(&tr));

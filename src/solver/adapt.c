@@ -157,55 +157,40 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The force's penalty part (src/estimate/cycle_bars.c): with -accuracy on the force and the penalty method, a second
-   solve on the cycle's mesh at eps / CYCLE_EPS_RATIO from its solution, whose force magnitude the cycle records; as
-   -bars' second solve, it leaves the cycle's solution, eps, contact state and record of the outcome as they were, and
-   counts in the run's totals. No value if it fails. */
+/* The force's penalty part (src/estimate/cycle_bars.c): with -accuracy on the force and the penalty method, the force
+   at eps / CYCLE_EPS_RATIO on the cycle's mesh, predicted along the tangent of the solution path from the cycle's
+   solution (one linear solve with its preconditioner, EpsSweepTangent(), whose iterations count in the run's totals);
+   the cycle records its magnitude. The cycle's solution, eps and contact state stay as they were. No value if the
+   tangent's solve fails. */
 static PetscErrorCode AdaptForceAtSmallerEps(DM dm, AppCtx *user, SNES snes, Vec u, CycleRecord *c)
 {
-  const AdaptOptions *ad    = &user->opt->adapt;
-  const RunStats      saved = user->rec.stats;
-  PetscReal           eps, f = 0.0;
-  Vec                 u0;
+  const AdaptOptions *ad = &user->opt->adapt;
+  PetscReal           eps, eps_new, f = 0.0;
+  PetscBool           ok = PETSC_FALSE;
+  PetscInt            dim;
+  Vec                 dir, u_new;
   Quantities          q;
 
   PetscFunctionBeginUser;
   if (!(ad->accuracy > 0.0) || !ad->target[ACCURACY_FORCE] || !ContactHasPenalty(user->contact) || !c->converged) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(DMGetDimension(dm, &dim));
   PetscCall(ContactGetEps(user->contact, &eps));
-  PetscCall(VecDuplicate(u, &u0));
-  PetscCall(VecCopy(u, u0));
-  PetscCall(ContactSetEps(user->contact, dm, eps / CYCLE_EPS_RATIO));
-  {
-    const PetscReal eps_new = eps / CYCLE_EPS_RATIO;
-    PetscBool       ok      = PETSC_FALSE;
-    Vec             dir;
-
-    PetscCall(VecDuplicate(u, &dir));
-    PetscCall(EpsSweepTangent(snes, dm, user, u, dir, &ok));
-    if (ok) {
-      PetscInt dim;
-
-      PetscCall(VecAXPY(u, (eps_new - eps) * eps_new / (eps * eps), dir));
-      PetscCall(DMGetDimension(dm, &dim));
-      PetscCall(PostprocessContact(dm, user, u));
-      PostprocessGetQuantities(user, &q);
-      for (PetscInt d = 0; d < dim; ++d) f += PetscSqr(q.force[d]);
-      c->force_eps = PetscSqrtReal(f);
-    }
-    PetscCall(VecDestroy(&dir));
+  eps_new = eps / CYCLE_EPS_RATIO;
+  PetscCall(ContactSetEps(user->contact, dm, eps_new));
+  PetscCall(VecDuplicate(u, &dir));
+  PetscCall(EpsSweepTangent(snes, dm, user, u, dir, &ok));
+  if (ok) { /* u(eps_new) = u + (eps_new - eps) du/deps, du/deps = dir eps_new / eps^2 */
+    PetscCall(VecDuplicate(u, &u_new));
+    PetscCall(VecWAXPY(u_new, (eps_new - eps) * eps_new / (eps * eps), dir, u));
+    PetscCall(PostprocessContact(dm, user, u_new));
+    PostprocessGetQuantities(user, &q);
+    for (PetscInt d = 0; d < dim; ++d) f += PetscSqr(q.force[d]);
+    c->force_eps = PetscSqrtReal(f);
+    PetscCall(VecDestroy(&u_new));
   }
+  PetscCall(VecDestroy(&dir));
   PetscCall(ContactSetEps(user->contact, dm, eps));
-  PetscCall(VecCopy(u0, u));
-  PetscCall(VecDestroy(&u0));
   PetscCall(PostprocessContact(dm, user, u)); /* the contact state of the cycle's solution again */
-  {
-    const RunStats now = user->rec.stats;
-
-    user->rec.stats                  = saved;
-    user->rec.stats.newton_its_total = now.newton_its_total;
-    user->rec.stats.ksp_its_total    = now.ksp_its_total;
-    user->rec.stats.time_solve       = now.time_solve;
-  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
