@@ -377,12 +377,13 @@ typedef struct {
   PetscReal  estimate, estimate_penalty; /* the estimate and its penalty part, */
   PetscReal  norm;                       /*   and the energy norm of the solution, its scale */
   PetscReal  error_energy;
-  Quantities q;                   /* the quantities users read on the cycle's mesh */
-  PetscReal  value[ACCURACY_NUM]; /* -accuracy's quantities (the energy: the solution's energy norm; the force: its magnitude) */
-  PetscReal  bar[ACCURACY_NUM];   /*   and their error bars (the energy: the estimate), NaN where there is none */
-  PetscReal  force_eps;           /* the force's magnitude at eps / CYCLE_EPS_RATIO on the same mesh (the tangent's), NaN without it */
-  PetscInt   unseen;              /* contact nodes the rule does not see (EstimateMarkUnseenContact()) */
-  PetscBool  accurate;            /* every quantity asked for within -accuracy */
+  Quantities q;                       /* the quantities users read on the cycle's mesh */
+  PetscReal  value[ACCURACY_NUM];     /* -accuracy's quantities (the energy: the solution's energy norm; the force: its magnitude) */
+  PetscReal  bar[ACCURACY_NUM];       /*   and their error bars (the energy: the estimate), NaN where there is none */
+  PetscReal  value_eps[ACCURACY_NUM]; /* the quantities at eps / CYCLE_EPS_RATIO on the same mesh (the tangent's), NaN without them */
+  PetscReal  eps, eps_scale;          /* the penalty's eps on the cycle and its scale h/M (h: the smallest contact cell), NaN without it */
+  PetscInt   unseen;                  /* contact nodes the rule does not see (EstimateMarkUnseenContact()) */
+  PetscBool  accurate;                /* every quantity asked for within -accuracy */
   PetscInt   newton_its, ksp_its;
   PetscReal  time_solve;
   PetscReal  time_mesh;  /* s: this cycle's mesh from the last (refined or remeshed) and its problem's set-up (0 for the first) */

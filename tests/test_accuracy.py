@@ -2,7 +2,8 @@
 quantities asked for are below TOL times their values. The bars come from the cycles themselves (Roache's two-level
 index with the safety factor 3 and the order 1, 1/2 for the zone's size, against the last two cycles with 4 and more
 times fewer unknowns; the force's penalty part apart, from the tangent of the solution path to eps/10 on each cycle,
-and its mesh part at the order 2); the energy's bar is the error estimate. Checked against the manufactured solution's exact values, the Hertz closed form on
+and its mesh part at the order 2; where eps <= h/10, the size's penalty part apart too, and its mesh part at the
+order 1); the energy's bar is the error estimate. Checked against the manufactured solution's exact values, the Hertz closed form on
 a 10 x 10 block (where the closed form is a reference to about 0.2%, docs/estimate.md), on 2 ranks
 against 1, on a mesh that does not see the contact, and on the refusals."""
 
@@ -33,6 +34,42 @@ def test_the_force_at_eps_over_10_from_the_tangent_is_the_solve_s(eps0):
     d_tangent = c["contact_force_value"][0] - c["contact_force_value_eps"][0]
     d_solve = c["contact_force_value"][0] - solved
     assert abs(d_tangent / d_solve - 1) <= 0.15, (d_tangent, d_solve)
+
+
+def _two_level(c, q, last, order, dim=2):
+    """Roache's two-level index of cycle last against the last cycle with 2^dim times fewer unknowns and the one before
+    it, safety factor 3 (src/estimate/cycle_bars.c), or None before both exist."""
+    n = c["n_dofs"]
+    j = max((m for m in range(last) if n[m] * 2**dim <= n[last]), default=-1)
+    if j < 1:
+        return None
+    return max(3 * abs(c[q][m] - c[q][last]) / ((n[last] / n[m]) ** (order / dim) - 1) for m in (j, j - 1))
+
+
+@pytest.mark.parametrize("eps0", ["1", "0.1"])
+def test_the_zone_size_bar_takes_its_penalty_part_apart_where_eps_is_small(eps0):
+    """The zone's size's bar, recomputed from /cycles: where eps <= h/(10 M) (eps0 = 0.1, -accuracy's default), its
+    penalty part |W(eps) - W(eps/10)| (1 + 3 / (10^(1/2) - 1)) plus its mesh part at the order 1, at least the one-cell
+    band; at eps = h the order 1/2 on the whole size, at least the band (the manufactured solution's size error falls
+    like h^(1/2) there, and its penalty part on one mesh does not show it: docs/estimate.md)."""
+    _, h5 = run(MMS + ["-dm_plex_box_faces", "8,8", "-penalty_eps0", eps0, "-accuracy", "1e-9", "-adapt_cycles", 6], f"accuracy_size_bar_{eps0}")
+    c = cycles(h5)
+    assert np.all(np.isfinite(c["contact_size_value_eps"])) and np.all(np.isfinite(c["eps"])), c["contact_size_value_eps"]
+    checked = 0
+    for last in range(len(c["n_dofs"])):
+        if eps0 == "0.1":
+            mesh = _two_level(c, "contact_size_value", last, 1.0)
+            pen = abs(c["contact_size_value"][last] - c["contact_size_value_eps"][last]) * (1 + 3 / (10**0.5 - 1))
+            bar = None if mesh is None else max(mesh + pen, c["contact_size_band"][last])
+        else:
+            whole = _two_level(c, "contact_size_value", last, 0.5)
+            bar = None if whole is None else max(whole, c["contact_size_band"][last])
+        if bar is None:
+            assert np.isnan(c["contact_size_bar"][last]), last
+        else:
+            assert abs(c["contact_size_bar"][last] / bar - 1) < 1e-12, (last, c["contact_size_bar"][last], bar)
+            checked += 1
+    assert checked >= 2, checked
 
 
 def test_accuracy_on_the_manufactured_solution_ends_within_the_tolerance():

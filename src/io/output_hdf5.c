@@ -643,8 +643,11 @@ static PetscErrorCode WriteCycles(MPI_Comm comm, const AppCtx *user, PetscViewer
     CYCLE_COLUMN(label, c[i].value[k]);
     PetscCall(PetscSNPrintf(label, sizeof(label), "%s_bar", AccuracyQuantities[k]));
     CYCLE_COLUMN(label, c[i].bar[k]);
+    if (k == ACCURACY_ENERGY) continue;
+    PetscCall(PetscSNPrintf(label, sizeof(label), "%s_value_eps", AccuracyQuantities[k]));
+    CYCLE_COLUMN(label, c[i].value_eps[k]);
   }
-  CYCLE_COLUMN("contact_force_value_eps", c[i].force_eps);
+  CYCLE_COLUMN("eps", c[i].eps);
   CYCLE_COLUMN("unseen_contact", (PetscReal)c[i].unseen);
   CYCLE_COLUMN("accurate", c[i].accurate ? 1.0 : 0.0);
   CYCLE_COLUMN("error_energy", c[i].error_energy);

@@ -146,8 +146,14 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
   c->norm             = user->rec.estimate.norm;
   PetscCall(PostprocessContact(dm, user, u));
   PostprocessGetQuantities(user, &c->q);
-  c->marked       = 0;
-  c->force_eps    = PETSC_NAN;
+  c->marked = 0;
+  for (PetscInt q = 0; q < ACCURACY_NUM; ++q) c->value_eps[q] = PETSC_NAN;
+  c->eps       = PETSC_NAN;
+  c->eps_scale = PETSC_NAN;
+  if (ContactHasPenalty(user->contact)) {
+    PetscCall(ContactGetEps(user->contact, &c->eps));
+    PetscCall(ContactGetPenaltyScale(user->contact, &c->eps_scale));
+  }
   c->error_energy = PETSC_NAN;
   if (user->scene.exact) {
     PetscCall(ErrorNormsCompute(dm, user, u));
@@ -172,7 +178,8 @@ static PetscErrorCode AdaptForceAtSmallerEps(DM dm, AppCtx *user, SNES snes, Vec
   Quantities          q;
 
   PetscFunctionBeginUser;
-  if (!(ad->accuracy > 0.0) || !ad->target[ACCURACY_FORCE] || !ContactHasPenalty(user->contact) || !c->converged) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!(ad->accuracy > 0.0) || !(ad->target[ACCURACY_FORCE] || ad->target[ACCURACY_SIZE]) || !ContactHasPenalty(user->contact) || !c->converged)
+    PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(ContactGetEps(user->contact, &eps));
   eps_new = eps / CYCLE_EPS_RATIO;
@@ -185,7 +192,9 @@ static PetscErrorCode AdaptForceAtSmallerEps(DM dm, AppCtx *user, SNES snes, Vec
     PetscCall(PostprocessContact(dm, user, u_new));
     PostprocessGetQuantities(user, &q);
     for (PetscInt d = 0; d < dim; ++d) f += PetscSqr(q.force[d]);
-    c->force_eps = PetscSqrtReal(f);
+    c->value_eps[ACCURACY_FORCE]    = PetscSqrtReal(f);
+    c->value_eps[ACCURACY_PRESSURE] = q.pressure_max;
+    c->value_eps[ACCURACY_SIZE]     = q.contact_size;
     PetscCall(VecDestroy(&u_new));
   }
   PetscCall(VecDestroy(&dir));
