@@ -2,8 +2,8 @@
 quantities asked for are below TOL times their values. The bars come from the cycles themselves (Roache's two-level
 index with the safety factor 3 and the order 1, 1/2 for the zone's size, against the last two cycles with 4 and more
 times fewer unknowns; the force's penalty part apart, from the tangent of the solution path to eps/10 on each cycle,
-and its mesh part at the order 2; where eps <= h/10, the size's penalty part apart too, and its mesh part at the
-order 1); the energy's bar is the error estimate. Checked against the manufactured solution's exact values, the Hertz closed form on
+and its mesh part at the order 2; the largest pressure's penalty part added; where eps <= h/10, the size's penalty part
+apart too, and its mesh part at the order 1); the energy's bar is the error estimate. Checked against the manufactured solution's exact values, the Hertz closed form on
 a 10 x 10 block (where the closed form is a reference to about 0.2%, docs/estimate.md), on 2 ranks
 against 1, on a mesh that does not see the contact, and on the refusals."""
 
@@ -47,11 +47,12 @@ def _two_level(c, q, last, order, dim=2):
 
 
 @pytest.mark.parametrize("eps0", ["1", "0.1"])
-def test_the_zone_size_bar_takes_its_penalty_part_apart_where_eps_is_small(eps0):
-    """The zone's size's bar, recomputed from /cycles: where eps <= h/(10 M) (eps0 = 0.1, -accuracy's default), its
-    penalty part |W(eps) - W(eps/10)| (1 + 3 / (10^(1/2) - 1)) plus its mesh part at the order 1, at least the one-cell
-    band; at eps = h the order 1/2 on the whole size, at least the band (the manufactured solution's size error falls
-    like h^(1/2) there, and its penalty part on one mesh does not show it: docs/estimate.md)."""
+def test_the_size_and_pressure_bars_take_their_penalty_parts_apart(eps0):
+    """The zone's size's and the largest pressure's bars, recomputed from /cycles. The size's: where eps <= h/(10 M)
+    (eps0 = 0.1, -accuracy's default), its penalty part |W(eps) - W(eps/10)| (1 + 3 / (10^(1/2) - 1)) plus its mesh
+    part at the order 1, at least the one-cell band; at eps = h the order 1/2 on the whole size, at least the band (the
+    manufactured solution's size error falls like h^(1/2) there, and its penalty part on one mesh does not show it:
+    docs/estimate.md). The pressure's, at any eps: the index at the order 1 plus |p(eps) - p(eps/10)| (1 + 3 / 9)."""
     _, h5 = run(MMS + ["-dm_plex_box_faces", "8,8", "-penalty_eps0", eps0, "-accuracy", "1e-9", "-adapt_cycles", 6], f"accuracy_size_bar_{eps0}")
     c = cycles(h5)
     assert np.all(np.isfinite(c["contact_size_value_eps"])) and np.all(np.isfinite(c["eps"])), c["contact_size_value_eps"]
@@ -68,6 +69,8 @@ def test_the_zone_size_bar_takes_its_penalty_part_apart_where_eps_is_small(eps0)
             assert np.isnan(c["contact_size_bar"][last]), last
         else:
             assert abs(c["contact_size_bar"][last] / bar - 1) < 1e-12, (last, c["contact_size_bar"][last], bar)
+            pressure = _two_level(c, "pressure_max_value", last, 1.0) + abs(c["pressure_max_value"][last] - c["pressure_max_value_eps"][last]) * (1 + 3 / 9)
+            assert abs(c["pressure_max_bar"][last] / pressure - 1) < 1e-12, (last, c["pressure_max_bar"][last], pressure)
             checked += 1
     assert checked >= 2, checked
 

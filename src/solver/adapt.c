@@ -163,12 +163,12 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The force's penalty part (src/estimate/cycle_bars.c): with -accuracy on the force and the penalty method, the force
-   at eps / CYCLE_EPS_RATIO on the cycle's mesh, predicted along the tangent of the solution path from the cycle's
-   solution (one linear solve with its preconditioner, EpsSweepTangent(), whose iterations count in the run's totals);
-   the cycle records its magnitude. The cycle's solution, eps and contact state stay as they were. No value if the
-   tangent's solve fails. */
-static PetscErrorCode AdaptForceAtSmallerEps(DM dm, AppCtx *user, SNES snes, Vec u, CycleRecord *c)
+/* The quantities' penalty parts (src/estimate/cycle_bars.c): with -accuracy on the force, the largest pressure or the
+   zone's size and the penalty method, the quantities at eps / CYCLE_EPS_RATIO on the cycle's mesh, predicted along the
+   tangent of the solution path from the cycle's solution (one linear solve with its preconditioner, EpsSweepTangent(),
+   whose iterations count in the run's totals); the cycle records them. The cycle's solution, eps and contact state stay
+   as they were. No values if the tangent's solve fails. */
+static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes, Vec u, CycleRecord *c)
 {
   const AdaptOptions *ad = &user->opt->adapt;
   PetscReal           eps, eps_new, f = 0.0;
@@ -178,7 +178,8 @@ static PetscErrorCode AdaptForceAtSmallerEps(DM dm, AppCtx *user, SNES snes, Vec
   Quantities          q;
 
   PetscFunctionBeginUser;
-  if (!(ad->accuracy > 0.0) || !(ad->target[ACCURACY_FORCE] || ad->target[ACCURACY_SIZE]) || !ContactHasPenalty(user->contact) || !c->converged)
+  if (!(ad->accuracy > 0.0) || !(ad->target[ACCURACY_FORCE] || ad->target[ACCURACY_PRESSURE] || ad->target[ACCURACY_SIZE]) ||
+      !ContactHasPenalty(user->contact) || !c->converged)
     PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(ContactGetEps(user->contact, &eps));
@@ -233,7 +234,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     SolverStart    start;
 
     PetscCall(AdaptRecord(*dm, user, *u, k));
-    PetscCall(AdaptForceAtSmallerEps(*dm, user, *snes, *u, c));
+    PetscCall(AdaptQuantitiesAtSmallerEps(*dm, user, *snes, *u, c));
     c->time_mesh = time_mesh;
     PetscCall(CycleBarsCompute(user, dim, k));
     PetscCall(EstimateMarkUnseenContact(*dm, user, *u, &marked, &c->unseen)); /* the cells around the contact the mesh misses */
