@@ -27,8 +27,8 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PetscPrintf(comm, "scene %s, %" PetscInt_FMT "D, ", user->scene.name, dim));
   PetscCall(ContactView(user->contact, PETSC_VIEWER_STDOUT_(comm))); /* method penalty (gauss quadrature, eps = ...) */
-  PetscCall(
-      PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, h = %g, %d rank(s)\n", user->opt->degree, ndofs, (double)user->prob.h, size));
+  PetscCall(PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, largest cell h = %g, %d rank(s)\n", user->opt->degree, ndofs,
+                        (double)user->prob.h, size));
   if (s->default_mg)
     PetscCall(PetscPrintf(comm,
                           "  linear solver: CG with the geometric multigrid of the %" PetscInt_FMT
