@@ -13,11 +13,16 @@
      (one or two cells marked around a contact the mesh does not see) did not refine at all (314 to 460 unknowns in 6
      cycles, the estimate growing), and once Gmsh met overlapping facets on the curved surface; with the mean the mesh
      shrank. The smallest spreads a mark to the cells around it: 314 to 55,255 unknowns in 7 cycles.
-   - 2D without Gmsh's Laplace smoothing (Mesh.Smoothing 0; its frontal-Delaunay points are placed for quality
-     already): the smoothing was a quarter of the cylinder's -accuracy 0.03 run (perf), which took 1.22 s and 8,556
-     unknowns without it against 1.65 s and 12,615 with it (the stop moves with the meshes; every bar still covered
-     over 15 cycles), and 0.01 the same time (3.5 to 3.8 s, 39,270 unknowns against 35,679). In 3D it is kept: without
-     it the sphere's -accuracy 0.1 took 77,923 unknowns and 17.8 s against 58,233 and 12.2 s.
+   - 2D without Gmsh's Laplace smoothing (Mesh.Smoothing 0): the smoothing was a quarter of the cylinder's -accuracy
+     0.03 run (perf), which took 1.22 s and 8,556 unknowns without it against 1.65 s and 12,615 with it (the stop moves
+     with the meshes; every bar still covered over 15 cycles), and 0.01 the same time (3.5 to 3.8 s, 39,270 unknowns
+     against 35,679). In 3D it is kept: without it the sphere's -accuracy 0.1 took 77,923 unknowns and 17.8 s against
+     58,233 and 12.2 s.
+   - 2D with Gmsh's Delaunay algorithm (Mesh.Algorithm 5) rather than its default frontal-Delaunay (6), whose point
+     insertion with the background mesh's size lookups was a third of the cylinder's 0.01 run: 3 alternated pairs,
+     0.03 in 1.18 s against 1.31 s (7,056 unknowns against 8,556), 0.01 in 2.91 s against 3.81 s (36,047 against
+     39,270); every bar still covered over 15 cycles. In 3D (the surface meshes) the default is kept: the sphere took
+     10.7 and 13.3 s against 14.2 and 14.0 s, but the sphere indenter 9.1 and 8.7 s against 7.7 and 8.1 s.
    Gmsh runs on rank 0 on the gathered cells, sorted by their centroids so that the view is the same on any number of
    ranks (Gmsh's search of a point's cell depends on their order where the values jump); the mesh it writes is read by
    all ranks and distributed as a mesh file is (METIS).
@@ -141,8 +146,11 @@ static PetscErrorCode GmshRemesh(const char model[], const MeshBox *box, PetscIn
   GmshCall(G.gmshOptionSetNumber("Mesh.MeshSizeFromPoints", 0, &ierr_gmsh), "set Mesh.MeshSizeFromPoints");
   GmshCall(G.gmshOptionSetNumber("Mesh.MeshSizeFromCurvature", 0, &ierr_gmsh), "set Mesh.MeshSizeFromCurvature");
   GmshCall(G.gmshOptionSetNumber("Mesh.MshFileVersion", 4.1, &ierr_gmsh), "set Mesh.MshFileVersion");
-  /* 2D: no Laplace smoothing of the frontal-Delaunay triangles (see the head of the file) */
-  if (dim == 2) GmshCall(G.gmshOptionSetNumber("Mesh.Smoothing", 0, &ierr_gmsh), "set Mesh.Smoothing");
+  /* 2D: Gmsh's Delaunay algorithm, no Laplace smoothing (see the head of the file) */
+  if (dim == 2) {
+    GmshCall(G.gmshOptionSetNumber("Mesh.Algorithm", 5, &ierr_gmsh), "set Mesh.Algorithm");
+    GmshCall(G.gmshOptionSetNumber("Mesh.Smoothing", 0, &ierr_gmsh), "set Mesh.Smoothing");
+  }
   GmshCall(view = G.gmshViewAdd("size", -1, &ierr_gmsh), "add the size view");
   GmshCall(G.gmshViewAddListData(view, dim == 2 ? "ST" : "SS", (int)ncells, data, (size_t)(ncells * nv * 4), &ierr_gmsh), "fill the size view");
   GmshCall(field = G.gmshModelMeshFieldAdd("PostView", -1, &ierr_gmsh), "add the size field");
