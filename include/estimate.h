@@ -14,7 +14,7 @@ PetscErrorCode EstimateView(MPI_Comm comm, const ErrorEstimate *est, const Error
 /* marking.c: the cells an adaptive refinement refines (Doerfler's bulk criterion) */
 PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DMLabel *marked, PetscInt *nmarked);
 /* cycle_bars.c: the bars of -accuracy's quantities on the adaptive cycles */
-#define CYCLE_EPS_RATIO 10.0 /* the force's penalty part on a cycle: its force at eps / CYCLE_EPS_RATIO (src/solver/adapt.c) */
+#define CYCLE_EPS_RATIO 10.0 /* the quantities' penalty parts on a cycle: their values at eps / CYCLE_EPS_RATIO (src/solver/adapt.c) */
 PetscErrorCode CycleBarsCompute(AppCtx *user, PetscInt dim, PetscInt last);
 PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nunseen);
 

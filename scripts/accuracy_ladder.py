@@ -38,7 +38,7 @@ from signorini.runs import read_run  # noqa: E402
 CASE = "cylinder-indenter"
 MMS_EXACT = {"contact_force": 0.0720182, "pressure_max": 0.402594, "contact_size": 0.447214}  # docs/estimate.md
 QUANTITIES = "contact_force,pressure_max,contact_size"
-# the coverage series run every cycle with the bars -accuracy computes (the force's penalty part on each mesh): a
+# the coverage series run every cycle with the bars -accuracy computes (the quantities' penalty parts on each mesh): a
 # tolerance no cycle reaches
 EVERY_CYCLE = ["-accuracy", "1e-12", "-accuracy_quantity", QUANTITIES]
 
