@@ -26,6 +26,7 @@ PetscErrorCode PostprocessPenetration(AppCtx *user);
 void           PostprocessGetQuantities(const AppCtx *user, Quantities *q);
 /* contact_zone.c */
 PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size, PetscReal *band);
+PetscErrorCode PostprocessContactEdgeFaces(DM dm, AppCtx *user, Vec u, PetscInt *n, PetscInt **faces);
 
 /* contact_checks.c */
 PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user);

@@ -367,6 +367,7 @@ typedef struct {
   PetscBool target[ACCURACY_NUM];      /*   of these quantities (-accuracy_quantity) */
   char      model[PETSC_MAX_PATH_LEN]; /* -adapt_model: the Gmsh model remeshed at each cycle ("": the mesh refined) */
   PetscReal newton_fraction;           /* -accuracy_newton_fraction: Newton stops at this fraction of the error (0: never) */
+  PetscBool mark_edge, mark_edge_set;  /* -adapt_mark_edge: with -accuracy on the size, refine along the zone's edge too (unset: in 2D) */
 } AdaptOptions;
 
 /* One cycle of the adaptive refinement (/cycles in the output): the mesh, the estimate of its solution and the true
@@ -374,6 +375,7 @@ typedef struct {
    the solve on it. */
 typedef struct {
   PetscInt   n_dofs, n_cells, marked;
+  PetscInt   marked_edge;                /* the cells along the zone's edge marked too (EstimateMarkContactEdge()) */
   PetscReal  estimate, estimate_penalty; /* the estimate and its penalty part, */
   PetscReal  norm;                       /*   and the energy norm of the solution, its scale */
   PetscReal  error_energy;

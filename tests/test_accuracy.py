@@ -149,13 +149,41 @@ def test_accuracy_ladder_on_the_hertz_indenter(big_block):
     assert runs[0.01][1]["n_dofs"][-1] > runs[0.03][1]["n_dofs"][-1]
 
 
+def test_marking_the_zone_edge_stops_the_indenter_sooner(big_block):
+    """With -accuracy on the zone's size, the cells along its edge are marked too (EstimateMarkContactEdge(), by default
+    in 2D) exactly on the cycles whose one-cell band, the floor of the size's bar, is above the tolerance, and the 1%
+    run stops with fewer unknowns than Doerfler's marking alone (measured: 42,287 against 78,458), its bars still
+    covering the closed form's width and largest pressure."""
+    tol, runs = 0.01, {}
+    for edge in ("true", "false"):
+        _, h5 = run(indenter(big_block) + ["-accuracy", tol, "-accuracy_quantity", "contact_force,pressure_max,contact_size", "-adapt_mark_edge", edge],
+                    f"accuracy_edge_{edge}")
+        a, _ = load(h5)
+        assert a["accuracy_reached"] == 1, edge
+        runs[edge] = cycles(h5)
+    c = runs["true"]
+    above = c["contact_size_band"][:-1] > tol * np.abs(c["contact_size_value"][:-1])
+    assert np.array_equal(c["marked_edge"][:-1] > 0, above), (c["marked_edge"], c["contact_size_band"] / np.abs(c["contact_size_value"]))
+    assert c["marked_edge"][-1] == 0 and np.all(runs["false"]["marked_edge"] == 0)
+    assert c["n_dofs"][-1] <= 0.75 * runs["false"]["n_dofs"][-1], (c["n_dofs"][-1], runs["false"]["n_dofs"][-1])
+    width, p0 = hertz.closed_form(2, 2 * c["contact_force_value"][-1])
+    for q, exact in (("contact_size", width), ("pressure_max", p0)):
+        assert abs(c[f"{q}_value"][-1] - exact) <= c[f"{q}_bar"][-1] <= tol * abs(c[f"{q}_value"][-1]) * (1 + 1e-12), q
+    # 2 ranks mark the same edge cells (at 3%, where the band is above the tolerance over the first 10 cycles)
+    args = indenter(big_block) + ["-accuracy", 0.03, "-accuracy_quantity", "contact_force,pressure_max,contact_size"]
+    c1, c2 = cycles(run(args, "accuracy_edge_np1")[1]), cycles(run(args, "accuracy_edge_np2", np_=2)[1])
+    assert c1["marked_edge"].sum() > 0
+    for k in ("n_dofs", "marked", "marked_edge", "accurate"):
+        assert np.array_equal(c1[k], c2[k]), (k, c1[k], c2[k])
+
+
 def test_accuracy_on_two_ranks_equals_one_rank():
     """The same cycles, bars and stop on 2 ranks as on 1."""
     args = MMS + ["-dm_plex_box_faces", "8,8", "-accuracy", 0.25]
     _, one = run(args, "accuracy_np1")
     _, two = run(args, "accuracy_np2", np_=2)
     c1, c2 = cycles(one), cycles(two)
-    for k in ("n_dofs", "n_cells", "marked", "accurate"):
+    for k in ("n_dofs", "n_cells", "marked", "marked_edge", "accurate"):
         assert np.array_equal(c1[k], c2[k]), (k, c1[k], c2[k])
     for q in QUANTITIES:
         np.testing.assert_allclose(c2[f"{q}_bar"], c1[f"{q}_bar"], rtol=1e-7)

@@ -5,6 +5,7 @@
    to *marked, created if NULL; *nmarked counts them over all ranks. */
 #include "contact.h"
 #include "estimate.h"
+#include "physics.h"
 
 #define MARK_BISECTIONS 60 /* halvings of [0, max eta_T]: t to 1e-18 of the largest indicator */
 
@@ -83,5 +84,29 @@ PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *ma
     PetscCall(DMPlexRestoreTransitiveClosure(dm, cs->point[i], PETSC_FALSE, &nstar, &star));
   }
   PetscCall(PetscFree(unseen));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The cells along the contact zone's edge: the cells of the faces of Gamma_C that the edge crosses, the one-cell band
+   that floors the zone's size's bar (src/estimate/cycle_bars.c, src/physics/contact_zone.c). Doerfler's marking on the
+   energy-norm indicators refines them only where the energy's error is, while the size's bar cannot fall below the
+   band: marking them too halves the band at each cycle (-adapt_mark_edge). Added to *marked, created if NULL and there
+   is one; *nmarked counts the cells over all ranks. */
+PetscErrorCode EstimateMarkContactEdge(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nmarked)
+{
+  PetscInt *faces, n, local = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PostprocessContactEdgeFaces(dm, user, u, &n, &faces));
+  for (PetscInt i = 0; i < n; ++i) {
+    const PetscInt *support;
+
+    if (!*marked) PetscCall(DMLabelCreate(PETSC_COMM_SELF, "adapt", marked));
+    PetscCall(DMPlexGetSupport(dm, faces[i], &support)); /* one cell: a boundary face */
+    PetscCall(DMLabelSetValue(*marked, support[0], DM_ADAPT_REFINE));
+    ++local;
+  }
+  PetscCall(PetscFree(faces));
+  PetscCall(MPIU_Allreduce(&local, nmarked, 1, MPIU_INT, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

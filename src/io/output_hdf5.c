@@ -652,6 +652,7 @@ static PetscErrorCode WriteCycles(MPI_Comm comm, const AppCtx *user, PetscViewer
   CYCLE_COLUMN("accurate", c[i].accurate ? 1.0 : 0.0);
   CYCLE_COLUMN("error_energy", c[i].error_energy);
   CYCLE_COLUMN("marked", (PetscReal)c[i].marked);
+  CYCLE_COLUMN("marked_edge", (PetscReal)c[i].marked_edge);
   CYCLE_COLUMN("newton_its", (PetscReal)c[i].newton_its);
   CYCLE_COLUMN("ksp_its", (PetscReal)c[i].ksp_its);
   CYCLE_COLUMN("time_solve", c[i].time_solve);

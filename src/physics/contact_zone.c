@@ -94,62 +94,93 @@ static PetscReal TriangleArea(const PetscReal a[], const PetscReal b[], const Pe
   return 0.5 * PetscSqrtReal(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
 }
 
-PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size, PetscReal *band)
+/* Each vertex's s (the head of the file) at the chart's points, 0 off Gamma_C, the same on every rank that shares it. */
+static PetscErrorCode ZoneValues(DM dm, AppCtx *user, Vec u, PetscReal **s)
 {
   const ContactSet  *cs;
   const PetscReal    E = user->opt->material.young_modulus;
-  PetscInt           dim, pStart, pEnd, vStart, vEnd, nroots;
-  PetscReal         *s, local[2] = {0.0, 0.0}, global[2];
+  PetscInt           dim, pStart, pEnd, nroots;
   PetscSF            sf;
-  DM                 cdm;
-  PetscSection       csec;
-  Vec                coords;
-  const PetscScalar *x, *xc;
+  const PetscScalar *x;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(ContactGetSet(user->contact, &cs));
   PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
-  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  PetscCall(PetscCalloc1(pEnd - pStart, &s)); /* 0 at a node of Gamma_C with no free component (clamped) */
+  PetscCall(PetscCalloc1(pEnd - pStart, s)); /* 0 at a node of Gamma_C with no free component (clamped) */
   PetscCall(VecGetArrayRead(u, &x));
   for (PetscInt i = 0; i < cs->n; ++i) {
     if (!cs->is_vertex[i]) continue;
-    s[cs->point[i] - pStart] = ContactNodePenetration(cs, dim, i, x);
-    s[cs->point[i] - pStart] += PetscPowReal(cs->weight[i], 1.0 / (dim - 1)) / E * cs->pressure[i];
+    (*s)[cs->point[i] - pStart] = ContactNodePenetration(cs, dim, i, x);
+    (*s)[cs->point[i] - pStart] += PetscPowReal(cs->weight[i], 1.0 / (dim - 1)) / E * cs->pressure[i];
   }
   PetscCall(VecRestoreArrayRead(u, &x));
   PetscCall(DMGetPointSF(dm, &sf)); /* the owners' values to the ranks that share the vertex */
   PetscCall(PetscSFGetGraph(sf, &nroots, NULL, NULL, NULL));
   if (nroots >= 0) {
-    PetscCall(PetscSFBcastBegin(sf, MPIU_REAL, s, s, MPI_REPLACE));
-    PetscCall(PetscSFBcastEnd(sf, MPIU_REAL, s, s, MPI_REPLACE));
+    PetscCall(PetscSFBcastBegin(sf, MPIU_REAL, *s, *s, MPI_REPLACE));
+    PetscCall(PetscSFBcastEnd(sf, MPIU_REAL, *s, *s, MPI_REPLACE));
   }
-  PetscCall(DMGetCoordinateDM(dm, &cdm));
-  PetscCall(DMGetLocalSection(cdm, &csec));
-  PetscCall(DMGetCoordinatesLocal(dm, &coords));
-  PetscCall(VecGetArrayRead(coords, &xc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* A boundary face's vertices: their coordinates X (NULL: not wanted) and their values sv of s, nv of them. */
+static PetscErrorCode FaceVertices(DM dm, PetscInt face, const PetscReal s[], PetscReal X[][3], PetscReal sv[], PetscInt *nv)
+{
+  PetscInt          *cl = NULL, ncl, dim, pStart, vStart, vEnd;
+  DM                 cdm;
+  PetscSection       csec;
+  Vec                coords;
+  const PetscScalar *xc = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetChart(dm, &pStart, NULL));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  if (X) {
+    PetscCall(DMGetCoordinateDM(dm, &cdm));
+    PetscCall(DMGetLocalSection(cdm, &csec));
+    PetscCall(DMGetCoordinatesLocal(dm, &coords));
+    PetscCall(VecGetArrayRead(coords, &xc));
+  }
+  *nv = 0;
+  PetscCall(DMPlexGetTransitiveClosure(dm, face, PETSC_TRUE, &ncl, &cl));
+  for (PetscInt j = 0; j < ncl && *nv < 4; ++j) {
+    const PetscInt p = cl[2 * j];
+
+    if (p < vStart || p >= vEnd) continue;
+    if (X) {
+      PetscInt off;
+
+      PetscCall(PetscSectionGetOffset(csec, p, &off));
+      for (PetscInt d = 0; d < dim; ++d) X[*nv][d] = PetscRealPart(xc[off + d]);
+    }
+    sv[(*nv)++] = s[p - pStart];
+  }
+  PetscCall(DMPlexRestoreTransitiveClosure(dm, face, PETSC_TRUE, &ncl, &cl));
+  if (X) PetscCall(VecRestoreArrayRead(coords, &xc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size, PetscReal *band)
+{
+  PetscInt   dim;
+  PetscReal *s, local[2] = {0.0, 0.0}, global[2];
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(ZoneValues(dm, user, u, &s));
   for (PetscInt k = 0; k < user->scene.bcs.ncontact; ++k) {
     PetscInt *faces, nf;
 
     PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[k], &nf, &faces));
     for (PetscInt i = 0; i < nf; ++i) {
-      PetscInt *cl = NULL, ncl, nv = 0, ns;
+      PetscInt  nv, ns;
       PetscReal X[4][3] = {{0.0}}, sv[4];
 
       PetscCall(DMPlexGetSupportSize(dm, faces[i], &ns));
       if (ns != 1) continue; /* not a boundary face */
-      PetscCall(DMPlexGetTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &cl));
-      for (PetscInt j = 0; j < ncl && nv < 4; ++j) {
-        const PetscInt p = cl[2 * j];
-        PetscInt       off;
-
-        if (p < vStart || p >= vEnd) continue;
-        PetscCall(PetscSectionGetOffset(csec, p, &off));
-        for (PetscInt d = 0; d < dim; ++d) X[nv][d] = PetscRealPart(xc[off + d]);
-        sv[nv++] = s[p - pStart];
-      }
-      PetscCall(DMPlexRestoreTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &cl));
+      PetscCall(FaceVertices(dm, faces[i], s, X, sv, &nv));
       if (dim == 2) {
         const PetscReal len = PetscSqrtReal(PetscSqr(X[1][0] - X[0][0]) + PetscSqr(X[1][1] - X[0][1]));
 
@@ -172,10 +203,48 @@ PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *siz
     }
     PetscCall(PetscFree(faces));
   }
-  PetscCall(VecRestoreArrayRead(coords, &xc));
   PetscCall(PetscFree(s));
   PetscCall(MPIU_Allreduce(local, global, 2, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
   *size = global[0];
   *band = global[1];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The faces of Gamma_C that the zone's edge crosses, the band's (on this rank; *faces allocated, PetscFree()). */
+PetscErrorCode PostprocessContactEdgeFaces(DM dm, AppCtx *user, Vec u, PetscInt *n, PetscInt **edge)
+{
+  PetscReal *s;
+  PetscInt   cap = 16;
+
+  PetscFunctionBeginUser;
+  PetscCall(ZoneValues(dm, user, u, &s));
+  *n = 0;
+  PetscCall(PetscMalloc1(cap, edge));
+  for (PetscInt k = 0; k < user->scene.bcs.ncontact; ++k) {
+    PetscInt *faces, nf;
+
+    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[k], &nf, &faces));
+    for (PetscInt i = 0; i < nf; ++i) {
+      PetscInt  nv, ns;
+      PetscReal sv[4];
+
+      PetscCall(DMPlexGetSupportSize(dm, faces[i], &ns));
+      if (ns != 1) continue;
+      PetscCall(FaceVertices(dm, faces[i], s, NULL, sv, &nv));
+      if (!Crossed(nv, sv)) continue;
+      if (*n == cap) {
+        PetscInt *grown;
+
+        cap *= 2;
+        PetscCall(PetscMalloc1(cap, &grown));
+        PetscCall(PetscArraycpy(grown, *edge, *n));
+        PetscCall(PetscFree(*edge));
+        *edge = grown;
+      }
+      (*edge)[(*n)++] = faces[i];
+    }
+    PetscCall(PetscFree(faces));
+  }
+  PetscCall(PetscFree(s));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
