@@ -26,6 +26,7 @@ PetscErrorCode PostprocessPenetration(AppCtx *user);
 void           PostprocessGetQuantities(const AppCtx *user, Quantities *q);
 /* contact_zone.c */
 PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size, PetscReal *band);
+PetscErrorCode PostprocessPressureStep(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal *step);
 PetscErrorCode PostprocessContactEdgeFaces(DM dm, AppCtx *user, Vec u, PetscInt *n, PetscInt **faces);
 
 /* contact_checks.c */

@@ -279,6 +279,8 @@ typedef struct {
   PetscReal pressure_max;              /* the largest nodal contact pressure */
   PetscReal contact_size;              /* the contact zone's measure on Gamma_C: its width in 2D, its area in 3D */
   PetscReal contact_size_band;         /* the measure of the one-cell strip along the zone's edge: the size's resolution */
+  PetscReal pressure_max_step;         /* the largest change of the nodal pressure from the largest's node to a neighbour on
+                                          Gamma_C: the largest pressure's resolution */
   PetscReal penetration_max;           /* the largest penetration */
   PetscReal energy;                    /* 1/2 a(u,u) - L(u) + the contact term's energy */
   PetscReal reaction[BOUNDARY_MAX][3]; /* the force of each clamp or slip face set's support on the body */
@@ -315,6 +317,7 @@ typedef struct {
   PetscReal           pressure_max;              /* the largest nodal contact pressure */
   PetscReal           contact_size;              /* the contact zone's width (2D) or area (3D), PostprocessContactSize() */
   PetscReal           contact_size_band;         /*   and the one-cell strip along its edge (its resolution on the mesh) */
+  PetscReal           pressure_max_step;         /* the largest pressure's change to its node's neighbours on Gamma_C */
   PetscReal           contact_force_vector[3];   /* the obstacle's force on the body: the sum of R = K u + r0 over the contact nodes */
   PetscReal           reaction[BOUNDARY_MAX][3]; /* force the support of each clamp or slip face set exerts on the body */
   MeshPartitionStats  partition;                 /* from MeshPartitionGetStats() */

@@ -7,6 +7,7 @@ apart too, and its mesh part at the order 1); the energy's bar is the error esti
 a 10 x 10 block (where the closed form is a reference to about 0.2%, docs/estimate.md), on 2 ranks
 against 1, on a mesh that does not see the contact, and on the refusals."""
 
+import h5py
 import numpy as np
 import pytest
 
@@ -52,7 +53,8 @@ def test_the_size_and_pressure_bars_take_their_penalty_parts_apart(eps0):
     (eps0 = 0.1, -accuracy's default), its penalty part |W(eps) - W(eps/10)| (1 + 3 / (10^(1/2) - 1)) plus its mesh
     part at the order 1, at least the one-cell band; at eps = h the order 1/2 on the whole size, at least the band (the
     manufactured solution's size error falls like h^(1/2) there, and its penalty part on one mesh does not show it:
-    docs/estimate.md). The pressure's, at any eps: the index at the order 1 plus |p(eps) - p(eps/10)| (1 + 3 / 9)."""
+    docs/estimate.md). The pressure's, at any eps: the index at the order 1 plus |p(eps) - p(eps/10)| (1 + 3 / 9), at
+    least the step of the nodal pressure from its largest to its node's neighbours on Gamma_C."""
     _, h5 = run(MMS + ["-dm_plex_box_faces", "8,8", "-penalty_eps0", eps0, "-accuracy", "1e-9", "-adapt_cycles", 6], f"accuracy_size_bar_{eps0}")
     c = cycles(h5)
     assert np.all(np.isfinite(c["contact_size_value_eps"])) and np.all(np.isfinite(c["eps"])), c["contact_size_value_eps"]
@@ -70,9 +72,22 @@ def test_the_size_and_pressure_bars_take_their_penalty_parts_apart(eps0):
         else:
             assert abs(c["contact_size_bar"][last] / bar - 1) < 1e-12, (last, c["contact_size_bar"][last], bar)
             pressure = _two_level(c, "pressure_max_value", last, 1.0) + abs(c["pressure_max_value"][last] - c["pressure_max_value_eps"][last]) * (1 + 3 / 9)
+            pressure = max(pressure, c["pressure_max_step"][last])
             assert abs(c["pressure_max_bar"][last] / pressure - 1) < 1e-12, (last, c["pressure_max_bar"][last], pressure)
             checked += 1
     assert checked >= 2, checked
+    # the step, the pressure bar's floor, from the last mesh's fields: the largest pressure's node against the nodes of
+    # Gamma_C it shares a cell with (the manufactured solution's maximum: the end of Gamma_C, where the profile is steep)
+    a, _ = load(h5)
+    with h5py.File(h5, "r") as f:
+        p, on = f["vertex_fields/contact_pressure"][:].ravel(), f["vertex_fields/contact_boundary"][:].ravel() > 0
+        cells = f["viz/topology/cells"][:]
+    top = int(np.argmax(p))
+    near = np.unique(cells[(cells == top).any(axis=1)])
+    near = near[on[near] & (near != top)]
+    assert a["pressure_max"] == p[top] and a["pressure_max_step"] == c["pressure_max_step"][-1]
+    assert abs(a["pressure_max_step"] / (p[top] - p[near].min()) - 1) < 1e-12, (a["pressure_max_step"], p[top] - p[near])
+    assert a["pressure_max_step"] > 0.01 * p[top]
 
 
 def test_accuracy_on_the_manufactured_solution_ends_within_the_tolerance():

@@ -354,6 +354,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteRealAttr(v, "pressure_max", s->pressure_max));           /* the largest nodal contact pressure */
   PetscCall(WriteRealAttr(v, "contact_size", s->contact_size));           /* the contact zone's width (2D) or area (3D) */
   PetscCall(WriteRealAttr(v, "contact_size_band", s->contact_size_band)); /* the one-cell strip along its edge */
+  PetscCall(WriteRealAttr(v, "pressure_max_step", s->pressure_max_step)); /* the largest pressure's change to its neighbours */
   for (PetscInt c = 0; c < dim; ++c) {                                    /* the total force of the obstacle, contact_force_x, _y, _z */
     char name[32];
 
@@ -636,6 +637,7 @@ static PetscErrorCode WriteCycles(MPI_Comm comm, const AppCtx *user, PetscViewer
   CYCLE_COLUMN("pressure_max", c[i].q.pressure_max);
   CYCLE_COLUMN("contact_size", c[i].q.contact_size);
   CYCLE_COLUMN("contact_size_band", c[i].q.contact_size_band);
+  CYCLE_COLUMN("pressure_max_step", c[i].q.pressure_max_step);
   for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
     char label[64];
 

@@ -94,13 +94,28 @@ static PetscReal TriangleArea(const PetscReal a[], const PetscReal b[], const Pe
   return 0.5 * PetscSqrtReal(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
 }
 
+/* The owners' values at the chart's points to the ranks that share them. */
+static PetscErrorCode ShareValues(DM dm, PetscReal v[])
+{
+  PetscSF  sf;
+  PetscInt nroots;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetPointSF(dm, &sf));
+  PetscCall(PetscSFGetGraph(sf, &nroots, NULL, NULL, NULL));
+  if (nroots >= 0) {
+    PetscCall(PetscSFBcastBegin(sf, MPIU_REAL, v, v, MPI_REPLACE));
+    PetscCall(PetscSFBcastEnd(sf, MPIU_REAL, v, v, MPI_REPLACE));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Each vertex's s (the head of the file) at the chart's points, 0 off Gamma_C, the same on every rank that shares it. */
 static PetscErrorCode ZoneValues(DM dm, AppCtx *user, Vec u, PetscReal **s)
 {
   const ContactSet  *cs;
   const PetscReal    E = user->opt->material.young_modulus;
-  PetscInt           dim, pStart, pEnd, nroots;
-  PetscSF            sf;
+  PetscInt           dim, pStart, pEnd;
   const PetscScalar *x;
 
   PetscFunctionBeginUser;
@@ -115,12 +130,7 @@ static PetscErrorCode ZoneValues(DM dm, AppCtx *user, Vec u, PetscReal **s)
     (*s)[cs->point[i] - pStart] += PetscPowReal(cs->weight[i], 1.0 / (dim - 1)) / E * cs->pressure[i];
   }
   PetscCall(VecRestoreArrayRead(u, &x));
-  PetscCall(DMGetPointSF(dm, &sf)); /* the owners' values to the ranks that share the vertex */
-  PetscCall(PetscSFGetGraph(sf, &nroots, NULL, NULL, NULL));
-  if (nroots >= 0) {
-    PetscCall(PetscSFBcastBegin(sf, MPIU_REAL, *s, *s, MPI_REPLACE));
-    PetscCall(PetscSFBcastEnd(sf, MPIU_REAL, *s, *s, MPI_REPLACE));
-  }
+  PetscCall(ShareValues(dm, *s));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -246,5 +256,46 @@ PetscErrorCode PostprocessContactEdgeFaces(DM dm, AppCtx *user, Vec u, PetscInt 
     PetscCall(PetscFree(faces));
   }
   PetscCall(PetscFree(s));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The largest pressure's resolution: the largest change of the nodal pressure from a node that carries the largest,
+   pressure_max, to the other vertices of its faces of Gamma_C, over all ranks (0 without contact). The nodal maximum
+   stands for the largest pressure of the cells around its node, across which the discrete pressure changes by this
+   much; where the maximum sits at a kink or an end of the profile (the manufactured solution's, at the end of Gamma_C,
+   changes there at the order h) the cycles' differences do not see that error while the refinement goes elsewhere,
+   and the largest pressure's bar takes the step as its floor (src/estimate/cycle_bars.c), as the size's takes its band. */
+PetscErrorCode PostprocessPressureStep(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal *step)
+{
+  const ContactSet *cs;
+  PetscInt          pStart, pEnd;
+  PetscReal        *p, local = 0.0;
+
+  PetscFunctionBeginUser;
+  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
+  PetscCall(PetscCalloc1(pEnd - pStart, &p));
+  for (PetscInt i = 0; i < cs->n; ++i)
+    if (cs->is_vertex[i]) p[cs->point[i] - pStart] = cs->pressure[i];
+  PetscCall(ShareValues(dm, p));
+  for (PetscInt k = 0; k < user->scene.bcs.ncontact && pressure_max > 0.0; ++k) {
+    PetscInt *faces, nf;
+
+    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[k], &nf, &faces));
+    for (PetscInt i = 0; i < nf; ++i) {
+      PetscInt  nv, ns;
+      PetscReal pv[4];
+      PetscBool top = PETSC_FALSE;
+
+      PetscCall(DMPlexGetSupportSize(dm, faces[i], &ns));
+      if (ns != 1) continue;
+      PetscCall(FaceVertices(dm, faces[i], p, NULL, pv, &nv));
+      for (PetscInt v = 0; v < nv; ++v) top = (PetscBool)(top || pv[v] == pressure_max);
+      for (PetscInt v = 0; v < nv && top; ++v) local = PetscMax(local, pressure_max - pv[v]);
+    }
+    PetscCall(PetscFree(faces));
+  }
+  PetscCall(PetscFree(p));
+  PetscCall(MPIU_Allreduce(&local, step, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -79,6 +79,7 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
     PetscCall(MPIU_Allreduce(&pmax, &st->pressure_max, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
   }
   PetscCall(PostprocessContactSize(dm, user, u, &st->contact_size, &st->contact_size_band));
+  PetscCall(PostprocessPressureStep(dm, user, st->pressure_max, &st->pressure_max_step));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -91,6 +92,7 @@ void PostprocessGetQuantities(const AppCtx *user, Quantities *q)
   q->pressure_max      = st->pressure_max;
   q->contact_size      = st->contact_size;
   q->contact_size_band = st->contact_size_band;
+  q->pressure_max_step = st->pressure_max_step;
   q->penetration_max   = st->max_penetration;
   q->energy            = st->energy;
   for (PetscInt i = 0; i < BOUNDARY_MAX; ++i)
