@@ -62,12 +62,23 @@ static struct {
   GMSH_FUNCTIONS(GMSH_DECLARE)
 } G;
 
+/* RTLD_DEEPBIND: Gmsh's libraries look their symbols up in their own dependencies first, not through the solver's
+   whole global scope (PETSc's, MPI's and HDF5's libraries) before them. Gmsh brings 71 libraries of its own
+   (OpenCASCADE, FLTK, image formats); its loading took 0.24 to 0.35 s of the Hertz cylinder's first remesh so, 0.08 to
+   0.11 s with it (RTLD_LAZY alone: 0.24 to 0.27 s). It also keeps Gmsh's libraries from binding to a same-named symbol
+   of the solver's. Not under AddressSanitizer, whose runtime refuses it. */
+#if defined(RTLD_DEEPBIND) && !defined(__SANITIZE_ADDRESS__)
+#  define GMSH_DLOPEN (RTLD_NOW | RTLD_LOCAL | RTLD_DEEPBIND)
+#else
+#  define GMSH_DLOPEN (RTLD_NOW | RTLD_LOCAL)
+#endif
+
 static PetscErrorCode GmshLoad(void)
 {
   PetscFunctionBeginUser;
   if (G.lib) PetscFunctionReturn(PETSC_SUCCESS);
-  G.lib = dlopen("libgmsh.so.4.8", RTLD_NOW | RTLD_LOCAL);
-  if (!G.lib) G.lib = dlopen("libgmsh.so", RTLD_NOW | RTLD_LOCAL);
+  G.lib = dlopen("libgmsh.so.4.8", GMSH_DLOPEN);
+  if (!G.lib) G.lib = dlopen("libgmsh.so", GMSH_DLOPEN);
   PetscCheck(G.lib, PETSC_COMM_SELF, PETSC_ERR_LIB, "Gmsh's library cannot be loaded (%s): apt-get install libgmsh4.8", dlerror());
 #define GMSH_LOAD(f)                       \
   G.f = (__typeof__(f) *)dlsym(G.lib, #f); \
