@@ -370,7 +370,7 @@ typedef struct {
   PetscBool target[ACCURACY_NUM];      /*   of these quantities (-accuracy_quantity) */
   char      model[PETSC_MAX_PATH_LEN]; /* -adapt_model: the Gmsh model remeshed at each cycle ("": the mesh refined) */
   PetscReal newton_fraction;           /* -accuracy_newton_fraction: Newton stops at this fraction of the error (0: never) */
-  PetscBool mark_edge, mark_edge_set;  /* -adapt_mark_edge: with -accuracy on the size, refine along the zone's edge too (unset: in 2D) */
+  PetscBool mark_edge;                 /* -adapt_mark_edge: with -accuracy on the size, refine along the zone's edge too */
 } AdaptOptions;
 
 /* One cycle of the adaptive refinement (/cycles in the output): the mesh, the estimate of its solution and the true
