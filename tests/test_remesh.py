@@ -180,6 +180,20 @@ def test_remeshing_the_3d_box_on_two_ranks_gives_the_one_rank_cycles():
     assert np.allclose(c1["error_energy"], c2["error_energy"], rtol=1e-6, atol=0), (c1["error_energy"], c2["error_energy"])
 
 
+def test_marking_the_zone_edge_in_3d_on_two_ranks_gives_the_one_rank_cycles():
+    """With -accuracy on the zone's size the cells along its edge are marked too (-adapt_mark_edge, on by default): in
+    3D, where the remeshed sizes are the vertices' smallest over all ranks, 2 ranks mark the same cells and make the same
+    meshes as 1 rank."""
+    args = MMS3 + ["-accuracy", 1e-9, "-accuracy_quantity", "contact_size", "-adapt_cycles", 2]
+    _, h1 = run(args, "remesh3d_edge_np1")
+    _, h2 = run(args, "remesh3d_edge_np2", np_=2)
+    c1, c2 = cycles(h1), cycles(h2)
+    assert c1["marked_edge"][:-1].min() > 0, c1["marked_edge"]
+    for k in ("n_dofs", "n_cells", "marked", "marked_edge"):
+        assert np.array_equal(c1[k], c2[k]), (k, c1[k], c2[k])
+    assert np.allclose(c1["contact_size"], c2["contact_size"], rtol=1e-6, atol=0), (c1["contact_size"], c2["contact_size"])
+
+
 def test_a_model_that_is_not_the_meshs_is_refused(disk, tmp_path):
     """The block's model given for the disk's mesh: the remeshed mesh lacks the disk's face set "top" (3), and the run
     stops at the first remesh with an error naming the model and the face set, before any solve on it."""
