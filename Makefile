@@ -134,10 +134,10 @@ accuracy-ladder: deps
 	$(PYTHON) scripts/accuracy_ladder.py
 
 # The ladder's 0.3% rung, on a cylinder of radius 10 (the same a; with radius 1 the closed form itself is 0.25% from the
-# model: make hertz-curvature): output/accuracy_ladder_r10/accuracy_ladder.{md,csv} (about 2 minutes, 2.3 GB)
+# model: make hertz-curvature): output/accuracy_ladder_r10/accuracy_ladder.{md,csv} (about 2 minutes, 2.3 GB; one run, timed once)
 accuracy-ladder-fine: deps
 	@$(MAKE) --no-print-directory $(BIN)
-	$(PYTHON) scripts/accuracy_ladder.py --tols 0.003 --radius 10 --pairs 1 --no-coverage --outdir output/accuracy_ladder_r10
+	$(PYTHON) scripts/accuracy_ladder.py --tols 0.003 --radius 10 --pairs 0 --no-coverage --outdir output/accuracy_ladder_r10
 
 # How close Hertz's closed form holds on the 2D indenter: its offset against the obstacle's curvature a / R and the
 # Poisson ratio (docs/hertz.md): output/hertz_curvature/hertz_curvature.{md,csv}
