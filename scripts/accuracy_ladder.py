@@ -32,7 +32,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from signorini import estimates as st  # noqa: E402
 from signorini import geometry, hertz  # noqa: E402
-from signorini.mpirun import paired_medians  # noqa: E402
+from signorini.mpirun import paired_medians, timing_text  # noqa: E402
 from signorini.mpirun import timed_or_exit as solve  # noqa: E402
 from signorini.paths import ROOT  # noqa: E402
 from signorini.report import csv_text, write_text  # noqa: E402
@@ -119,7 +119,7 @@ def main():
         err = hertz.quantity_errors(CASE, a, force_ref, args.radius)
         bars = accuracy_bars(a, QUANTITIES.split(","))
         best = next(((h, c, b) for h, c, b in hand if all(abs(e) <= tol for e in hertz.quantity_errors(CASE, b, force_ref, args.radius).values())), None)
-        t_ad, t_hd = paired_medians(cmd, best[1] if best else None, args.pairs) if args.pairs else (t_once, float("nan"))
+        t_ad, t_hd = paired_medians(cmd, best[1] if best else None, args.pairs, once=t_once)
         ratio = t_ad / t_hd if best else float("nan")
         row = [tol, int(a["n_dofs"]), int(a["accuracy_reached"]), t_ad]
         row += [err[q] for q in QUANTITIES.split(",")] + [bars[q] for q in QUANTITIES.split(",")]
@@ -135,7 +135,7 @@ def main():
     text = [f"# -accuracy on the 2D Hertz cylinder indenter (radius {args.radius:g}, block {st.BLOCK:g} x {st.BLOCK:g}, eps = h/10, from h = 0.5 uniform)", "",
             f"`/usr/bin/python3 scripts/accuracy_ladder.py --tols {args.tols} --pairs {args.pairs} --radius {args.radius:g}`. Errors: the width and the largest "
             "pressure against the closed form at the run's force, the force against the finest run's; in brackets the run's bar "
-            f"(relative). Times: medians of {args.pairs} alternated pairs, whole processes.", "",
+            f"(relative). Times: {timing_text(args.pairs)}.", "",
             "| TOL | unknowns | reached | force | largest pressure | width | covered | time (s) | fewest hand-graded unknowns within TOL (h_near, G: unknowns) | its time (s) | adaptive / hand-graded |",
             "|---|---|---|---|---|---|---|---|---|---|---|"] + md + ["", "Hand-graded meshes (size h_near + G r up to 0.5), one solve each:", "",
                                                                      "| h_near, G | unknowns | force | largest pressure | width |", "|---|---|---|---|---|"] + hand_md

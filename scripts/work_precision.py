@@ -40,8 +40,6 @@ MMS_EXACT = {"contact_force": 0.0720182, "pressure_max": 0.402594, "contact_size
 ERRORS = {2: (0.03, 0.01, 0.003), 3: (0.1, 0.03)}  # 3D: 1% would reach the last cycle, the force's reference
 BIN = os.path.join(ROOT, "bin", "signorini")
 CYLINDER_HAND = [0.004, 0.002, 0.001, 0.0005]
-# 3D: GAMG with its aggregates on the unfiltered graph, as scripts/accuracy_remesh.py runs the sphere
-GAMG_3D = ["-options_file", "options/solvers/gamg.yaml", "-pc_gamg_threshold", "0"]
 
 
 def dim_of(case):
@@ -99,12 +97,12 @@ def runs_of(case, outdir, cycles):
         for h in (0.2, 0.1, 0.05, 0.035):
             mesh = os.path.join(outdir, f"sphere_h{h:g}.msh")
             geometry.quarter_sphere(mesh, radius=hertz.RADIUS, h_far=h, h_near=h, width=0.5, model=model if h == 0.2 else None)
-            fam["uniform"].append(single(hertz_cmd(case, mesh) + GAMG_3D, os.path.join(outdir, f"sphere_uniform_{h:g}.h5"), 3))
+            fam["uniform"].append(single(hertz_cmd(case, mesh) + hertz.GAMG_3D, os.path.join(outdir, f"sphere_uniform_{h:g}.h5"), 3))
         for h_near in hertz.CASES[case]["h_near"]:
             mesh = os.path.join(outdir, f"sphere_graded_{h_near:g}.msh")
             hertz.write_mesh(case, h_near, mesh)
-            fam["hand-graded"].append(single(hertz_cmd(case, mesh) + GAMG_3D, os.path.join(outdir, f"sphere_graded_{h_near:g}.h5"), 3))
-        adaptive = hertz_cmd(case, os.path.join(outdir, "sphere_h0.2.msh")) + GAMG_3D + ["-adapt_model", model, "-adapt_cycles", str(cycles)]
+            fam["hand-graded"].append(single(hertz_cmd(case, mesh) + hertz.GAMG_3D, os.path.join(outdir, f"sphere_graded_{h_near:g}.h5"), 3))
+        adaptive = hertz_cmd(case, os.path.join(outdir, "sphere_h0.2.msh")) + hertz.GAMG_3D + ["-adapt_model", model, "-adapt_cycles", str(cycles)]
     else:  # the elastic cylinder: uniform meshes of the quarter disk, make hertz's grading, the model remeshed
         model = os.path.join(outdir, "disk.geo")
         for h in (0.1, 0.05, 0.025, 0.0125, 0.00625):

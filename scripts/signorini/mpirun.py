@@ -82,15 +82,23 @@ def timed_or_exit(cmd):
     return time.perf_counter() - t0
 
 
-def paired_medians(cmd, other, pairs):
+def paired_medians(cmd, other, pairs, once=None):
     """The median wall times of cmd and of other (None: none) over `pairs` alternated runs, side by side so that the
-    machine's noise falls on both; NaN for a missing other."""
+    machine's noise falls on both; NaN for a missing other. pairs 0: (once, NaN), cmd's time already measured once
+    (a run too long to repeat)."""
+    if pairs == 0:
+        return once, float("nan")
     t, t_other = [], []
     for _ in range(pairs):
         t.append(timed_or_exit(cmd))
         if other:
             t_other.append(timed_or_exit(other))
     return statistics.median(t), statistics.median(t_other) if other else float("nan")
+
+
+def timing_text(pairs):
+    """How paired_medians() timed: for a report's text."""
+    return f"medians of {pairs} alternated pairs, whole processes" if pairs else "one run of the adaptive process, not paired"
 
 
 def tail(text, n=LOG_TAIL_LINES):

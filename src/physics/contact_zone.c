@@ -172,47 +172,63 @@ static PetscErrorCode FaceVertices(DM dm, PetscInt face, const PetscReal s[], Pe
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The boundary faces of Gamma_C on this rank, over its face sets in turn (*faces allocated, PetscFree()). */
+static PetscErrorCode GammaCFaces(DM dm, const AppCtx *user, PetscInt *n, PetscInt **faces)
+{
+  PetscFunctionBeginUser;
+  *n = 0;
+  PetscCall(PetscMalloc1(1, faces));
+  for (PetscInt k = 0; k < user->scene.bcs.ncontact; ++k) {
+    PetscInt *set, nf;
+
+    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[k], &nf, &set));
+    PetscCall(PetscRealloc(sizeof(PetscInt) * (*n + nf + 1), faces));
+    for (PetscInt i = 0; i < nf; ++i) {
+      PetscInt ns;
+
+      PetscCall(DMPlexGetSupportSize(dm, set[i], &ns));
+      if (ns == 1) (*faces)[(*n)++] = set[i]; /* a boundary face */
+    }
+    PetscCall(PetscFree(set));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size, PetscReal *band)
 {
-  PetscInt   dim;
+  PetscInt   dim, *faces, nf;
   PetscReal *s, local[2] = {0.0, 0.0}, global[2];
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(ZoneValues(dm, user, u, &s));
-  for (PetscInt k = 0; k < user->scene.bcs.ncontact; ++k) {
-    PetscInt *faces, nf;
+  PetscCall(GammaCFaces(dm, user, &nf, &faces));
+  for (PetscInt i = 0; i < nf; ++i) {
+    PetscInt  nv;
+    PetscReal X[4][3] = {{0.0}}, sv[4];
 
-    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[k], &nf, &faces));
-    for (PetscInt i = 0; i < nf; ++i) {
-      PetscInt  nv, ns;
-      PetscReal X[4][3] = {{0.0}}, sv[4];
+    PetscCall(FaceVertices(dm, faces[i], s, X, sv, &nv));
+    if (dim == 2) {
+      const PetscReal len = PetscSqrtReal(PetscSqr(X[1][0] - X[0][0]) + PetscSqr(X[1][1] - X[0][1]));
 
-      PetscCall(DMPlexGetSupportSize(dm, faces[i], &ns));
-      if (ns != 1) continue; /* not a boundary face */
-      PetscCall(FaceVertices(dm, faces[i], s, X, sv, &nv));
-      if (dim == 2) {
-        const PetscReal len = PetscSqrtReal(PetscSqr(X[1][0] - X[0][0]) + PetscSqr(X[1][1] - X[0][1]));
+      local[0] += PositiveMeasure(2, sv, len);
+      if (Crossed(2, sv)) local[1] += len;
+    } else { /* a triangle, or a quadrilateral as two */
+      const PetscReal t0[3] = {sv[0], sv[1], sv[2]};
+      const PetscInt  v0[3] = {0, 1, 2};
 
-        local[0] += PositiveMeasure(2, sv, len);
-        if (Crossed(2, sv)) local[1] += len;
-      } else { /* a triangle, or a quadrilateral as two */
-        const PetscReal t0[3] = {sv[0], sv[1], sv[2]};
-        const PetscInt  v0[3] = {0, 1, 2};
+      local[0] += PositiveMeasure(3, t0, TriangleArea(X[0], X[1], X[2]));
+      local[1] += TriangleBand(X, v0, t0);
+      if (nv == 4) {
+        const PetscReal t1[3] = {sv[0], sv[2], sv[3]};
+        const PetscInt  v1[3] = {0, 2, 3};
 
-        local[0] += PositiveMeasure(3, t0, TriangleArea(X[0], X[1], X[2]));
-        local[1] += TriangleBand(X, v0, t0);
-        if (nv == 4) {
-          const PetscReal t1[3] = {sv[0], sv[2], sv[3]};
-          const PetscInt  v1[3] = {0, 2, 3};
-
-          local[0] += PositiveMeasure(3, t1, TriangleArea(X[0], X[2], X[3]));
-          local[1] += TriangleBand(X, v1, t1);
-        }
+        local[0] += PositiveMeasure(3, t1, TriangleArea(X[0], X[2], X[3]));
+        local[1] += TriangleBand(X, v1, t1);
       }
     }
-    PetscCall(PetscFree(faces));
   }
+  PetscCall(PetscFree(faces));
   PetscCall(PetscFree(s));
   PetscCall(MPIU_Allreduce(local, global, 2, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
   *size = global[0];
@@ -224,36 +240,18 @@ PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *siz
 PetscErrorCode PostprocessContactEdgeFaces(DM dm, AppCtx *user, Vec u, PetscInt *n, PetscInt **edge)
 {
   PetscReal *s;
-  PetscInt   cap = 16;
+  PetscInt   nf;
 
   PetscFunctionBeginUser;
   PetscCall(ZoneValues(dm, user, u, &s));
+  PetscCall(GammaCFaces(dm, user, &nf, edge));
   *n = 0;
-  PetscCall(PetscMalloc1(cap, edge));
-  for (PetscInt k = 0; k < user->scene.bcs.ncontact; ++k) {
-    PetscInt *faces, nf;
+  for (PetscInt i = 0; i < nf; ++i) { /* kept in place */
+    PetscInt  nv;
+    PetscReal sv[4];
 
-    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[k], &nf, &faces));
-    for (PetscInt i = 0; i < nf; ++i) {
-      PetscInt  nv, ns;
-      PetscReal sv[4];
-
-      PetscCall(DMPlexGetSupportSize(dm, faces[i], &ns));
-      if (ns != 1) continue;
-      PetscCall(FaceVertices(dm, faces[i], s, NULL, sv, &nv));
-      if (!Crossed(nv, sv)) continue;
-      if (*n == cap) {
-        PetscInt *grown;
-
-        cap *= 2;
-        PetscCall(PetscMalloc1(cap, &grown));
-        PetscCall(PetscArraycpy(grown, *edge, *n));
-        PetscCall(PetscFree(*edge));
-        *edge = grown;
-      }
-      (*edge)[(*n)++] = faces[i];
-    }
-    PetscCall(PetscFree(faces));
+    PetscCall(FaceVertices(dm, (*edge)[i], s, NULL, sv, &nv));
+    if (Crossed(nv, sv)) (*edge)[(*n)++] = (*edge)[i];
   }
   PetscCall(PetscFree(s));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -268,7 +266,7 @@ PetscErrorCode PostprocessContactEdgeFaces(DM dm, AppCtx *user, Vec u, PetscInt 
 PetscErrorCode PostprocessPressureStep(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal *step)
 {
   const ContactSet *cs;
-  PetscInt          pStart, pEnd;
+  PetscInt          pStart, pEnd, nf, *faces;
   PetscReal        *p, local = 0.0;
 
   PetscFunctionBeginUser;
@@ -278,23 +276,17 @@ PetscErrorCode PostprocessPressureStep(DM dm, AppCtx *user, PetscReal pressure_m
   for (PetscInt i = 0; i < cs->n; ++i)
     if (cs->is_vertex[i]) p[cs->point[i] - pStart] = cs->pressure[i];
   PetscCall(ShareValues(dm, p));
-  for (PetscInt k = 0; k < user->scene.bcs.ncontact && pressure_max > 0.0; ++k) {
-    PetscInt *faces, nf;
+  PetscCall(GammaCFaces(dm, user, &nf, &faces));
+  for (PetscInt i = 0; i < nf && pressure_max > 0.0; ++i) {
+    PetscInt  nv;
+    PetscReal pv[4];
+    PetscBool top = PETSC_FALSE;
 
-    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[k], &nf, &faces));
-    for (PetscInt i = 0; i < nf; ++i) {
-      PetscInt  nv, ns;
-      PetscReal pv[4];
-      PetscBool top = PETSC_FALSE;
-
-      PetscCall(DMPlexGetSupportSize(dm, faces[i], &ns));
-      if (ns != 1) continue;
-      PetscCall(FaceVertices(dm, faces[i], p, NULL, pv, &nv));
-      for (PetscInt v = 0; v < nv; ++v) top = (PetscBool)(top || pv[v] == pressure_max);
-      for (PetscInt v = 0; v < nv && top; ++v) local = PetscMax(local, pressure_max - pv[v]);
-    }
-    PetscCall(PetscFree(faces));
+    PetscCall(FaceVertices(dm, faces[i], p, NULL, pv, &nv));
+    for (PetscInt v = 0; v < nv; ++v) top = (PetscBool)(top || pv[v] == pressure_max);
+    for (PetscInt v = 0; v < nv && top; ++v) local = PetscMax(local, pressure_max - pv[v]);
   }
+  PetscCall(PetscFree(faces));
   PetscCall(PetscFree(p));
   PetscCall(MPIU_Allreduce(&local, step, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
   PetscFunctionReturn(PETSC_SUCCESS);
