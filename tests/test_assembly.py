@@ -96,9 +96,10 @@ def test_penalty_gauss_closed_form_equals_petsc(name, args, tmp_path):
 @pytest.mark.parametrize("mat_type", ("aij", "sbaij"))
 @pytest.mark.parametrize("dim", (2, 3), ids=("2d", "3d"))
 def test_partly_constrained_vertices_are_preallocated_exactly(dim, mat_type, tmp_path):
-    """A slip face fixes one component of its vertices, so K has a row per dof (block size 1): on one rank its
-    preallocation is counted from the mesh's edges (AssemblyP1PreallocateScalar()), exact for aij and for sbaij's upper
-    triangle, and K is the FE one. The Hertz cylinder's quarter disk (2D) and the sphere indenter's quarter block (3D)."""
+    """A slip face fixes one component of its vertices, so K has a row per dof (block size 1): on one rank aij is built
+    in its own CSR arrays with the pattern of the mesh's edges (AssemblyP1CreateSeqAIJScalar()), and sbaij's upper
+    triangle is preallocated from the same edges (AssemblyP1PreallocateScalar()); both exact, and K is the FE one. The
+    Hertz cylinder's quarter disk (2D) and the sphere indenter's quarter block (3D)."""
     import sys
     sys.path.insert(0, os.path.join(ROOT, "scripts"))
     from signorini import hertz

@@ -3,7 +3,9 @@
    matrices added in place, cell by cell in the order MatSetValues() would add them, so the values are the same to the
    bit. MatSetValues() searches the row for each entry it adds, and
    MatSeqAIJSetPreallocationCSR() inserts a given pattern row by row through it. The arrays belong to a container
-   composed with K and are freed with it. Applies where every vertex is free or fully constrained (a block per vertex). */
+   composed with K and are freed with it. A block per vertex where every vertex is free or fully constrained; scalar
+   rows where some vertex is partly fixed (a slip condition), whose MatSetValues() path was two thirds of the set-up of
+   each remeshed cycle of the Hertz sphere (its symmetry planes). */
 #include <petscdmplex.h>
 #include "discretization.h"
 #include "physics.h"
@@ -196,6 +198,147 @@ static void SeqAddBlock(void *ctx, PetscInt va, PetscInt vb, const PetscScalar *
     for (PetscInt d = 0; d < bs; ++d) s->ca[bs * bs * s->bptr[r] + ci * bs * nr + k * bs + d] += v[ci * ld + d];
 }
 
+/* One rank, a vertex with some components fixed and others free (a slip condition: -bc_slip, a symmetry plane): K's
+   rows are scalar. The free components of a vertex have consecutive global numbers, first[v] on; every row of vertex
+   v holds the same columns: the free components of v and of its neighbours along the edges, nbr[vptr[v] ..
+   vptr[v + 1]) in the order of their first[] (sorted columns), neighbour k's at colofs[vptr[v] + k] of the row. */
+typedef struct {
+  PetscInt        dim;
+  const PetscInt *vidx, *first, *vptr, *nbr, *colofs, *ci;
+  PetscScalar    *ca;
+} SeqAddScalar;
+
+static void SeqAddScalarBlock(void *ctx, PetscInt va, PetscInt vb, const PetscScalar *v, PetscInt ld)
+{
+  const SeqAddScalar *s   = (const SeqAddScalar *)ctx;
+  const PetscInt      dim = s->dim;
+  PetscInt            k   = s->vptr[va];
+
+  if (s->first[va] < 0 || s->first[vb] < 0) return;
+  while (s->nbr[k] != vb) ++k; /* present: an edge or the vertex itself */
+  for (PetscInt ci = 0; ci < dim; ++ci) {
+    const PetscInt g = s->vidx[va * dim + ci];
+
+    if (g < 0) continue;
+    for (PetscInt d = 0; d < dim; ++d) {
+      const PetscInt j = s->vidx[vb * dim + d];
+
+      if (j >= 0) s->ca[s->ci[g] + s->colofs[k] + (j - s->first[vb])] += v[ci * ld + d];
+    }
+  }
+}
+
+/* K on one rank as SeqAIJ with scalar rows (bs = 1: some vertex partly fixed), in its own CSR arrays as for a block per
+   vertex (AssemblyP1CreateSeqAIJ()): the pattern from the edges, the element matrices added in place in MatSetValues()'s
+   order, so the values are the same to the bit. *done is false, and nothing is built, where a vertex's free components
+   are not numbered consecutively. */
+static PetscErrorCode AssemblyP1CreateSeqAIJScalar(DM dm, const AppCtx *user, PetscInt nlocal, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
+                                                   PetscBool *done)
+{
+  PetscInt     dim, vStart, vEnd, eStart, eEnd, nv, *first, *nfree, *vptr, *nbr, *key, *colofs, *fill, *ci_, *cj;
+  PetscScalar *ca;
+  PetscBool    consecutive = PETSC_TRUE;
+
+  PetscFunctionBeginUser;
+  *done = PETSC_FALSE;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(DMPlexGetDepthStratum(dm, 1, &eStart, &eEnd));
+  nv = vEnd - vStart;
+  PetscCall(PetscMalloc2(nv, &first, nv, &nfree));
+  for (PetscInt v = 0; v < nv && consecutive; ++v) {
+    first[v] = -1;
+    nfree[v] = 0;
+    for (PetscInt e = 0; e < dim; ++e) {
+      const PetscInt g = vidx[v * dim + e];
+
+      if (g < 0) continue;
+      if (first[v] < 0) first[v] = g;
+      consecutive = (PetscBool)(g == first[v] + nfree[v] && g < nlocal);
+      ++nfree[v];
+      if (!consecutive) break;
+    }
+  }
+  if (!consecutive) {
+    PetscCall(PetscFree2(first, nfree));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  /* the vertices next to each free vertex, itself included: counted, then filled */
+  PetscCall(PetscCalloc1(nv + 1, &vptr));
+  PetscCall(PetscCalloc1(nv, &fill));
+  for (PetscInt pass = 0; pass < 2; ++pass) {
+    if (pass) {
+      for (PetscInt v = 0; v < nv; ++v) vptr[v + 1] += vptr[v];
+      PetscCall(PetscMalloc3(vptr[nv], &nbr, vptr[nv], &key, vptr[nv], &colofs));
+    }
+    for (PetscInt v = 0; v < nv; ++v) {
+      if (first[v] < 0) continue;
+      if (pass)
+        nbr[vptr[v] + fill[v]++] = v;
+      else
+        ++vptr[v + 1];
+    }
+    for (PetscInt e = eStart; e < eEnd; ++e) {
+      const PetscInt *cone;
+      PetscInt        a, b;
+
+      PetscCall(DMPlexGetCone(dm, e, &cone));
+      a = cone[0] - vStart;
+      b = cone[1] - vStart;
+      if (first[a] < 0 || first[b] < 0) continue;
+      if (pass) {
+        nbr[vptr[a] + fill[a]++] = b;
+        nbr[vptr[b] + fill[b]++] = a;
+      } else {
+        ++vptr[a + 1];
+        ++vptr[b + 1];
+      }
+    }
+  }
+  PetscCall(PetscFree(fill));
+  /* each vertex's neighbours in the order of their columns, and where each one's columns start in the row */
+  PetscCall(PetscMalloc1(nlocal + 1, &ci_));
+  ci_[0] = 0;
+  {
+    PetscInt *len; /* the length of each row */
+
+    PetscCall(PetscCalloc1(nlocal + 1, &len));
+    for (PetscInt v = 0; v < nv; ++v) {
+      PetscInt n = 0;
+
+      if (first[v] < 0) continue;
+      for (PetscInt k = vptr[v]; k < vptr[v + 1]; ++k) key[k] = first[nbr[k]];
+      PetscCall(PetscSortIntWithArray(vptr[v + 1] - vptr[v], &key[vptr[v]], &nbr[vptr[v]]));
+      for (PetscInt k = vptr[v]; k < vptr[v + 1]; ++k) {
+        colofs[k] = n;
+        n += nfree[nbr[k]];
+      }
+      for (PetscInt c = 0; c < nfree[v]; ++c) len[first[v] + c] = n;
+    }
+    for (PetscInt g = 0; g < nlocal; ++g) ci_[g + 1] = ci_[g] + len[g];
+    PetscCall(PetscFree(len));
+  }
+  PetscCall(PetscMalloc1(ci_[nlocal] + 1, &cj));
+  PetscCall(PetscCalloc1(ci_[nlocal] + 1, &ca));
+  for (PetscInt v = 0; v < nv; ++v)
+    for (PetscInt c = 0; c < nfree[v]; ++c)
+      for (PetscInt k = vptr[v]; k < vptr[v + 1]; ++k)
+        for (PetscInt d = 0; d < nfree[nbr[k]]; ++d) cj[ci_[first[v] + c] + colofs[k] + d] = first[nbr[k]] + d;
+  {
+    SeqAddScalar add = {dim, vidx, first, vptr, nbr, colofs, ci_, ca};
+
+    PetscCall(AssemblyP1CellLoop(dm, &user->opt->material, cverts, SeqAddScalarBlock, &add));
+  }
+  PetscCall(PetscFree3(nbr, key, colofs));
+  PetscCall(PetscFree(vptr));
+  PetscCall(PetscFree2(first, nfree));
+  PetscCall(MatCreateSeqAIJWithArrays(PetscObjectComm((PetscObject)dm), nlocal, nlocal, ci_, cj, ca, K));
+  PetscCall(AssemblyP1CSRCompose(*K, ci_, cj, ca, NULL, NULL, NULL));
+  PetscCall(MatSetFromOptions(*K));
+  *done = PETSC_TRUE;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
                                       PetscBool *done)
 {
@@ -210,8 +353,14 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   *done = PETSC_FALSE;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(DMGetDimension(dm, &dim));
+  if (size > 1) PetscFunctionReturn(PETSC_SUCCESS);
+  if (bs == 1 && dim > 1) { /* some vertex partly fixed */
+    PetscCall(AssemblyP1CSRApplies(dm, dim, user->opt->solver.given.mat_type, &applies));
+    if (applies) PetscCall(AssemblyP1CreateSeqAIJScalar(dm, user, nlocal, vidx, cverts, K, done));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
   PetscCall(AssemblyP1CSRApplies(dm, bs, user->opt->solver.given.mat_type, &applies));
-  if (size > 1 || !applies) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!applies) PetscFunctionReturn(PETSC_SUCCESS);
   nb = nlocal / bs;
   PetscCall(AssemblyP1BlockPattern(dm, bs, nb, vidx, &bptr, &bcol));
   PetscCall(PetscMalloc1(nlocal + 1, &ci_));
