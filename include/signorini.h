@@ -365,7 +365,7 @@ typedef enum { ACCURACY_ENERGY, ACCURACY_FORCE, ACCURACY_PRESSURE, ACCURACY_SIZE
 extern const char *const AccuracyQuantities[];
 typedef struct {
   PetscInt  cycles;                    /* 0: no adaptive refinement; with -accuracy, the most cycles */
-  PetscReal fraction;                  /* -adapt_fraction */
+  PetscReal fraction;                  /* -adapt_fraction (0: the default, AdaptSolve()'s) */
   PetscReal accuracy;                  /* -accuracy: the relative error asked for (0: none), */
   PetscBool target[ACCURACY_NUM];      /*   of these quantities (-accuracy_quantity) */
   char      model[PETSC_MAX_PATH_LEN]; /* -adapt_model: the Gmsh model remeshed at each cycle ("": the mesh refined) */
@@ -464,6 +464,7 @@ typedef struct {
   PetscInt      nsteps;
   CycleRecord  *cycles; /* one per mesh of the adaptive refinement (-adapt_cycles) */
   PetscInt      ncycles;
+  PetscReal     adapt_fraction;           /*   the fraction of the estimate's square they marked (Doerfler's theta) */
   ErrorNorms    errors;                   /* against the scene's exact solution */
   ErrorNorms    ref_errors;               /* against the -reference solution */
   ErrorEstimate estimate;                 /* the a posteriori estimate of the error */

@@ -108,6 +108,25 @@ def test_the_hertz_sphere_remeshes_in_3d(sphere):
     assert len(x) > 30 and np.max(np.abs(np.linalg.norm(x - [0.0, 0.0, 1.0], axis=1) - 1.0)) < 1e-6
 
 
+def test_3d_accuracy_on_contact_quantities_marks_a_smaller_fraction(sphere):
+    """In 3D a remeshed vertex takes the smallest size of its cells, so a marked cell refines its neighbours too: with
+    Doerfler's theta = 0.5 the sphere's unknowns grew about 3.2 times a cycle, and -accuracy's stop overshot by up to
+    that. Where -accuracy asks for contact quantities only, the default theta is 0.3 (recorded as adapt_fraction): over
+    the same 6 cycles its unknowns grow at most 2.5 times a cycle in the last two (measured 2.2 and 2.3),
+    -adapt_fraction 0.5's at least 2.6 (measured 2.8 and 3.2). With the energy among the quantities the default stays
+    0.5."""
+    mesh, model = sphere
+    args = case_args("sphere", mesh) + ["-adapt_model", model, "-accuracy", 1e-9, "-accuracy_quantity", "contact_force,pressure_max,contact_size",
+                                        "-adapt_cycles", 6]
+    _, h_def = run(args, "remesh_sphere_theta_default")
+    _, h_half = run(args + ["-adapt_fraction", 0.5], "remesh_sphere_theta_half")
+    _, h_energy = run(args[:-4] + ["-accuracy_quantity", "energy,contact_size", "-adapt_cycles", 1], "remesh_sphere_theta_energy")
+    assert load(h_def)[0]["adapt_fraction"] == 0.3 and load(h_half)[0]["adapt_fraction"] == 0.5
+    assert load(h_energy)[0]["adapt_fraction"] == 0.5
+    g_def, g_half = (np.exp(np.diff(np.log(cycles(h)["n_dofs"]))[-2:]) for h in (h_def, h_half))
+    assert g_def.max() <= 2.5 and g_half.min() >= 2.6, (g_def, g_half)
+
+
 def test_a_gamg_breakdown_on_a_carried_solution_is_recovered_without_a_direct_solve(sphere):
     """The sphere's fifth remeshed cycle (5,910 unknowns): the carried solution's first Jacobian holds the penalty rows
     of its contact, GAMG's aggregates of contact nodes alone (options/solvers/gamg.yaml's threshold drops their links
@@ -168,6 +187,7 @@ def test_accuracy_on_the_3d_manufactured_solution_remeshes_the_box():
     norm, est, err = c["energy_value"][-1], c["estimate"][-1], c["error_energy"][-1]
     assert est <= 0.8 * norm and err <= 0.8 * norm, (est, err, norm)
     assert 4.0 <= est / err <= 8.0, est / err
+    assert a["adapt_fraction"] == 0.5  # the energy's target keeps Doerfler's default in 3D
 
 
 def test_remeshing_the_3d_box_on_two_ranks_gives_the_one_rank_cycles():

@@ -460,6 +460,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     PetscCall(WriteRealAttr(v, "time_estimate", user->rec.estimate.time));
   } else if (user->rec.estimate.unavailable[0])
     PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "estimate_unavailable", PETSC_STRING, user->rec.estimate.unavailable));
+  if (user->rec.ncycles) PetscCall(WriteRealAttr(v, "adapt_fraction", user->rec.adapt_fraction));
   if (user->opt->adapt.accuracy > 0.0 && user->rec.ncycles) { /* -accuracy: asked for, reached, and the last cycle's bars */
     const CycleRecord *c = &user->rec.cycles[user->rec.ncycles - 1];
 
