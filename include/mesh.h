@@ -87,6 +87,13 @@ PetscErrorCode MeshInterpolateVertexArrays(DM dm, DM fine, const PetscInt vertex
                                            PetscReal *fine_values[]);
 PetscErrorCode MeshInterpolateFromParents(DM dm, DM fine, const PetscInt parent[], PetscInt nvec, Vec loc[], Vec fine_loc[]);
 
+/* mesh_locate.c: the cell of a simplex mesh, given by its cells' vertices x[ncells][dim + 1][dim] (kept by the caller),
+   that holds a point, and the point's barycentric coordinates in it */
+typedef struct _n_MeshLocator *MeshLocator;
+PetscErrorCode                 MeshLocatorCreate(PetscInt dim, PetscInt ncells, const PetscReal x[], MeshLocator *locator);
+void                           MeshLocatorFind(MeshLocator locator, const PetscReal p[], PetscInt *cell, PetscReal lambda[]);
+PetscErrorCode                 MeshLocatorDestroy(MeshLocator *locator);
+
 /* mesh_transfer.c: a P1 field carried from a mesh to its remeshing (the old cells on rank 0) */
 typedef struct _n_MeshTransfer *MeshTransfer;
 PetscErrorCode                  MeshTransferCreate(MPI_Comm comm, PetscInt dim, PetscInt ncells, PetscReal x[], PetscReal u[], MeshTransfer *tr);
