@@ -117,62 +117,88 @@ PetscErrorCode AssemblyP1CSRCompose(Mat K, PetscInt *i, PetscInt *j, PetscScalar
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The block pattern of K on one rank with a block of bs = dim dofs per vertex: block row r (a free vertex) holds the
-   blocks bcol[bptr[r] .. bptr[r + 1]), sorted: itself and its free neighbours along the edges (two vertices of a
-   simplex mesh share a cell exactly when an edge joins them). Counted in a first pass, filled in a second. */
-PetscErrorCode AssemblyP1BlockPattern(DM dm, PetscInt bs, PetscInt nb, const PetscInt vidx[], PetscInt **bptr, PetscInt **bcol)
+/* The vertices next to each kept vertex v (keep[v], local numbers from the first vertex): itself, then its kept
+   neighbours along the edges in the edges' order (two vertices of a simplex mesh share a cell exactly when an edge
+   joins them), nbr[vptr[v] .. vptr[v + 1]). Counted in a first pass, filled in a second; free both with PetscFree(). */
+static PetscErrorCode VertexNeighbours(DM dm, const PetscBool keep[], PetscInt **vptr, PetscInt **nbr)
 {
-  PetscInt dim, vStart, vEnd, eStart, eEnd, *fill = NULL;
+  PetscInt vStart, vEnd, eStart, eEnd, nv, *fill;
 
   PetscFunctionBeginUser;
-  PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
   PetscCall(DMPlexGetDepthStratum(dm, 1, &eStart, &eEnd));
-  PetscCall(PetscCalloc1(nb + 1, bptr));
-  for (PetscInt v = vStart; v < vEnd; ++v) {
-    const PetscInt *g = &vidx[(v - vStart) * dim];
-
-    if (g[0] < 0) continue; /* fully constrained: no row */
-    for (PetscInt e = 0; e < dim; ++e)
-      PetscCheck(g[e] == g[0] + e && g[0] % bs == 0 && g[0] / bs < nb, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Vertex %" PetscInt_FMT " is not one block",
-                 v);
-  }
+  nv = vEnd - vStart;
+  PetscCall(PetscCalloc1(nv + 1, vptr));
+  PetscCall(PetscCalloc1(nv + 1, &fill));
   for (PetscInt pass = 0; pass < 2; ++pass) {
-    if (pass) { /* offsets from the counts */
-      for (PetscInt r = 0; r < nb; ++r) (*bptr)[r + 1] += (*bptr)[r];
-      PetscCall(PetscMalloc1((*bptr)[nb], bcol));
-      PetscCall(PetscCalloc1(nb, &fill));
+    if (pass) {
+      for (PetscInt v = 0; v < nv; ++v) (*vptr)[v + 1] += (*vptr)[v];
+      PetscCall(PetscMalloc1((*vptr)[nv] + 1, nbr));
     }
-    for (PetscInt v = vStart; v < vEnd; ++v) {
-      const PetscInt a = vidx[(v - vStart) * dim];
-
-      if (a < 0) continue;
+    for (PetscInt v = 0; v < nv; ++v) {
+      if (!keep[v]) continue;
       if (pass)
-        (*bcol)[(*bptr)[a / bs] + fill[a / bs]++] = a / bs;
+        (*nbr)[(*vptr)[v] + fill[v]++] = v;
       else
-        ++(*bptr)[a / bs + 1];
+        ++(*vptr)[v + 1];
     }
     for (PetscInt e = eStart; e < eEnd; ++e) {
       const PetscInt *cone;
       PetscInt        a, b;
 
       PetscCall(DMPlexGetCone(dm, e, &cone));
-      a = vidx[(cone[0] - vStart) * dim];
-      b = vidx[(cone[1] - vStart) * dim];
-      if (a < 0 || b < 0) continue;
-      a /= bs;
-      b /= bs;
+      a = cone[0] - vStart;
+      b = cone[1] - vStart;
+      if (!keep[a] || !keep[b]) continue;
       if (pass) {
-        (*bcol)[(*bptr)[a] + fill[a]++] = b;
-        (*bcol)[(*bptr)[b] + fill[b]++] = a;
+        (*nbr)[(*vptr)[a] + fill[a]++] = b;
+        (*nbr)[(*vptr)[b] + fill[b]++] = a;
       } else {
-        ++(*bptr)[a + 1];
-        ++(*bptr)[b + 1];
+        ++(*vptr)[a + 1];
+        ++(*vptr)[b + 1];
       }
     }
   }
-  for (PetscInt r = 0; r < nb; ++r) PetscCall(PetscSortInt((*bptr)[r + 1] - (*bptr)[r], &(*bcol)[(*bptr)[r]]));
   PetscCall(PetscFree(fill));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The block pattern of K on one rank with a block of bs = dim dofs per vertex: block row r (a free vertex) holds the
+   blocks bcol[bptr[r] .. bptr[r + 1]), sorted: itself and its free neighbours along the edges (two vertices of a
+   simplex mesh share a cell exactly when an edge joins them: VertexNeighbours()). */
+PetscErrorCode AssemblyP1BlockPattern(DM dm, PetscInt bs, PetscInt nb, const PetscInt vidx[], PetscInt **bptr, PetscInt **bcol)
+{
+  PetscInt   dim, vStart, vEnd, *vptr, *nbr;
+  PetscBool *keep;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
+  PetscCall(PetscMalloc1(vEnd - vStart + 1, &keep));
+  for (PetscInt v = vStart; v < vEnd; ++v) {
+    const PetscInt *g = &vidx[(v - vStart) * dim];
+
+    keep[v - vStart] = (PetscBool)(g[0] >= 0); /* fully constrained: no row */
+    if (g[0] < 0) continue;
+    for (PetscInt e = 0; e < dim; ++e)
+      PetscCheck(g[e] == g[0] + e && g[0] % bs == 0 && g[0] / bs < nb, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Vertex %" PetscInt_FMT " is not one block",
+                 v);
+  }
+  PetscCall(VertexNeighbours(dm, keep, &vptr, &nbr));
+  PetscCall(PetscCalloc1(nb + 1, bptr)); /* block row r = a free vertex's first dof / bs: its vertex's neighbours' blocks */
+  for (PetscInt v = 0; v < vEnd - vStart; ++v)
+    if (keep[v]) (*bptr)[vidx[v * dim] / bs + 1] = vptr[v + 1] - vptr[v];
+  for (PetscInt r = 0; r < nb; ++r) (*bptr)[r + 1] += (*bptr)[r];
+  PetscCall(PetscMalloc1((*bptr)[nb], bcol));
+  for (PetscInt v = 0; v < vEnd - vStart; ++v) {
+    const PetscInt r = keep[v] ? vidx[v * dim] / bs : -1;
+
+    for (PetscInt k = 0; r >= 0 && k < vptr[v + 1] - vptr[v]; ++k) (*bcol)[(*bptr)[r] + k] = vidx[nbr[vptr[v] + k] * dim] / bs;
+  }
+  for (PetscInt r = 0; r < nb; ++r) PetscCall(PetscSortInt((*bptr)[r + 1] - (*bptr)[r], &(*bcol)[(*bptr)[r]]));
+  PetscCall(PetscFree(vptr));
+  PetscCall(PetscFree(nbr));
+  PetscCall(PetscFree(keep));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -235,7 +261,7 @@ static void SeqAddScalarBlock(void *ctx, PetscInt va, PetscInt vb, const PetscSc
 static PetscErrorCode AssemblyP1CreateSeqAIJScalar(DM dm, const AppCtx *user, PetscInt nlocal, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
                                                    PetscBool *done)
 {
-  PetscInt     dim, vStart, vEnd, eStart, eEnd, nv, *first, *nfree, *vptr, *nbr, *key, *colofs, *fill, *ci_, *cj;
+  PetscInt     dim, vStart, vEnd, nv, *first, *nfree, *vptr, *nbr, *key, *colofs, *ci_, *cj;
   PetscScalar *ca;
   PetscBool    consecutive = PETSC_TRUE;
 
@@ -243,7 +269,6 @@ static PetscErrorCode AssemblyP1CreateSeqAIJScalar(DM dm, const AppCtx *user, Pe
   *done = PETSC_FALSE;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  PetscCall(DMPlexGetDepthStratum(dm, 1, &eStart, &eEnd));
   nv = vEnd - vStart;
   PetscCall(PetscMalloc2(nv, &first, nv, &nfree));
   for (PetscInt v = 0; v < nv && consecutive; ++v) {
@@ -263,39 +288,15 @@ static PetscErrorCode AssemblyP1CreateSeqAIJScalar(DM dm, const AppCtx *user, Pe
     PetscCall(PetscFree2(first, nfree));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  /* the vertices next to each free vertex, itself included: counted, then filled */
-  PetscCall(PetscCalloc1(nv + 1, &vptr));
-  PetscCall(PetscCalloc1(nv, &fill));
-  for (PetscInt pass = 0; pass < 2; ++pass) {
-    if (pass) {
-      for (PetscInt v = 0; v < nv; ++v) vptr[v + 1] += vptr[v];
-      PetscCall(PetscMalloc3(vptr[nv], &nbr, vptr[nv], &key, vptr[nv], &colofs));
-    }
-    for (PetscInt v = 0; v < nv; ++v) {
-      if (first[v] < 0) continue;
-      if (pass)
-        nbr[vptr[v] + fill[v]++] = v;
-      else
-        ++vptr[v + 1];
-    }
-    for (PetscInt e = eStart; e < eEnd; ++e) {
-      const PetscInt *cone;
-      PetscInt        a, b;
+  { /* the vertices next to each free vertex, itself included */
+    PetscBool *keep;
 
-      PetscCall(DMPlexGetCone(dm, e, &cone));
-      a = cone[0] - vStart;
-      b = cone[1] - vStart;
-      if (first[a] < 0 || first[b] < 0) continue;
-      if (pass) {
-        nbr[vptr[a] + fill[a]++] = b;
-        nbr[vptr[b] + fill[b]++] = a;
-      } else {
-        ++vptr[a + 1];
-        ++vptr[b + 1];
-      }
-    }
+    PetscCall(PetscMalloc1(nv + 1, &keep));
+    for (PetscInt v = 0; v < nv; ++v) keep[v] = (PetscBool)(first[v] >= 0);
+    PetscCall(VertexNeighbours(dm, keep, &vptr, &nbr));
+    PetscCall(PetscFree(keep));
+    PetscCall(PetscMalloc2(vptr[nv] + 1, &key, vptr[nv] + 1, &colofs));
   }
-  PetscCall(PetscFree(fill));
   /* each vertex's neighbours in the order of their columns, and where each one's columns start in the row */
   PetscCall(PetscMalloc1(nlocal + 1, &ci_));
   ci_[0] = 0;
@@ -329,7 +330,8 @@ static PetscErrorCode AssemblyP1CreateSeqAIJScalar(DM dm, const AppCtx *user, Pe
 
     PetscCall(AssemblyP1CellLoop(dm, &user->opt->material, cverts, SeqAddScalarBlock, &add));
   }
-  PetscCall(PetscFree3(nbr, key, colofs));
+  PetscCall(PetscFree2(key, colofs));
+  PetscCall(PetscFree(nbr));
   PetscCall(PetscFree(vptr));
   PetscCall(PetscFree2(first, nfree));
   PetscCall(MatCreateSeqAIJWithArrays(PetscObjectComm((PetscObject)dm), nlocal, nlocal, ci_, cj, ca, K));

@@ -9,11 +9,11 @@
 #include "mesh.h"
 
 struct _n_MeshTransfer {
-  MPI_Comm   comm;
-  PetscInt   dim, nv, ncells; /* rank 0: the old cells, nv vertices each */
-  PetscReal *x;               /*   [ncells][nv][dim] their vertices */
-  PetscReal *u;               /*   [ncells][nv][dim] the field at them */
-  MeshLocator locator;        /*   finds the old cell of a new vertex (mesh_locate.c) */
+  MPI_Comm    comm;
+  PetscInt    dim, nv, ncells; /* rank 0: the old cells, nv vertices each */
+  PetscReal  *x;               /*   [ncells][nv][dim] their vertices */
+  PetscReal  *u;               /*   [ncells][nv][dim] the field at them */
+  MeshLocator locator;         /*   finds the old cell of a new vertex (mesh_locate.c) */
 };
 
 /* The field at x (rank 0): the old field of the cell that holds x best, or outside the old mesh of the cell x is nearest
