@@ -42,6 +42,8 @@ CASES = {
     "bars_mms_np2": (2, ["-scene", "mms", "-dm_plex_box_faces", "16,16", "-bars"], 0),
     "bars_3d_grid_sequence_nodal": (1, ["-dm_plex_dim", 3, "-dm_plex_box_faces", "2,2,2", "-penalty_quadrature", "nodal", "-contact_grid_sequence", 2,
                                         "-bars"], 0),
+    # the 3D box remeshed by Gmsh on rank 0 (its sizes gathered, the old cells' tree carrying the solution to the new mesh)
+    "remesh_3d_slip_np2": (2, ["-dm_plex_dim", 3, "-dm_plex_box_faces", "2,2,2", "-adapt_cycles", 2, "-bc_slip", 4, "-bc_slip_4_components", 0], 0),
     "failed_solve": (1, ["-dm_plex_box_faces", "8,8", "-snes_max_it", 1], 3),
     "bad_input": (1, ["-dm_plex_box_faces", "8,8", "-young_modulus", "nan"], None),
 }
