@@ -10,10 +10,10 @@
 
 struct _n_MeshTransfer {
   MPI_Comm    comm;
-  PetscInt    dim, nv, ncells; /* rank 0: the old cells, nv vertices each */
-  PetscReal  *x;               /*   [ncells][nv][dim] their vertices */
-  PetscReal  *u;               /*   [ncells][nv][dim] the field at them */
-  MeshLocator locator;         /*   finds the old cell of a new vertex (mesh_locate.c) */
+  PetscInt    dim, nv; /* rank 0: the old cells, nv vertices each */
+  PetscReal  *x;       /*   [cells][nv][dim] their vertices */
+  PetscReal  *u;       /*   [cells][nv][dim] the field at them */
+  MeshLocator locator; /*   finds the old cell of a new vertex (mesh_locate.c) */
 };
 
 /* The field at x (rank 0): the old field of the cell that holds x best, or outside the old mesh of the cell x is nearest
@@ -37,12 +37,11 @@ PetscErrorCode MeshTransferCreate(MPI_Comm comm, PetscInt dim, PetscInt ncells, 
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(tr));
-  (*tr)->comm   = comm;
-  (*tr)->dim    = dim;
-  (*tr)->nv     = dim + 1;
-  (*tr)->ncells = ncells;
-  (*tr)->x      = x;
-  (*tr)->u      = u;
+  (*tr)->comm = comm;
+  (*tr)->dim  = dim;
+  (*tr)->nv   = dim + 1;
+  (*tr)->x    = x;
+  (*tr)->u    = u;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   if (rank == 0) PetscCall(MeshLocatorCreate(dim, ncells, x, &(*tr)->locator));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -13,12 +13,9 @@
    true energy-norm error where the scene knows the exact solution, the quantities and their bars, the marked cells,
    the solve and the times.
    With -accuracy on the zone's size, the cells along the zone's edge are marked too while its one-cell band, the floor
-   of the size's bar, is above the tolerance (EstimateMarkContactEdge(); -adapt_mark_edge). Measured (docs/estimate.md,
-   "Marking the zone's edge"): in 2D, where Doerfler's marking refines the large block's far field, the 1% runs stop at
-   42,287 unknowns instead of 78,458 (the indenter) and 19,062 instead of 36,047 (the cylinder), the 3% runs at about
-   the same; in 3D it saves a cycle where the band is the last bar above the tolerance (the sphere at 3%: 766,249
-   unknowns, 312 s and 2.9 GB against 2,009,429, 1,049 s and 7.8 GB) and costs more unknowns a cycle where it does not
-   (the sphere at 10%: 70,644 against 58,233; the sphere indenter at 3%: 1,387,913 against 1,318,894). */
+   of the size's bar, is above the tolerance (EstimateMarkContactEdge(); -adapt_mark_edge): Doerfler's marking on the
+   energy-norm indicators refines the band only where the energy's error is, and the size's bar cannot fall below it.
+   What it saves and costs in 2D and 3D is measured in docs/estimate.md, "Marking the zone's edge". */
 #include "contact.h"
 #include "estimate.h"
 #include "mesh.h"
