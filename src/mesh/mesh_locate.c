@@ -1,9 +1,10 @@
 /* The cell of a simplex mesh that holds a point (mesh_transfer.c: the old solution at the new vertices of a remeshed
-   mesh). The cells are given by their vertices alone, as gathered on rank 0. A tree of the cells' bounding boxes (a bounding volume hierarchy: each
-   node the box of its cells, halved at the median centroid along its longest side, down to a few cells a leaf) follows the mesh's grading, where a
-   uniform grid of buckets crowded the contact zone's cells, a hundred times smaller than the mean, by thousands a bucket. Outside the mesh (a point
-   of a curved boundary, beyond the old mesh's chords by their sagitta), the cell the point is nearest to leaving, among those whose boxes come
-   nearest. */
+   mesh). The cells are given by their vertices alone, as gathered on rank 0. A tree of the cells' bounding boxes (a
+   bounding volume hierarchy: each node the box of its cells, halved at the median centroid along its longest side,
+   down to a few cells a leaf) follows the mesh's grading, where a uniform grid of buckets crowded the contact zone's
+   cells, a hundred times smaller than the mean, by thousands a bucket. Outside the mesh (a point of a curved boundary,
+   beyond the old mesh's chords by their sagitta), the cell the point is nearest to leaving, among those whose boxes
+   come nearest. */
 #include "mesh.h"
 
 struct _n_MeshLocator {
