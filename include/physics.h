@@ -28,6 +28,8 @@ void           PostprocessGetQuantities(const AppCtx *user, Quantities *q);
 PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size, PetscReal *band);
 PetscErrorCode PostprocessPressureStep(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal *step);
 PetscErrorCode PostprocessContactEdgeFaces(DM dm, AppCtx *user, Vec u, PetscInt *n, PetscInt **faces);
+/* pressure_peak.c */
+PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal step, PetscReal *peak, PetscReal *se);
 
 /* contact_checks.c */
 PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user);

@@ -281,6 +281,8 @@ typedef struct {
   PetscReal contact_size_band;         /* the measure of the one-cell strip along the zone's edge: the size's resolution */
   PetscReal pressure_max_step;         /* the largest change of the nodal pressure from the largest's node to a neighbour on
                                           Gamma_C: the largest pressure's resolution */
+  PetscReal pressure_peak;             /* the largest pressure recovered by a local quadratic fit (src/physics/pressure_peak.c) */
+  PetscReal pressure_peak_stderr;      /*   and the fit's standard error there: its resolution */
   PetscReal penetration_max;           /* the largest penetration */
   PetscReal energy;                    /* 1/2 a(u,u) - L(u) + the contact term's energy */
   PetscReal reaction[BOUNDARY_MAX][3]; /* the force of each clamp or slip face set's support on the body */
@@ -318,6 +320,8 @@ typedef struct {
   PetscReal           contact_size;              /* the contact zone's width (2D) or area (3D), PostprocessContactSize() */
   PetscReal           contact_size_band;         /*   and the one-cell strip along its edge (its resolution on the mesh) */
   PetscReal           pressure_max_step;         /* the largest pressure's change to its node's neighbours on Gamma_C */
+  PetscReal           pressure_peak;             /* the largest pressure recovered from the nodes around it (pressure_peak.c) */
+  PetscReal           pressure_peak_stderr;      /*   and the fit's standard error */
   PetscReal           contact_force_vector[3];   /* the obstacle's force on the body: the sum of R = K u + r0 over the contact nodes */
   PetscReal           reaction[BOUNDARY_MAX][3]; /* force the support of each clamp or slip face set exerts on the body */
   MeshPartitionStats  partition;                 /* from MeshPartitionGetStats() */
@@ -361,7 +365,7 @@ typedef struct {
 
 /* Adaptive refinement (-adapt_cycles, src/solver/adapt.c): the cycles of estimate, mark, refine and solve after the
    first solve, and the fraction of the estimate's square the marked cells hold (Doerfler's theta). */
-typedef enum { ACCURACY_ENERGY, ACCURACY_FORCE, ACCURACY_PRESSURE, ACCURACY_SIZE, ACCURACY_NUM } AccuracyQuantity;
+typedef enum { ACCURACY_ENERGY, ACCURACY_FORCE, ACCURACY_PRESSURE, ACCURACY_SIZE, ACCURACY_PEAK, ACCURACY_NUM } AccuracyQuantity;
 extern const char *const AccuracyQuantities[];
 typedef struct {
   PetscInt  cycles;                    /* 0: no adaptive refinement; with -accuracy, the most cycles */

@@ -26,6 +26,26 @@ def contact_vertices(h5):
     return x[on]
 
 
+def recovered_peak(h5, k):
+    """src/physics/pressure_peak.c's fit, computed again from the last mesh's fields: the quadratic in the tangent
+    coordinates (x, and y in 3D: the flat foundation's normal is the last axis) fitted by least squares to the pressures
+    of the k nodes in contact nearest the largest's, its value there and its standard error."""
+    with h5py.File(h5, "r") as f:
+        x = f["geometry/vertices"][:]
+        p = f["vertex_fields/contact_pressure"][:].ravel()
+    dim = x.shape[1]
+    on = np.flatnonzero(p > 0)
+    top = on[np.argmax(p[on])]
+    near = on[np.argsort(np.linalg.norm(x[on] - x[top], axis=1), kind="stable")[:k]]
+    s = x[near, : dim - 1] - x[top, : dim - 1]
+    cols = [np.ones(k), s[:, 0], s[:, 0] ** 2] if dim == 2 else [np.ones(k), s[:, 0], s[:, 1], s[:, 0] ** 2, s[:, 0] * s[:, 1], s[:, 1] ** 2]
+    design = np.column_stack(cols)
+    c, *_ = np.linalg.lstsq(design, p[near], rcond=None)
+    r = p[near] - design @ c
+    se = np.sqrt(r @ r / (k - design.shape[1]) * np.linalg.inv(design.T @ design)[0, 0])
+    return c[0], se
+
+
 def uniform_with_model(tmp_path_factory, shape, name, h):
     """A make_mesh shape of radius 1 meshed uniformly at h, and its model: (mesh, model)."""
     d = tmp_path_factory.mktemp(f"remesh_{name}")
@@ -92,8 +112,11 @@ def test_remeshing_on_two_ranks_gives_the_one_rank_cycles(disk):
     _, h2 = run(args, "remesh_np2", np_=2)
     c1, c2 = cycles(h1), cycles(h2)
     assert np.array_equal(c1["n_dofs"], c2["n_dofs"]) and np.array_equal(c1["n_cells"], c2["n_cells"]), (c1["n_dofs"], c2["n_dofs"])
-    for q in ("contact_force_y", "estimate"):
+    for q in ("contact_force_y", "estimate", "pressure_peak"):
         assert np.allclose(c1[q], c2[q], rtol=1e-6, atol=0), (q, c1[q], c2[q])
+    peak, se = recovered_peak(h1, 5)
+    a = load(h1)[0]
+    assert abs(a["pressure_peak"] / peak - 1) < 1e-10 and abs(a["pressure_peak_stderr"] / se - 1) < 1e-8, (a["pressure_peak"], peak, se)
 
 
 def test_the_hertz_sphere_remeshes_in_3d(sphere):
@@ -125,6 +148,30 @@ def test_3d_accuracy_on_contact_quantities_marks_a_smaller_fraction(sphere):
     assert load(h_energy)[0]["adapt_fraction"] == 0.5
     g_def, g_half = (np.exp(np.diff(np.log(cycles(h)["n_dofs"]))[-2:]) for h in (h_def, h_half))
     assert g_def.max() <= 2.5 and g_half.min() >= 2.6, (g_def, g_half)
+
+
+def test_the_recovered_peak_pressure_reaches_a_tolerance_the_nodal_maximum_scatters_across(sphere):
+    """On tetrahedra the nodal pressures scatter about the Hertz profile by a few percent, and the largest of them picks
+    the scatter's top (src/physics/pressure_peak.c). -accuracy 0.1 on the sphere, asking for the recovered peak
+    (pressure_peak: the quadratic fitted to the 20 nodes in contact nearest the largest's): it stops within the
+    tolerance with the peak within its bar of the closed form at the run's force and within 1% of it; over the last
+    three cycles the peak stays within 1% of the closed form while the nodal maximum is at least twice as far (measured
+    -0.5%, +0.5%, +0.01% against +5.5%, +3.0%, +2.1%); the bar is at least the fit's standard error; and the peak is the
+    fit numpy makes of the last mesh's fields."""
+    mesh, model = sphere
+    args = case_args("sphere", mesh) + hertz.GAMG_3D + ["-adapt_model", model, "-accuracy", 0.1, "-accuracy_quantity",
+                                                         "contact_force,pressure_peak,contact_size"]
+    _, h5 = run(args, "remesh_sphere_peak")
+    a, c = load(h5)[0], cycles(h5)
+    assert a["accuracy_reached"] == 1 and a["converged"] == 1
+    p0 = np.array([hertz.closed_form(3, 4 * abs(f))[1] for f in c["contact_force_z"]])
+    err_peak, err_nodal = c["pressure_peak"] / p0 - 1, c["pressure_max"] / p0 - 1
+    assert abs(err_peak[-1]) * p0[-1] <= a["accuracy_pressure_peak_bar"], (err_peak[-1], a["accuracy_pressure_peak_bar"] / p0[-1])
+    assert np.all(np.abs(err_peak[-3:]) <= 0.01) and np.all(np.abs(err_nodal[-3:]) >= 2 * np.abs(err_peak[-3:])), (err_peak, err_nodal)
+    has_bar = np.isfinite(c["pressure_peak_bar"])
+    assert has_bar.sum() >= 2 and np.all(c["pressure_peak_bar"][has_bar] >= c["pressure_peak_stderr"][has_bar])
+    peak, se = recovered_peak(h5, 20)
+    assert abs(a["pressure_peak"] / peak - 1) < 1e-10 and abs(a["pressure_peak_stderr"] / se - 1) < 1e-8, (a["pressure_peak"], peak, se)
 
 
 def test_a_gamg_breakdown_on_a_carried_solution_is_recovered_without_a_direct_solve(sphere):
@@ -211,7 +258,8 @@ def test_marking_the_zone_edge_in_3d_on_two_ranks_gives_the_one_rank_cycles():
     assert c1["marked_edge"][:-1].min() > 0, c1["marked_edge"]
     for k in ("n_dofs", "n_cells", "marked", "marked_edge"):
         assert np.array_equal(c1[k], c2[k]), (k, c1[k], c2[k])
-    assert np.allclose(c1["contact_size"], c2["contact_size"], rtol=1e-6, atol=0), (c1["contact_size"], c2["contact_size"])
+    for q in ("contact_size", "pressure_peak"):
+        assert np.allclose(c1[q], c2[q], rtol=1e-6, atol=0), (q, c1[q], c2[q])
 
 
 def test_a_model_that_is_not_the_meshs_is_refused(disk, tmp_path):

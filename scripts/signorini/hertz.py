@@ -181,14 +181,18 @@ def quantity_exact(case, force, radius=RADIUS):
     return {"pressure_max": p0, "contact_size": a if c["dim"] == 2 else math.pi * a * a / 4}
 
 
-def quantity_errors(case, attrs, force_ref, radius=RADIUS):
-    """Relative errors of a run's -accuracy quantities (its /run attributes): the largest pressure and the size against
-    the closed form at the run's force (quantity_exact()), and the force against force_ref."""
+def quantity_errors(case, attrs, force_ref, radius=RADIUS, quantities=("contact_force", "pressure_max", "contact_size")):
+    """Relative errors of a run's -accuracy quantities (its /run attributes), in the order of quantities: the largest
+    pressure (pressure_max, nodal, or pressure_peak, recovered) and the size against the closed form at the run's force
+    (quantity_exact()), and the force against force_ref."""
     axis = "xyz"[CASES[case]["dim"] - 1]
     force = abs(float(attrs[f"contact_force_{axis}"]))
     exact = quantity_exact(case, force, radius)
-    return {"contact_force": force / force_ref - 1, "pressure_max": float(attrs["pressure_max"]) / exact["pressure_max"] - 1,
-            "contact_size": float(attrs["contact_size"]) / exact["contact_size"] - 1}
+    errors = {"contact_force": force / force_ref - 1, "contact_size": float(attrs["contact_size"]) / exact["contact_size"] - 1}
+    for q in ("pressure_max", "pressure_peak"):  # the nodal maximum and the recovered peak (src/physics/pressure_peak.c)
+        if q in quantities:
+            errors[q] = float(attrs[q]) / exact["pressure_max"] - 1
+    return {q: errors[q] for q in quantities}
 
 
 def fit_profile(radius_sq, traction, a_h, inner=0.8):

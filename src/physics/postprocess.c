@@ -80,6 +80,7 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   }
   PetscCall(PostprocessContactSize(dm, user, u, &st->contact_size, &st->contact_size_band));
   PetscCall(PostprocessPressureStep(dm, user, st->pressure_max, &st->pressure_max_step));
+  PetscCall(PostprocessPressurePeak(dm, user, st->pressure_max, st->pressure_max_step, &st->pressure_peak, &st->pressure_peak_stderr));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -89,12 +90,14 @@ void PostprocessGetQuantities(const AppCtx *user, Quantities *q)
   const RunStats *st = &user->rec.stats;
 
   for (PetscInt c = 0; c < 3; ++c) q->force[c] = st->contact_force_vector[c];
-  q->pressure_max      = st->pressure_max;
-  q->contact_size      = st->contact_size;
-  q->contact_size_band = st->contact_size_band;
-  q->pressure_max_step = st->pressure_max_step;
-  q->penetration_max   = st->max_penetration;
-  q->energy            = st->energy;
+  q->pressure_max         = st->pressure_max;
+  q->contact_size         = st->contact_size;
+  q->contact_size_band    = st->contact_size_band;
+  q->pressure_max_step    = st->pressure_max_step;
+  q->pressure_peak        = st->pressure_peak;
+  q->pressure_peak_stderr = st->pressure_peak_stderr;
+  q->penetration_max      = st->max_penetration;
+  q->energy               = st->energy;
   for (PetscInt i = 0; i < BOUNDARY_MAX; ++i)
     for (PetscInt c = 0; c < 3; ++c) q->reaction[i][c] = st->reaction[i][c];
 }

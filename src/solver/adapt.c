@@ -32,6 +32,7 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
   PetscBool cycles_given, quantities_given, fraction_given;
 
   PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < ACCURACY_NUM; ++k) quantities[k] = (PetscEnum)k; /* what -help shows */
   ad->cycles          = 0;
   ad->fraction        = 0.0; /* AdaptFraction()'s default */
   ad->accuracy        = 0.0;
@@ -48,9 +49,11 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
                              NULL, ad->fraction, &ad->fraction, &fraction_given));
   PetscCall(PetscOptionsReal("-accuracy", "Refine adaptively until the error bars of the quantities are below this fraction of their values", NULL,
                              ad->accuracy, &ad->accuracy, NULL));
-  PetscCall(PetscOptionsEnumArray("-accuracy_quantity",
-                                  "The quantities -accuracy asks for (energy: the energy-norm estimate against the solution's energy norm)", NULL,
-                                  AccuracyQuantities, quantities, &nq, &quantities_given));
+  PetscCall(PetscOptionsEnumArray(
+      "-accuracy_quantity",
+      "The quantities -accuracy asks for (energy: the energy-norm estimate against the solution's energy norm; pressure_peak: the "
+      "largest pressure recovered from the nodes around it; default: all but pressure_peak)",
+      NULL, AccuracyQuantities, quantities, &nq, &quantities_given));
   PetscCall(PetscOptionsReal("-accuracy_newton_fraction",
                              "Each cycle's Newton stops once its step's energy norm is below this fraction of the error estimate expected on the "
                              "cycle's mesh (0: at -snes_rtol)",
@@ -80,8 +83,8 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
              "-accuracy_newton_fraction is a fraction of the error estimate in [0, 1), got %g", (double)ad->newton_fraction);
   PetscCheck(!quantities_given || ad->accuracy > 0.0, comm, PETSC_ERR_USER_INPUT, "-accuracy_quantity needs -accuracy TOL");
   PetscCheck(!quantities_given || nq > 0, comm, PETSC_ERR_USER_INPUT,
-             "-accuracy_quantity needs at least one of energy, contact_force, pressure_max, contact_size");
-  for (PetscInt k = 0; k < ACCURACY_NUM; ++k) ad->target[k] = (PetscBool)!quantities_given;
+             "-accuracy_quantity needs at least one of energy, contact_force, pressure_max, contact_size, pressure_peak");
+  for (PetscInt k = 0; k < ACCURACY_NUM; ++k) ad->target[k] = (PetscBool)(!quantities_given && k != ACCURACY_PEAK); /* the nodal maximum's */
   for (PetscInt k = 0; k < nq && quantities_given; ++k) ad->target[quantities[k]] = PETSC_TRUE;
   if (ad->accuracy > 0.0) {
     PetscCheck(!cycles_given || ad->cycles > 0, comm, PETSC_ERR_USER_INPUT, "-accuracy refines adaptively: -adapt_cycles 0 leaves it no cycle");
@@ -189,7 +192,8 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
   Quantities          q;
 
   PetscFunctionBeginUser;
-  if (!(ad->accuracy > 0.0) || !(ad->target[ACCURACY_FORCE] || ad->target[ACCURACY_PRESSURE] || ad->target[ACCURACY_SIZE]) ||
+  if (!(ad->accuracy > 0.0) ||
+      !(ad->target[ACCURACY_FORCE] || ad->target[ACCURACY_PRESSURE] || ad->target[ACCURACY_SIZE] || ad->target[ACCURACY_PEAK]) ||
       !ContactHasPenalty(user->contact) || !c->converged)
     PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
@@ -207,6 +211,7 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
     c->value_eps[ACCURACY_FORCE]    = PetscSqrtReal(f);
     c->value_eps[ACCURACY_PRESSURE] = q.pressure_max;
     c->value_eps[ACCURACY_SIZE]     = q.contact_size;
+    c->value_eps[ACCURACY_PEAK]     = q.pressure_peak;
     PetscCall(VecDestroy(&u_new));
   }
   PetscCall(VecDestroy(&dir));

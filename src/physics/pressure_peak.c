@@ -1,0 +1,247 @@
+/* The largest contact pressure recovered from the nodal pressures around it: pressure_peak.
+
+   The nodal pressure (the node's reaction over its lumped area, ContactPostProcess()) scatters from node to node on an
+   irregular triangulation of Gamma_C by more than its error at the profile's top. On tetrahedra the scatter is the
+   P1 traction's: with one eps over Gamma_C it falls with h (the quarter sphere of make hertz, one eps at h_near / 100:
+   a standard deviation about the Hertz profile of 2.8%, 1.6% and 1.0% at h_near = 0.01, 0.005 and 0.0025, within
+   r < a/2), but not with the number of unknowns that the marking puts at the zone's edge, and the largest nodal value
+   picks the scatter's upper tail (+1.1% to +2.1% over those meshes and the 10% stop of -accuracy on the sphere). A local
+   eps that follows each cell's diameter adds its own jumps (+8.3% at h_near = 0.005, MeshSetContactCellSizes()).
+
+   The peak averages the scatter out as superconvergent patch recovery does for stresses (Zienkiewicz and Zhu): the
+   quadratic polynomial in the tangent plane of Gamma_C at the largest nodal pressure's node that fits, by least
+   squares, the pressures of the PEAK_NODES nearest nodes in contact (about two rings of a triangulated surface, one
+   side of the top in 2D), evaluated at that node. The fit's own standard error at the node,
+     se^2 = s^2 (D^T D)^{-1}_00,  s^2 = |p - D c|^2 / (K - m),
+   (D the K x m design matrix of the monomials, c the coefficients) says how well the scatter is averaged; it is the
+   floor of the peak's -accuracy bar, as the nodal step is the largest pressure's (src/estimate/cycle_bars.c).
+   The patch's radius is a few cells, so that the fit's truncation (the profile's quartic term: (rho / a)^4 / 8 of a
+   Hertz peak at rho = a / 4, 0.05%) stays below its scatter where the zone spans tens of cells; with fewer nodes in
+   contact than twice the monomials the peak is the nodal maximum and its floor the nodal step.
+
+   Every rank gathers the nodes in contact (their position, normal and pressure: the zone is a small part of Gamma_C)
+   and computes the same fit: the top and the patch are chosen by the pressures and positions alone, ties broken by the
+   coordinates, and the fit sums its nodes in the order of their distance, so that the peak does not depend on the
+   partition beyond the pressures' own solver tolerance. */
+#include "physics.h"
+
+#define PEAK_NODES_2D 5  /* the top and two nodes on each side */
+#define PEAK_NODES_3D 20 /* the top and about two rings of triangles around it */
+#define PEAK_STRIDE 7    /* x[3], normal[3], p of each gathered node */
+
+typedef struct {
+  PetscReal dist;
+  PetscInt  i;
+} PeakNode;
+
+static const PetscReal *peak_rows; /* the gathered rows, for the ordering below */
+
+/* By the distance to the top, ties by the coordinates: the same order whatever order the ranks gathered the nodes in. */
+static int ComparePeakNodes(const void *a, const void *b)
+{
+  const PeakNode *x = (const PeakNode *)a, *y = (const PeakNode *)b;
+
+  if (x->dist != y->dist) return x->dist < y->dist ? -1 : 1;
+  for (PetscInt d = 0; d < 3; ++d) {
+    const PetscReal u = peak_rows[x->i * PEAK_STRIDE + d], v = peak_rows[y->i * PEAK_STRIDE + d];
+
+    if (u != v) return u < v ? -1 : 1;
+  }
+  return 0;
+}
+
+/* The nodes of this rank's contact set that carry a pressure, PEAK_STRIDE reals each, gathered on every rank. */
+static PetscErrorCode GatherContactNodes(DM dm, const ContactSet *cs, PetscInt dim, PetscInt *n, PetscReal **rows)
+{
+  MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
+  PetscMPIInt        size, nlocal = 0, *counts, *displs;
+  PetscReal         *mine;
+  PetscSection       csec;
+  Vec                coords;
+  const PetscScalar *xc;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(DMGetCoordinateSection(dm, &csec));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(VecGetArrayRead(coords, &xc));
+  PetscCall(PetscMalloc1(cs->n * PEAK_STRIDE + 1, &mine));
+  for (PetscInt i = 0; i < cs->n; ++i) {
+    PetscInt   off;
+    PetscReal *row = &mine[nlocal * PEAK_STRIDE];
+
+    if (!cs->is_vertex[i] || !(cs->pressure[i] > 0.0)) continue;
+    PetscCall(PetscSectionGetOffset(csec, cs->point[i], &off));
+    for (PetscInt d = 0; d < 3; ++d) {
+      row[d]     = d < dim ? PetscRealPart(xc[off + d]) : 0.0;
+      row[3 + d] = d < dim ? cs->normal[i * dim + d] : 0.0;
+    }
+    row[6] = cs->pressure[i];
+    ++nlocal;
+  }
+  PetscCall(VecRestoreArrayRead(coords, &xc));
+  PetscCall(PetscMalloc2(size, &counts, size + 1, &displs));
+  nlocal *= PEAK_STRIDE;
+  PetscCallMPI(MPI_Allgather(&nlocal, 1, MPI_INT, counts, 1, MPI_INT, comm));
+  displs[0] = 0;
+  for (PetscMPIInt r = 0; r < size; ++r) displs[r + 1] = displs[r] + counts[r];
+  PetscCall(PetscMalloc1(displs[size] + 1, rows));
+  PetscCallMPI(MPI_Allgatherv(mine, nlocal, MPIU_REAL, *rows, counts, displs, MPIU_REAL, comm));
+  *n = displs[size] / PEAK_STRIDE;
+  PetscCall(PetscFree2(counts, displs));
+  PetscCall(PetscFree(mine));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Two unit vectors orthogonal to n and each other (3D), or one (2D): the tangent plane's coordinates. */
+static void TangentBasis(PetscInt dim, const PetscReal n[], PetscReal t[2][3])
+{
+  if (dim == 2) {
+    t[0][0] = -n[1];
+    t[0][1] = n[0];
+    t[0][2] = 0.0;
+    return;
+  }
+  {
+    PetscInt  k    = 0; /* the axis least along n */
+    PetscReal e[3] = {0.0, 0.0, 0.0}, en, len = 0.0;
+
+    for (PetscInt d = 1; d < 3; ++d)
+      if (PetscAbsReal(n[d]) < PetscAbsReal(n[k])) k = d;
+    e[k] = 1.0;
+    en   = n[k];
+    for (PetscInt d = 0; d < 3; ++d) {
+      t[0][d] = e[d] - en * n[d];
+      len += PetscSqr(t[0][d]);
+    }
+    for (PetscInt d = 0; d < 3; ++d) t[0][d] /= PetscSqrtReal(len);
+    t[1][0] = n[1] * t[0][2] - n[2] * t[0][1];
+    t[1][1] = n[2] * t[0][0] - n[0] * t[0][2];
+    t[1][2] = n[0] * t[0][1] - n[1] * t[0][0];
+  }
+}
+
+/* Least squares by modified Gram-Schmidt: A (k x m, row-major) = Q R, overwritten by Q; c = R^{-1} Q^T b; *se the
+   standard error of c[0]. PETSC_FALSE where a column depends on the others (a patch on one line in 3D). */
+static PetscBool LeastSquares(PetscInt k, PetscInt m, PetscReal A[], const PetscReal b[], PetscReal c[], PetscReal *se)
+{
+  PetscReal R[6][6] = {{0.0}}, Ri[6][6] = {{0.0}}, qb[6], rss = 0.0, row0 = 0.0;
+
+  for (PetscInt j = 0; j < m; ++j) {
+    PetscReal norm = 0.0, norm0 = 0.0;
+
+    for (PetscInt i = 0; i < k; ++i) norm0 += PetscSqr(A[i * m + j]);
+    for (PetscInt l = 0; l < j; ++l) {
+      PetscReal dot = 0.0;
+
+      for (PetscInt i = 0; i < k; ++i) dot += A[i * m + l] * A[i * m + j];
+      R[l][j] = dot;
+      for (PetscInt i = 0; i < k; ++i) A[i * m + j] -= dot * A[i * m + l];
+    }
+    for (PetscInt i = 0; i < k; ++i) norm += PetscSqr(A[i * m + j]);
+    if (!(norm > 1e-16 * norm0) || !(norm0 > 0.0)) return PETSC_FALSE;
+    R[j][j] = PetscSqrtReal(norm);
+    for (PetscInt i = 0; i < k; ++i) A[i * m + j] /= R[j][j];
+  }
+  for (PetscInt j = 0; j < m; ++j) {
+    qb[j] = 0.0;
+    for (PetscInt i = 0; i < k; ++i) qb[j] += A[i * m + j] * b[i];
+  }
+  for (PetscInt j = m - 1; j >= 0; --j) { /* R c = Q^T b */
+    c[j] = qb[j];
+    for (PetscInt l = j + 1; l < m; ++l) c[j] -= R[j][l] * c[l];
+    c[j] /= R[j][j];
+  }
+  for (PetscInt i = 0; i < k; ++i) { /* the residual is b less its projection on Q's columns */
+    PetscReal r = b[i];
+
+    for (PetscInt j = 0; j < m; ++j) r -= A[i * m + j] * qb[j];
+    rss += PetscSqr(r);
+  }
+  for (PetscInt j = m - 1; j >= 0; --j) { /* R^{-1}, upper triangular */
+    Ri[j][j] = 1.0 / R[j][j];
+    for (PetscInt l = j + 1; l < m; ++l) {
+      PetscReal sum = 0.0;
+
+      for (PetscInt q = j + 1; q <= l; ++q) sum += R[j][q] * Ri[q][l];
+      Ri[j][l] = -sum / R[j][j];
+    }
+  }
+  for (PetscInt l = 0; l < m; ++l) row0 += PetscSqr(Ri[0][l]); /* (D^T D)^{-1}_00 = |row 0 of R^{-1}|^2 */
+  *se = PetscSqrtReal(rss / (k - m) * row0);
+  return PETSC_TRUE;
+}
+
+/* The peak and its standard error (the head of the file), on every rank; pressure_max and step, the nodal maximum and
+   its step (PostprocessPressureStep()), where there is too little contact to fit. */
+PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal step, PetscReal *peak, PetscReal *se)
+{
+  const ContactSet *cs;
+  PetscInt          dim, n = 0, top    = 0, m, k;
+  PetscReal        *rows, t[2][3], rho = 0.0, A[PEAK_NODES_3D * 6], b[PEAK_NODES_3D], c[6];
+  PeakNode         *order;
+
+  PetscFunctionBeginUser;
+  *peak = pressure_max;
+  *se   = step;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(GatherContactNodes(dm, cs, dim, &n, &rows));
+  m = dim == 2 ? 3 : 6;
+  k = dim == 2 ? PEAK_NODES_2D : PEAK_NODES_3D;
+  if (n < 2 * m) {
+    PetscCall(PetscFree(rows));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  k = PetscMin(k, n);
+  for (PetscInt i = 1; i < n; ++i) { /* the largest nodal pressure; ties by the coordinates */
+    const PetscReal *ri = &rows[i * PEAK_STRIDE], *rt = &rows[top * PEAK_STRIDE];
+    PetscBool        larger = (PetscBool)(ri[6] > rt[6]);
+
+    for (PetscInt d = 0; d < 3 && ri[6] == rt[6] && !larger; ++d) {
+      if (ri[d] != rt[d]) {
+        larger = (PetscBool)(ri[d] < rt[d]);
+        break;
+      }
+    }
+    if (larger) top = i;
+  }
+  PetscCall(PetscMalloc1(n, &order));
+  for (PetscInt i = 0; i < n; ++i) {
+    PetscReal d2 = 0.0;
+
+    for (PetscInt d = 0; d < 3; ++d) d2 += PetscSqr(rows[i * PEAK_STRIDE + d] - rows[top * PEAK_STRIDE + d]);
+    order[i].dist = PetscSqrtReal(d2);
+    order[i].i    = i;
+  }
+  peak_rows = rows;
+  qsort(order, n, sizeof(*order), ComparePeakNodes);
+  peak_rows = NULL;
+  TangentBasis(dim, &rows[top * PEAK_STRIDE + 3], t);
+  rho = order[k - 1].dist;
+  for (PetscInt j = 0; j < k; ++j) { /* the monomials of the tangent coordinates over rho */
+    const PetscReal *r    = &rows[order[j].i * PEAK_STRIDE];
+    PetscReal        s[2] = {0.0, 0.0};
+
+    for (PetscInt a = 0; a < dim - 1; ++a)
+      for (PetscInt d = 0; d < 3; ++d) s[a] += (r[d] - rows[top * PEAK_STRIDE + d]) * t[a][d] / rho;
+    A[j * m + 0] = 1.0;
+    A[j * m + 1] = s[0];
+    if (dim == 2)
+      A[j * m + 2] = s[0] * s[0];
+    else {
+      A[j * m + 2] = s[1];
+      A[j * m + 3] = s[0] * s[0];
+      A[j * m + 4] = s[0] * s[1];
+      A[j * m + 5] = s[1] * s[1];
+    }
+    b[j] = r[6];
+  }
+  if (LeastSquares(k, m, A, b, c, se))
+    *peak = c[0];
+  else
+    *se = step;
+  PetscCall(PetscFree(order));
+  PetscCall(PetscFree(rows));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
