@@ -30,11 +30,10 @@
 #define PEAK_STRIDE 7    /* x[3], normal[3], p of each gathered node */
 
 typedef struct {
-  PetscReal dist;
-  PetscInt  i;
+  PetscReal dist; /* to the top */
+  PetscReal x[3];
+  PetscInt  i; /* its row */
 } PeakNode;
-
-static const PetscReal *peak_rows; /* the gathered rows, for the ordering below */
 
 /* By the distance to the top, ties by the coordinates: the same order whatever order the ranks gathered the nodes in. */
 static int ComparePeakNodes(const void *a, const void *b)
@@ -42,11 +41,8 @@ static int ComparePeakNodes(const void *a, const void *b)
   const PeakNode *x = (const PeakNode *)a, *y = (const PeakNode *)b;
 
   if (x->dist != y->dist) return x->dist < y->dist ? -1 : 1;
-  for (PetscInt d = 0; d < 3; ++d) {
-    const PetscReal u = peak_rows[x->i * PEAK_STRIDE + d], v = peak_rows[y->i * PEAK_STRIDE + d];
-
-    if (u != v) return u < v ? -1 : 1;
-  }
+  for (PetscInt d = 0; d < 3; ++d)
+    if (x->x[d] != y->x[d]) return x->x[d] < y->x[d] ? -1 : 1;
   return 0;
 }
 
@@ -210,13 +206,14 @@ PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_m
   for (PetscInt i = 0; i < n; ++i) {
     PetscReal d2 = 0.0;
 
-    for (PetscInt d = 0; d < 3; ++d) d2 += PetscSqr(rows[i * PEAK_STRIDE + d] - rows[top * PEAK_STRIDE + d]);
+    for (PetscInt d = 0; d < 3; ++d) {
+      order[i].x[d] = rows[i * PEAK_STRIDE + d];
+      d2 += PetscSqr(rows[i * PEAK_STRIDE + d] - rows[top * PEAK_STRIDE + d]);
+    }
     order[i].dist = PetscSqrtReal(d2);
     order[i].i    = i;
   }
-  peak_rows = rows;
   qsort(order, n, sizeof(*order), ComparePeakNodes);
-  peak_rows = NULL;
   TangentBasis(dim, &rows[top * PEAK_STRIDE + 3], t);
   rho = order[k - 1].dist;
   for (PetscInt j = 0; j < k; ++j) { /* the monomials of the tangent coordinates over rho */
