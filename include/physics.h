@@ -29,7 +29,7 @@ PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *siz
 PetscErrorCode PostprocessPressureStep(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal *step);
 PetscErrorCode PostprocessContactEdgeFaces(DM dm, AppCtx *user, Vec u, PetscInt *n, PetscInt **faces);
 /* pressure_peak.c */
-PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal step, PetscReal *peak, PetscReal *se);
+PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal step, PetscReal *peak, PetscReal *resolution);
 
 /* contact_checks.c */
 PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user);

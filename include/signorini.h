@@ -282,7 +282,7 @@ typedef struct {
   PetscReal pressure_max_step;         /* the largest change of the nodal pressure from the largest's node to a neighbour on
                                           Gamma_C: the largest pressure's resolution */
   PetscReal pressure_peak;             /* the largest pressure recovered by a local quadratic fit (src/physics/pressure_peak.c) */
-  PetscReal pressure_peak_stderr;      /*   and the fit's standard error there: its resolution */
+  PetscReal pressure_peak_resolution;  /*   and its resolution: the fit's standard error or its step to the top's neighbours */
   PetscReal penetration_max;           /* the largest penetration */
   PetscReal energy;                    /* 1/2 a(u,u) - L(u) + the contact term's energy */
   PetscReal reaction[BOUNDARY_MAX][3]; /* the force of each clamp or slip face set's support on the body */
@@ -321,7 +321,7 @@ typedef struct {
   PetscReal           contact_size_band;         /*   and the one-cell strip along its edge (its resolution on the mesh) */
   PetscReal           pressure_max_step;         /* the largest pressure's change to its node's neighbours on Gamma_C */
   PetscReal           pressure_peak;             /* the largest pressure recovered from the nodes around it (pressure_peak.c) */
-  PetscReal           pressure_peak_stderr;      /*   and the fit's standard error */
+  PetscReal           pressure_peak_resolution;  /*   and its resolution (the fit's standard error or step) */
   PetscReal           contact_force_vector[3];   /* the obstacle's force on the body: the sum of R = K u + r0 over the contact nodes */
   PetscReal           reaction[BOUNDARY_MAX][3]; /* force the support of each clamp or slip face set exerts on the body */
   MeshPartitionStats  partition;                 /* from MeshPartitionGetStats() */

@@ -70,8 +70,9 @@
    indenter's stops), and on tetrahedra it is the nodal tractions' scatter (3.6% at the sphere's 10% stop, 2.5% at the
    sphere indenter's 3%), which the stops of the spheres' 10% runs do not see.
    The recovered peak (pressure_peak, src/physics/pressure_peak.c) has the largest pressure's bar, the index and the
-   penalty part, with the fit's standard error at the node as its floor instead of the step: the fit averages the
-   scatter that the step measures. On the sphere's 3% run it stops at 143,995 unknowns with the peak +0.03% from the
+   penalty part, with the fit's resolution as its floor instead of the nodal step (the fit's standard error at the
+   node, or its own step to the top's neighbours where that is larger): the fit averages the scatter that the nodal
+   step measures. On the sphere's 3% run it stops at 143,995 unknowns with the peak +0.03% from the
    closed form within its bar 1.8%, where the nodal maximum's floor held the stop to 507,252 (docs/estimate.md).
    The energy's bar is the error estimate itself, against the solution's energy norm (src/estimate/estimate.c). */
 #include "estimate.h"
@@ -181,6 +182,6 @@ PetscErrorCode CycleBarsCompute(AppCtx *user, PetscInt dim, PetscInt last)
   }
   if (!PetscIsNanReal(c->bar[ACCURACY_SIZE])) c->bar[ACCURACY_SIZE] = PetscMax(c->bar[ACCURACY_SIZE], c->q.contact_size_band);
   if (!PetscIsNanReal(c->bar[ACCURACY_PRESSURE])) c->bar[ACCURACY_PRESSURE] = PetscMax(c->bar[ACCURACY_PRESSURE], c->q.pressure_max_step);
-  if (!PetscIsNanReal(c->bar[ACCURACY_PEAK])) c->bar[ACCURACY_PEAK] = PetscMax(c->bar[ACCURACY_PEAK], c->q.pressure_peak_stderr);
+  if (!PetscIsNanReal(c->bar[ACCURACY_PEAK])) c->bar[ACCURACY_PEAK] = PetscMax(c->bar[ACCURACY_PEAK], c->q.pressure_peak_resolution);
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -351,13 +351,13 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteRealAttr(v, "max_penetration", s->max_penetration));
   PetscCall(WriteRealAttr(v, "contact_force", s->contact_force));
   PetscCall(WriteRealAttr(v, "energy", s->energy));
-  PetscCall(WriteRealAttr(v, "pressure_max", s->pressure_max));                 /* the largest nodal contact pressure */
-  PetscCall(WriteRealAttr(v, "contact_size", s->contact_size));                 /* the contact zone's width (2D) or area (3D) */
-  PetscCall(WriteRealAttr(v, "contact_size_band", s->contact_size_band));       /* the one-cell strip along its edge */
-  PetscCall(WriteRealAttr(v, "pressure_max_step", s->pressure_max_step));       /* the largest pressure's change to its neighbours */
-  PetscCall(WriteRealAttr(v, "pressure_peak", s->pressure_peak));               /* the largest pressure recovered by a local fit */
-  PetscCall(WriteRealAttr(v, "pressure_peak_stderr", s->pressure_peak_stderr)); /*   and the fit's standard error */
-  for (PetscInt c = 0; c < dim; ++c) {                                          /* the total force of the obstacle, contact_force_x, _y, _z */
+  PetscCall(WriteRealAttr(v, "pressure_max", s->pressure_max));                         /* the largest nodal contact pressure */
+  PetscCall(WriteRealAttr(v, "contact_size", s->contact_size));                         /* the contact zone's width (2D) or area (3D) */
+  PetscCall(WriteRealAttr(v, "contact_size_band", s->contact_size_band));               /* the one-cell strip along its edge */
+  PetscCall(WriteRealAttr(v, "pressure_max_step", s->pressure_max_step));               /* the largest pressure's change to its neighbours */
+  PetscCall(WriteRealAttr(v, "pressure_peak", s->pressure_peak));                       /* the largest pressure recovered by a local fit */
+  PetscCall(WriteRealAttr(v, "pressure_peak_resolution", s->pressure_peak_resolution)); /*   and its resolution */
+  for (PetscInt c = 0; c < dim; ++c) {                                                  /* the total force of the obstacle, contact_force_x, _y, _z */
     char name[32];
 
     PetscCall(PetscSNPrintf(name, sizeof(name), "contact_force_%c", "xyz"[c]));
@@ -642,7 +642,7 @@ static PetscErrorCode WriteCycles(MPI_Comm comm, const AppCtx *user, PetscViewer
   CYCLE_COLUMN("contact_size_band", c[i].q.contact_size_band);
   CYCLE_COLUMN("pressure_max_step", c[i].q.pressure_max_step);
   CYCLE_COLUMN("pressure_peak", c[i].q.pressure_peak);
-  CYCLE_COLUMN("pressure_peak_stderr", c[i].q.pressure_peak_stderr);
+  CYCLE_COLUMN("pressure_peak_resolution", c[i].q.pressure_peak_resolution);
   for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
     char label[64];
 

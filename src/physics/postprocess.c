@@ -80,7 +80,7 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   }
   PetscCall(PostprocessContactSize(dm, user, u, &st->contact_size, &st->contact_size_band));
   PetscCall(PostprocessPressureStep(dm, user, st->pressure_max, &st->pressure_max_step));
-  PetscCall(PostprocessPressurePeak(dm, user, st->pressure_max, st->pressure_max_step, &st->pressure_peak, &st->pressure_peak_stderr));
+  PetscCall(PostprocessPressurePeak(dm, user, st->pressure_max, st->pressure_max_step, &st->pressure_peak, &st->pressure_peak_resolution));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -95,7 +95,7 @@ void PostprocessGetQuantities(const AppCtx *user, Quantities *q)
   q->contact_size_band    = st->contact_size_band;
   q->pressure_max_step    = st->pressure_max_step;
   q->pressure_peak        = st->pressure_peak;
-  q->pressure_peak_stderr = st->pressure_peak_stderr;
+  q->pressure_peak_resolution = st->pressure_peak_resolution;
   q->penetration_max      = st->max_penetration;
   q->energy               = st->energy;
   for (PetscInt i = 0; i < BOUNDARY_MAX; ++i)
