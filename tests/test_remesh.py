@@ -30,7 +30,8 @@ def recovered_peak(h5, k):
     """src/physics/pressure_peak.c's fit, computed again from the last mesh's fields: the quadratic in the tangent
     coordinates (x, and y in 3D: the flat foundation's normal is the last axis) fitted by least squares to the pressures
     of the k nodes in contact nearest the largest's, its value there and its resolution: the larger of its standard
-    error and its change to the nodes within 1.5 times the nearest one's distance."""
+    error and its change to the nodes within 1.5 times the nearest one's distance less twice that change's standard
+    deviation."""
     with h5py.File(h5, "r") as f:
         x = f["geometry/vertices"][:]
         p = f["vertex_fields/contact_pressure"][:].ravel()
@@ -44,10 +45,10 @@ def recovered_peak(h5, k):
     design = np.column_stack(cols)
     c, *_ = np.linalg.lstsq(design, p[near], rcond=None)
     r = p[near] - design @ c
-    se = np.sqrt(r @ r / (k - design.shape[1]) * np.linalg.inv(design.T @ design)[0, 0])
+    cov = r @ r / (k - design.shape[1]) * np.linalg.inv(design.T @ design)
     ring = np.sort(dist)[1] * 1.5
-    step = max(abs(c[0] - design[j] @ c) for j in range(1, k) if np.linalg.norm(x[near[j]] - x[top]) <= ring)
-    return c[0], max(se, step)
+    steps = [design[j] - design[0] for j in range(1, k) if np.linalg.norm(x[near[j]] - x[top]) <= ring]
+    return c[0], max([np.sqrt(cov[0, 0])] + [abs(d @ c) - 2 * np.sqrt(d @ cov @ d) for d in steps])
 
 
 def uniform_with_model(tmp_path_factory, shape, name, h):

@@ -17,8 +17,11 @@
    fit's change from the top to the top's neighbours (the nodes within PEAK_RING times the nearest one's distance) how
    well the mesh resolves the profile there, as the nodal step does (PostprocessPressureStep()): where the maximum sits
    at a steep end of the profile (the manufactured solution's, at the end of Gamma_C: +3.4% from the closed form at
-   2,534 unknowns, where the standard error was 2.0%) the step is the larger. The larger of the two is the peak's
-   resolution, the floor of its -accuracy bar (src/estimate/cycle_bars.c).
+   2,534 unknowns, where the standard error was 2.0%) the step is the larger. The step counts beyond PEAK_SIGNIFICANT
+   times its own standard deviation (that of the linear functional c . (phi_j - phi_top) of the coefficients): at a
+   smooth top the fitted slope is the scatter's, which the standard error already holds (the sphere's 1% run, one of
+   its late cycles: a step of 1.07% of p0 that was 2.3 of its deviations, where the standard error was 0.50%). The
+   larger of the two is the peak's resolution, the floor of its -accuracy bar (src/estimate/cycle_bars.c).
    The patch's radius is a few cells, so that the fit's truncation (the profile's quartic term: (rho / a)^4 / 8 of a
    Hertz peak at rho = a / 4, 0.05%) stays below its scatter where the zone spans tens of cells; with fewer nodes in
    contact than twice the monomials the peak is the nodal maximum and its floor the nodal step.
@@ -29,10 +32,11 @@
    partition beyond the pressures' own solver tolerance. */
 #include "physics.h"
 
-#define PEAK_NODES_2D 5  /* the top and two nodes on each side */
-#define PEAK_NODES_3D 20 /* the top and about two rings of triangles around it */
-#define PEAK_STRIDE 7    /* x[3], normal[3], p of each gathered node */
-#define PEAK_RING 1.5    /* the top's neighbours: the nodes within this times the nearest one's distance */
+#define PEAK_NODES_2D 5      /* the top and two nodes on each side */
+#define PEAK_NODES_3D 20     /* the top and about two rings of triangles around it */
+#define PEAK_STRIDE 7        /* x[3], normal[3], p of each gathered node */
+#define PEAK_RING 1.5        /* the top's neighbours: the nodes within this times the nearest one's distance */
+#define PEAK_SIGNIFICANT 2.0 /* the fit's step counts beyond this many of its own standard deviations */
 
 typedef struct {
   PetscReal dist; /* to the top */
@@ -141,11 +145,26 @@ static void Monomials(PetscInt dim, const PetscReal t[2][3], const PetscReal top
   phi[5] = s[1] * s[1];
 }
 
-/* Least squares by modified Gram-Schmidt: A (k x m, row-major) = Q R, overwritten by Q; c = R^{-1} Q^T b; *se the
-   standard error of c[0]. PETSC_FALSE where a column depends on the others (a patch on one line in 3D). */
-static PetscBool LeastSquares(PetscInt k, PetscInt m, PetscReal A[], const PetscReal b[], PetscReal c[], PetscReal *se)
+/* The standard deviation of d . c, c the coefficients of LeastSquares(): (s2 d^T Ri Ri^T d)^(1/2). */
+static PetscReal FunctionalDeviation(PetscInt m, const PetscReal Ri[6][6], PetscReal s2, const PetscReal d[])
 {
-  PetscReal R[6][6] = {{0.0}}, Ri[6][6] = {{0.0}}, qb[6], rss = 0.0, row0 = 0.0;
+  PetscReal sum = 0.0;
+
+  for (PetscInt l = 0; l < m; ++l) {
+    PetscReal e = 0.0;
+
+    for (PetscInt i = 0; i <= l; ++i) e += Ri[i][l] * d[i];
+    sum += PetscSqr(e);
+  }
+  return PetscSqrtReal(s2 * sum);
+}
+
+/* Least squares by modified Gram-Schmidt: A (k x m, row-major) = Q R, overwritten by Q; c = R^{-1} Q^T b, Ri = R^{-1}
+   and *s2 the residual's variance |b - A c|^2 / (k - m), so that the covariance of c is s2 Ri Ri^T. PETSC_FALSE where
+   a column depends on the others (a patch on one line in 3D). */
+static PetscBool LeastSquares(PetscInt k, PetscInt m, PetscReal A[], const PetscReal b[], PetscReal c[], PetscReal Ri[6][6], PetscReal *s2)
+{
+  PetscReal R[6][6] = {{0.0}}, qb[6], rss = 0.0;
 
   for (PetscInt j = 0; j < m; ++j) {
     PetscReal norm = 0.0, norm0 = 0.0;
@@ -178,6 +197,8 @@ static PetscBool LeastSquares(PetscInt k, PetscInt m, PetscReal A[], const Petsc
     for (PetscInt j = 0; j < m; ++j) r -= A[i * m + j] * qb[j];
     rss += PetscSqr(r);
   }
+  for (PetscInt j = 0; j < m; ++j)
+    for (PetscInt l = 0; l < m; ++l) Ri[j][l] = 0.0;
   for (PetscInt j = m - 1; j >= 0; --j) { /* R^{-1}, upper triangular */
     Ri[j][j] = 1.0 / R[j][j];
     for (PetscInt l = j + 1; l < m; ++l) {
@@ -187,8 +208,7 @@ static PetscBool LeastSquares(PetscInt k, PetscInt m, PetscReal A[], const Petsc
       Ri[j][l] = -sum / R[j][j];
     }
   }
-  for (PetscInt l = 0; l < m; ++l) row0 += PetscSqr(Ri[0][l]); /* (D^T D)^{-1}_00 = |row 0 of R^{-1}|^2 */
-  *se = PetscSqrtReal(rss / (k - m) * row0);
+  *s2 = rss / (k - m);
   return PETSC_TRUE;
 }
 
@@ -198,7 +218,7 @@ PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_m
 {
   const ContactSet *cs;
   PetscInt          dim, n = 0, top    = 0, m, k;
-  PetscReal        *rows, t[2][3], rho = 0.0, A[PEAK_NODES_3D * 6], b[PEAK_NODES_3D], c[6];
+  PetscReal        *rows, t[2][3], rho = 0.0, A[PEAK_NODES_3D * 6], b[PEAK_NODES_3D], c[6], Ri[6][6], s2;
   PeakNode         *order;
 
   PetscFunctionBeginUser;
@@ -244,14 +264,18 @@ PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_m
     Monomials(dim, t, &rows[top * PEAK_STRIDE], rho, &rows[order[j].i * PEAK_STRIDE], &A[j * m]);
     b[j] = rows[order[j].i * PEAK_STRIDE + 6];
   }
-  if (LeastSquares(k, m, A, b, c, resolution)) {
-    *peak = c[0];
-    for (PetscInt j = 1; j < k && order[j].dist <= PEAK_RING * order[1].dist; ++j) { /* the fit's step to the top's neighbours */
-      PetscReal phi[6], v = 0.0;
+  if (LeastSquares(k, m, A, b, c, Ri, &s2)) {
+    const PetscReal e0[6] = {1.0, 0.0, 0.0, 0.0, 0.0, 0.0};
 
-      Monomials(dim, t, &rows[top * PEAK_STRIDE], rho, &rows[order[j].i * PEAK_STRIDE], phi);
-      for (PetscInt l = 0; l < m; ++l) v += c[l] * phi[l];
-      *resolution = PetscMax(*resolution, PetscAbsReal(c[0] - v));
+    *peak       = c[0];
+    *resolution = FunctionalDeviation(m, Ri, s2, e0);                                /* the standard error at the top */
+    for (PetscInt j = 1; j < k && order[j].dist <= PEAK_RING * order[1].dist; ++j) { /* the fit's step to the top's neighbours */
+      PetscReal d[6], v = 0.0;
+
+      Monomials(dim, t, &rows[top * PEAK_STRIDE], rho, &rows[order[j].i * PEAK_STRIDE], d);
+      d[0] = 0.0; /* the step c . (phi_j - phi_top), phi_top = e0 */
+      for (PetscInt l = 0; l < m; ++l) v += c[l] * d[l];
+      *resolution = PetscMax(*resolution, PetscAbsReal(v) - PEAK_SIGNIFICANT * FunctionalDeviation(m, Ri, s2, d));
     }
   } else
     *resolution = step;
