@@ -181,19 +181,27 @@ def test_the_recovered_peak_pressure_reaches_a_tolerance_the_nodal_maximum_scatt
 
 def test_a_gamg_breakdown_on_a_carried_solution_is_recovered_without_a_direct_solve(sphere):
     """The sphere's fifth remeshed cycle (5,910 unknowns): the carried solution's first Jacobian holds the penalty rows
-    of its contact, GAMG's aggregates of contact nodes alone (options/solvers/gamg.yaml's threshold drops their links
-    into the body) make CG break down, and GAMG rebuilt on the unfiltered graph (src/solver/pc_recovery.c, step 2)
-    solves it, without the direct solve of step 3: the same cycles and answer as the direct solver's."""
+    of its contact, GAMG's aggregates of contact nodes alone (the threshold drops their links into the body) make CG
+    break down, and GAMG rebuilt on the unfiltered graph (src/solver/pc_recovery.c, step 2) solves it, without the
+    direct solve of step 3: the same cycles and answer as the direct solver's. Whether the breakdown comes at
+    options/solvers/gamg.yaml's threshold 0.01 is a matter of round-off: it did on the machines of earlier sessions, and
+    on a later one only at 0.1; so both thresholds run, at least one breaks down, and each that does recovers so."""
     mesh, model = sphere
     args = case_args("sphere", mesh) + ["-adapt_model", model, "-adapt_cycles", 5]
-    _, h5 = run(args + ["-options_file", "options/solvers/gamg.yaml"], "remesh_sphere_gamg")
     _, ref = run(args, "remesh_sphere_direct")
-    a, b = load(h5)[0], load(ref)[0]
-    assert a["converged"] == 1 and a["pc_breakdowns"] >= 2, a.get("pc_recovery")
-    assert "unfiltered graph" in a["pc_recovery"] and "direct solve" not in a["pc_recovery"], a["pc_recovery"]
-    assert np.array_equal(cycles(h5)["n_dofs"], cycles(ref)["n_dofs"])
-    for q in ("contact_force_z", "pressure_max", "contact_size"):
-        assert abs(a[q] - b[q]) <= 1e-6 * abs(b[q]), (q, a[q], b[q])
+    b = load(ref)[0]
+    breakdowns = 0
+    for threshold in (0.01, 0.1):
+        _, h5 = run(args + ["-options_file", "options/solvers/gamg.yaml", "-pc_gamg_threshold", threshold], f"remesh_sphere_gamg_{threshold:g}")
+        a = load(h5)[0]
+        assert a["converged"] == 1, threshold
+        if a["pc_breakdowns"]:
+            assert "unfiltered graph" in a["pc_recovery"] and "direct solve" not in a["pc_recovery"], (threshold, a["pc_recovery"])
+        breakdowns += a["pc_breakdowns"]
+        assert np.array_equal(cycles(h5)["n_dofs"], cycles(ref)["n_dofs"]), threshold
+        for q in ("contact_force_z", "pressure_max", "contact_size"):
+            assert abs(a[q] - b[q]) <= 1e-6 * abs(b[q]), (threshold, q, a[q], b[q])
+    assert breakdowns >= 2, breakdowns
 
 
 BAD = {"missing": (["-options_file", "options/mms.yaml", "-adapt_cycles", 1, "-adapt_model", "no/such/model.geo"],
