@@ -72,8 +72,9 @@
    The recovered peak (pressure_peak, src/physics/pressure_peak.c) has the largest pressure's bar, the index and the
    penalty part, with the fit's resolution as its floor instead of the nodal step (the fit's standard error at the
    node, or its own step to the top's neighbours beyond twice that step's deviation where that is larger): the fit
-   averages the scatter that the nodal step measures. On the sphere's 3% run it stops at 143,995 unknowns with the peak +0.03% from the
-   closed form within its bar 1.8%, where the nodal maximum's floor held the stop to 507,252 (docs/estimate.md).
+   averages the scatter that the nodal step measures. On the sphere's 3% run it stops at 143,995 unknowns with the
+   peak +0.03% from the closed form within its bar 1.8%, where the nodal maximum's floor held the stop to 507,252
+   (docs/estimate.md).
    The energy's bar is the error estimate itself, against the solution's energy norm (src/estimate/estimate.c). */
 #include "estimate.h"
 

@@ -90,14 +90,14 @@ void PostprocessGetQuantities(const AppCtx *user, Quantities *q)
   const RunStats *st = &user->rec.stats;
 
   for (PetscInt c = 0; c < 3; ++c) q->force[c] = st->contact_force_vector[c];
-  q->pressure_max         = st->pressure_max;
-  q->contact_size         = st->contact_size;
-  q->contact_size_band    = st->contact_size_band;
-  q->pressure_max_step    = st->pressure_max_step;
-  q->pressure_peak        = st->pressure_peak;
+  q->pressure_max             = st->pressure_max;
+  q->contact_size             = st->contact_size;
+  q->contact_size_band        = st->contact_size_band;
+  q->pressure_max_step        = st->pressure_max_step;
+  q->pressure_peak            = st->pressure_peak;
   q->pressure_peak_resolution = st->pressure_peak_resolution;
-  q->penetration_max      = st->max_penetration;
-  q->energy               = st->energy;
+  q->penetration_max          = st->max_penetration;
+  q->energy                   = st->energy;
   for (PetscInt i = 0; i < BOUNDARY_MAX; ++i)
     for (PetscInt c = 0; c < 3; ++c) q->reaction[i][c] = st->reaction[i][c];
 }

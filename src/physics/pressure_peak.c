@@ -26,10 +26,11 @@
    Hertz peak at rho = a / 4, 0.05%) stays below its scatter where the zone spans tens of cells; with fewer nodes in
    contact than twice the monomials the peak is the nodal maximum and its floor the nodal step.
 
-   Every rank gathers the nodes in contact (their position, normal and pressure: the zone is a small part of Gamma_C)
-   and computes the same fit: the top and the patch are chosen by the pressures and positions alone, ties broken by the
-   coordinates, and the fit sums its nodes in the order of their distance, so that the peak does not depend on the
-   partition beyond the pressures' own solver tolerance. */
+   Every rank computes the same fit from the same nodes: each rank's largest nodal pressure is gathered on every rank,
+   the largest of them is the top, and each rank's own PEAK_NODES nearest it are gathered too, among which are the
+   PEAK_NODES nearest over all ranks (a node's position, normal and pressure each). The top and the patch are chosen by
+   the pressures and positions alone, ties broken by the coordinates, and the fit sums its nodes in the order of their
+   distance, so that the peak does not depend on the partition beyond the pressures' own solver tolerance. */
 #include "physics.h"
 
 #define PEAK_NODES_2D 5      /* the top and two nodes on each side */
@@ -55,25 +56,22 @@ static int ComparePeakNodes(const void *a, const void *b)
   return 0;
 }
 
-/* The nodes of this rank's contact set that carry a pressure, PEAK_STRIDE reals each, gathered on every rank. */
-static PetscErrorCode GatherContactNodes(DM dm, const ContactSet *cs, PetscInt dim, PetscInt *n, PetscReal **rows)
+/* The nodes of this rank's contact set that carry a pressure, PEAK_STRIDE reals each. */
+static PetscErrorCode LocalContactRows(DM dm, const ContactSet *cs, PetscInt dim, PetscInt *n, PetscReal **rows)
 {
-  MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
-  PetscMPIInt        size, nlocal = 0, *counts, *displs;
-  PetscReal         *mine;
   PetscSection       csec;
   Vec                coords;
   const PetscScalar *xc;
 
   PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(DMGetCoordinateSection(dm, &csec));
   PetscCall(DMGetCoordinatesLocal(dm, &coords));
   PetscCall(VecGetArrayRead(coords, &xc));
-  PetscCall(PetscMalloc1(cs->n * PEAK_STRIDE + 1, &mine));
+  PetscCall(PetscMalloc1(cs->n * PEAK_STRIDE + 1, rows));
+  *n = 0;
   for (PetscInt i = 0; i < cs->n; ++i) {
     PetscInt   off;
-    PetscReal *row = &mine[nlocal * PEAK_STRIDE];
+    PetscReal *row = &(*rows)[*n * PEAK_STRIDE];
 
     if (!cs->is_vertex[i] || !(cs->pressure[i] > 0.0)) continue;
     PetscCall(PetscSectionGetOffset(csec, cs->point[i], &off));
@@ -82,19 +80,67 @@ static PetscErrorCode GatherContactNodes(DM dm, const ContactSet *cs, PetscInt d
       row[3 + d] = d < dim ? cs->normal[i * dim + d] : 0.0;
     }
     row[6] = cs->pressure[i];
-    ++nlocal;
+    ++*n;
   }
   PetscCall(VecRestoreArrayRead(coords, &xc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Every rank's n rows, in the order of the ranks, on every rank. */
+static PetscErrorCode AllgatherRows(MPI_Comm comm, PetscInt n, const PetscReal rows[], PetscInt *total, PetscReal **all)
+{
+  PetscMPIInt size, count, *counts, *displs;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_size(comm, &size));
+  PetscCall(PetscMPIIntCast(n * PEAK_STRIDE, &count));
   PetscCall(PetscMalloc2(size, &counts, size + 1, &displs));
-  nlocal *= PEAK_STRIDE;
-  PetscCallMPI(MPI_Allgather(&nlocal, 1, MPI_INT, counts, 1, MPI_INT, comm));
+  PetscCallMPI(MPI_Allgather(&count, 1, MPI_INT, counts, 1, MPI_INT, comm));
   displs[0] = 0;
   for (PetscMPIInt r = 0; r < size; ++r) displs[r + 1] = displs[r] + counts[r];
-  PetscCall(PetscMalloc1(displs[size] + 1, rows));
-  PetscCallMPI(MPI_Allgatherv(mine, nlocal, MPIU_REAL, *rows, counts, displs, MPIU_REAL, comm));
-  *n = displs[size] / PEAK_STRIDE;
+  PetscCall(PetscMalloc1(displs[size] + 1, all));
+  PetscCallMPI(MPI_Allgatherv(rows, count, MPIU_REAL, *all, counts, displs, MPIU_REAL, comm));
+  *total = displs[size] / PEAK_STRIDE;
   PetscCall(PetscFree2(counts, displs));
-  PetscCall(PetscFree(mine));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The row with the largest pressure, ties by the smaller coordinates; -1 without rows. */
+static PetscInt LargestRow(PetscInt n, const PetscReal rows[])
+{
+  PetscInt top = n > 0 ? 0 : -1;
+
+  for (PetscInt i = 1; i < n; ++i) {
+    const PetscReal *ri = &rows[i * PEAK_STRIDE], *rt = &rows[top * PEAK_STRIDE];
+    PetscBool        larger = (PetscBool)(ri[6] > rt[6]);
+
+    for (PetscInt d = 0; d < 3 && ri[6] == rt[6] && !larger; ++d) {
+      if (ri[d] != rt[d]) {
+        larger = (PetscBool)(ri[d] < rt[d]);
+        break;
+      }
+    }
+    if (larger) top = i;
+  }
+  return top;
+}
+
+/* The rows in the order of their distance to top (ComparePeakNodes()). */
+static PetscErrorCode SortByDistance(PetscInt n, const PetscReal rows[], const PetscReal top[], PeakNode **order)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscMalloc1(n + 1, order));
+  for (PetscInt i = 0; i < n; ++i) {
+    PetscReal d2 = 0.0;
+
+    for (PetscInt d = 0; d < 3; ++d) {
+      (*order)[i].x[d] = rows[i * PEAK_STRIDE + d];
+      d2 += PetscSqr(rows[i * PEAK_STRIDE + d] - top[d]);
+    }
+    (*order)[i].dist = PetscSqrtReal(d2);
+    (*order)[i].i    = i;
+  }
+  qsort(*order, n, sizeof(**order), ComparePeakNodes);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -216,9 +262,10 @@ static PetscBool LeastSquares(PetscInt k, PetscInt m, PetscReal A[], const Petsc
    step (PostprocessPressureStep()), where there is too little contact to fit. */
 PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal step, PetscReal *peak, PetscReal *resolution)
 {
+  MPI_Comm          comm = PetscObjectComm((PetscObject)dm);
   const ContactSet *cs;
-  PetscInt          dim, n = 0, top    = 0, m, k;
-  PetscReal        *rows, t[2][3], rho = 0.0, A[PEAK_NODES_3D * 6], b[PEAK_NODES_3D], c[6], Ri[6][6], s2;
+  PetscInt          dim, nlocal, ntotal, ntops, nnear, n, m, k, lt;
+  PetscReal        *mine, *tops, *near, *rows, top[PEAK_STRIDE], t[2][3], rho, A[PEAK_NODES_3D * 6], b[PEAK_NODES_3D], c[6], Ri[6][6], s2;
   PeakNode         *order;
 
   PetscFunctionBeginUser;
@@ -226,42 +273,32 @@ PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_m
   *resolution = step;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(ContactGetSet(user->contact, &cs));
-  PetscCall(GatherContactNodes(dm, cs, dim, &n, &rows));
+  PetscCall(LocalContactRows(dm, cs, dim, &nlocal, &mine));
+  PetscCall(MPIU_Allreduce(&nlocal, &ntotal, 1, MPIU_INT, MPI_SUM, comm));
   m = dim == 2 ? 3 : 6;
-  k = dim == 2 ? PEAK_NODES_2D : PEAK_NODES_3D;
-  if (n < 2 * m) {
-    PetscCall(PetscFree(rows));
+  k = PetscMin(dim == 2 ? PEAK_NODES_2D : PEAK_NODES_3D, ntotal);
+  if (ntotal < 2 * m) {
+    PetscCall(PetscFree(mine));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  k = PetscMin(k, n);
-  for (PetscInt i = 1; i < n; ++i) { /* the largest nodal pressure; ties by the coordinates */
-    const PetscReal *ri = &rows[i * PEAK_STRIDE], *rt = &rows[top * PEAK_STRIDE];
-    PetscBool        larger = (PetscBool)(ri[6] > rt[6]);
-
-    for (PetscInt d = 0; d < 3 && ri[6] == rt[6] && !larger; ++d) {
-      if (ri[d] != rt[d]) {
-        larger = (PetscBool)(ri[d] < rt[d]);
-        break;
-      }
-    }
-    if (larger) top = i;
-  }
-  PetscCall(PetscMalloc1(n, &order));
-  for (PetscInt i = 0; i < n; ++i) {
-    PetscReal d2 = 0.0;
-
-    for (PetscInt d = 0; d < 3; ++d) {
-      order[i].x[d] = rows[i * PEAK_STRIDE + d];
-      d2 += PetscSqr(rows[i * PEAK_STRIDE + d] - rows[top * PEAK_STRIDE + d]);
-    }
-    order[i].dist = PetscSqrtReal(d2);
-    order[i].i    = i;
-  }
-  qsort(order, n, sizeof(*order), ComparePeakNodes);
-  TangentBasis(dim, &rows[top * PEAK_STRIDE + 3], t);
+  /* the top: the largest of the ranks' largest; then the k nearest it: among the ranks' own k nearest */
+  lt = LargestRow(nlocal, mine);
+  PetscCall(AllgatherRows(comm, lt >= 0 ? 1 : 0, lt >= 0 ? &mine[lt * PEAK_STRIDE] : mine, &ntops, &tops));
+  PetscCall(PetscArraycpy(top, &tops[LargestRow(ntops, tops) * PEAK_STRIDE], PEAK_STRIDE));
+  PetscCall(PetscFree(tops));
+  PetscCall(SortByDistance(nlocal, mine, top, &order));
+  nnear = PetscMin(k, nlocal);
+  PetscCall(PetscMalloc1(nnear * PEAK_STRIDE + 1, &near));
+  for (PetscInt j = 0; j < nnear; ++j) PetscCall(PetscArraycpy(&near[j * PEAK_STRIDE], &mine[order[j].i * PEAK_STRIDE], PEAK_STRIDE));
+  PetscCall(PetscFree(order));
+  PetscCall(PetscFree(mine));
+  PetscCall(AllgatherRows(comm, nnear, near, &n, &rows));
+  PetscCall(PetscFree(near));
+  PetscCall(SortByDistance(n, rows, top, &order));
+  TangentBasis(dim, &top[3], t);
   rho = order[k - 1].dist;
   for (PetscInt j = 0; j < k; ++j) {
-    Monomials(dim, t, &rows[top * PEAK_STRIDE], rho, &rows[order[j].i * PEAK_STRIDE], &A[j * m]);
+    Monomials(dim, t, top, rho, &rows[order[j].i * PEAK_STRIDE], &A[j * m]);
     b[j] = rows[order[j].i * PEAK_STRIDE + 6];
   }
   if (LeastSquares(k, m, A, b, c, Ri, &s2)) {
@@ -272,7 +309,7 @@ PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_m
     for (PetscInt j = 1; j < k && order[j].dist <= PEAK_RING * order[1].dist; ++j) { /* the fit's step to the top's neighbours */
       PetscReal d[6], v = 0.0;
 
-      Monomials(dim, t, &rows[top * PEAK_STRIDE], rho, &rows[order[j].i * PEAK_STRIDE], d);
+      Monomials(dim, t, top, rho, &rows[order[j].i * PEAK_STRIDE], d);
       d[0] = 0.0; /* the step c . (phi_j - phi_top), phi_top = e0 */
       for (PetscInt l = 0; l < m; ++l) v += c[l] * d[l];
       *resolution = PetscMax(*resolution, PetscAbsReal(v) - PEAK_SIGNIFICANT * FunctionalDeviation(m, Ri, s2, d));
