@@ -51,7 +51,7 @@ CASES = {
 
 @pytest.mark.slow
 def test_sanitizers_report_nothing():
-    p = subprocess.run(["make", "--no-print-directory", "asan"], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    p = subprocess.run(["make", "--no-print-directory", "-j2", "asan"], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
     assert p.returncode == 0, p.stdout[-3000:]
     env = dict(ENV, ASAN_OPTIONS="detect_leaks=0", UBSAN_OPTIONS="print_stacktrace=1")
     os.makedirs(os.path.join(OUT, "asan"), exist_ok=True)
