@@ -31,12 +31,6 @@ COARSE = {"cylinder": (geometry.quarter_disk, 0.1), "sphere": (geometry.quarter_
 SOLVER = {"cylinder": [], "sphere": hertz.GAMG_3D, "sphere-indenter": hertz.GAMG_3D}
 
 
-
-
-
-
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--cases", default="cylinder,sphere")
