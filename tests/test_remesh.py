@@ -275,14 +275,19 @@ def test_marking_the_zone_edge_in_3d_on_two_ranks_gives_the_one_rank_cycles():
         assert np.allclose(c1[q], c2[q], rtol=1e-6, atol=0), (q, c1[q], c2[q])
 
 
-def test_a_model_that_is_not_the_meshs_is_refused(disk, tmp_path):
+def test_a_model_that_is_not_the_meshs_is_refused(disk, tmp_path, monkeypatch):
     """The block's model given for the disk's mesh: the remeshed mesh lacks the disk's face set "top" (3), and the run
-    stops at the first remesh with an error naming the model and the face set, before any solve on it."""
+    stops at the first remesh with an error naming the model and the face set, before any solve on it; Gmsh's mesh
+    file, written to PETSc's temporary directory (PETSC_TMP), is removed all the same."""
     mesh, _ = disk
     block_model = str(tmp_path / "block.geo")
     geometry.block(str(tmp_path / "block.msh"), radius=1.0, h_far=0.2, h_near=0.2, width=0.5, model=block_model)
+    tmp = tmp_path / "tmp"
+    tmp.mkdir()
+    monkeypatch.setenv("PETSC_TMP", str(tmp))
     refused(case_args("cylinder", mesh) + ["-adapt_model", block_model, "-adapt_cycles", 1], "remesh_bad_model",
             f"-adapt_model {block_model}: the mesh Gmsh made of the model has no face in the face set 3")
+    assert not list(tmp.iterdir()), list(tmp.iterdir())
 
 
 @pytest.mark.parametrize("np_", [1, 2])

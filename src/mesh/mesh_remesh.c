@@ -413,10 +413,10 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
   PetscCheck(!failed, comm, PETSC_ERR_LIB, "-adapt_model %s: %s", model[0] ? model : "(the box of the options)", why);
   PetscCallMPI(MPI_Bcast(out, sizeof(out), MPI_CHAR, 0, comm));
   PetscCall(MeshReadRemeshed(comm, out, remeshed));
+  PetscCallMPI(MPI_Barrier(comm));
+  if (rank == 0) (void)unlink(out); /* read: removed before the checks, which may refuse the mesh */
   PetscCall(CheckFaceSets(dm, *remeshed, model));
   if (loc) PetscCall(MeshTransferCreate(comm, dim, total / per, all_x, all_u, tr)); /* which owns all_x and all_u (rank 0) */
-  PetscCallMPI(MPI_Barrier(comm));
-  if (rank == 0) (void)unlink(out);
   {
     MatType mtype;
 
