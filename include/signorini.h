@@ -375,6 +375,7 @@ typedef struct {
   char      model[PETSC_MAX_PATH_LEN]; /* -adapt_model: the Gmsh model remeshed at each cycle ("": the mesh refined) */
   PetscReal newton_fraction;           /* -accuracy_newton_fraction: Newton stops at this fraction of the error (0: never) */
   PetscBool mark_edge;                 /* -adapt_mark_edge: with -accuracy on the size, refine along the zone's edge too */
+  PetscBool monitor;                   /* -adapt_monitor: a line for each cycle as it ends */
 } AdaptOptions;
 
 /* One cycle of the adaptive refinement (/cycles in the output): the mesh, the estimate of its solution and the true

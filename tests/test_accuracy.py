@@ -7,6 +7,8 @@ apart too, and its mesh part at the order 1); the energy's bar is the error esti
 a 10 x 10 block (where the closed form is a reference to about 0.2%, docs/estimate.md), on 2 ranks
 against 1, on a mesh that does not see the contact, and on the refusals."""
 
+import re
+
 import h5py
 import numpy as np
 import pytest
@@ -111,6 +113,31 @@ def test_accuracy_on_the_manufactured_solution_ends_within_the_tolerance():
     # a bar once a cycle with 4 times fewer unknowns and one before it exist
     coarser = [np.sum(c["n_dofs"][:k] * 4 <= c["n_dofs"][k]) >= 2 for k in range(len(c["n_dofs"]))]
     assert np.array_equal(np.isnan(c["contact_force_bar"]), ~np.array(coarser)), (c["n_dofs"], c["contact_force_bar"])
+
+
+def test_the_monitor_prints_each_cycle_as_the_cycles_record_it():
+    """-adapt_monitor: one line per cycle, printed as the cycle ends (before the summary), whose unknowns, estimate,
+    Newton steps and relative bars (the quantities -accuracy asks for; "--" before a cycle has one) are /cycles' row,
+    and "reached" on the last; without it, no such line."""
+    args = MMS + ["-dm_plex_box_faces", "8,8", "-penalty_eps0", 0.1, "-accuracy", 0.12, "-accuracy_quantity", "contact_force,contact_size"]
+    out, h5 = run(args + ["-adapt_monitor"], "accuracy_monitor")
+    c = cycles(h5)
+    lines = [line for line in out.splitlines() if line.startswith("  adapt cycle ")]
+    assert len(lines) == len(c["n_dofs"]) >= 5 and out.index(lines[-1]) < out.index("scene mms"), out[-3000:]
+    for k, line in enumerate(lines):
+        m = re.match(r"  adapt cycle (\d+): (\d+) dofs, estimate (\S+), Newton (\d+), \S+ s; bars contact_force (\S+) contact_size (\S+?)(: reached)?$", line)
+        assert m, line
+        assert int(m[1]) == k and int(m[2]) == c["n_dofs"][k] and int(m[4]) == c["newton_its"][k], (line, c["n_dofs"][k])
+        assert abs(float(m[3]) / c["estimate"][k] - 1) < 1e-4, (line, c["estimate"][k])
+        for q, printed in (("contact_force", m[5]), ("contact_size", m[6])):
+            bar = c[f"{q}_bar"][k] / abs(c[f"{q}_value"][k])
+            if printed == "--":
+                assert np.isnan(bar), (line, q)
+            else:
+                assert abs(float(printed.rstrip("%")) / (100 * bar) - 1) < 0.05, (line, q, bar)
+        assert bool(m[7]) == (k == len(lines) - 1) == bool(c["accurate"][k]), line
+    out, _ = run(args, "accuracy_no_monitor")
+    assert "adapt cycle" not in out
 
 
 @pytest.fixture(scope="module")

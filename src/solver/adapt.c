@@ -38,6 +38,7 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
   ad->accuracy        = 0.0;
   ad->newton_fraction = 0.0;
   ad->mark_edge       = PETSC_TRUE;
+  ad->monitor         = PETSC_FALSE;
   PetscOptionsBegin(comm, NULL, "Adaptive refinement", "Signorini");
   PetscCall(PetscOptionsInt(
       "-adapt_cycles",
@@ -62,6 +63,10 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
                              "With -accuracy on the contact size, refine the cells along the contact zone's edge too while its one-cell band, "
                              "the floor of the size's bar, is above the tolerance",
                              NULL, ad->mark_edge, &ad->mark_edge, NULL));
+  PetscCall(PetscOptionsBool("-adapt_monitor",
+                             "Print a line for each adaptive cycle as it ends: its unknowns, estimate, solve, time and, with -accuracy, the bars "
+                             "asked for",
+                             NULL, ad->monitor, &ad->monitor, NULL));
   ad->model[0] = '\0';
   PetscCall(PetscOptionsString(
       "-adapt_model",
@@ -230,6 +235,33 @@ static PetscBool Accurate(const AdaptOptions *ad, const CycleRecord *c)
   return PETSC_TRUE;
 }
 
+/* -adapt_monitor: cycle k's line as it ends (the /cycles row's numbers), so that a long -accuracy run shows its progress;
+   flushed, since the summary's table comes only after the last cycle. */
+static PetscErrorCode AdaptMonitor(MPI_Comm comm, const AdaptOptions *ad, const CycleRecord *c, PetscInt k)
+{
+  PetscMPIInt rank;
+
+  PetscFunctionBeginUser;
+  if (!ad->monitor) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscPrintf(comm, "  adapt cycle %" PetscInt_FMT ": %" PetscInt_FMT " dofs, estimate %.4e, Newton %" PetscInt_FMT ", %.3g s%s", k,
+                        c->n_dofs, (double)c->estimate, c->newton_its, (double)c->time_cycle, c->converged ? "" : " (solve failed)"));
+  if (ad->accuracy > 0.0) {
+    PetscCall(PetscPrintf(comm, "; bars"));
+    for (PetscInt q = 0; q < ACCURACY_NUM; ++q) {
+      if (!ad->target[q]) continue;
+      if (PetscIsNanReal(c->bar[q]))
+        PetscCall(PetscPrintf(comm, " %s --", AccuracyQuantities[q]));
+      else
+        PetscCall(PetscPrintf(comm, " %s %.2g%%", AccuracyQuantities[q], (double)(100.0 * c->bar[q] / PetscAbsReal(c->value[q]))));
+    }
+    PetscCall(PetscPrintf(comm, "%s", c->accurate ? ": reached" : ""));
+  }
+  PetscCall(PetscPrintf(comm, "\n"));
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) fflush(PETSC_STDOUT);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Doerfler's theta: -adapt_fraction where given; by default 0.5, and 0.3 in 3D where -accuracy asks for contact
    quantities only (not the energy). In 3D each remeshed vertex takes the smallest size of its cells
    (mesh_remesh.c), so a marked cell refines its twenty-odd neighbours too and theta = 0.5 grew the Hertz sphere's
@@ -282,6 +314,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     PetscCall(PetscTime(&t0)); /* the cycle: its mesh, its solve (the first solve for cycle 0), estimate and marking */
     c->time_cycle = (t0 - t_last) + (k == 0 ? c->time_solve : 0.0);
     t_last        = t0;
+    PetscCall(AdaptMonitor(PetscObjectComm((PetscObject)*dm), ad, c, k));
     if (c->accurate || k == ad->cycles || !user->rec.stats.converged ||
         (!c->marked && !c->marked_edge && !c->unseen)) { /* done, or a zero estimate: nothing to refine */
       PetscCall(DMLabelDestroy(&marked));
