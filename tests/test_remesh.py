@@ -29,14 +29,14 @@ def contact_vertices(h5):
 def recovered_peak(h5, k):
     """src/physics/pressure_peak.c's fit, computed again from the last mesh's fields: the quadratic in the tangent
     coordinates (x, and y in 3D: the flat foundation's normal is the last axis) fitted by least squares to the pressures
-    of the k nodes in contact nearest the largest's, its value there and its resolution: the larger of its standard
-    error and its change to the nodes within 1.5 times the nearest one's distance less twice that change's standard
-    deviation."""
+    of the k nodes in contact (a pressure above 1e-6 of the largest) nearest the largest's, its value there and its
+    resolution: the larger of its standard error and its change to the nodes within 1.5 times the nearest one's
+    distance less twice that change's standard deviation."""
     with h5py.File(h5, "r") as f:
         x = f["geometry/vertices"][:]
         p = f["vertex_fields/contact_pressure"][:].ravel()
     dim = x.shape[1]
-    on = np.flatnonzero(p > 0)
+    on = np.flatnonzero(p > 1e-6 * p.max())
     top = on[np.argmax(p[on])]
     dist = np.linalg.norm(x[on] - x[top], axis=1)
     near = on[np.argsort(dist, kind="stable")[:k]]
