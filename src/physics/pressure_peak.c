@@ -29,8 +29,9 @@
    Every rank computes the same fit from the same nodes: each rank's largest nodal pressure is gathered on every rank,
    the largest of them is the top, and each rank's own PEAK_NODES nearest it are gathered too, among which are the
    PEAK_NODES nearest over all ranks (a node's position, normal and pressure each). The top and the patch are chosen by
-   the pressures and positions alone, ties broken by the coordinates (pressures within PEAK_TIE of each other tie), and the fit sums its nodes in the
-   order of their distance, so that the peak does not depend on the partition beyond the pressures' own solver tolerance. */
+   the pressures and positions alone, ties broken by the coordinates (pressures within PEAK_TIE of the largest tie, and
+   below PEAK_TIE of it a node carries none), and the fit sums its nodes in the order of their distance, so that the
+   peak does not depend on the partition, or on the solve's last bits, beyond the pressures' own solver tolerance. */
 #include "physics.h"
 
 #define PEAK_NODES_2D 5      /* the top and two nodes on each side */
@@ -38,7 +39,7 @@
 #define PEAK_STRIDE 7        /* x[3], normal[3], p of each gathered node */
 #define PEAK_RING 1.5        /* the top's neighbours: the nodes within this times the nearest one's distance */
 #define PEAK_SIGNIFICANT 2.0 /* the fit's step counts beyond this many of its own standard deviations */
-#define PEAK_TIE 1e-6        /* pressures within this fraction of the largest are a tie, decided by the coordinates */
+#define PEAK_TIE 1e-6        /* pressures within this fraction of the largest tie (the coordinates decide); below it, none */
 
 typedef struct {
   PetscReal dist; /* to the top */
@@ -109,7 +110,7 @@ static PetscErrorCode AllgatherRows(MPI_Comm comm, PetscInt n, const PetscReal r
 /* Of the rows whose pressure is within PEAK_TIE of the largest, pmax, the one with the smallest coordinates; -1 without
    such rows. Two nodes whose pressures are equal but for round-off (the two sides of a symmetric top) are one tie, so
    that the top, and the fit around it, do not flip with the solve's last bits (the default square's 8 x 8 SNESVI run
-   on 2 ranks gave 0.7124 and 0.7069 in two runs whose fields agreed to 1e-12). */
+   fitted at one side's node on 1 rank and at the other's on 2: 0.7157 and 0.7069). */
 static PetscInt TopRow(PetscInt n, const PetscReal rows[], PetscReal pmax)
 {
   PetscInt top = -1;
@@ -283,8 +284,10 @@ PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_m
   *resolution = step;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(ContactGetSet(user->contact, &cs));
-  /* the largest pressure over all ranks; the nodes below PEAK_TIE of it carry none (a node at the zone's edge whose
-     pressure is a round-off, of either sign, is out on every run and partition) */
+  /* the largest vertex pressure over all ranks (pressure_max counts every point of the set); the nodes below PEAK_TIE
+     of it carry none (a node at the zone's edge whose pressure is a round-off, of either sign, is out on every run and
+     partition: the default square's 8 x 8 SNESVI run on 2 ranks gave 0.7124 and 0.7069 in two runs, its count of nodes
+     moving across the fit's threshold) */
   pmax = PETSC_MIN_REAL;
   for (PetscInt i = 0; i < cs->n; ++i)
     if (cs->is_vertex[i]) pmax = PetscMax(pmax, cs->pressure[i]);
