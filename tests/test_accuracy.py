@@ -49,6 +49,14 @@ def _two_level(c, q, last, order, dim=2):
     return max(3 * abs(c[q][m] - c[q][last]) / ((n[last] / n[m]) ** (order / dim) - 1) for m in (j, j - 1))
 
 
+def _peak_index(c, last, dim=2):
+    """The recovered peak's index: _two_level()'s at the order 1 on the part of each change beyond twice its standard
+    deviation, the two cycles' resolutions (src/estimate/cycle_bars.c, PeakBar())."""
+    n, v, res = c["n_dofs"], c["pressure_peak_value"], c["pressure_peak_resolution"]
+    j = max((m for m in range(last) if n[m] * 2**dim <= n[last]), default=-1)
+    return max(3 * max(abs(v[m] - v[last]) - 2 * np.hypot(res[m], res[last]), 0) / ((n[last] / n[m]) ** (1 / dim) - 1) for m in (j, j - 1))
+
+
 @pytest.mark.parametrize("eps0", ["1", "0.1"])
 def test_the_size_and_pressure_bars_take_their_penalty_parts_apart(eps0):
     """The zone's size's and the largest pressure's bars, recomputed from /cycles. The size's: where eps <= h/(10 M)
@@ -56,7 +64,8 @@ def test_the_size_and_pressure_bars_take_their_penalty_parts_apart(eps0):
     part at the order 1, at least the one-cell band; at eps = h the order 1/2 on the whole size, at least the band (the
     manufactured solution's size error falls like h^(1/2) there, and its penalty part on one mesh does not show it:
     docs/estimate.md). The pressure's, at any eps: the index at the order 1 plus |p(eps) - p(eps/10)| (1 + 3 / 9), at
-    least the step of the nodal pressure from its largest to its node's neighbours on Gamma_C."""
+    least the step of the nodal pressure from its largest to its node's neighbours on Gamma_C. The recovered peak's: the
+    index on the changes beyond twice their deviation, plus its penalty part, plus twice its resolution."""
     _, h5 = run(MMS + ["-dm_plex_box_faces", "8,8", "-penalty_eps0", eps0, "-accuracy", "1e-9", "-adapt_cycles", 6], f"accuracy_size_bar_{eps0}")
     c = cycles(h5)
     assert np.all(np.isfinite(c["contact_size_value_eps"])) and np.all(np.isfinite(c["eps"])), c["contact_size_value_eps"]
@@ -76,6 +85,9 @@ def test_the_size_and_pressure_bars_take_their_penalty_parts_apart(eps0):
             pressure = _two_level(c, "pressure_max_value", last, 1.0) + abs(c["pressure_max_value"][last] - c["pressure_max_value_eps"][last]) * (1 + 3 / 9)
             pressure = max(pressure, c["pressure_max_step"][last])
             assert abs(c["pressure_max_bar"][last] / pressure - 1) < 1e-12, (last, c["pressure_max_bar"][last], pressure)
+            peak = (_peak_index(c, last) + abs(c["pressure_peak_value"][last] - c["pressure_peak_value_eps"][last]) * (1 + 3 / 9)
+                    + 2 * c["pressure_peak_resolution"][last])
+            assert abs(c["pressure_peak_bar"][last] / peak - 1) < 1e-12, (last, c["pressure_peak_bar"][last], peak)
             checked += 1
     assert checked >= 2, checked
     # the step, the pressure bar's floor, from the last mesh's fields: the largest pressure's node against the nodes of

@@ -29,26 +29,46 @@ def contact_vertices(h5):
 def recovered_peak(h5, k):
     """src/physics/pressure_peak.c's fit, computed again from the last mesh's fields: the quadratic in the tangent
     coordinates (x, and y in 3D: the flat foundation's normal is the last axis) fitted by least squares to the pressures
-    of the k nodes in contact (a pressure above 1e-6 of the largest) nearest the largest's, its value there and its
-    resolution: the larger of its standard error and its change to the nodes within 1.5 times the nearest one's
-    distance less twice that change's standard deviation."""
+    of the nodes in contact (a pressure above 1e-6 of the largest) nearest the largest's, the k nearest and all within
+    0.3 of its distance to the nearest node of Gamma_C out of contact; its value at its largest where that lies within
+    the patch (else at the largest's node), and its resolution: the larger of its standard error there and its change
+    to the nodes within 1.5 times the nearest one's distance less twice that change's standard deviation."""
     with h5py.File(h5, "r") as f:
         x = f["geometry/vertices"][:]
         p = f["vertex_fields/contact_pressure"][:].ravel()
+        gamma_c = np.asarray(f["vertex_fields/contact_boundary"][:]).ravel() > 0
     dim = x.shape[1]
-    on = np.flatnonzero(p > 1e-6 * p.max())
+    on, off = np.flatnonzero(gamma_c & (p > 1e-6 * p.max())), np.flatnonzero(gamma_c & ~(p > 1e-6 * p.max()))
     top = on[np.argmax(p[on])]
     dist = np.linalg.norm(x[on] - x[top], axis=1)
-    near = on[np.argsort(dist, kind="stable")[:k]]
+    order = np.argsort(dist, kind="stable")
+    edge = 0.3 * np.linalg.norm(x[off] - x[top], axis=1).min() if len(off) else 0.0
+    n = max(k, np.count_nonzero(dist <= edge))
+    near, rho = on[order[:n]], dist[order[n - 1]]
     s = x[near, : dim - 1] - x[top, : dim - 1]
-    cols = [np.ones(k), s[:, 0], s[:, 0] ** 2] if dim == 2 else [np.ones(k), s[:, 0], s[:, 1], s[:, 0] ** 2, s[:, 0] * s[:, 1], s[:, 1] ** 2]
-    design = np.column_stack(cols)
+
+    def monomials(s):
+        s = np.atleast_2d(s)
+        cols = [np.ones(len(s)), s[:, 0], s[:, 0] ** 2] if dim == 2 else [np.ones(len(s)), s[:, 0], s[:, 1], s[:, 0] ** 2, s[:, 0] * s[:, 1], s[:, 1] ** 2]
+        return np.column_stack(cols)
+
+    design = monomials(s)
     c, *_ = np.linalg.lstsq(design, p[near], rcond=None)
     r = p[near] - design @ c
-    cov = r @ r / (k - design.shape[1]) * np.linalg.inv(design.T @ design)
+    cov = r @ r / (n - design.shape[1]) * np.linalg.inv(design.T @ design)
+    if dim == 2:
+        hess, grad = np.array([[2 * c[2]]]), c[1:2]
+    else:
+        hess, grad = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]]), c[1:3]
+    at = np.zeros(dim - 1)
+    if np.all(np.linalg.eigvalsh(hess) < 0):
+        at = np.linalg.solve(hess, -grad)
+        if np.linalg.norm(at) > rho:
+            at = np.zeros(dim - 1)
+    phi = monomials(at)[0]
     ring = np.sort(dist)[1] * 1.5
-    steps = [design[j] - design[0] for j in range(1, k) if np.linalg.norm(x[near[j]] - x[top]) <= ring]
-    return c[0], max([np.sqrt(cov[0, 0])] + [abs(d @ c) - 2 * np.sqrt(d @ cov @ d) for d in steps])
+    steps = [design[j] - design[0] for j in range(1, n) if np.linalg.norm(x[near[j]] - x[top]) <= ring]
+    return phi @ c, max([np.sqrt(phi @ cov @ phi)] + [abs(d @ c) - 2 * np.sqrt(d @ cov @ d) for d in steps])
 
 
 def uniform_with_model(tmp_path_factory, shape, name, h):
