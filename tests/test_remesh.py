@@ -178,11 +178,11 @@ def test_3d_accuracy_on_contact_quantities_marks_a_smaller_fraction(sphere):
 def test_the_recovered_peak_pressure_reaches_a_tolerance_the_nodal_maximum_scatters_across(sphere):
     """On tetrahedra the nodal pressures scatter about the Hertz profile by a few percent, and the largest of them picks
     the scatter's top (src/physics/pressure_peak.c). -accuracy 0.1 on the sphere, asking for the recovered peak
-    (pressure_peak: the quadratic fitted to the 20 nodes in contact nearest the largest's): it stops within the
+    (pressure_peak: the quadratic fitted to the nodes in contact around the largest's, at its own largest): it stops within the
     tolerance with the peak within its bar of the closed form at the run's force and within 1% of it; over the last
     three cycles the peak stays within 1% of the closed form while the nodal maximum is at least twice as far (measured
-    -0.5%, +0.5%, +0.01% against +5.5%, +3.0%, +2.1%); the bar is at least the fit's resolution; and the peak is the
-    fit numpy makes of the last mesh's fields."""
+    MEASURED); the bar is at least twice the fit's resolution (its deviation, src/estimate/cycle_bars.c); and the peak is
+    the fit numpy makes of the last mesh's fields."""
     mesh, model = sphere
     args = case_args("sphere", mesh) + hertz.GAMG_3D + ["-adapt_model", model, "-accuracy", 0.1, "-accuracy_quantity",
                                                          "contact_force,pressure_peak,contact_size"]
@@ -194,7 +194,7 @@ def test_the_recovered_peak_pressure_reaches_a_tolerance_the_nodal_maximum_scatt
     assert abs(err_peak[-1]) * p0[-1] <= a["accuracy_pressure_peak_bar"], (err_peak[-1], a["accuracy_pressure_peak_bar"] / p0[-1])
     assert np.all(np.abs(err_peak[-3:]) <= 0.01) and np.all(np.abs(err_nodal[-3:]) >= 2 * np.abs(err_peak[-3:])), (err_peak, err_nodal)
     has_bar = np.isfinite(c["pressure_peak_bar"])
-    assert has_bar.sum() >= 2 and np.all(c["pressure_peak_bar"][has_bar] >= c["pressure_peak_resolution"][has_bar])
+    assert has_bar.sum() >= 2 and np.all(c["pressure_peak_bar"][has_bar] >= 2 * c["pressure_peak_resolution"][has_bar])
     peak, se = recovered_peak(h5, 20)
     assert abs(a["pressure_peak"] / peak - 1) < 1e-10 and abs(a["pressure_peak_resolution"] / se - 1) < 1e-8, (a["pressure_peak"], peak, se)
 
