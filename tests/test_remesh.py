@@ -181,8 +181,8 @@ def test_the_recovered_peak_pressure_reaches_a_tolerance_the_nodal_maximum_scatt
     (pressure_peak: the quadratic fitted to the nodes in contact around the largest's, at its own largest): it stops within the
     tolerance with the peak within its bar of the closed form at the run's force and within 1% of it; over the last
     three cycles the peak stays within 1% of the closed form while the nodal maximum is at least twice as far (measured
-    -0.52%, +0.54%, +0.14% against +5.5%, +3.0%, +2.1%); the bar is at least twice the fit's resolution (its deviation, src/estimate/cycle_bars.c); and the peak is
-    the fit numpy makes of the last mesh's fields."""
+    -0.52%, +0.54%, +0.14% against +5.5%, +3.0%, +2.1%); the bar is at least twice the fit's resolution (its deviation,
+    src/estimate/cycle_bars.c); and the peak is the fit numpy makes of the last mesh's fields."""
     mesh, model = sphere
     args = case_args("sphere", mesh) + hertz.GAMG_3D + ["-adapt_model", model, "-accuracy", 0.1, "-accuracy_quantity",
                                                          "contact_force,pressure_peak,contact_size"]
