@@ -26,13 +26,14 @@ def contact_vertices(h5):
     return x[on]
 
 
-def recovered_peak(h5, k):
+def recovered_peak(h5, k, at_top=False):
     """src/physics/pressure_peak.c's fit, computed again from the last mesh's fields: the quadratic in the tangent
     coordinates (x, and y in 3D: the flat foundation's normal is the last axis) fitted by least squares to the pressures
     of the nodes in contact (a pressure above 1e-6 of the largest) nearest the largest's, the k nearest and all within
     0.3 of its distance to the nearest node of Gamma_C out of contact; its value at its largest where that lies within
-    the patch (else at the largest's node), and its resolution: the larger of its standard error there and its change
-    to the nodes within 1.5 times the nearest one's distance less twice that change's standard deviation."""
+    the patch (else at the largest's node; at_top: always there), and its resolution: the larger of its standard error
+    there and its change to the nodes within 1.5 times the nearest one's distance less twice that change's standard
+    deviation."""
     with h5py.File(h5, "r") as f:
         x = f["geometry/vertices"][:]
         p = f["vertex_fields/contact_pressure"][:].ravel()
@@ -61,7 +62,7 @@ def recovered_peak(h5, k):
     else:
         hess, grad = np.array([[2 * c[3], c[4]], [c[4], 2 * c[5]]]), c[1:3]
     at = np.zeros(dim - 1)
-    if np.all(np.linalg.eigvalsh(hess) < 0):
+    if not at_top and np.all(np.linalg.eigvalsh(hess) < 0):
         at = np.linalg.solve(hess, -grad)
         if np.linalg.norm(at) > rho:
             at = np.zeros(dim - 1)
@@ -130,7 +131,8 @@ def test_accuracy_on_the_hertz_cylinder_remeshes_its_model(disk):
 
 def test_remeshing_on_two_ranks_gives_the_one_rank_cycles(disk):
     """Gmsh meshes on rank 0 the cells gathered and sorted by their centroids: 2 ranks give the meshes of 1 (the same
-    unknowns at every cycle) and the same answers to solver tolerance."""
+    unknowns at every cycle) and the same answers to solver tolerance. The recovered peak is the fit numpy makes of the
+    last mesh's fields, taken at the fit's largest, which lies off the top's node here."""
     mesh, model = disk
     args = case_args("cylinder", mesh) + ["-adapt_model", model, "-adapt_cycles", 5]
     _, h1 = run(args, "remesh_np1")
@@ -142,6 +144,8 @@ def test_remeshing_on_two_ranks_gives_the_one_rank_cycles(disk):
     peak, se = recovered_peak(h1, 5)
     a = load(h1)[0]
     assert abs(a["pressure_peak"] / peak - 1) < 1e-10 and abs(a["pressure_peak_resolution"] / se - 1) < 1e-8, (a["pressure_peak"], peak, se)
+    # the fit's largest lies within the patch here, off the top's node (0.12% above the fit there, measured)
+    assert peak > (1 + 1e-4) * recovered_peak(h1, 5, at_top=True)[0]
 
 
 def test_the_hertz_sphere_remeshes_in_3d(sphere):
