@@ -71,8 +71,9 @@ static int ComparePeakNodes(const void *a, const void *b)
   return 0;
 }
 
-/* The nodes of this rank's contact set that carry a pressure above pmin, PEAK_STRIDE reals each. */
-static PetscErrorCode LocalContactRows(DM dm, const ContactSet *cs, PetscInt dim, PetscReal pmin, PetscInt *n, PetscReal **rows)
+/* The vertices of this rank's contact set that carry a pressure above pmin (in_contact), or pmin or less (not), PEAK_STRIDE
+   reals each. */
+static PetscErrorCode LocalContactRows(DM dm, const ContactSet *cs, PetscInt dim, PetscReal pmin, PetscBool in_contact, PetscInt *n, PetscReal **rows)
 {
   PetscSection       csec;
   Vec                coords;
@@ -88,7 +89,7 @@ static PetscErrorCode LocalContactRows(DM dm, const ContactSet *cs, PetscInt dim
     PetscInt   off;
     PetscReal *row = &(*rows)[*n * PEAK_STRIDE];
 
-    if (!cs->is_vertex[i] || !(cs->pressure[i] > pmin)) continue;
+    if (!cs->is_vertex[i] || (PetscBool)(cs->pressure[i] > pmin) != in_contact) continue;
     PetscCall(PetscSectionGetOffset(csec, cs->point[i], &off));
     for (PetscInt d = 0; d < 3; ++d) {
       row[d]     = d < dim ? PetscRealPart(xc[off + d]) : 0.0;
@@ -309,32 +310,6 @@ static PetscBool LeastSquares(PetscInt k, PetscInt m, PetscReal A[], const Petsc
   return PETSC_TRUE;
 }
 
-/* The distance from top to the nearest vertex of this rank's contact set that carries no pressure (pmin or less): the
-   zone's edge, as far as the zone reaches on this rank; PETSC_MAX_REAL where every vertex is in contact. */
-static PetscErrorCode LocalEdgeDistance(DM dm, const ContactSet *cs, PetscInt dim, PetscReal pmin, const PetscReal top[], PetscReal *dist)
-{
-  PetscSection       csec;
-  Vec                coords;
-  const PetscScalar *xc;
-
-  PetscFunctionBeginUser;
-  PetscCall(DMGetCoordinateSection(dm, &csec));
-  PetscCall(DMGetCoordinatesLocal(dm, &coords));
-  PetscCall(VecGetArrayRead(coords, &xc));
-  *dist = PETSC_MAX_REAL;
-  for (PetscInt i = 0; i < cs->n; ++i) {
-    PetscInt  off;
-    PetscReal d2 = 0.0;
-
-    if (!cs->is_vertex[i] || cs->pressure[i] > pmin) continue;
-    PetscCall(PetscSectionGetOffset(csec, cs->point[i], &off));
-    for (PetscInt d = 0; d < dim; ++d) d2 += PetscSqr(PetscRealPart(xc[off + d]) - top[d]);
-    *dist = PetscMin(*dist, PetscSqrtReal(d2));
-  }
-  PetscCall(VecRestoreArrayRead(coords, &xc));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* The peak and its resolution (the head of the file), on every rank; pressure_max and step, the nodal maximum and its
    step (PostprocessPressureStep()), where there is too little contact to fit. */
 PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal step, PetscReal *peak, PetscReal *resolution)
@@ -359,7 +334,7 @@ PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_m
     if (cs->is_vertex[i]) pmax = PetscMax(pmax, cs->pressure[i]);
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &pmax, 1, MPIU_REAL, MPIU_MAX, comm));
   if (!(pmax > 0.0)) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(LocalContactRows(dm, cs, dim, PEAK_TIE * pmax, &nlocal, &mine));
+  PetscCall(LocalContactRows(dm, cs, dim, PEAK_TIE * pmax, PETSC_TRUE, &nlocal, &mine));
   PetscCall(MPIU_Allreduce(&nlocal, &ntotal, 1, MPIU_INT, MPI_SUM, comm));
   m = dim == 2 ? 3 : 6;
   k = PetscMin(dim == 2 ? PEAK_NODES_2D : PEAK_NODES_3D, ntotal);
@@ -372,9 +347,23 @@ PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_m
   PetscCall(AllgatherRows(comm, lt >= 0 ? 1 : 0, lt >= 0 ? &mine[lt * PEAK_STRIDE] : mine, &ntops, &tops));
   PetscCall(PetscArraycpy(top, &tops[TopRow(ntops, tops, pmax) * PEAK_STRIDE], PEAK_STRIDE));
   PetscCall(PetscFree(tops));
-  /* the patch: the nodes within PEAK_ZONE of the top's distance to the zone's edge, and at least the k nearest; each
-     rank's own such nodes hold all of the patch's */
-  PetscCall(LocalEdgeDistance(dm, cs, dim, PEAK_TIE * pmax, top, &edge));
+  /* the patch: the nodes within PEAK_ZONE of the top's distance to the zone's edge (the nearest vertex without pressure,
+     PETSC_MAX_REAL where every vertex is in contact), and at least the k nearest; each rank's own such nodes hold all of
+     the patch's */
+  {
+    PetscReal *out;
+    PetscInt   nout;
+
+    PetscCall(LocalContactRows(dm, cs, dim, PEAK_TIE * pmax, PETSC_FALSE, &nout, &out));
+    edge = PETSC_MAX_REAL;
+    for (PetscInt i = 0; i < nout; ++i) {
+      PetscReal d2 = 0.0;
+
+      for (PetscInt d = 0; d < 3; ++d) d2 += PetscSqr(out[i * PEAK_STRIDE + d] - top[d]);
+      edge = PetscMin(edge, PetscSqrtReal(d2));
+    }
+    PetscCall(PetscFree(out));
+  }
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &edge, 1, MPIU_REAL, MPIU_MIN, comm));
   edge = edge < PETSC_MAX_REAL ? PEAK_ZONE * edge : 0.0;
   PetscCall(SortByDistance(nlocal, mine, top, &order));
