@@ -39,22 +39,16 @@ def test_the_force_at_eps_over_10_from_the_tangent_is_the_solve_s(eps0):
     assert abs(d_tangent / d_solve - 1) <= 0.15, (d_tangent, d_solve)
 
 
-def _two_level(c, q, last, order, dim=2):
+def _two_level(c, q, last, order, dim=2, deviation=None):
     """Roache's two-level index of cycle last against the last cycle with 2^dim times fewer unknowns and the one before
-    it, safety factor 3 (src/estimate/cycle_bars.c), or None before both exist."""
+    it, safety factor 3 (src/estimate/cycle_bars.c), or None before both exist; with deviation (a /cycles name: the
+    recovered peak's resolution, PeakBar()), on the part of each change beyond twice the two cycles' deviations."""
     n = c["n_dofs"]
     j = max((m for m in range(last) if n[m] * 2**dim <= n[last]), default=-1)
     if j < 1:
         return None
-    return max(3 * abs(c[q][m] - c[q][last]) / ((n[last] / n[m]) ** (order / dim) - 1) for m in (j, j - 1))
-
-
-def _peak_index(c, last, dim=2):
-    """The recovered peak's index: _two_level()'s at the order 1 on the part of each change beyond twice its standard
-    deviation, the two cycles' resolutions (src/estimate/cycle_bars.c, PeakBar())."""
-    n, v, res = c["n_dofs"], c["pressure_peak_value"], c["pressure_peak_resolution"]
-    j = max((m for m in range(last) if n[m] * 2**dim <= n[last]), default=-1)
-    return max(3 * max(abs(v[m] - v[last]) - 2 * np.hypot(res[m], res[last]), 0) / ((n[last] / n[m]) ** (1 / dim) - 1) for m in (j, j - 1))
+    s = np.zeros(len(n)) if deviation is None else c[deviation]
+    return max(3 * max(abs(c[q][m] - c[q][last]) - 2 * np.hypot(s[m], s[last]), 0) / ((n[last] / n[m]) ** (order / dim) - 1) for m in (j, j - 1))
 
 
 @pytest.mark.parametrize("eps0", ["1", "0.1"])
@@ -85,7 +79,7 @@ def test_the_size_and_pressure_bars_take_their_penalty_parts_apart(eps0):
             pressure = _two_level(c, "pressure_max_value", last, 1.0) + abs(c["pressure_max_value"][last] - c["pressure_max_value_eps"][last]) * (1 + 3 / 9)
             pressure = max(pressure, c["pressure_max_step"][last])
             assert abs(c["pressure_max_bar"][last] / pressure - 1) < 1e-12, (last, c["pressure_max_bar"][last], pressure)
-            peak = (_peak_index(c, last) + abs(c["pressure_peak_value"][last] - c["pressure_peak_value_eps"][last]) * (1 + 3 / 9)
+            peak = (_two_level(c, "pressure_peak_value", last, 1.0, deviation="pressure_peak_resolution") + abs(c["pressure_peak_value"][last] - c["pressure_peak_value_eps"][last]) * (1 + 3 / 9)
                     + 2 * c["pressure_peak_resolution"][last])
             assert abs(c["pressure_peak_bar"][last] / peak - 1) < 1e-12, (last, c["pressure_peak_bar"][last], peak)
             checked += 1

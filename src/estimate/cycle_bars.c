@@ -104,6 +104,12 @@ static PetscReal Size(const CycleRecord *c, PetscInt dim)
   return PetscPowReal((PetscReal)c->n_dofs, -1.0 / dim);
 }
 
+/* Roache's two-level index of the last cycle against cycle m, from the change of a quantity between them, at the order r. */
+static PetscReal Index(const CycleRecord c[], PetscInt m, PetscInt last, PetscInt dim, PetscReal change, PetscReal r)
+{
+  return CYCLE_SAFETY * change / (PetscPowReal(Size(&c[m], dim) / Size(&c[last], dim), r) - 1.0);
+}
+
 /* The bar of quantity k on the last cycle, NaN before the cycle twice as coarse and the one before it exist; r its order. */
 static PetscReal Bar(const CycleRecord c[], PetscInt k, PetscInt last, PetscInt dim, PetscReal r)
 {
@@ -111,9 +117,7 @@ static PetscReal Bar(const CycleRecord c[], PetscInt k, PetscInt last, PetscInt 
   PetscReal      bar = 0.0;
 
   if (j < 1) return PETSC_NAN;
-  for (PetscInt m = j; m >= j - 1; --m)
-    bar = PetscMax(bar,
-                   CYCLE_SAFETY * PetscAbsReal(c[m].value[k] - c[last].value[k]) / (PetscPowReal(Size(&c[m], dim) / Size(&c[last], dim), r) - 1.0));
+  for (PetscInt m = j; m >= j - 1; --m) bar = PetscMax(bar, Index(c, m, last, dim, PetscAbsReal(c[m].value[k] - c[last].value[k]), r));
   return bar;
 }
 
@@ -137,8 +141,7 @@ static PetscReal ForceBar(const CycleRecord c[], PetscInt last, PetscInt dim)
   for (PetscInt m = j; m >= j - 1; --m) {
     const PetscReal f0 = (R * c[m].value_eps[k] - c[m].value[k]) / (R - 1.0);
 
-    mesh =
-        PetscMax(mesh, CYCLE_SAFETY * PetscAbsReal(f0 - f0_last) / (PetscPowReal(Size(&c[m], dim) / Size(&c[last], dim), CYCLE_ORDER_FORCE) - 1.0));
+    mesh = PetscMax(mesh, Index(c, m, last, dim, PetscAbsReal(f0 - f0_last), CYCLE_ORDER_FORCE));
   }
   return mesh + PenaltyPart(&c[last], k, 1.0);
 }
@@ -164,7 +167,7 @@ static PetscReal PeakBar(const CycleRecord c[], PetscInt last, PetscInt dim)
     const PetscReal noise  = CYCLE_PEAK_NOISE * PetscSqrtReal(PetscSqr(c[m].q.pressure_peak_resolution) + PetscSqr(res)),
                     change = PetscMax(PetscAbsReal(c[m].value[k] - c[last].value[k]) - noise, 0.0);
 
-    index = PetscMax(index, CYCLE_SAFETY * change / (PetscPowReal(Size(&c[m], dim) / Size(&c[last], dim), CYCLE_ORDER) - 1.0));
+    index = PetscMax(index, Index(c, m, last, dim, change, CYCLE_ORDER));
   }
   return index + (PetscIsNanReal(penalty) ? 0.0 : penalty) + CYCLE_PEAK_NOISE * res;
 }

@@ -150,19 +150,23 @@ static PetscInt TopRow(PetscInt n, const PetscReal rows[], PetscReal pmax)
   return top;
 }
 
+/* The distance from a gathered node's row to top. */
+static PetscReal RowDistance(const PetscReal row[], const PetscReal top[])
+{
+  PetscReal d2 = 0.0;
+
+  for (PetscInt d = 0; d < 3; ++d) d2 += PetscSqr(row[d] - top[d]);
+  return PetscSqrtReal(d2);
+}
+
 /* The rows in the order of their distance to top (ComparePeakNodes()). */
 static PetscErrorCode SortByDistance(PetscInt n, const PetscReal rows[], const PetscReal top[], PeakNode **order)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscMalloc1(n + 1, order));
   for (PetscInt i = 0; i < n; ++i) {
-    PetscReal d2 = 0.0;
-
-    for (PetscInt d = 0; d < 3; ++d) {
-      (*order)[i].x[d] = rows[i * PEAK_STRIDE + d];
-      d2 += PetscSqr(rows[i * PEAK_STRIDE + d] - top[d]);
-    }
-    (*order)[i].dist = PetscSqrtReal(d2);
+    for (PetscInt d = 0; d < 3; ++d) (*order)[i].x[d] = rows[i * PEAK_STRIDE + d];
+    (*order)[i].dist = RowDistance(&rows[i * PEAK_STRIDE], top);
     (*order)[i].i    = i;
   }
   qsort(*order, n, sizeof(**order), ComparePeakNodes);
@@ -356,12 +360,7 @@ PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_m
 
     PetscCall(LocalContactRows(dm, cs, dim, PEAK_TIE * pmax, PETSC_FALSE, &nout, &out));
     edge = PETSC_MAX_REAL;
-    for (PetscInt i = 0; i < nout; ++i) {
-      PetscReal d2 = 0.0;
-
-      for (PetscInt d = 0; d < 3; ++d) d2 += PetscSqr(out[i * PEAK_STRIDE + d] - top[d]);
-      edge = PetscMin(edge, PetscSqrtReal(d2));
-    }
+    for (PetscInt i = 0; i < nout; ++i) edge = PetscMin(edge, RowDistance(&out[i * PEAK_STRIDE], top));
     PetscCall(PetscFree(out));
   }
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &edge, 1, MPIU_REAL, MPIU_MIN, comm));
