@@ -75,7 +75,8 @@ PetscErrorCode ContactGetEpsRange(Contact ct, PetscReal *eps_min, PetscReal *eps
 PetscErrorCode ContactFaceEps(Contact ct, PetscReal cell_diameter, PetscReal *eps);
 PetscErrorCode ContactGetPenaltyScale(Contact ct, PetscReal *eps_start);
 PetscErrorCode ContactGetSet(Contact ct, const ContactSet **cs);
-PetscErrorCode ContactUnseenNodes(Contact ct, Vec u, PetscBool unseen[], PetscInt *count); /* penetrating with no force from the rule */
+PetscErrorCode ContactUnseenNodes(Contact ct, Vec u, PetscBool unseen[], PetscInt *count,
+                                  PetscReal *force); /* penetrating with no force from the rule */
 
 /* The terms of the nonlinear problem: F(u) = K u + r0 + (contact term), J = K + (contact Jacobian). */
 PetscErrorCode ContactAddResidual(Contact ct, DM dm, Vec u, Vec F);

@@ -257,6 +257,7 @@ typedef struct {
 #define CONTACT_CHECK_OVERLAP_RATIO 0.1 /*   and than this part of the overlapped part's width is warned of */
 #define CONTACT_CHECK_ZONE_CELLS_2D 4.0 /* a contact zone spanning fewer cells is warned of (bench/zone_resolution.md) */
 #define CONTACT_CHECK_ZONE_CELLS_3D 6.0 /*   in 3D (bench/zone_resolution_3d.md) */
+#define CONTACT_CHECK_UNSEEN_SHARE 1e-3 /* unseen contact is warned of where the penalty law would put this part of the force on it */
 #define MESH_CURVED_RIDGES_MIN 3        /* a mesh file's boundary turning by a small angle at this many ridges is curved (MeshCountCurvedRidges()) */
 typedef struct {
   PetscBool geometry_checked, resolution_checked;
@@ -267,7 +268,9 @@ typedef struct {
   PetscInt  zone_faces;         /* faces of Gamma_C whose every node carries contact force */
   PetscReal zone_cells;         /* cells across the contact zone: zone_faces in 2D, sqrt(2 zone_faces / pi) in 3D */
   PetscReal zone_limit;         /* fewer cells are warned of: CONTACT_CHECK_ZONE_CELLS_2D or _3D */
-  PetscInt  unseen_nodes;       /* contact nodes that penetrate while the rule exerts no force on them (ContactUnseenNodes()) */
+  PetscInt  unseen_nodes;       /* contact nodes that penetrate while the rule exerts no force on them (ContactUnseenNodes()), */
+  PetscReal unseen_force;       /*   the force the penalty law would put on them, */
+  PetscReal unseen_share;       /*   and its part of the force's magnitude (PETSC_INFINITY where the force is zero) */
   PetscInt  curved_refined;     /* a mesh file's curved boundary (MeshBox.curved_ridges) that the solver refined on its chords: its ridges, */
   PetscInt  curved_refinements; /*   the refinements (-dm_refine and -contact_grid_sequence), */
   PetscReal curved_x[3];        /*   and one of the ridges */
@@ -392,7 +395,8 @@ typedef struct {
   PetscReal  bar[ACCURACY_NUM];       /*   and their error bars (the energy: the estimate), NaN where there is none */
   PetscReal  value_eps[ACCURACY_NUM]; /* the quantities at eps / CYCLE_EPS_RATIO on the same mesh (the tangent's), NaN without them */
   PetscReal  eps, eps_scale;          /* the penalty's eps on the cycle and its scale h/M (h: the smallest contact cell), NaN without it */
-  PetscInt   unseen;                  /* contact nodes the rule does not see (EstimateMarkUnseenContact()) */
+  PetscInt   unseen;                  /* contact nodes the rule does not see (EstimateMarkUnseenContact()), */
+  PetscReal  unseen_force;            /*   and the force the penalty law would put on them */
   PetscBool  accurate;                /* every quantity asked for within -accuracy */
   PetscInt   newton_its, ksp_its;
   PetscReal  time_solve;

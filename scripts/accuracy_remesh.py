@@ -40,6 +40,9 @@ def main():
     ap.add_argument("--outdir", default=os.path.join(ROOT, "output", "accuracy_remesh"))
     ap.add_argument("--radius", type=float, default=hertz.RADIUS,
                     help="the sphere indenter's rigid radius, its depth 0.01 / radius (the same a; the closed form neglects terms of order a / R)")
+    ap.add_argument("--hand-h-near", default=None, help="the hand-graded meshes' h_near, comma-separated (default: make hertz's, the case's)")
+    ap.add_argument("--hand-h-far", type=float, default=None,
+                    help="the hand-graded meshes' far-field size (default: make hertz's, 0.2 on the sphere, whose force stands 3%% off)")
     args = ap.parse_args()
     os.makedirs(args.outdir, exist_ok=True)
     rows, md = [], []
@@ -60,10 +63,13 @@ def main():
         axis = "xyz"[hertz.CASES[case]["dim"] - 1]
         force_ref = abs(float(adaptive[tols[-1]][1][f"contact_force_{axis}"]))
         hand = []
-        for h_near in hertz.CASES[case]["h_near"]:
-            hmesh = os.path.join(args.outdir, f"{case}_graded_{h_near:g}.msh")
-            hertz.write_mesh(case, h_near, hmesh)
-            out = os.path.join(args.outdir, f"{case}_graded_{h_near:g}.h5")
+        h_nears = [float(v) for v in args.hand_h_near.split(",")] if args.hand_h_near else hertz.CASES[case]["h_near"]
+        far = {"h_far": args.hand_h_far} if args.hand_h_far else {}
+        for h_near in h_nears:
+            label = f"{h_near:g}" + (f"_far{args.hand_h_far:g}" if far else "")
+            hmesh = os.path.join(args.outdir, f"{case}_graded_{label}.msh")
+            hertz.write_mesh(case, h_near, hmesh, **far)
+            out = os.path.join(args.outdir, f"{case}_graded_{label}.h5")
             hcmd = hertz.command(case, hmesh, "eps=h/10", out, radius=args.radius)[3:] + SOLVER[case]
             solve(hcmd)
             hand.append((h_near, hcmd, read_run(out), hertz.measure(case, out, radius=args.radius)))

@@ -155,6 +155,16 @@ def big_block(tmp_path_factory):
     return path
 
 
+def accurate(c, tol, quantities):
+    """Accurate() of src/solver/adapt.c recomputed from /cycles: a converged solve, the force the penalty law would put
+    on the contact nodes the rule misses at most a tenth of tol times the force, and each bar at most tol times its
+    value."""
+    ok = (c["converged"] == 1) & ((c["unseen_contact"] == 0) | (c["unseen_force"] <= 0.1 * tol * np.abs(c["contact_force_value"])))
+    for q in quantities:
+        ok &= c[f"{q}_bar"] <= tol * np.abs(c[f"{q}_value"])  # NaN: no bar yet
+    return ok
+
+
 def indenter(mesh):
     return hertz.command("cylinder-indenter", mesh, "eps=h/10", "unused.h5")[4:-2]
 
@@ -167,10 +177,19 @@ def test_a_mesh_that_does_not_see_the_contact_is_refined_where_it_penetrates(big
     out, h5 = run(indenter(big_block), "accuracy_unseen_single")
     a, _ = load(h5)
     assert a["contact_unseen_nodes"] == 1 and a["contact_force_y"] == 0.0 and a["warnings"] >= 1, (a["contact_unseen_nodes"], a["warnings"])
-    assert "penetrate the obstacle while the penalty rule exerts no force on them" in out
+    assert "penetrate the obstacle while the penalty rule exerts no force on them (the rule exerts no force at all)" in out
+    # the force the penalty law would put on that node, w d / eps_i, with eps_i between the run's eps_min and eps_max
+    with h5py.File(h5, "r") as f:
+        v = f["vertex_fields"]
+        d, w = -v["normal_gap"][:], v["contact_area"][:]
+        node = np.argmax(np.where(v["contact_boundary"][:] > 0, d, -np.inf))
+    assert d[node] > 0.0
+    law = w[node] * d[node]
+    assert law / a["eps_max"] * (1 - 1e-12) <= a["contact_unseen_force"] <= law / a["eps_min"] * (1 + 1e-12), (a["contact_unseen_force"], law / a["eps"])
     _, h5 = run(indenter(big_block) + ["-adapt_cycles", 4], "accuracy_unseen")
     c = cycles(h5)
     assert c["unseen_contact"][0] >= 1 and c["contact_force_y"][0] == 0.0 and c["estimate"][0] == 0.0, c
+    assert c["unseen_force"][0] > 0.0 and np.all((c["unseen_force"] > 0) == (c["unseen_contact"] > 0)), c["unseen_force"]
     assert c["unseen_contact"][-1] == 0 and c["contact_force_y"][-1] < 0.0, c
     assert np.all(c["accurate"] == 0)
     a, _ = load(h5)
@@ -187,6 +206,9 @@ def test_accuracy_ladder_on_the_hertz_indenter(big_block):
         a, _ = load(h5)
         assert a["accuracy_reached"] == 1, tol
         runs[tol] = (a, cycles(h5))
+        c = runs[tol][1]
+        assert np.array_equal(c["accurate"] == 1, accurate(c, tol, ("contact_force", "pressure_max", "contact_size"))), (tol, c["accurate"])
+        assert c["unseen_contact"][0] > 0 and c["accurate"][0] == 0  # the coarse mesh misses the zone (test above)
     fine = runs[0.01][1]["contact_force_value"][-1]
     for tol, (a, c) in runs.items():
         force = c["contact_force_value"][-1]

@@ -538,28 +538,35 @@ PetscErrorCode ContactPostProcess(Contact ct, DM dm, Vec R, Vec u, PetscReal tol
    point 0.1 from the axis): the discrete problem has no contact there, its solution and its error estimate are zero.
    A node the rule sees has the penalty's pressure d / eps_i at its penetration d, or more; an unseen one has less than
    CONTACT_UNSEEN_FRACTION of it. unseen[i] (NULL: not asked) flags this rank's nodes, *count is over all ranks.
-   SNESVI and no contact see every node: none. */
+   *force (NULL: not asked) is the force the penalty law would put on them, the sum of w_i d_i / eps_i (w_i the node's
+   lumped area): what the solution misses there, to first order. That weighs an unseen node: on the coarse block it is
+   the whole force (the rule's force is zero); at the edge of a resolved zone, where a node penetrates by a hundredth of
+   the largest penetration between two of the rule's points, it is a negligible part (the sphere indenter at R = 10
+   and 1.8 million unknowns: 15 nodes, 5.6e-7 of the force). SNESVI and no contact see every node: none. */
 #define CONTACT_UNSEEN_FRACTION 1e-2
 
-PetscErrorCode ContactUnseenNodes(Contact ct, Vec u, PetscBool unseen[], PetscInt *count)
+PetscErrorCode ContactUnseenNodes(Contact ct, Vec u, PetscBool unseen[], PetscInt *count, PetscReal *force)
 {
   const ContactSet  *cs = &ct->set;
   const PetscScalar *x;
-  PetscInt           local = 0;
+  PetscInt           local       = 0;
+  PetscReal          local_force = 0.0;
 
   PetscFunctionBeginUser;
   for (PetscInt i = 0; i < cs->n && unseen; ++i) unseen[i] = PETSC_FALSE;
   if (ct->has_penalty) {
     PetscCall(VecGetArrayRead(u, &x));
     for (PetscInt i = 0; i < cs->n; ++i) {
-      const PetscReal d = ContactNodePenetration(cs, ct->dim, i, x);
+      const PetscReal d = ContactNodePenetration(cs, ct->dim, i, x), eps = ContactNodeEps(cs, ct->eps, i);
 
-      if (!(d > 0.0) || cs->pressure[i] >= CONTACT_UNSEEN_FRACTION * d / ContactNodeEps(cs, ct->eps, i)) continue;
+      if (!(d > 0.0) || cs->pressure[i] >= CONTACT_UNSEEN_FRACTION * d / eps) continue;
       ++local;
+      local_force += cs->weight[i] * d / eps;
       if (unseen) unseen[i] = PETSC_TRUE;
     }
     PetscCall(VecRestoreArrayRead(u, &x));
   }
+  if (force) PetscCall(MPIU_Allreduce(&local_force, force, 1, MPIU_REAL, MPIU_SUM, ct->comm));
   PetscCall(MPIU_Allreduce(&local, count, 1, MPIU_INT, MPI_SUM, ct->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -61,8 +61,9 @@ PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DM
 /* The cells around each contact node the mesh does not see (ContactUnseenNodes(): it penetrates the obstacle while the
    rule exerts no force on it, as on a mesh whose Gauss points all miss the contact zone, where the solution and the
    estimate are zero) are marked too (added to *marked, created if NULL and there is one), so that the cycles refine
-   until the rule sees the contact; *nunseen counts the nodes over all ranks. */
-PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nunseen)
+   until the rule sees the contact; *nunseen counts the nodes over all ranks, *force is the force the penalty law
+   would put on them. */
+PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nunseen, PetscReal *force)
 {
   const ContactSet *cs;
   PetscBool        *unseen;
@@ -71,7 +72,7 @@ PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *ma
   PetscFunctionBeginUser;
   PetscCall(ContactGetSet(user->contact, &cs));
   PetscCall(PetscMalloc1(cs->n + 1, &unseen));
-  PetscCall(ContactUnseenNodes(user->contact, u, unseen, nunseen));
+  PetscCall(ContactUnseenNodes(user->contact, u, unseen, nunseen, force));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   for (PetscInt i = 0; i < cs->n; ++i) {
     PetscInt *star = NULL, nstar;

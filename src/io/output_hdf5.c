@@ -425,7 +425,8 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     if (s->checks.resolution_checked) {
       PetscCall(WriteIntAttr(v, "contact_zone_faces", s->checks.zone_faces));
       PetscCall(WriteRealAttr(v, "contact_zone_cells", s->checks.zone_cells));
-      PetscCall(WriteIntAttr(v, "contact_unseen_nodes", s->checks.unseen_nodes)); /* penetrating with no force from the rule: a warning */
+      PetscCall(WriteIntAttr(v, "contact_unseen_nodes", s->checks.unseen_nodes));  /* penetrating with no force from the rule, */
+      PetscCall(WriteRealAttr(v, "contact_unseen_force", s->checks.unseen_force)); /* the law's force there: a warning above a share */
     }
   }
   PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));
@@ -656,6 +657,7 @@ static PetscErrorCode WriteCycles(MPI_Comm comm, const AppCtx *user, PetscViewer
   }
   CYCLE_COLUMN("eps", c[i].eps);
   CYCLE_COLUMN("unseen_contact", (PetscReal)c[i].unseen);
+  CYCLE_COLUMN("unseen_force", c[i].unseen_force);
   CYCLE_COLUMN("accurate", c[i].accurate ? 1.0 : 0.0);
   CYCLE_COLUMN("error_energy", c[i].error_energy);
   CYCLE_COLUMN("marked", (PetscReal)c[i].marked);

@@ -157,7 +157,13 @@ PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user, Vec u)
   ck->zone_cells         = dim == 2 ? (PetscReal)ck->zone_faces : PetscSqrtReal(2.0 * (PetscReal)ck->zone_faces / PETSC_PI);
   ck->zone_limit         = dim == 2 ? CONTACT_CHECK_ZONE_CELLS_2D : CONTACT_CHECK_ZONE_CELLS_3D;
   ck->resolution_checked = PETSC_TRUE;
-  PetscCall(ContactUnseenNodes(user->contact, u, NULL, &ck->unseen_nodes));
+  PetscCall(ContactUnseenNodes(user->contact, u, NULL, &ck->unseen_nodes, &ck->unseen_force));
+  {
+    const PetscReal *f     = user->rec.stats.contact_force_vector;
+    const PetscReal  force = PetscSqrtReal(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
+
+    ck->unseen_share = ck->unseen_nodes == 0 ? 0.0 : (force > 0.0 ? ck->unseen_force / force : PETSC_INFINITY);
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -192,14 +198,20 @@ PetscErrorCode ContactChecksWarnings(MPI_Comm comm, const ContactChecks *ck, Pet
                             "contact\n",
                             (double)ck->zone_cells, ck->zone_faces, (double)ck->zone_limit));
   }
-  if (ck->resolution_checked && ck->unseen_nodes > 0) {
+  if (ck->resolution_checked && ck->unseen_nodes > 0 && !(ck->unseen_share <= CONTACT_CHECK_UNSEEN_SHARE)) {
+    char share[64];
+
+    if (ck->unseen_share >= PETSC_INFINITY)
+      PetscCall(PetscSNPrintf(share, sizeof(share), "the rule exerts no force at all"));
+    else
+      PetscCall(PetscSNPrintf(share, sizeof(share), "the penalty law would put %.2g%% of the force on them", (double)(100.0 * ck->unseen_share)));
     ++n;
     if (print)
       PetscCall(PetscPrintf(comm,
-                            "  WARNING: %" PetscInt_FMT " node(s) of Gamma_C penetrate the obstacle while the penalty rule exerts no force on them: "
-                            "the contact zone there is smaller than the faces, and the rule's points miss it (the force and the estimate see "
-                            "no contact); refine near the contact, or let -adapt_cycles or -accuracy refine there\n",
-                            ck->unseen_nodes));
+                            "  WARNING: %" PetscInt_FMT " node(s) of Gamma_C penetrate the obstacle while the penalty rule exerts no force on them "
+                            "(%s): the contact zone there is smaller than the faces, and the rule's points miss it (the force and the estimate "
+                            "see no contact); refine near the contact, or let -adapt_cycles or -accuracy refine there\n",
+                            ck->unseen_nodes, share));
   }
   if (ck->curved_refined) {
     ++n;
