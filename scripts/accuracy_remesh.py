@@ -101,7 +101,8 @@ def main():
               "bar_pressure", "bar_contact_size", "a_error", "p0_error", "covered", "hand_h_near", "hand_n_dofs", "hand_time", "time_ratio"]
     write_text(os.path.join(args.outdir, "accuracy_remesh.csv"), csv_text(header, rows))
     text = ["# -accuracy by remeshing the Gmsh model on make hertz's curved bodies (eps = h/10)", "",
-            f"`/usr/bin/python3 scripts/accuracy_remesh.py --cases {args.cases} --tols {args.tols} --tols-3d {args.tols_3d} --pairs {args.pairs} --radius {args.radius:g}`. The cylinder starts "
+            f"`/usr/bin/python3 scripts/accuracy_remesh.py --cases {args.cases} --tols {args.tols} --tols-3d {args.tols_3d} --pairs {args.pairs} --radius {args.radius:g}"
+            + (f" --hand-h-near {args.hand_h_near}" if args.hand_h_near else "") + (f" --hand-h-far {args.hand_h_far:g}" if args.hand_h_far else "") + f"`. The cylinder starts "
             "from a uniform h = 0.1, the sphere from 0.2. Errors: the largest pressure (the nodal maximum in 2D, the recovered peak "
             "pressure_peak in 3D) and the size (2D half-width, 3D quarter area) against "
             "the closed form at the run's force, the force against the finest run's; in brackets the run's bar (relative); make hertz's "
