@@ -191,6 +191,8 @@ def test_a_mesh_that_does_not_see_the_contact_is_refined_where_it_penetrates(big
     assert c["unseen_contact"][0] >= 1 and c["contact_force_y"][0] == 0.0 and c["estimate"][0] == 0.0, c
     assert c["unseen_force"][0] > 0.0 and np.all((c["unseen_force"] > 0) == (c["unseen_contact"] > 0)), c["unseen_force"]
     c2 = cycles(run(indenter(big_block) + ["-adapt_cycles", 4], "accuracy_unseen_np2", np_=2)[1])  # summed over the ranks
+    out, _ = run(indenter(big_block) + ["-accuracy", 0.1, "-adapt_cycles", 1], "accuracy_unseen_held")
+    assert re.search(r"not reached after 1 cycles \(\d+ dofs\): the mesh does not see the contact at some nodes", out), out[-1500:]
     assert np.array_equal(c2["unseen_contact"], c["unseen_contact"]) and np.allclose(c2["unseen_force"], c["unseen_force"], rtol=1e-10, atol=0)
     assert c["unseen_contact"][-1] == 0 and c["contact_force_y"][-1] < 0.0, c
     assert np.all(c["accurate"] == 0)

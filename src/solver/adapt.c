@@ -233,10 +233,14 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
    indenter at R = 10 and 0.3%: 5 and 15 such nodes on its last two cycles, 3.5e-7 and 5.6e-7 of the force). */
 #define ADAPT_UNSEEN_SHARE 0.1
 
+static PetscBool UnseenHolds(const AdaptOptions *ad, const CycleRecord *c)
+{
+  return (PetscBool)(c->unseen && !(c->unseen_force <= ADAPT_UNSEEN_SHARE * ad->accuracy * c->value[ACCURACY_FORCE]));
+}
+
 static PetscBool Accurate(const AdaptOptions *ad, const CycleRecord *c)
 {
-  if (!(ad->accuracy > 0.0) || !c->converged) return PETSC_FALSE;
-  if (c->unseen && !(c->unseen_force <= ADAPT_UNSEEN_SHARE * ad->accuracy * c->value[ACCURACY_FORCE])) return PETSC_FALSE;
+  if (!(ad->accuracy > 0.0) || !c->converged || UnseenHolds(ad, c)) return PETSC_FALSE;
   for (PetscInt k = 0; k < ACCURACY_NUM; ++k)
     if (ad->target[k] && !(c->bar[k] <= ad->accuracy * PetscAbsReal(c->value[k]))) return PETSC_FALSE; /* NaN: not yet */
   return PETSC_TRUE;
@@ -377,7 +381,7 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
     else
       PetscCall(PetscPrintf(
           comm, "  WARNING: accuracy %g not reached after %" PetscInt_FMT " cycles (%" PetscInt_FMT " dofs)%s%s; the last cycle's bars:\n",
-          (double)ad->accuracy, user->rec.ncycles - 1, c->n_dofs, c->unseen ? ": the mesh does not see the contact at some nodes" : "",
+          (double)ad->accuracy, user->rec.ncycles - 1, c->n_dofs, UnseenHolds(ad, c) ? ": the mesh does not see the contact at some nodes" : "",
           !c->converged ? ": the last solve failed" : ""));
     for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
       if (!ad->target[k]) continue;
