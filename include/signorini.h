@@ -370,6 +370,10 @@ typedef struct {
    first solve, and the fraction of the estimate's square the marked cells hold (Doerfler's theta). */
 typedef enum { ACCURACY_ENERGY, ACCURACY_FORCE, ACCURACY_PRESSURE, ACCURACY_SIZE, ACCURACY_PEAK, ACCURACY_NUM } AccuracyQuantity;
 extern const char *const AccuracyQuantities[];
+/* Why the cycles stopped (/run adapt_stop): -accuracy reached, the cycles of -adapt_cycles done, the mesh at
+   -adapt_max_dofs, a failed solve, or nothing left to refine (a zero estimate). */
+typedef enum { ADAPT_STOP_ACCURACY, ADAPT_STOP_CYCLES, ADAPT_STOP_MAX_DOFS, ADAPT_STOP_SOLVE_FAILED, ADAPT_STOP_NOTHING_MARKED } AdaptStop;
+extern const char *const AdaptStops[];
 typedef struct {
   PetscInt  cycles;                    /* 0: no adaptive refinement; with -accuracy, the most cycles */
   PetscReal fraction;                  /* -adapt_fraction (0: the default, AdaptSolve()'s) */
@@ -379,6 +383,7 @@ typedef struct {
   PetscReal newton_fraction;           /* -accuracy_newton_fraction: Newton stops at this fraction of the error (0: never) */
   PetscBool mark_edge;                 /* -adapt_mark_edge: with -accuracy on the size, refine along the zone's edge too */
   PetscBool monitor;                   /* -adapt_monitor: a line for each cycle as it ends */
+  PetscInt  max_dofs;                  /* -adapt_max_dofs: no mesh with this many unknowns or more is refined (0: no limit) */
 } AdaptOptions;
 
 /* One cycle of the adaptive refinement (/cycles in the output): the mesh, the estimate of its solution and the true
@@ -474,6 +479,7 @@ typedef struct {
   CycleRecord  *cycles; /* one per mesh of the adaptive refinement (-adapt_cycles) */
   PetscInt      ncycles;
   PetscReal     adapt_fraction;           /*   the fraction of the estimate's square they marked (Doerfler's theta) */
+  AdaptStop     adapt_stop;               /*   and why they stopped */
   ErrorNorms    errors;                   /* against the scene's exact solution */
   ErrorNorms    ref_errors;               /* against the -reference solution */
   ErrorEstimate estimate;                 /* the a posteriori estimate of the error */

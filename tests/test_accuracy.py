@@ -109,7 +109,7 @@ def test_accuracy_on_the_manufactured_solution_ends_within_the_tolerance():
     a, _ = load(h5)
     c = cycles(h5)
     assert a["accuracy_reached"] == 1 and c["accurate"][-1] == 1 and np.all(c["accurate"][:-1] == 0), c["accurate"]
-    assert "accuracy 0.1 reached at cycle" in out
+    assert "accuracy 0.1 reached at cycle" in out and a["adapt_stop"] == "accuracy"
     norm = c["energy_value"][-1]
     assert c["estimate"][-1] <= 0.1 * norm and c["error_energy"][-1] <= 0.1 * norm / 3, (c["estimate"][-1], c["error_energy"][-1], norm)
     for q, exact in MMS_EXACT.items():
@@ -119,6 +119,28 @@ def test_accuracy_on_the_manufactured_solution_ends_within_the_tolerance():
     # a bar once a cycle with 4 times fewer unknowns and one before it exist
     coarser = [np.sum(c["n_dofs"][:k] * 4 <= c["n_dofs"][k]) >= 2 for k in range(len(c["n_dofs"]))]
     assert np.array_equal(np.isnan(c["contact_force_bar"]), ~np.array(coarser)), (c["n_dofs"], c["contact_force_bar"])
+
+
+def test_a_budget_of_unknowns_stops_the_cycles_where_the_mesh_reaches_it():
+    """-adapt_max_dofs N refines no mesh with N unknowns or more. -accuracy 0.01 on the manufactured solution from
+    8 x 8, which 2,000 unknowns do not reach: the run stops at the first cycle with at least 2,000 unknowns, writes its
+    output flagged not reached (/run adapt_stop "max_dofs"), and says why. Its cycles are those of the same run without
+    the budget stopped after as many cycles by -adapt_cycles (adapt_stop "cycles"): the budget decides where the cycles
+    stop, never what they compute."""
+    base = MMS + ["-dm_plex_box_faces", "8,8", "-penalty_eps0", 0.1, "-accuracy", 0.01]
+    out, h5 = run(base + ["-adapt_max_dofs", 2000], "accuracy_max_dofs")
+    a, _ = load(h5)
+    c = cycles(h5)
+    n = c["n_dofs"]
+    assert len(n) >= 3 and n[-1] >= 2000 and np.all(n[:-1] < 2000), n
+    assert a["accuracy_reached"] == 0 and a["adapt_stop"] == "max_dofs" and a["adapt_max_dofs"] == 2000, a
+    assert re.search(r"WARNING: accuracy 0.01 not reached after \d+ cycles \(%d dofs\): the mesh reached -adapt_max_dofs" % n[-1], out), out
+    out_free, h5_free = run(base + ["-adapt_cycles", len(n) - 1], "accuracy_max_dofs_free")
+    free = cycles(h5_free)
+    assert load(h5_free)[0]["adapt_stop"] == "cycles" and "-adapt_max_dofs" not in out_free
+    assert np.array_equal(free["n_dofs"], n), (free["n_dofs"], n)
+    for key in ("estimate", "contact_force_value", "contact_size_value", "energy_bar"):
+        assert np.allclose(free[key], c[key], rtol=1e-12, atol=0), key
 
 
 def test_the_monitor_prints_each_cycle_as_the_cycles_record_it():
@@ -291,7 +313,8 @@ BAD = {"zero": (MMS + ["-accuracy", 0, "-accuracy_quantity", "energy"], "-accura
        "one": (MMS + ["-accuracy", 1.5], "-accuracy is a relative error in (0, 1)"),
        "no_cycles": (MMS + ["-accuracy", 0.1, "-adapt_cycles", 0], "-adapt_cycles 0 leaves it no cycle"),
        "name": (MMS + ["-accuracy", 0.1, "-accuracy_quantity", "force"], "Unknown enum value 'force' for -accuracy_quantity"),
-       "quads": (MMS + ["-dm_plex_simplex", 0, "-accuracy", 0.1], "-adapt_cycles refines triangles and tetrahedra only, not quadrilaterals")}
+       "quads": (MMS + ["-dm_plex_simplex", 0, "-accuracy", 0.1], "-adapt_cycles refines triangles and tetrahedra only, not quadrilaterals"),
+       "max_dofs": (MMS + ["-accuracy", 0.1, "-adapt_max_dofs", -3], "-adapt_max_dofs must be >= 0 (0: no limit), got -3")}
 
 
 @pytest.mark.parametrize("case", BAD)

@@ -463,7 +463,11 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     PetscCall(WriteRealAttr(v, "time_estimate", user->rec.estimate.time));
   } else if (user->rec.estimate.unavailable[0])
     PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "estimate_unavailable", PETSC_STRING, user->rec.estimate.unavailable));
-  if (user->rec.ncycles) PetscCall(WriteRealAttr(v, "adapt_fraction", user->rec.adapt_fraction));
+  if (user->rec.ncycles) {
+    PetscCall(WriteRealAttr(v, "adapt_fraction", user->rec.adapt_fraction));
+    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "adapt_stop", PETSC_STRING, AdaptStops[user->rec.adapt_stop]));
+    if (user->opt->adapt.max_dofs) PetscCall(WriteIntAttr(v, "adapt_max_dofs", user->opt->adapt.max_dofs));
+  }
   if (user->opt->adapt.accuracy > 0.0 && user->rec.ncycles) { /* -accuracy: asked for, reached, and the last cycle's bars */
     const CycleRecord *c = &user->rec.cycles[user->rec.ncycles - 1];
 

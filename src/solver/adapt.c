@@ -15,7 +15,11 @@
    With -accuracy on the zone's size, the cells along the zone's edge are marked too while its one-cell band, the floor
    of the size's bar, is above the tolerance (EstimateMarkContactEdge(); -adapt_mark_edge): Doerfler's marking on the
    energy-norm indicators refines the band only where the energy's error is, and the size's bar cannot fall below it.
-   What it saves and costs in 2D and 3D is measured in docs/estimate.md, "Marking the zone's edge". */
+   What it saves and costs in 2D and 3D is measured in docs/estimate.md, "Marking the zone's edge".
+   -adapt_max_dofs N is a budget, as MFEM's ThresholdRefiner::SetMaxElements(): no mesh with N unknowns or more is
+   refined, so the cycles stop at the first that reaches it (its growth over N is one cycle's); where -accuracy is not
+   reached there, the summary says so, and /run adapt_stop records why the cycles stopped. It decides where the cycles
+   stop, never what they compute. */
 #include "contact.h"
 #include "estimate.h"
 #include "mesh.h"
@@ -24,6 +28,8 @@
 #include "verify.h"
 
 #define ADAPT_ACCURACY_CYCLES 40 /* -accuracy's most cycles unless -adapt_cycles says */
+
+const char *const AdaptStops[] = {"accuracy", "cycles", "max_dofs", "solve_failed", "nothing_marked", "AdaptStop", "ADAPT_STOP_", NULL};
 
 PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
 {
@@ -39,6 +45,7 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
   ad->newton_fraction = 0.0;
   ad->mark_edge       = PETSC_TRUE;
   ad->monitor         = PETSC_FALSE;
+  ad->max_dofs        = 0;
   PetscOptionsBegin(comm, NULL, "Adaptive refinement", "Signorini");
   PetscCall(PetscOptionsInt(
       "-adapt_cycles",
@@ -67,6 +74,10 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
                              "Print a line for each adaptive cycle as it ends: its unknowns, estimate, solve, time and, with -accuracy, the bars "
                              "asked for",
                              NULL, ad->monitor, &ad->monitor, NULL));
+  PetscCall(PetscOptionsInt("-adapt_max_dofs",
+                            "Refine no mesh with this many unknowns or more: the cycles stop there, as a budget (0: no limit; the last mesh "
+                            "may exceed it by one cycle's growth)",
+                            NULL, ad->max_dofs, &ad->max_dofs, NULL));
   ad->model[0] = '\0';
   PetscCall(PetscOptionsString(
       "-adapt_model",
@@ -80,6 +91,7 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
     PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "-adapt_model: the Gmsh model '%s' does not exist or cannot be read", ad->model);
   }
   PetscCheck(ad->cycles >= 0, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles must be >= 0, got %" PetscInt_FMT, ad->cycles);
+  PetscCheck(ad->max_dofs >= 0, comm, PETSC_ERR_USER_INPUT, "-adapt_max_dofs must be >= 0 (0: no limit), got %" PetscInt_FMT, ad->max_dofs);
   PetscCheck(!fraction_given || (ad->fraction > 0.0 && ad->fraction <= 1.0), comm, PETSC_ERR_USER_INPUT, "-adapt_fraction must lie in (0, 1], got %g",
              (double)ad->fraction);
   PetscCheck(ad->accuracy >= 0.0 && ad->accuracy < 1.0, comm, PETSC_ERR_USER_INPUT, "-accuracy is a relative error in (0, 1), got %g",
@@ -309,6 +321,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     DMLabel        marked = NULL;
     PetscLogDouble t0, t1;
     SolverStart    start;
+    PetscBool      at_max;
 
     PetscCall(AdaptRecord(*dm, user, *u, k));
     PetscCall(AdaptQuantitiesAtSmallerEps(*dm, user, *snes, *u, c));
@@ -317,7 +330,8 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     PetscCall(EstimateMarkUnseenContact(*dm, user, *u, &marked, &c->unseen, &c->unseen_force)); /* the cells around the contact the mesh misses */
     c->accurate    = Accurate(ad, c);
     c->marked_edge = 0;
-    if (!c->accurate && k < ad->cycles && user->rec.stats.converged) {
+    at_max         = (PetscBool)(ad->max_dofs > 0 && c->n_dofs >= ad->max_dofs);
+    if (!c->accurate && k < ad->cycles && user->rec.stats.converged && !at_max) {
       PetscCall(EstimateMark(*dm, &user->rec.estimate, user->rec.adapt_fraction, &marked, &c->marked));
       if (ad->mark_edge && ad->accuracy > 0.0 && ad->target[ACCURACY_SIZE] && c->q.contact_size_band > ad->accuracy * PetscAbsReal(c->q.contact_size))
         PetscCall(EstimateMarkContactEdge(*dm, user, *u, &marked, &c->marked_edge));
@@ -326,8 +340,13 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     c->time_cycle = (t0 - t_last) + (k == 0 ? c->time_solve : 0.0);
     t_last        = t0;
     PetscCall(AdaptMonitor(PetscObjectComm((PetscObject)*dm), ad, c, k));
-    if (c->accurate || k == ad->cycles || !user->rec.stats.converged ||
+    if (c->accurate || !user->rec.stats.converged || at_max || k == ad->cycles ||
         (!c->marked && !c->marked_edge && !c->unseen)) { /* done, or a zero estimate: nothing to refine */
+      user->rec.adapt_stop = c->accurate                  ? ADAPT_STOP_ACCURACY
+                             : !user->rec.stats.converged ? ADAPT_STOP_SOLVE_FAILED
+                             : at_max                     ? ADAPT_STOP_MAX_DOFS
+                             : k == ad->cycles            ? ADAPT_STOP_CYCLES
+                                                          : ADAPT_STOP_NOTHING_MARKED;
       PetscCall(DMLabelDestroy(&marked));
       break;
     }
@@ -372,6 +391,9 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
                           "  %.4e  %s%6" PetscInt_FMT "  %6" PetscInt_FMT "  %6" PetscInt_FMT "\n",
                           k, c->n_dofs, c->n_cells, (double)c->estimate, err, c->marked, c->newton_its, c->ksp_its));
   }
+  if (user->rec.adapt_stop == ADAPT_STOP_MAX_DOFS && !(ad->accuracy > 0.0))
+    PetscCall(PetscPrintf(comm, "  the cycles stopped at -adapt_max_dofs %" PetscInt_FMT ": the last mesh has %" PetscInt_FMT " dofs\n", ad->max_dofs,
+                          user->rec.cycles[user->rec.ncycles - 1].n_dofs));
   if (ad->accuracy > 0.0) {
     const CycleRecord *c = &user->rec.cycles[user->rec.ncycles - 1];
 
@@ -380,9 +402,9 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
                             user->rec.ncycles - 1, c->n_dofs));
     else
       PetscCall(PetscPrintf(
-          comm, "  WARNING: accuracy %g not reached after %" PetscInt_FMT " cycles (%" PetscInt_FMT " dofs)%s%s; the last cycle's bars:\n",
+          comm, "  WARNING: accuracy %g not reached after %" PetscInt_FMT " cycles (%" PetscInt_FMT " dofs)%s%s%s; the last cycle's bars:\n",
           (double)ad->accuracy, user->rec.ncycles - 1, c->n_dofs, UnseenHolds(ad, c) ? ": the mesh does not see the contact at some nodes" : "",
-          !c->converged ? ": the last solve failed" : ""));
+          !c->converged ? ": the last solve failed" : "", user->rec.adapt_stop == ADAPT_STOP_MAX_DOFS ? ": the mesh reached -adapt_max_dofs" : ""));
     for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
       if (!ad->target[k]) continue;
       if (PetscIsNanReal(c->bar[k]))
