@@ -378,7 +378,7 @@ typedef struct {
   PetscInt  cycles;                    /* 0: no adaptive refinement; with -accuracy, the most cycles */
   PetscReal fraction;                  /* -adapt_fraction (0: the default, AdaptSolve()'s) */
   PetscReal accuracy;                  /* -accuracy: the relative error asked for (0: none), */
-  PetscBool target[ACCURACY_NUM];      /*   of these quantities (-accuracy_quantity) */
+  PetscBool target[ACCURACY_NUM];      /*   of these quantities (-accuracy_quantity; all false: the default, AdaptTargets()) */
   char      model[PETSC_MAX_PATH_LEN]; /* -adapt_model: the Gmsh model remeshed at each cycle ("": the mesh refined) */
   PetscReal newton_fraction;           /* -accuracy_newton_fraction: Newton stops at this fraction of the error (0: never) */
   PetscBool mark_edge;                 /* -adapt_mark_edge: with -accuracy on the size, refine along the zone's edge too */
@@ -478,13 +478,14 @@ typedef struct {
   PetscInt      nsteps;
   CycleRecord  *cycles; /* one per mesh of the adaptive refinement (-adapt_cycles) */
   PetscInt      ncycles;
-  PetscReal     adapt_fraction;           /*   the fraction of the estimate's square they marked (Doerfler's theta) */
-  AdaptStop     adapt_stop;               /*   and why they stopped */
-  ErrorNorms    errors;                   /* against the scene's exact solution */
-  ErrorNorms    ref_errors;               /* against the -reference solution */
-  ErrorEstimate estimate;                 /* the a posteriori estimate of the error */
-  ErrorBars     bars;                     /* the error bars of the quantities (-bars) */
-  char          diagnostics_failed[1024]; /* the diagnostics that failed after the solve, with their messages ("" if none) */
+  PetscReal     adapt_fraction;                /*   the fraction of the estimate's square they marked (Doerfler's theta) */
+  AdaptStop     adapt_stop;                    /*   and why they stopped */
+  PetscBool     accuracy_target[ACCURACY_NUM]; /* the quantities -accuracy asked for on this mesh's dimension (AdaptTargets()) */
+  ErrorNorms    errors;                        /* against the scene's exact solution */
+  ErrorNorms    ref_errors;                    /* against the -reference solution */
+  ErrorEstimate estimate;                      /* the a posteriori estimate of the error */
+  ErrorBars     bars;                          /* the error bars of the quantities (-bars) */
+  char          diagnostics_failed[1024];      /* the diagnostics that failed after the solve, with their messages ("" if none) */
 } RunRecord;
 
 /* The state of a run, by concern: its options, its scene, the problem on the current mesh, the hierarchy of the meshes

@@ -476,7 +476,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
       char name[64];
 
-      if (!user->opt->adapt.target[k]) continue;
+      if (!user->rec.accuracy_target[k]) continue;
       PetscCall(PetscSNPrintf(name, sizeof(name), "accuracy_%s_value", AccuracyQuantities[k]));
       PetscCall(WriteRealAttr(v, name, c->value[k]));
       PetscCall(PetscSNPrintf(name, sizeof(name), "accuracy_%s_bar", AccuracyQuantities[k]));
