@@ -16,7 +16,7 @@ else
   CC           = mpicc
 endif
 CFLAGS  ?= -O2 -g
-CFLAGS  += -std=c99 -Wall -Wextra -Wno-unused-parameter -Iinclude -Ibuild
+CFLAGS  += -std=c99 -Wall -Wextra -Wno-unused-parameter -Werror=implicit-function-declaration -Iinclude -Ibuild
 LDLIBS  += $(PETSC_LIBS) -lyaml -lmetis -lm -ldl
 
 SRC = $(wildcard src/*.c src/*/*.c)

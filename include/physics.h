@@ -24,6 +24,7 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u);
 PetscErrorCode PostprocessLiftEnergy(DM dm, const AppCtx *user, PetscReal weak_lift, PetscReal *energy);
 PetscErrorCode PostprocessPenetration(AppCtx *user);
 void           PostprocessGetQuantities(const AppCtx *user, Quantities *q);
+PetscReal      PostprocessForceMagnitude(const Quantities *q, PetscInt dim);
 /* contact_zone.c */
 PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size, PetscReal *band);
 PetscErrorCode PostprocessPressureStep(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal *step);

@@ -74,12 +74,10 @@ static PetscInt BarsSizeIndex(PetscInt dim)
 static PetscInt List(const AppCtx *user, PetscInt dim, const Quantities *q, char names[][64], PetscReal v[], PetscReal kind[])
 {
   PetscInt  n     = 0;
-  PetscReal force = 0.0, reactions = 0.0;
+  PetscReal force = PostprocessForceMagnitude(q, dim), reactions = 0.0;
 
-  for (PetscInt c = 0; c < dim; ++c) force += PetscSqr(q->force[c]);
   for (PetscInt i = 0; i < user->scene.bcs.n; ++i)
     for (PetscInt c = 0; c < dim; ++c) reactions += PetscSqr(q->reaction[i][c]);
-  force     = PetscSqrtReal(force);
   reactions = PetscMax(PetscSqrtReal(reactions), force);
   for (PetscInt c = 0; c < dim; ++c) {
     if (names) PetscSNPrintf(names[n], 64, "contact_force_%c", "xyz"[c]);

@@ -78,6 +78,7 @@
    (PeakBar()): on the same cycles 0.25% to 1.1%, covering the error at 1.4 times at least (docs/estimate.md).
    The energy's bar is the error estimate itself, against the solution's energy norm (src/estimate/estimate.c). */
 #include "estimate.h"
+#include "physics.h"
 
 #define CYCLE_SAFETY 3.0          /* Roache's safety factor of a two-level study whose order comes from theory */
 #define CYCLE_RATIO 2.0           /* the cycles compared differ by at least this ratio of h_k = N_k^(-1/dim) */
@@ -184,12 +185,10 @@ static PetscReal SizeBar(const CycleRecord c[], PetscInt last, PetscInt dim)
 PetscErrorCode CycleBarsCompute(AppCtx *user, PetscInt dim, PetscInt last)
 {
   CycleRecord *c = &user->rec.cycles[last];
-  PetscReal    f = 0.0;
 
   PetscFunctionBeginUser;
-  for (PetscInt d = 0; d < dim; ++d) f += PetscSqr(c->q.force[d]);
   c->value[ACCURACY_ENERGY]   = c->norm;
-  c->value[ACCURACY_FORCE]    = PetscSqrtReal(f);
+  c->value[ACCURACY_FORCE]    = PostprocessForceMagnitude(&c->q, dim);
   c->value[ACCURACY_PRESSURE] = c->q.pressure_max;
   c->value[ACCURACY_SIZE]     = c->q.contact_size;
   c->value[ACCURACY_PEAK]     = c->q.pressure_peak;

@@ -84,6 +84,15 @@ PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The contact force's magnitude, |F| over its dim components: the value of the force that -bars and -accuracy bar. */
+PetscReal PostprocessForceMagnitude(const Quantities *q, PetscInt dim)
+{
+  PetscReal f = 0.0;
+
+  for (PetscInt d = 0; d < dim; ++d) f += PetscSqr(q->force[d]);
+  return PetscSqrtReal(f);
+}
+
 /* The quantities users read, as PostprocessContact() left them in the record. */
 void PostprocessGetQuantities(const AppCtx *user, Quantities *q)
 {

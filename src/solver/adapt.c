@@ -204,7 +204,7 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
 {
   const AdaptOptions *ad     = &user->opt->adapt;
   const PetscBool    *target = user->rec.accuracy_target;
-  PetscReal           eps, eps_new, f = 0.0;
+  PetscReal           eps, eps_new;
   PetscBool           ok = PETSC_FALSE;
   PetscInt            dim;
   Vec                 dir, u_new;
@@ -225,8 +225,7 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
     PetscCall(VecWAXPY(u_new, (eps_new - eps) * eps_new / (eps * eps), dir, u));
     PetscCall(PostprocessContact(dm, user, u_new));
     PostprocessGetQuantities(user, &q);
-    for (PetscInt d = 0; d < dim; ++d) f += PetscSqr(q.force[d]);
-    c->value_eps[ACCURACY_FORCE]    = PetscSqrtReal(f);
+    c->value_eps[ACCURACY_FORCE]    = PostprocessForceMagnitude(&q, dim);
     c->value_eps[ACCURACY_PRESSURE] = q.pressure_max;
     c->value_eps[ACCURACY_SIZE]     = q.contact_size;
     c->value_eps[ACCURACY_PEAK]     = q.pressure_peak;
