@@ -258,6 +258,23 @@ static PetscBool Accurate(const AdaptOptions *ad, const PetscBool target[], cons
   return PETSC_TRUE;
 }
 
+/* Whether the energy's bar alone keeps a converged cycle from -accuracy: asked for and above the tolerance, while every
+   other quantity asked for has a bar within it (at least one such quantity). The summary then says so. */
+static PetscBool OnlyEnergyHolds(const AdaptOptions *ad, const PetscBool target[], const CycleRecord *c)
+{
+  PetscBool others = PETSC_FALSE;
+
+  if (!(ad->accuracy > 0.0) || !c->converged || UnseenHolds(ad, c) || !target[ACCURACY_ENERGY] ||
+      c->bar[ACCURACY_ENERGY] <= ad->accuracy * PetscAbsReal(c->value[ACCURACY_ENERGY]))
+    return PETSC_FALSE;
+  for (PetscInt k = ACCURACY_FORCE; k < ACCURACY_NUM; ++k) {
+    if (!target[k]) continue;
+    if (!(c->bar[k] <= ad->accuracy * PetscAbsReal(c->value[k]))) return PETSC_FALSE; /* NaN: not yet */
+    others = PETSC_TRUE;
+  }
+  return others;
+}
+
 /* -adapt_monitor: cycle k's line as it ends (the /cycles row's numbers), so that a long -accuracy run shows its progress;
    flushed, since the summary's table comes only after the last cycle. */
 static PetscErrorCode AdaptMonitor(MPI_Comm comm, const AdaptOptions *ad, const PetscBool target[], const CycleRecord *c, PetscInt k)
@@ -433,6 +450,19 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
         PetscCall(PetscPrintf(comm, "    %-14s %.6g +- %.2g (%.2g%%)%s\n", AccuracyQuantities[k], (double)c->value[k], (double)c->bar[k],
                               (double)(100.0 * c->bar[k] / PetscAbsReal(c->value[k])),
                               k == ACCURACY_ENERGY ? " (the energy norm and the error estimate)" : ""));
+    }
+    if (!c->accurate && OnlyEnergyHolds(ad, user->rec.accuracy_target, c)) {
+      char names[256] = "";
+
+      for (PetscInt k = ACCURACY_FORCE; k < ACCURACY_NUM; ++k)
+        if (user->rec.accuracy_target[k]) {
+          PetscCall(PetscStrlcat(names, names[0] ? "," : "", sizeof(names)));
+          PetscCall(PetscStrlcat(names, AccuracyQuantities[k], sizeof(names)));
+        }
+      PetscCall(PetscPrintf(comm,
+                            "  only the energy's bar is above the tolerance: the energy norm's error lies over the whole body, and on a body much "
+                            "larger than its contact zone it falls slowly; -accuracy_quantity %s asks for the contact quantities alone\n",
+                            names));
     }
   }
   PetscFunctionReturn(PETSC_SUCCESS);
