@@ -207,6 +207,12 @@ def test_the_summary_says_where_the_energy_alone_holds_the_stop(big_block):
         assert c[f"{q}_bar"][-1] <= 0.03 * abs(c[f"{q}_value"][-1]), q
     assert "only the energy's bar is above the tolerance" in out, out[-2000:]
     assert "-accuracy_quantity contact_force,pressure_max,contact_size asks for the contact quantities alone" in out
+    # and once as it happens, at the first such cycle, before the summary
+    alone = [k for k in range(len(c["n_dofs"])) if c["energy_bar"][k] > 0.03 * c["energy_value"][k]
+             and all(c[f"{q}_bar"][k] <= 0.03 * abs(c[f"{q}_value"][k]) for q in ("contact_force", "pressure_max", "contact_size"))]
+    said = re.findall(r"-accuracy 0.03: at cycle (\d+) \((\d+) dofs\) only the energy's bar", out)
+    assert said == [(str(alone[0]), str(int(c["n_dofs"][alone[0]])))], (said, alone)
+    assert out.index("only the energy's bar (") < out.index("scene general")
 
 
 def test_a_mesh_that_does_not_see_the_contact_is_refined_where_it_penetrates(big_block):

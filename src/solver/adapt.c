@@ -275,6 +275,43 @@ static PetscBool OnlyEnergyHolds(const AdaptOptions *ad, const PetscBool target[
   return others;
 }
 
+/* The quantities asked for other than the energy, comma-separated, as -accuracy_quantity takes them. */
+static PetscErrorCode ContactTargetNames(const PetscBool target[], char names[], size_t len)
+{
+  PetscFunctionBeginUser;
+  names[0] = '\0';
+  for (PetscInt k = ACCURACY_FORCE; k < ACCURACY_NUM; ++k)
+    if (target[k]) {
+      PetscCall(PetscStrlcat(names, names[0] ? "," : "", len));
+      PetscCall(PetscStrlcat(names, AccuracyQuantities[k], len));
+    }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The first cycle that the energy's bar alone keeps from -accuracy says so as it ends, once: on a body much larger than
+   its contact zone the cycles may go on for long for the energy alone, and the user may rather stop and ask for the
+   contact quantities. It changes nothing of the run. */
+static PetscErrorCode AdaptWarnEnergyAlone(MPI_Comm comm, const AdaptOptions *ad, const PetscBool target[], const CycleRecord *c, PetscInt k,
+                                           PetscBool *warned)
+{
+  char        names[256];
+  PetscMPIInt rank;
+
+  PetscFunctionBeginUser;
+  if (*warned || c->accurate || !OnlyEnergyHolds(ad, target, c)) PetscFunctionReturn(PETSC_SUCCESS);
+  *warned = PETSC_TRUE;
+  PetscCall(ContactTargetNames(target, names, sizeof(names)));
+  PetscCall(PetscPrintf(comm,
+                        "  -accuracy %g: at cycle %" PetscInt_FMT " (%" PetscInt_FMT " dofs) only the energy's bar (%.2g%%) is above the tolerance, "
+                        "and the cycles go on for it; -accuracy_quantity %s asks for the contact quantities alone, -adapt_max_dofs bounds "
+                        "the cycles\n",
+                        (double)ad->accuracy, k, c->n_dofs, (double)(100.0 * c->bar[ACCURACY_ENERGY] / PetscAbsReal(c->value[ACCURACY_ENERGY])),
+                        names));
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) fflush(PETSC_STDOUT);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* -adapt_monitor: cycle k's line as it ends (the /cycles row's numbers), so that a long -accuracy run shows its progress;
    flushed, since the summary's table comes only after the last cycle. */
 static PetscErrorCode AdaptMonitor(MPI_Comm comm, const AdaptOptions *ad, const PetscBool target[], const CycleRecord *c, PetscInt k)
@@ -342,6 +379,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
   PetscInt            dim;
   PetscBool           remesh;
   PetscLogDouble      t_last, time_mesh = 0.0;
+  PetscBool           warned_energy = PETSC_FALSE; /* AdaptWarnEnergyAlone(), once */
 
   PetscFunctionBeginUser;
   if (!ad->cycles) PetscFunctionReturn(PETSC_SUCCESS);
@@ -376,6 +414,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     c->time_cycle = (t0 - t_last) + (k == 0 ? c->time_solve : 0.0);
     t_last        = t0;
     PetscCall(AdaptMonitor(PetscObjectComm((PetscObject)*dm), ad, user->rec.accuracy_target, c, k));
+    PetscCall(AdaptWarnEnergyAlone(PetscObjectComm((PetscObject)*dm), ad, user->rec.accuracy_target, c, k, &warned_energy));
     if (c->accurate || !user->rec.stats.converged || at_max || k == ad->cycles ||
         (!c->marked && !c->marked_edge && !c->unseen)) { /* done, or a zero estimate: nothing to refine */
       user->rec.adapt_stop = c->accurate                  ? ADAPT_STOP_ACCURACY
@@ -452,13 +491,9 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
                               k == ACCURACY_ENERGY ? " (the energy norm and the error estimate)" : ""));
     }
     if (!c->accurate && OnlyEnergyHolds(ad, user->rec.accuracy_target, c)) {
-      char names[256] = "";
+      char names[256];
 
-      for (PetscInt k = ACCURACY_FORCE; k < ACCURACY_NUM; ++k)
-        if (user->rec.accuracy_target[k]) {
-          PetscCall(PetscStrlcat(names, names[0] ? "," : "", sizeof(names)));
-          PetscCall(PetscStrlcat(names, AccuracyQuantities[k], sizeof(names)));
-        }
+      PetscCall(ContactTargetNames(user->rec.accuracy_target, names, sizeof(names)));
       PetscCall(PetscPrintf(comm,
                             "  only the energy's bar is above the tolerance: the energy norm's error lies over the whole body, and on a body much "
                             "larger than its contact zone it falls slowly; -accuracy_quantity %s asks for the contact quantities alone\n",
