@@ -7,7 +7,9 @@
 PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const PetscInt coarse_requests[2], const PetscInt coarse_faces[3],
                           PetscInt coarse_min_levels, MeshBox *box, DM *dm);
 PetscErrorCode MeshIndexCellTypes(DM dm);
-PetscErrorCode MeshReadRemeshed(MPI_Comm comm, const char filename[], DM *dm);
+PetscErrorCode MeshReadRemeshed(MPI_Comm comm, const char filename[], PetscBool petsc_read, DM *dm);
+/* mesh_gmsh_read.c: the mesh Gmsh wrote for a remeshing, read as PETSc reads it with interpolation, faster */
+PetscErrorCode MeshReadGmshRemeshed(MPI_Comm comm, const char file[], DM *dm);
 PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[]);
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],
                                     PetscBool distribute, PetscInt slab_rows, PetscBool petsc_interpolate, PetscBool check, DM *dm);

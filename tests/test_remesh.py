@@ -129,6 +129,24 @@ def test_accuracy_on_the_hertz_cylinder_remeshes_its_model(disk):
     assert abs(m["a_error"]) <= 0.03 and abs(m["p0_error"]) <= 0.03, m
 
 
+@pytest.mark.parametrize("case", ["cylinder", "box3d"])
+def test_the_direct_read_of_a_remeshed_mesh_is_petscs(case, disk):
+    """Each remeshed mesh is read by PETSc without interpolation, its faces and edges built directly and its face sets
+    set from the file's boundary elements (src/mesh/mesh_gmsh_read.c): on one rank every cycle is the one that PETSc's
+    interpolating reader gives (-mesh_remeshed_petsc_read), to the last bit, on the cylinder's model (2D, 4 cycles) and
+    on the 3D box (2 cycles, its sides' face sets carrying the boundary conditions)."""
+    mesh, model = disk
+    args = (case_args("cylinder", mesh) + ["-adapt_model", model, "-adapt_cycles", 4] if case == "cylinder"
+            else MMS3 + ["-adapt_cycles", 2])
+    _, direct = run(args, f"remesh_read_{case}_direct")
+    _, petsc = run(args + ["-mesh_remeshed_petsc_read"], f"remesh_read_{case}_petsc")
+    c, r = cycles(direct), cycles(petsc)
+    assert len(c["n_dofs"]) == (5 if case == "cylinder" else 3) and np.all(np.diff(c["n_dofs"]) > 0), c["n_dofs"]
+    for key in c:
+        if not key.startswith("time"):
+            assert np.array_equal(c[key], r[key], equal_nan=True), key
+
+
 def test_remeshing_on_two_ranks_gives_the_one_rank_cycles(disk):
     """Gmsh meshes on rank 0 the cells gathered and sorted by their centroids: 2 ranks give the meshes of 1 (the same
     unknowns at every cycle) and the same answers to solver tolerance. The recovered peak is the fit numpy makes of the

@@ -59,11 +59,11 @@ static PetscErrorCode MeshReadFile(MPI_Comm comm, const char filename[], DM *dm)
 PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const PetscInt coarse_requests[2], const PetscInt coarse_faces[3],
                           PetscInt coarse_min_levels, MeshBox *box, DM *dm)
 {
-  PetscInt            dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine, curved_ridges = 0;
-  PetscReal           curved_x[3] = {0, 0, 0};
-  PetscReal           lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
-  PetscBool           simplex, has_file, dim_set, nests, parallel_read = PETSC_FALSE, petsc_interpolate, check_interpolation, check_closures;
-  char                filename[PETSC_MAX_PATH_LEN] = "";
+  PetscInt  dim, faces[3], nfaces = 3, nlower = 3, nupper = 3, refine, curved_ridges = 0;
+  PetscReal curved_x[3] = {0, 0, 0};
+  PetscReal lower[3] = {0.0, 0.0, 0.0}, upper[3] = {1.0, 1.0, 1.0};
+  PetscBool simplex, has_file, dim_set, nests, parallel_read = PETSC_FALSE, petsc_interpolate, check_interpolation, check_closures, petsc_read;
+  char      filename[PETSC_MAX_PATH_LEN] = "";
   MeshPartitionerType partitioner;
   PetscMPIInt         size;
   PetscInt            coarse = 0, coarse_request, slab_rows = 0;
@@ -93,6 +93,11 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
   PetscCall(PetscOptionsBool("-box_petsc_interpolate",
                              "Interpolate the simplex box (faces, edges) with DMPlexInterpolate(), not the project's direct build",
                              "MeshCreateInterpolatedSimplices", petsc_interpolate, &petsc_interpolate, NULL));
+  petsc_read = PETSC_FALSE;
+  PetscCall(PetscOptionsBool("-mesh_remeshed_petsc_read",
+                             "Read each mesh Gmsh makes for the adaptive cycles with PETSc's reader and DMPlexInterpolate(), not the project's "
+                             "direct build (the same mesh, slower)",
+                             "MeshReadGmshRemeshed", petsc_read, &petsc_read, NULL));
   check_interpolation = PETSC_FALSE;
   PetscCall(PetscOptionsBool("-box_interpolation_check", "Build the serial simplex box both ways and print how their topologies differ",
                              "MeshCompareTopology", check_interpolation, &check_interpolation, NULL));
@@ -236,6 +241,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
     box->from_file     = has_file;
     box->refine        = refine;
     box->curved_ridges = curved_ridges;
+    box->petsc_read    = petsc_read;
     for (PetscInt d = 0; d < 3; ++d) box->curved_x[d] = curved_x[d];
     for (PetscInt d = 0; d < dim; ++d) {
       box->faces[d] = faces[d];
@@ -265,12 +271,15 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* A mesh Gmsh wrote for the run (mesh_remesh.c), read as a mesh file is: checked, its physical groups' names, and
-   distributed by METIS. */
-PetscErrorCode MeshReadRemeshed(MPI_Comm comm, const char filename[], DM *dm)
+/* A mesh Gmsh wrote for the run (mesh_remesh.c), read as a mesh file is, its faces and edges built directly
+   (mesh_gmsh_read.c): checked, its physical groups' names, and distributed by METIS. */
+PetscErrorCode MeshReadRemeshed(MPI_Comm comm, const char filename[], PetscBool petsc_read, DM *dm)
 {
   PetscFunctionBeginUser;
-  PetscCall(MeshReadFile(comm, filename, dm));
+  if (petsc_read)
+    PetscCall(MeshReadFile(comm, filename, dm));
+  else
+    PetscCall(MeshReadGmshRemeshed(comm, filename, dm));
   PetscCall(MeshCheckFile(*dm, filename));
   PetscCall(MeshLabelGmshNames(*dm, filename));
   PetscCall(MeshPartitionDistribute(MESH_PARTITIONER_METIS, dm));

@@ -412,7 +412,7 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
   PetscCallMPI(MPI_Bcast(why, sizeof(why), MPI_CHAR, 0, comm));
   PetscCheck(!failed, comm, PETSC_ERR_LIB, "-adapt_model %s: %s", model[0] ? model : "(the box of the options)", why);
   PetscCallMPI(MPI_Bcast(out, sizeof(out), MPI_CHAR, 0, comm));
-  PetscCall(MeshReadRemeshed(comm, out, remeshed));
+  PetscCall(MeshReadRemeshed(comm, out, box->petsc_read, remeshed));
   PetscCallMPI(MPI_Barrier(comm));
   if (rank == 0) (void)unlink(out); /* read: removed before the checks, which may refuse the mesh */
   PetscCall(CheckFaceSets(dm, *remeshed, model));
