@@ -272,7 +272,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
 }
 
 /* A mesh Gmsh wrote for the run (mesh_remesh.c), read as a mesh file is, its faces and edges built directly
-   (mesh_gmsh_read.c): checked, its physical groups' names, and distributed by METIS. */
+   (mesh_gmsh_read.c; with -mesh_remeshed_petsc_read by PETSc's reader): checked, its physical groups' names, and
+   distributed by METIS. */
 PetscErrorCode MeshReadRemeshed(MPI_Comm comm, const char filename[], PetscBool petsc_read, DM *dm)
 {
   PetscFunctionBeginUser;

@@ -1,7 +1,7 @@
 /* The mesh Gmsh writes at each remeshing (mesh_remesh.c), read as PETSc's Gmsh reader reads it with interpolation, in
-   about two fifths of its time. PETSc 3.18 reads the cells and vertices, then builds the faces and edges by DMPlexInterpolate(),
-   which was four fifths of the reading and a tenth of a 3D adaptive run (docs/estimate.md, "The remeshing's own
-   costs"). Here PETSc reads the cells and vertices alone (DMPlexCreateGmshFromFile() without interpolation: the same
+   about two fifths of its time. PETSc 3.18 reads the cells and vertices, then builds the faces and edges by
+   DMPlexInterpolate(), which was four fifths of the reading and a tenth of a 3D adaptive run (docs/estimate.md, "The
+   remeshing's own costs"). Here PETSc reads the cells and vertices alone (DMPlexCreateGmshFromFile() without interpolation: the same
    vertex numbering and cell cones), the faces and edges are built directly as the simplex box's are
    (MeshCreateInterpolatedSimplices(): DMPlexInterpolate()'s points, cones and orientations), and the labels are set as
    PETSc's reader sets them: its "Cell Sets" copied, and each boundary element of the file gives the face its vertices
@@ -9,8 +9,8 @@
    The boundary elements come from the file itself (Gmsh's MSH 4.1 ASCII, as GmshRemesh() writes it), with PETSc's
    vertex numbering: the nodes in the file's order, those used by some element. On the make hertz sphere's graded mesh
    (121,151 tetrahedra): 0.51 s against 1.23 s (0.2 s of it the boundary elements' parsing), and no entry of the
-   topology, the coordinates or the labels differs (MeshCompareTopology()). Rank 0 reads; the other ranks have the empty mesh, as with PETSc's reader.
- */
+   topology, the coordinates or the labels differs (MeshCompareTopology()). Rank 0 reads; the other ranks have the
+   empty mesh, as with PETSc's reader. */
 #include <stdio.h>
 #include <string.h>
 #include "mesh.h"
@@ -41,10 +41,6 @@ static PetscErrorCode ReadEntityTags(FILE *fp, const char file[], PetscInt fdim,
   PetscCheck(fscanf(fp, "%ld %ld %ld %ld", &count[0], &count[1], &count[2], &count[3]) == 4, PETSC_COMM_SELF, PETSC_ERR_FILE_READ, "%s: $Entities",
              file);
   for (PetscInt d = 0; d < 4; ++d) {
-    if (d == fdim) {
-      PetscCall(PetscMalloc1(count[d] + 1, tag));
-      *ntags = 0;
-    }
     for (long e = 0; e < count[d]; ++e) {
       long etag, nphys, p, nb, b;
 

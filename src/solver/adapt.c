@@ -250,11 +250,17 @@ static PetscBool UnseenHolds(const AdaptOptions *ad, const CycleRecord *c)
   return (PetscBool)(c->unseen && !(c->unseen_force <= ADAPT_UNSEEN_SHARE * ad->accuracy * c->value[ACCURACY_FORCE]));
 }
 
+/* Whether quantity k's bar is within the tolerance on cycle c (a NaN bar, before the cycles compared exist, is not). */
+static PetscBool Within(const AdaptOptions *ad, const CycleRecord *c, PetscInt k)
+{
+  return (PetscBool)(c->bar[k] <= ad->accuracy * PetscAbsReal(c->value[k]));
+}
+
 static PetscBool Accurate(const AdaptOptions *ad, const PetscBool target[], const CycleRecord *c)
 {
   if (!(ad->accuracy > 0.0) || !c->converged || UnseenHolds(ad, c)) return PETSC_FALSE;
   for (PetscInt k = 0; k < ACCURACY_NUM; ++k)
-    if (target[k] && !(c->bar[k] <= ad->accuracy * PetscAbsReal(c->value[k]))) return PETSC_FALSE; /* NaN: not yet */
+    if (target[k] && !Within(ad, c, k)) return PETSC_FALSE;
   return PETSC_TRUE;
 }
 
@@ -264,12 +270,10 @@ static PetscBool OnlyEnergyHolds(const AdaptOptions *ad, const PetscBool target[
 {
   PetscBool others = PETSC_FALSE;
 
-  if (!(ad->accuracy > 0.0) || !c->converged || UnseenHolds(ad, c) || !target[ACCURACY_ENERGY] ||
-      c->bar[ACCURACY_ENERGY] <= ad->accuracy * PetscAbsReal(c->value[ACCURACY_ENERGY]))
-    return PETSC_FALSE;
+  if (!(ad->accuracy > 0.0) || !c->converged || UnseenHolds(ad, c) || !target[ACCURACY_ENERGY] || Within(ad, c, ACCURACY_ENERGY)) return PETSC_FALSE;
   for (PetscInt k = ACCURACY_FORCE; k < ACCURACY_NUM; ++k) {
     if (!target[k]) continue;
-    if (!(c->bar[k] <= ad->accuracy * PetscAbsReal(c->value[k]))) return PETSC_FALSE; /* NaN: not yet */
+    if (!Within(ad, c, k)) return PETSC_FALSE;
     others = PETSC_TRUE;
   }
   return others;
@@ -298,7 +302,7 @@ static PetscErrorCode AdaptWarnEnergyAlone(MPI_Comm comm, const AdaptOptions *ad
   PetscMPIInt rank;
 
   PetscFunctionBeginUser;
-  if (*warned || c->accurate || !OnlyEnergyHolds(ad, target, c)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (*warned || !OnlyEnergyHolds(ad, target, c)) PetscFunctionReturn(PETSC_SUCCESS);
   *warned = PETSC_TRUE;
   PetscCall(ContactTargetNames(target, names, sizeof(names)));
   PetscCall(PetscPrintf(comm,
@@ -490,7 +494,7 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
                               (double)(100.0 * c->bar[k] / PetscAbsReal(c->value[k])),
                               k == ACCURACY_ENERGY ? " (the energy norm and the error estimate)" : ""));
     }
-    if (!c->accurate && OnlyEnergyHolds(ad, user->rec.accuracy_target, c)) {
+    if (OnlyEnergyHolds(ad, user->rec.accuracy_target, c)) {
       char names[256];
 
       PetscCall(ContactTargetNames(user->rec.accuracy_target, names, sizeof(names)));
