@@ -7,9 +7,8 @@
 PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const PetscInt coarse_requests[2], const PetscInt coarse_faces[3],
                           PetscInt coarse_min_levels, MeshBox *box, DM *dm);
 PetscErrorCode MeshIndexCellTypes(DM dm);
-PetscErrorCode MeshReadRemeshed(MPI_Comm comm, const char filename[], PetscBool petsc_read, DM *dm);
-/* mesh_gmsh_read.c: the mesh Gmsh wrote for a remeshing, read as PETSc reads it with interpolation, faster */
-PetscErrorCode MeshReadGmshRemeshed(MPI_Comm comm, const char file[], DM *dm);
+PetscErrorCode MeshReadRemeshedFile(MPI_Comm comm, const char filename[], DM *dm);
+PetscErrorCode MeshDistributeRemeshed(const char what[], DM *dm);
 PetscErrorCode MeshCheckSize(MPI_Comm comm, PetscInt dim, PetscReal ncells, const char what[]);
 PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt faces[], const PetscReal lower[], const PetscReal upper[],
                                     PetscBool distribute, PetscInt slab_rows, PetscBool petsc_interpolate, PetscBool check, DM *dm);
@@ -73,8 +72,27 @@ PetscErrorCode MeshCheckFile(DM dm, const char filename[]);
 PetscErrorCode MeshCountInteriorFaces(DM dm, PetscInt n, const PetscInt faces[], PetscInt *ninterior);
 PetscErrorCode MeshCountCurvedRidges(DM dm, PetscInt *count, PetscReal x[3]);
 
-/* mesh_gmsh_names.c */
+/* mesh_gmsh_names.c: a label per named physical group of faces (PETSc labels them by number only) */
+#define MESH_MAX_NAMES 64
+typedef struct {
+  int  dim, tag;
+  char name[64];
+} MeshPhysicalName;
+PetscErrorCode MeshLabelPhysicalNames(DM dm, int n, const MeshPhysicalName names[]);
 PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[]);
+
+/* mesh_gmsh_build.c: the mesh Gmsh made for a remeshing, on rank 0, as PETSc's Gmsh reader numbers the file Gmsh would
+   write, built as that reader builds it with interpolation */
+typedef struct {
+  PetscInt         dim, ncells, nverts, nfaces;
+  PetscInt        *cells, *cell_set; /* [ncells][dim + 1] vertices, oriented as PETSc orients them; the first physical tag (-1: none) */
+  PetscReal       *coords;           /* [nverts][dim] */
+  PetscInt        *faces, *face_set; /* [nfaces][dim] vertices of the elements of dimension dim - 1; their first physical tag */
+  int              nnames;
+  MeshPhysicalName names[MESH_MAX_NAMES];
+} MeshSimplices;
+PetscErrorCode MeshSimplicesBuild(MPI_Comm comm, const MeshSimplices *s, DM *dm);
+PetscErrorCode MeshSimplicesReset(MeshSimplices *s);
 
 /* mesh_refine.c */
 PetscErrorCode MeshCellVertices(DM dm, PetscInt c, PetscInt verts[], PetscInt *nv);

@@ -232,7 +232,7 @@ typedef struct {
   PetscInt  refine;        /*   refined this many times by -dm_refine */
   PetscInt  curved_ridges; /*   whose boundary turns by a small angle at this many ridges: a curved boundary's chords (MeshCountCurvedRidges()) */
   PetscReal curved_x[3];   /*   one of them */
-  PetscBool petsc_read;    /* -mesh_remeshed_petsc_read: each remeshed mesh read by PETSc's reader, DMPlexInterpolate() (mesh_gmsh_read.c) */
+  PetscBool petsc_read;    /* -mesh_remeshed_petsc_read: each remeshed mesh written by Gmsh, read by PETSc's reader (mesh_gmsh_build.c) */
 } MeshBox;
 
 /* How the mesh is distributed over the ranks (-partitioner), and the quality of the partition. */

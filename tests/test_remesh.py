@@ -130,11 +130,12 @@ def test_accuracy_on_the_hertz_cylinder_remeshes_its_model(disk):
 
 
 @pytest.mark.parametrize("case", ["cylinder", "box3d"])
-def test_the_direct_read_of_a_remeshed_mesh_is_petscs(case, disk):
-    """Each remeshed mesh is read by PETSc without interpolation, its faces and edges built directly and its face sets
-    set from the file's boundary elements (src/mesh/mesh_gmsh_read.c): on one rank every cycle is the one that PETSc's
-    interpolating reader gives (-mesh_remeshed_petsc_read), to the last bit, on the cylinder's model (2D, 4 cycles) and
-    on the 3D box (2 cycles, its sides' face sets carrying the boundary conditions)."""
+def test_the_mesh_taken_from_gmsh_is_petscs_reading_of_its_file(case, disk):
+    """Each remeshed mesh is taken from Gmsh's API and built directly (src/mesh/mesh_gmsh_build.c: PETSc's reader's
+    numbering, the direct build's faces and edges, the face sets from the boundary elements, the coordinates to the
+    file's 16 digits): on one rank every cycle is the one that PETSc's interpolating reader gives of the file Gmsh
+    writes (-mesh_remeshed_petsc_read), to the last bit, on the cylinder's model (2D, 4 cycles) and on the 3D box
+    (2 cycles, its sides' face sets carrying the boundary conditions)."""
     mesh, model = disk
     args = (case_args("cylinder", mesh) + ["-adapt_model", model, "-adapt_cycles", 4] if case == "cylinder"
             else MMS3 + ["-adapt_cycles", 2])
@@ -347,17 +348,20 @@ def test_marking_the_zone_edge_in_3d_on_two_ranks_gives_the_one_rank_cycles():
         assert np.allclose(c1[q], c2[q], rtol=1e-6, atol=0), (q, c1[q], c2[q])
 
 
-def test_a_model_that_is_not_the_meshs_is_refused(disk, tmp_path, monkeypatch):
+@pytest.mark.parametrize("petsc_read", [False, True])
+def test_a_model_that_is_not_the_meshs_is_refused(petsc_read, disk, tmp_path, monkeypatch):
     """The block's model given for the disk's mesh: the remeshed mesh lacks the disk's face set "top" (3), and the run
-    stops at the first remesh with an error naming the model and the face set, before any solve on it; Gmsh's mesh
-    file, written to PETSc's temporary directory (PETSC_TMP), is removed all the same."""
+    stops at the first remesh with an error naming the model and the face set, before any solve on it, whether the
+    mesh is taken from Gmsh's API or (-mesh_remeshed_petsc_read) from the file Gmsh writes to PETSc's temporary
+    directory (PETSC_TMP), which is removed all the same."""
     mesh, _ = disk
     block_model = str(tmp_path / "block.geo")
     geometry.block(str(tmp_path / "block.msh"), radius=1.0, h_far=0.2, h_near=0.2, width=0.5, model=block_model)
     tmp = tmp_path / "tmp"
     tmp.mkdir()
     monkeypatch.setenv("PETSC_TMP", str(tmp))
-    refused(case_args("cylinder", mesh) + ["-adapt_model", block_model, "-adapt_cycles", 1], "remesh_bad_model",
+    refused(case_args("cylinder", mesh) + ["-adapt_model", block_model, "-adapt_cycles", 1] + (["-mesh_remeshed_petsc_read"] if petsc_read else []),
+            f"remesh_bad_model_{int(petsc_read)}",
             f"-adapt_model {block_model}: the mesh Gmsh made of the model has no face in the face set 3")
     assert not list(tmp.iterdir()), list(tmp.iterdir())
 

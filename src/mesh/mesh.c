@@ -95,9 +95,9 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
                              "MeshCreateInterpolatedSimplices", petsc_interpolate, &petsc_interpolate, NULL));
   petsc_read = PETSC_FALSE;
   PetscCall(PetscOptionsBool("-mesh_remeshed_petsc_read",
-                             "Read each mesh Gmsh makes for the adaptive cycles with PETSc's reader and DMPlexInterpolate(), not the project's "
-                             "direct build (the same mesh, slower)",
-                             "MeshReadGmshRemeshed", petsc_read, &petsc_read, NULL));
+                             "Read each mesh Gmsh makes for the adaptive cycles from the file Gmsh writes, with PETSc's reader and "
+                             "DMPlexInterpolate(), not the project's direct build from Gmsh's API (the same mesh, slower)",
+                             "MeshSimplicesBuild", petsc_read, &petsc_read, NULL));
   check_interpolation = PETSC_FALSE;
   PetscCall(PetscOptionsBool("-box_interpolation_check", "Build the serial simplex box both ways and print how their topologies differ",
                              "MeshCompareTopology", check_interpolation, &check_interpolation, NULL));
@@ -271,18 +271,21 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* A mesh Gmsh wrote for the run (mesh_remesh.c), read as a mesh file is, its faces and edges built directly
-   (mesh_gmsh_read.c; with -mesh_remeshed_petsc_read by PETSc's reader): checked, its physical groups' names, and
-   distributed by METIS. */
-PetscErrorCode MeshReadRemeshed(MPI_Comm comm, const char filename[], PetscBool petsc_read, DM *dm)
+/* The file Gmsh wrote for the run (mesh_remesh.c, -mesh_remeshed_petsc_read), read by PETSc's reader with its physical
+   groups' names: the reference that the direct build (mesh_gmsh_build.c) is compared to. */
+PetscErrorCode MeshReadRemeshedFile(MPI_Comm comm, const char filename[], DM *dm)
 {
   PetscFunctionBeginUser;
-  if (petsc_read)
-    PetscCall(MeshReadFile(comm, filename, dm));
-  else
-    PetscCall(MeshReadGmshRemeshed(comm, filename, dm));
-  PetscCall(MeshCheckFile(*dm, filename));
+  PetscCall(MeshReadFile(comm, filename, dm));
   PetscCall(MeshLabelGmshNames(*dm, filename));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* A mesh Gmsh made for the run (mesh_remesh.c), serial on rank 0: checked as a mesh file is and distributed by METIS. */
+PetscErrorCode MeshDistributeRemeshed(const char what[], DM *dm)
+{
+  PetscFunctionBeginUser;
+  PetscCall(MeshCheckFile(*dm, what));
   PetscCall(MeshPartitionDistribute(MESH_PARTITIONER_METIS, dm));
   PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
   PetscCall(PetscObjectSetName((PetscObject)*dm, "mesh"));

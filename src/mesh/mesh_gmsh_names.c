@@ -4,15 +4,8 @@
 #include <stdio.h>
 #include "mesh.h"
 
-#define GMSH_MAX_NAMES 64
-
-typedef struct {
-  int  dim, tag;
-  char name[64];
-} GmshName;
-
 /* Reads the $PhysicalNames section (text in every .msh version, binary ones too), stopping at the first section after it. */
-static int ReadPhysicalNames(const char filename[], GmshName names[], int *n)
+static int ReadPhysicalNames(const char filename[], MeshPhysicalName names[], int *n)
 {
   FILE *f = fopen(filename, "r");
   char  line[512];
@@ -33,9 +26,9 @@ static int ReadPhysicalNames(const char filename[], GmshName names[], int *n)
       in_section = 2;
       continue;
     }
-    if (count < GMSH_MAX_NAMES) {
-      GmshName g;
-      char    *open, *close;
+    if (count < MESH_MAX_NAMES) {
+      MeshPhysicalName g;
+      char            *open, *close;
 
       if (sscanf(line, "%d %d", &g.dim, &g.tag) != 2) continue;
       open  = strchr(line, '"');
@@ -51,21 +44,22 @@ static int ReadPhysicalNames(const char filename[], GmshName names[], int *n)
   return 0;
 }
 
-/* On the serial mesh just read from a .msh file: a label per named group of faces, with the group's number. */
-PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[])
+/* On a serial mesh (rank 0's names; the other ranks' are not read): a label per named group of faces, with the group's
+   number. */
+PetscErrorCode MeshLabelPhysicalNames(DM dm, int n, const MeshPhysicalName names_in[])
 {
-  MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
-  GmshName    names[GMSH_MAX_NAMES];
-  int         n = 0;
-  PetscMPIInt rank;
-  PetscInt    dim;
-  DMLabel     face_sets;
+  MPI_Comm         comm = PetscObjectComm((PetscObject)dm);
+  MeshPhysicalName names[MESH_MAX_NAMES];
+  PetscInt         dim;
+  DMLabel          face_sets;
+  PetscMPIInt      rank;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  if (rank == 0) (void)ReadPhysicalNames(filename, names, &n);
   PetscCallMPI(MPI_Bcast(&n, 1, MPI_INT, 0, comm));
-  PetscCallMPI(MPI_Bcast(names, (PetscMPIInt)(n * sizeof(GmshName)), MPI_BYTE, 0, comm));
+  PetscCheck(n <= MESH_MAX_NAMES, comm, PETSC_ERR_PLIB, "more than %d physical names", MESH_MAX_NAMES);
+  if (rank == 0 && n) PetscCall(PetscArraycpy(names, names_in, n)); /* rank 0's, sent below */
+  PetscCallMPI(MPI_Bcast(names, (PetscMPIInt)(n * sizeof(MeshPhysicalName)), MPI_BYTE, 0, comm));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMGetLabel(dm, "Face Sets", &face_sets));
   for (int i = 0; i < n; ++i) {
@@ -84,5 +78,19 @@ PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[])
       PetscCall(ISDestroy(&is));
     }
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* On the serial mesh just read from a .msh file: its $PhysicalNames' labels (MeshLabelPhysicalNames()). */
+PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[])
+{
+  MeshPhysicalName names[MESH_MAX_NAMES];
+  int              n = 0;
+  PetscMPIInt      rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(PetscObjectComm((PetscObject)dm), &rank));
+  if (rank == 0) (void)ReadPhysicalNames(filename, names, &n);
+  PetscCall(MeshLabelPhysicalNames(dm, n, names));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -24,8 +24,9 @@
      39,270); every bar still covered over 15 cycles. In 3D (the surface meshes) the default is kept: the sphere took
      10.7 and 13.3 s against 14.2 and 14.0 s, but the sphere indenter 9.1 and 8.7 s against 7.7 and 8.1 s.
    Gmsh runs on rank 0 on the gathered cells, sorted by their centroids so that the view is the same on any number of
-   ranks (Gmsh's search of a point's cell depends on their order where the values jump); the mesh it writes is read by
-   all ranks and distributed as a mesh file is (METIS).
+   ranks (Gmsh's search of a point's cell depends on their order where the values jump); the mesh it makes is taken
+   from its API on rank 0, built as PETSc's reader builds the file Gmsh would write (mesh_gmsh_build.c), and
+   distributed as a mesh file is (METIS).
    Without a model, the box of the options (-dm_plex_box_*) is the model: a 3D box adapts so. */
 #include <dlfcn.h>
 #include <gmshc.h>
@@ -45,6 +46,11 @@
   X(gmshModelAddPhysicalGroup)             \
   X(gmshModelGetBoundingBox)               \
   X(gmshModelGetEntities)                  \
+  X(gmshModelGetPhysicalGroups)            \
+  X(gmshModelGetPhysicalGroupsForEntity)   \
+  X(gmshModelGetPhysicalName)              \
+  X(gmshModelMeshGetElements)              \
+  X(gmshModelMeshGetNodes)                 \
   X(gmshModelMeshFieldAdd)                 \
   X(gmshModelMeshFieldSetAsBackgroundMesh) \
   X(gmshModelMeshFieldSetNumber)           \
@@ -135,10 +141,161 @@ static PetscErrorCode GmshBoxModel(const MeshBox *box)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Rank 0's part: the model opened (or the box built), the cells' sizes as its background mesh, the mesh generated and
-   written. data: ncells cells of nv vertices, each as Gmsh's list data (x of the vertices, then y, then z, then the
-   size at each). */
-static PetscErrorCode GmshRemesh(const char model[], const MeshBox *box, PetscInt dim, PetscInt ncells, PetscInt nv, double data[], const char out[])
+/* The nodes of a Gmsh element type: points, and first-order lines, triangles and tetrahedra (-1: another type). */
+static PetscInt GmshTypeNodes(int type)
+{
+  switch (type) {
+    case 15:
+      return 1;
+    case 1:
+      return 2;
+    case 2:
+      return 3;
+    case 4:
+      return 4;
+    default:
+      return -1;
+  }
+}
+
+/* n more entries of m PetscInts each in *a, of capacity *cap entries (doubled as needed), after *len of them. */
+static PetscErrorCode GrowInts(PetscInt **a, PetscInt *cap, PetscInt len, PetscInt n, PetscInt m)
+{
+  PetscInt *grown;
+
+  PetscFunctionBeginUser;
+  if (len + n <= *cap) PetscFunctionReturn(PETSC_SUCCESS);
+  *cap = PetscMax(2 * *cap, len + n);
+  PetscCall(PetscMalloc1(*cap * m, &grown));
+  PetscCall(PetscArraycpy(grown, *a, len * m));
+  PetscCall(PetscFree(*a));
+  *a = grown;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The mesh Gmsh made (rank 0), numbered as PETSc's Gmsh reader numbers the file Gmsh would write (mesh_gmsh_build.c):
+   the elements that file saves (where the model has physical groups, those of their entities: Mesh.SaveAll 0), in its
+   order (the entities of dimension 0 to dim, each by tag), the nodes they use in Gmsh's node order (the same
+   entities'), the cells oriented as DMPlexReorderCell() orients them, and the physical groups' names. */
+static PetscErrorCode GmshTakeMesh(PetscInt dim, MeshSimplices *s)
+{
+  size_t    *node_tags = NULL, nnodes = 0, ncoord = 0, npar = 0, ngroups = 0;
+  double    *xyz = NULL, *par = NULL;
+  int       *groups = NULL;
+  PetscInt  *index, *vertex, tag_max = 0, ccap = 0, fcap = 0, ccap_set = 0, fcap_set = 0;
+  PetscBool *used;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(s, sizeof(*s)));
+  s->dim = dim;
+  GmshCall(G.gmshModelMeshGetNodes(&node_tags, &nnodes, &xyz, &ncoord, &par, &npar, -1, -1, 0, 0, &ierr_gmsh), "get the mesh's nodes");
+  for (size_t i = 0; i < nnodes; ++i) tag_max = PetscMax(tag_max, (PetscInt)node_tags[i]);
+  PetscCall(PetscMalloc1(tag_max + 1, &index));
+  for (PetscInt t = 0; t <= tag_max; ++t) index[t] = -1;
+  for (size_t i = 0; i < nnodes; ++i) index[node_tags[i]] = (PetscInt)i;
+  PetscCall(PetscCalloc2(nnodes + 1, &used, nnodes + 1, &vertex));
+  GmshCall(G.gmshModelGetPhysicalGroups(&groups, &ngroups, -1, &ierr_gmsh), "list the physical groups");
+  for (size_t g = 0; g < ngroups / 2; ++g) { /* the names, as the file's $PhysicalNames; dim, tag pairs */
+    char *name = NULL;
+
+    GmshCall(G.gmshModelGetPhysicalName(groups[2 * g], groups[2 * g + 1], &name, &ierr_gmsh), "name a physical group");
+    if (name && name[0] && strlen(name) < sizeof(s->names[0].name) && s->nnames < MESH_MAX_NAMES) {
+      s->names[s->nnames].dim = groups[2 * g];
+      s->names[s->nnames].tag = groups[2 * g + 1];
+      PetscCall(PetscStrncpy(s->names[s->nnames].name, name, sizeof(s->names[0].name)));
+      s->nnames++;
+    }
+    G.gmshFree(name);
+  }
+  G.gmshFree(groups);
+  for (int d = 0; d <= (int)dim; ++d) {
+    int   *dimtags = NULL;
+    size_t nent    = 0;
+
+    GmshCall(G.gmshModelGetEntities(&dimtags, &nent, d, &ierr_gmsh), "list the model's entities");
+    for (size_t e = 0; e < nent / 2; ++e) { /* dim, tag pairs */
+      int     *phys = NULL, *types = NULL;
+      size_t   nphys = 0, ntypes = 0, *etags_n = NULL, netags = 0, *enodes_n = NULL, nenodes = 0, **etags = NULL, **enodes = NULL;
+      PetscInt first;
+
+      GmshCall(G.gmshModelGetPhysicalGroupsForEntity(d, dimtags[2 * e + 1], &phys, &nphys, &ierr_gmsh), "list an entity's physical groups");
+      first = nphys ? (PetscInt)phys[0] : -1;
+      G.gmshFree(phys);
+      if (ngroups && !nphys) continue; /* not saved */
+      GmshCall(
+          G.gmshModelMeshGetElements(&types, &ntypes, &etags, &etags_n, &netags, &enodes, &enodes_n, &nenodes, d, dimtags[2 * e + 1], &ierr_gmsh),
+          "get an entity's elements");
+      for (size_t t = 0; t < ntypes; ++t) {
+        const PetscInt  nn = GmshTypeNodes(types[t]), count = nn > 0 ? (PetscInt)(enodes_n[t] / (size_t)nn) : 0;
+        const PetscBool cell = (PetscBool)(d == (int)dim), face = (PetscBool)(d == (int)dim - 1);
+
+        PetscCheck(nn > 0, PETSC_COMM_SELF, PETSC_ERR_SUP, "Gmsh made elements of type %d (first-order simplices only)", types[t]);
+        if (cell) {
+          PetscCall(GrowInts(&s->cells, &ccap, s->ncells, count, nn));
+          PetscCall(GrowInts(&s->cell_set, &ccap_set, s->ncells, count, 1));
+        }
+        if (face) {
+          PetscCall(GrowInts(&s->faces, &fcap, s->nfaces, count, nn));
+          PetscCall(GrowInts(&s->face_set, &fcap_set, s->nfaces, count, 1));
+        }
+        for (PetscInt i = 0; i < count; ++i) {
+          for (PetscInt k = 0; k < nn; ++k) {
+            const size_t   tag = enodes[t][i * nn + k];
+            const PetscInt at  = tag <= (size_t)tag_max ? index[tag] : -1;
+
+            PetscCheck(at >= 0, PETSC_COMM_SELF, PETSC_ERR_LIB, "Gmsh's element names node %zu, which its nodes do not have", tag);
+            used[at] = PETSC_TRUE;
+            if (cell) s->cells[(s->ncells + i) * nn + k] = at;
+            if (face) s->faces[(s->nfaces + i) * nn + k] = at;
+          }
+          if (cell) s->cell_set[s->ncells + i] = first;
+          if (face) s->face_set[s->nfaces + i] = first;
+        }
+        if (cell) s->ncells += count;
+        if (face) s->nfaces += count;
+        G.gmshFree(etags[t]);
+        G.gmshFree(enodes[t]);
+      }
+      G.gmshFree(types);
+      G.gmshFree(etags);
+      G.gmshFree(etags_n);
+      G.gmshFree(enodes);
+      G.gmshFree(enodes_n);
+    }
+    G.gmshFree(dimtags);
+  }
+  for (size_t i = 0; i < nnodes; ++i) vertex[i] = used[i] ? s->nverts++ : -1; /* PETSc's vertexMap */
+  /* the coordinates as the file Gmsh writes holds them, to 16 significant digits: Gmsh's own doubles differ by an ulp,
+     and through the remeshing's sensitivity (the sizes, the marking's order, Gmsh's insertions) an ulp moves the later
+     cycles' meshes (the cylinder's 1% run from its ninth cycle on), so that -mesh_remeshed_petsc_read would no longer
+     give the same run */
+  PetscCall(PetscMalloc1(s->nverts * dim + 1, &s->coords));
+  for (size_t i = 0; i < nnodes; ++i)
+    if (vertex[i] >= 0)
+      for (PetscInt j = 0; j < dim; ++j) {
+        char digits[32];
+
+        (void)snprintf(digits, sizeof(digits), "%.16g", xyz[3 * i + j]);
+        s->coords[vertex[i] * dim + j] = (PetscReal)strtod(digits, NULL);
+      }
+  for (PetscInt c = 0; c < s->ncells; ++c) {
+    for (PetscInt k = 0; k <= dim; ++k) s->cells[c * (dim + 1) + k] = vertex[s->cells[c * (dim + 1) + k]];
+    PetscCall(DMPlexInvertCell(dim == 2 ? DM_POLYTOPE_TRIANGLE : DM_POLYTOPE_TETRAHEDRON, &s->cells[c * (dim + 1)]));
+  }
+  for (PetscInt f = 0; f < s->nfaces * dim; ++f) s->faces[f] = vertex[s->faces[f]];
+  G.gmshFree(node_tags);
+  G.gmshFree(xyz);
+  G.gmshFree(par);
+  PetscCall(PetscFree(index));
+  PetscCall(PetscFree2(used, vertex));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Rank 0's part: the model opened (or the box built), the cells' sizes as its background mesh, the mesh generated, and
+   taken from Gmsh's API (made) or, with out, written to that file. data: ncells cells of nv vertices, each as Gmsh's
+   list data (x of the vertices, then y, then z, then the size at each). */
+static PetscErrorCode GmshRemesh(const char model[], const MeshBox *box, PetscInt dim, PetscInt ncells, PetscInt nv, double data[], const char out[],
+                                 MeshSimplices *made)
 {
   int view, field;
 
@@ -168,7 +325,10 @@ static PetscErrorCode GmshRemesh(const char model[], const MeshBox *box, PetscIn
   GmshCall(G.gmshModelMeshFieldSetNumber(field, "ViewTag", view, &ierr_gmsh), "set the size field's view");
   GmshCall(G.gmshModelMeshFieldSetAsBackgroundMesh(field, &ierr_gmsh), "set the background mesh");
   GmshCall(G.gmshModelMeshGenerate((int)dim, &ierr_gmsh), "mesh the model");
-  GmshCall(G.gmshWrite(out, &ierr_gmsh), "write the mesh");
+  if (out)
+    GmshCall(G.gmshWrite(out, &ierr_gmsh), "write the mesh");
+  else
+    PetscCall(GmshTakeMesh(dim, made));
   GmshCall(G.gmshFinalize(&ierr_gmsh), "finish");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -306,13 +466,15 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
   PetscInt           dim, cStart, cEnd, pStart, nv, per, total = 0;
   PetscReal         *vsize = NULL;
   double            *mine, *all = NULL;
-  char               out[PETSC_MAX_PATH_LEN] = "", why[512] = "";
+  char               out[PETSC_MAX_PATH_LEN] = "", why[512] = "", what[PETSC_MAX_PATH_LEN + 64];
+  MeshSimplices      made;
   int                failed = 0;
   PetscSection       csec;
   Vec                coords;
   const PetscScalar *xc;
 
   PetscFunctionBeginUser;
+  PetscCall(PetscMemzero(&made, sizeof(made)));
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   PetscCallMPI(MPI_Comm_size(comm, &nranks));
   PetscCall(DMGetDimension(dm, &dim));
@@ -390,10 +552,12 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
     char tmp[PETSC_MAX_PATH_LEN];
 
     PetscCall(SortCells(total / per, nv, all));
-    PetscCall(PetscGetTmp(PETSC_COMM_SELF, tmp, sizeof(tmp)));
-    PetscCall(PetscSNPrintf(out, sizeof(out), "%s/signorini-remesh-%d.msh", tmp, (int)getpid()));
+    if (box->petsc_read) { /* for comparison: Gmsh writes the mesh, PETSc's reader reads it */
+      PetscCall(PetscGetTmp(PETSC_COMM_SELF, tmp, sizeof(tmp)));
+      PetscCall(PetscSNPrintf(out, sizeof(out), "%s/signorini-remesh-%d.msh", tmp, (int)getpid()));
+    }
     PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-    failed = GmshRemesh(model, box, dim, total / per, nv, all, out);
+    failed = GmshRemesh(model, box, dim, total / per, nv, all, out[0] ? out : NULL, &made);
     PetscCall(PetscPopErrorHandler());
     if (failed) {
       const char *text     = NULL;
@@ -403,7 +567,8 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
       if (G.gmshFinalize) G.gmshFinalize(&ierr_gmsh); /* whatever state Gmsh was left in */
       PetscCall(PetscErrorMessage(failed, &text, &specific));
       PetscCall(PetscStrncpy(why, specific && specific[0] ? specific : text, sizeof(why)));
-      (void)unlink(out);
+      if (out[0]) (void)unlink(out);
+      PetscCall(MeshSimplicesReset(&made));
     }
     PetscCall(PetscFree(all));
     PetscCall(PetscFree2(counts, displs));
@@ -411,10 +576,17 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
   PetscCallMPI(MPI_Bcast(&failed, 1, MPI_INT, 0, comm));
   PetscCallMPI(MPI_Bcast(why, sizeof(why), MPI_CHAR, 0, comm));
   PetscCheck(!failed, comm, PETSC_ERR_LIB, "-adapt_model %s: %s", model[0] ? model : "(the box of the options)", why);
-  PetscCallMPI(MPI_Bcast(out, sizeof(out), MPI_CHAR, 0, comm));
-  PetscCall(MeshReadRemeshed(comm, out, box->petsc_read, remeshed));
-  PetscCallMPI(MPI_Barrier(comm));
-  if (rank == 0) (void)unlink(out); /* read: removed before the checks, which may refuse the mesh */
+  PetscCall(PetscSNPrintf(what, sizeof(what), "the mesh Gmsh made of -adapt_model %s", model[0] ? model : "(the box of the options)"));
+  if (box->petsc_read) {
+    PetscCallMPI(MPI_Bcast(out, sizeof(out), MPI_CHAR, 0, comm));
+    PetscCall(MeshReadRemeshedFile(comm, out, remeshed));
+    PetscCallMPI(MPI_Barrier(comm));
+    if (rank == 0) (void)unlink(out); /* read: removed before the checks, which may refuse the mesh */
+  } else {
+    PetscCall(MeshSimplicesBuild(comm, &made, remeshed));
+    PetscCall(MeshSimplicesReset(&made));
+  }
+  PetscCall(MeshDistributeRemeshed(what, remeshed));
   PetscCall(CheckFaceSets(dm, *remeshed, model));
   if (loc) PetscCall(MeshTransferCreate(comm, dim, total / per, all_x, all_u, tr)); /* which owns all_x and all_u (rank 0) */
   {
