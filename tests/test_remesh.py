@@ -148,6 +148,45 @@ def test_the_mesh_taken_from_gmsh_is_petscs_reading_of_its_file(case, disk):
             assert np.array_equal(c[key], r[key], equal_nan=True), key
 
 
+def test_the_mesh_taken_from_gmsh_keeps_what_mesh_saveall_saves(tmp_path):
+    """A model of two squares, only one in a physical surface, that sets Mesh.SaveAll = 1: the file Gmsh writes holds
+    both squares' triangles and the boundary elements of both, and the mesh taken from Gmsh's API keeps them as PETSc's
+    reader of that file does (every /cycles value to the last bit, the squares pressed onto the plane y = 0; without the
+    rule the second square's top edges join no face and the run fails)."""
+    import gmsh
+    geo, msh = str(tmp_path / "two.geo"), str(tmp_path / "two.msh")
+    with open(geo, "w") as f:
+        f.write("""lc = 0.25;
+Point(1) = {0, 1, 0, lc}; Point(2) = {1, 1, 0, lc}; Point(3) = {2, 1, 0, lc};
+Point(4) = {2, 0, 0, lc}; Point(5) = {1, 0, 0, lc}; Point(6) = {0, 0, 0, lc};
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 4}; Line(4) = {4, 5}; Line(5) = {5, 6}; Line(6) = {6, 1}; Line(7) = {2, 5};
+Curve Loop(1) = {1, 7, 5, 6}; Plane Surface(1) = {1};
+Curve Loop(2) = {2, 3, 4, -7}; Plane Surface(2) = {2};
+Physical Curve("contact", 1) = {4, 5};
+Physical Curve("top", 2) = {1, 2};
+Physical Surface("body", 10) = {1};
+Mesh.SaveAll = 1;
+""")
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(geo)
+        gmsh.model.mesh.generate(2)
+        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.write(msh)
+    finally:
+        gmsh.finalize()
+    args = ["-dm_plex_filename", msh, "-scene", "general", "-contact_faces", "contact", "-bc_clamp", "top", "-bc_clamp_top_translate", "0,-0.01",
+            "-young_modulus", 1, "-poisson_ratio", 0.3, "-adapt_model", geo, "-adapt_cycles", 2]
+    _, direct = run(args, "remesh_saveall_direct")
+    _, petsc = run(args + ["-mesh_remeshed_petsc_read"], "remesh_saveall_petsc")
+    c, r = cycles(direct), cycles(petsc)
+    assert len(c["n_cells"]) == 3 and np.all(np.diff(c["n_cells"]) > 0) and np.all(c["contact_force_value"] > 0), (c["n_cells"], c["contact_force_value"])
+    for key in c:
+        if not key.startswith("time"):
+            assert np.array_equal(c[key], r[key], equal_nan=True), key
+
+
 def test_remeshing_on_two_ranks_gives_the_one_rank_cycles(disk):
     """Gmsh meshes on rank 0 the cells gathered and sorted by their centroids: 2 ranks give the meshes of 1 (the same
     unknowns at every cycle) and the same answers to solver tolerance. The recovered peak is the fit numpy makes of the

@@ -1,6 +1,6 @@
 /* The mesh Gmsh made at a remeshing (mesh_remesh.c), taken from Gmsh's API rather than from a file, built as PETSc
-   3.18's Gmsh reader (DMPlexCreateGmsh() with interpolation) builds the file Gmsh would write (MSH 4.1, Mesh.SaveAll 0:
-   where the model has physical groups, the elements of their entities alone):
+   3.18's Gmsh reader (DMPlexCreateGmsh() with interpolation) builds the file Gmsh would write (MSH 4.1; where the model
+   has physical groups, the elements of their entities alone, unless it sets Mesh.SaveAll):
    - the vertices: the nodes some saved element uses, in Gmsh's node order (its entities' order: points, curves,
      surfaces, volumes, each by tag), PETSc's vertexMap;
    - the cells: the saved elements of the mesh's dimension in Gmsh's element order (the entities' order), each cone

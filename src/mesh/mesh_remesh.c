@@ -58,6 +58,7 @@
   X(gmshModelOccAddBox)                    \
   X(gmshModelOccSynchronize)               \
   X(gmshOpen)                              \
+  X(gmshOptionGetNumber)                   \
   X(gmshOptionSetNumber)                   \
   X(gmshViewAdd)                           \
   X(gmshViewAddListData)                   \
@@ -174,13 +175,13 @@ static PetscErrorCode GrowInts(PetscInt **a, PetscInt *cap, PetscInt len, PetscI
 }
 
 /* The mesh Gmsh made (rank 0), numbered as PETSc's Gmsh reader numbers the file Gmsh would write (mesh_gmsh_build.c):
-   the elements that file saves (where the model has physical groups, those of their entities: Mesh.SaveAll 0), in its
-   order (the entities of dimension 0 to dim, each by tag), the nodes they use in Gmsh's node order (the same
-   entities'), the cells oriented as DMPlexReorderCell() orients them, and the physical groups' names. */
+   the elements that file saves (where the model has physical groups, those of their entities, unless the model sets
+   Mesh.SaveAll), in its order (the entities of dimension 0 to dim, each by tag), the nodes they use in Gmsh's node
+   order (the same entities'), the cells oriented as DMPlexReorderCell() orients them, and the physical groups' names. */
 static PetscErrorCode GmshTakeMesh(PetscInt dim, MeshSimplices *s)
 {
   size_t    *node_tags = NULL, nnodes = 0, ncoord = 0, npar = 0, ngroups = 0;
-  double    *xyz = NULL, *par = NULL;
+  double    *xyz = NULL, *par = NULL, save_all = 0.0;
   int       *groups = NULL;
   PetscInt  *index, *vertex, tag_max = 0, ccap = 0, fcap = 0, ccap_set = 0, fcap_set = 0;
   PetscBool *used;
@@ -208,6 +209,7 @@ static PetscErrorCode GmshTakeMesh(PetscInt dim, MeshSimplices *s)
     G.gmshFree(name);
   }
   G.gmshFree(groups);
+  GmshCall(G.gmshOptionGetNumber("Mesh.SaveAll", &save_all, &ierr_gmsh), "get Mesh.SaveAll");
   for (int d = 0; d <= (int)dim; ++d) {
     int   *dimtags = NULL;
     size_t nent    = 0;
@@ -221,7 +223,7 @@ static PetscErrorCode GmshTakeMesh(PetscInt dim, MeshSimplices *s)
       GmshCall(G.gmshModelGetPhysicalGroupsForEntity(d, dimtags[2 * e + 1], &phys, &nphys, &ierr_gmsh), "list an entity's physical groups");
       first = nphys ? (PetscInt)phys[0] : -1;
       G.gmshFree(phys);
-      if (ngroups && !nphys) continue; /* not saved */
+      if (ngroups && !nphys && save_all == 0.0) continue; /* not saved */
       GmshCall(
           G.gmshModelMeshGetElements(&types, &ntypes, &etags, &etags_n, &netags, &enodes, &enodes_n, &nenodes, d, dimtags[2 * e + 1], &ierr_gmsh),
           "get an entity's elements");
