@@ -82,7 +82,8 @@ PetscErrorCode MeshLabelPhysicalNames(DM dm, int n, const MeshPhysicalName names
 PetscErrorCode MeshLabelGmshNames(DM dm, const char filename[]);
 
 /* mesh_gmsh_build.c: the mesh Gmsh made for a remeshing, on rank 0, as PETSc's Gmsh reader numbers the file Gmsh would
-   write, built as that reader builds it with interpolation */
+   write (taken from Gmsh by MeshSimplicesFromGmsh(), src/mesh/mesh_gmsh.h), built as that reader builds it with
+   interpolation */
 typedef struct {
   PetscInt         dim, ncells, nverts, nfaces;
   PetscInt        *cells, *cell_set; /* [ncells][dim + 1] vertices, oriented as PETSc orients them; the first physical tag (-1: none) */

@@ -28,84 +28,10 @@
    from its API on rank 0, built as PETSc's reader builds the file Gmsh would write (mesh_gmsh_build.c), and
    distributed as a mesh file is (METIS).
    Without a model, the box of the options (-dm_plex_box_*) is the model: a 3D box adapts so. */
-#include <dlfcn.h>
-#include <gmshc.h>
 #include <petscsf.h>
 #include <stdlib.h>
 #include <unistd.h>
-#include "mesh.h"
-
-/* Gmsh's C API, loaded at the first remesh (GmshLoad()): linked, its library and OpenCASCADE's added 0.22 s to the
-   start of every run (0.44 s to 0.66 s on a 4 x 4 box), remeshing or not. */
-#define GMSH_FUNCTIONS(X)                  \
-  X(gmshFinalize)                          \
-  X(gmshFree)                              \
-  X(gmshInitialize)                        \
-  X(gmshLoggerGetLastError)                \
-  X(gmshModelAdd)                          \
-  X(gmshModelAddPhysicalGroup)             \
-  X(gmshModelGetBoundingBox)               \
-  X(gmshModelGetEntities)                  \
-  X(gmshModelGetPhysicalGroups)            \
-  X(gmshModelGetPhysicalGroupsForEntity)   \
-  X(gmshModelGetPhysicalName)              \
-  X(gmshModelMeshGetElements)              \
-  X(gmshModelMeshGetNodes)                 \
-  X(gmshModelMeshFieldAdd)                 \
-  X(gmshModelMeshFieldSetAsBackgroundMesh) \
-  X(gmshModelMeshFieldSetNumber)           \
-  X(gmshModelMeshGenerate)                 \
-  X(gmshModelOccAddBox)                    \
-  X(gmshModelOccSynchronize)               \
-  X(gmshOpen)                              \
-  X(gmshOptionGetNumber)                   \
-  X(gmshOptionSetNumber)                   \
-  X(gmshViewAdd)                           \
-  X(gmshViewAddListData)                   \
-  X(gmshWrite)
-#define GMSH_DECLARE(f) __typeof__(f) *f;
-static struct {
-  void *lib;
-  GMSH_FUNCTIONS(GMSH_DECLARE)
-} G;
-
-/* RTLD_DEEPBIND: Gmsh's libraries look their symbols up in their own dependencies first, not through the solver's
-   whole global scope (PETSc's, MPI's and HDF5's libraries) before them. Gmsh brings 71 libraries of its own
-   (OpenCASCADE, FLTK, image formats); its loading took 0.24 to 0.35 s of the Hertz cylinder's first remesh so, 0.08 to
-   0.11 s with it (RTLD_LAZY alone: 0.24 to 0.27 s). It also keeps Gmsh's libraries from binding to a same-named symbol
-   of the solver's. Not under AddressSanitizer, whose runtime refuses it. */
-#if defined(RTLD_DEEPBIND) && !defined(__SANITIZE_ADDRESS__)
-#  define GMSH_DLOPEN (RTLD_NOW | RTLD_LOCAL | RTLD_DEEPBIND)
-#else
-#  define GMSH_DLOPEN (RTLD_NOW | RTLD_LOCAL)
-#endif
-
-static PetscErrorCode GmshLoad(void)
-{
-  PetscFunctionBeginUser;
-  if (G.lib) PetscFunctionReturn(PETSC_SUCCESS);
-  G.lib = dlopen("libgmsh.so.4.8", GMSH_DLOPEN);
-  if (!G.lib) G.lib = dlopen("libgmsh.so", GMSH_DLOPEN);
-  PetscCheck(G.lib, PETSC_COMM_SELF, PETSC_ERR_LIB, "Gmsh's library cannot be loaded (%s): apt-get install libgmsh4.8", dlerror());
-#define GMSH_LOAD(f)                       \
-  G.f = (__typeof__(f) *)dlsym(G.lib, #f); \
-  PetscCheck(G.f, PETSC_COMM_SELF, PETSC_ERR_LIB, "Gmsh's library has no %s", #f);
-  GMSH_FUNCTIONS(GMSH_LOAD)
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* A Gmsh call's error as a PETSc error, with Gmsh's last message. */
-#define GmshCall(call, what)                                                                                       \
-  do {                                                                                                             \
-    int ierr_gmsh = 0;                                                                                             \
-    call;                                                                                                          \
-    if (ierr_gmsh) {                                                                                               \
-      char *msg = NULL;                                                                                            \
-      int   e2  = 0;                                                                                               \
-      G.gmshLoggerGetLastError(&msg, &e2);                                                                         \
-      SETERRQ(PETSC_COMM_SELF, PETSC_ERR_LIB, "Gmsh failed to %s: %s", what, msg &&msg[0] ? msg : "(no message)"); \
-    }                                                                                                              \
-  } while (0)
+#include "mesh_gmsh.h"
 
 /* The 3D box of the options as a Gmsh model (a 2D box is refined by PETSc, AdaptSolve()): an OpenCASCADE box, its
    sides' physical groups numbered as PETSc numbers them (MeshBoxFaceId(), found by their bounding boxes), the body 10. */
@@ -117,17 +43,17 @@ static PetscErrorCode GmshBoxModel(const MeshBox *box)
   size_t         n       = 0;
 
   PetscFunctionBeginUser;
-  GmshCall(G.gmshModelAdd("box", &ierr_gmsh), "add the box model");
+  GmshCall(gmsh_api.gmshModelAdd("box", &ierr_gmsh), "add the box model");
   PetscCheck(dim == 3, PETSC_COMM_SELF, PETSC_ERR_PLIB, "the box's Gmsh model is 3D");
-  GmshCall(body = G.gmshModelOccAddBox(lo[0], lo[1], lo[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], -1, &ierr_gmsh), "add the box");
-  GmshCall(G.gmshModelOccSynchronize(&ierr_gmsh), "synchronize the box");
-  GmshCall(G.gmshModelGetEntities(&dimtags, &n, (int)dim - 1, &ierr_gmsh), "list the box's sides");
+  GmshCall(body = gmsh_api.gmshModelOccAddBox(lo[0], lo[1], lo[2], hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2], -1, &ierr_gmsh), "add the box");
+  GmshCall(gmsh_api.gmshModelOccSynchronize(&ierr_gmsh), "synchronize the box");
+  GmshCall(gmsh_api.gmshModelGetEntities(&dimtags, &n, (int)dim - 1, &ierr_gmsh), "list the box's sides");
   for (size_t i = 0; i < n / 2; ++i) {
     double   bb[6];
     int      side = dimtags[2 * i + 1];
     PetscInt id   = -1;
 
-    GmshCall(G.gmshModelGetBoundingBox((int)dim - 1, side, &bb[0], &bb[1], &bb[2], &bb[3], &bb[4], &bb[5], &ierr_gmsh), "bound a side");
+    GmshCall(gmsh_api.gmshModelGetBoundingBox((int)dim - 1, side, &bb[0], &bb[1], &bb[2], &bb[3], &bb[4], &bb[5], &ierr_gmsh), "bound a side");
     for (PetscInt d = 0; d < dim; ++d) {
       const double tol = 1e-6 * (hi[d] - lo[d]) + 1e-6; /* OpenCASCADE pads its bounding boxes by about 1e-7 */
 
@@ -135,161 +61,10 @@ static PetscErrorCode GmshBoxModel(const MeshBox *box)
       id = MeshBoxFaceId(dim, d, PetscAbsReal(bb[d] - lo[d]) < PetscAbsReal(bb[d] - hi[d]) ? 0 : 1);
     }
     PetscCheck(id > 0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "a side of the Gmsh box is on no side of the box");
-    GmshCall(G.gmshModelAddPhysicalGroup((int)dim - 1, &side, 1, (int)id, &ierr_gmsh), "name a side");
+    GmshCall(gmsh_api.gmshModelAddPhysicalGroup((int)dim - 1, &side, 1, (int)id, &ierr_gmsh), "name a side");
   }
-  G.gmshFree(dimtags);
-  GmshCall(G.gmshModelAddPhysicalGroup((int)dim, &body, 1, 10, &ierr_gmsh), "name the body");
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The nodes of a Gmsh element type: points, and first-order lines, triangles and tetrahedra (-1: another type). */
-static PetscInt GmshTypeNodes(int type)
-{
-  switch (type) {
-    case 15:
-      return 1;
-    case 1:
-      return 2;
-    case 2:
-      return 3;
-    case 4:
-      return 4;
-    default:
-      return -1;
-  }
-}
-
-/* n more entries of m PetscInts each in *a, of capacity *cap entries (doubled as needed), after *len of them. */
-static PetscErrorCode GrowInts(PetscInt **a, PetscInt *cap, PetscInt len, PetscInt n, PetscInt m)
-{
-  PetscInt *grown;
-
-  PetscFunctionBeginUser;
-  if (len + n <= *cap) PetscFunctionReturn(PETSC_SUCCESS);
-  *cap = PetscMax(2 * *cap, len + n);
-  PetscCall(PetscMalloc1(*cap * m, &grown));
-  PetscCall(PetscArraycpy(grown, *a, len * m));
-  PetscCall(PetscFree(*a));
-  *a = grown;
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* The mesh Gmsh made (rank 0), numbered as PETSc's Gmsh reader numbers the file Gmsh would write (mesh_gmsh_build.c):
-   the elements that file saves (where the model has physical groups, those of their entities, unless the model sets
-   Mesh.SaveAll), in its order (the entities of dimension 0 to dim, each by tag), the nodes they use in Gmsh's node
-   order (the same entities'), the cells oriented as DMPlexReorderCell() orients them, and the physical groups' names. */
-static PetscErrorCode GmshTakeMesh(PetscInt dim, MeshSimplices *s)
-{
-  size_t    *node_tags = NULL, nnodes = 0, ncoord = 0, npar = 0, ngroups = 0;
-  double    *xyz = NULL, *par = NULL, save_all = 0.0;
-  int       *groups = NULL;
-  PetscInt  *index, *vertex, tag_max = 0, ccap = 0, fcap = 0, ccap_set = 0, fcap_set = 0;
-  PetscBool *used;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscMemzero(s, sizeof(*s)));
-  s->dim = dim;
-  GmshCall(G.gmshModelMeshGetNodes(&node_tags, &nnodes, &xyz, &ncoord, &par, &npar, -1, -1, 0, 0, &ierr_gmsh), "get the mesh's nodes");
-  for (size_t i = 0; i < nnodes; ++i) tag_max = PetscMax(tag_max, (PetscInt)node_tags[i]);
-  PetscCall(PetscMalloc1(tag_max + 1, &index));
-  for (PetscInt t = 0; t <= tag_max; ++t) index[t] = -1;
-  for (size_t i = 0; i < nnodes; ++i) index[node_tags[i]] = (PetscInt)i;
-  PetscCall(PetscCalloc2(nnodes + 1, &used, nnodes + 1, &vertex));
-  GmshCall(G.gmshModelGetPhysicalGroups(&groups, &ngroups, -1, &ierr_gmsh), "list the physical groups");
-  for (size_t g = 0; g < ngroups / 2; ++g) { /* the names, as the file's $PhysicalNames; dim, tag pairs */
-    char *name = NULL;
-
-    GmshCall(G.gmshModelGetPhysicalName(groups[2 * g], groups[2 * g + 1], &name, &ierr_gmsh), "name a physical group");
-    if (name && name[0] && strlen(name) < sizeof(s->names[0].name) && s->nnames < MESH_MAX_NAMES) {
-      s->names[s->nnames].dim = groups[2 * g];
-      s->names[s->nnames].tag = groups[2 * g + 1];
-      PetscCall(PetscStrncpy(s->names[s->nnames].name, name, sizeof(s->names[0].name)));
-      s->nnames++;
-    }
-    G.gmshFree(name);
-  }
-  G.gmshFree(groups);
-  GmshCall(G.gmshOptionGetNumber("Mesh.SaveAll", &save_all, &ierr_gmsh), "get Mesh.SaveAll");
-  for (int d = 0; d <= (int)dim; ++d) {
-    int   *dimtags = NULL;
-    size_t nent    = 0;
-
-    GmshCall(G.gmshModelGetEntities(&dimtags, &nent, d, &ierr_gmsh), "list the model's entities");
-    for (size_t e = 0; e < nent / 2; ++e) { /* dim, tag pairs */
-      int     *phys = NULL, *types = NULL;
-      size_t   nphys = 0, ntypes = 0, *etags_n = NULL, netags = 0, *enodes_n = NULL, nenodes = 0, **etags = NULL, **enodes = NULL;
-      PetscInt first;
-
-      GmshCall(G.gmshModelGetPhysicalGroupsForEntity(d, dimtags[2 * e + 1], &phys, &nphys, &ierr_gmsh), "list an entity's physical groups");
-      first = nphys ? (PetscInt)phys[0] : -1;
-      G.gmshFree(phys);
-      if (ngroups && !nphys && save_all == 0.0) continue; /* not saved */
-      GmshCall(
-          G.gmshModelMeshGetElements(&types, &ntypes, &etags, &etags_n, &netags, &enodes, &enodes_n, &nenodes, d, dimtags[2 * e + 1], &ierr_gmsh),
-          "get an entity's elements");
-      for (size_t t = 0; t < ntypes; ++t) {
-        const PetscInt  nn = GmshTypeNodes(types[t]), count = nn > 0 ? (PetscInt)(enodes_n[t] / (size_t)nn) : 0;
-        const PetscBool cell = (PetscBool)(d == (int)dim), face = (PetscBool)(d == (int)dim - 1);
-
-        PetscCheck(nn > 0, PETSC_COMM_SELF, PETSC_ERR_SUP, "Gmsh made elements of type %d (first-order simplices only)", types[t]);
-        if (cell) {
-          PetscCall(GrowInts(&s->cells, &ccap, s->ncells, count, nn));
-          PetscCall(GrowInts(&s->cell_set, &ccap_set, s->ncells, count, 1));
-        }
-        if (face) {
-          PetscCall(GrowInts(&s->faces, &fcap, s->nfaces, count, nn));
-          PetscCall(GrowInts(&s->face_set, &fcap_set, s->nfaces, count, 1));
-        }
-        for (PetscInt i = 0; i < count; ++i) {
-          for (PetscInt k = 0; k < nn; ++k) {
-            const size_t   tag = enodes[t][i * nn + k];
-            const PetscInt at  = tag <= (size_t)tag_max ? index[tag] : -1;
-
-            PetscCheck(at >= 0, PETSC_COMM_SELF, PETSC_ERR_LIB, "Gmsh's element names node %zu, which its nodes do not have", tag);
-            used[at] = PETSC_TRUE;
-            if (cell) s->cells[(s->ncells + i) * nn + k] = at;
-            if (face) s->faces[(s->nfaces + i) * nn + k] = at;
-          }
-          if (cell) s->cell_set[s->ncells + i] = first;
-          if (face) s->face_set[s->nfaces + i] = first;
-        }
-        if (cell) s->ncells += count;
-        if (face) s->nfaces += count;
-        G.gmshFree(etags[t]);
-        G.gmshFree(enodes[t]);
-      }
-      G.gmshFree(types);
-      G.gmshFree(etags);
-      G.gmshFree(etags_n);
-      G.gmshFree(enodes);
-      G.gmshFree(enodes_n);
-    }
-    G.gmshFree(dimtags);
-  }
-  for (size_t i = 0; i < nnodes; ++i) vertex[i] = used[i] ? s->nverts++ : -1; /* PETSc's vertexMap */
-  /* the coordinates as the file Gmsh writes holds them, to 16 significant digits: Gmsh's own doubles differ by an ulp,
-     and through the remeshing's sensitivity (the sizes, the marking's order, Gmsh's insertions) an ulp moves the later
-     cycles' meshes (the cylinder's 1% run from its ninth cycle on), so that -mesh_remeshed_petsc_read would no longer
-     give the same run */
-  PetscCall(PetscMalloc1(s->nverts * dim + 1, &s->coords));
-  for (size_t i = 0; i < nnodes; ++i)
-    if (vertex[i] >= 0)
-      for (PetscInt j = 0; j < dim; ++j) {
-        char digits[32];
-
-        (void)snprintf(digits, sizeof(digits), "%.16g", xyz[3 * i + j]);
-        s->coords[vertex[i] * dim + j] = (PetscReal)strtod(digits, NULL);
-      }
-  for (PetscInt c = 0; c < s->ncells; ++c) {
-    for (PetscInt k = 0; k <= dim; ++k) s->cells[c * (dim + 1) + k] = vertex[s->cells[c * (dim + 1) + k]];
-    PetscCall(DMPlexInvertCell(dim == 2 ? DM_POLYTOPE_TRIANGLE : DM_POLYTOPE_TETRAHEDRON, &s->cells[c * (dim + 1)]));
-  }
-  for (PetscInt f = 0; f < s->nfaces * dim; ++f) s->faces[f] = vertex[s->faces[f]];
-  G.gmshFree(node_tags);
-  G.gmshFree(xyz);
-  G.gmshFree(par);
-  PetscCall(PetscFree(index));
-  PetscCall(PetscFree2(used, vertex));
+  gmsh_api.gmshFree(dimtags);
+  GmshCall(gmsh_api.gmshModelAddPhysicalGroup((int)dim, &body, 1, 10, &ierr_gmsh), "name the body");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -302,36 +77,37 @@ static PetscErrorCode GmshRemesh(const char model[], const MeshBox *box, PetscIn
   int view, field;
 
   PetscFunctionBeginUser;
-  PetscCall(GmshLoad());
-  GmshCall(G.gmshInitialize(0, NULL, 0, &ierr_gmsh), "start");
-  GmshCall(G.gmshOptionSetNumber("General.Terminal", 0, &ierr_gmsh), "set General.Terminal");
-  GmshCall(G.gmshOptionSetNumber("General.NumThreads", 1, &ierr_gmsh), "set General.NumThreads");
+  PetscCall(MeshGmshLoad());
+  GmshCall(gmsh_api.gmshInitialize(0, NULL, 0, &ierr_gmsh), "start");
+  GmshCall(gmsh_api.gmshOptionSetNumber("General.Terminal", 0, &ierr_gmsh), "set General.Terminal");
+  GmshCall(gmsh_api.gmshOptionSetNumber("General.NumThreads", 1, &ierr_gmsh), "set General.NumThreads");
   if (model[0])
-    GmshCall(G.gmshOpen(model, &ierr_gmsh), "open the model (-adapt_model)");
+    GmshCall(gmsh_api.gmshOpen(model, &ierr_gmsh), "open the model (-adapt_model)");
   else
     PetscCall(GmshBoxModel(box));
   /* the size is the background mesh's alone: not the model's points', not extended from the boundary, not the
      curvature's */
-  GmshCall(G.gmshOptionSetNumber("Mesh.MeshSizeExtendFromBoundary", 0, &ierr_gmsh), "set Mesh.MeshSizeExtendFromBoundary");
-  GmshCall(G.gmshOptionSetNumber("Mesh.MeshSizeFromPoints", 0, &ierr_gmsh), "set Mesh.MeshSizeFromPoints");
-  GmshCall(G.gmshOptionSetNumber("Mesh.MeshSizeFromCurvature", 0, &ierr_gmsh), "set Mesh.MeshSizeFromCurvature");
-  GmshCall(G.gmshOptionSetNumber("Mesh.MshFileVersion", 4.1, &ierr_gmsh), "set Mesh.MshFileVersion");
+  GmshCall(gmsh_api.gmshOptionSetNumber("Mesh.MeshSizeExtendFromBoundary", 0, &ierr_gmsh), "set Mesh.MeshSizeExtendFromBoundary");
+  GmshCall(gmsh_api.gmshOptionSetNumber("Mesh.MeshSizeFromPoints", 0, &ierr_gmsh), "set Mesh.MeshSizeFromPoints");
+  GmshCall(gmsh_api.gmshOptionSetNumber("Mesh.MeshSizeFromCurvature", 0, &ierr_gmsh), "set Mesh.MeshSizeFromCurvature");
+  GmshCall(gmsh_api.gmshOptionSetNumber("Mesh.MshFileVersion", 4.1, &ierr_gmsh), "set Mesh.MshFileVersion");
   /* 2D: Gmsh's Delaunay algorithm, no Laplace smoothing (see the head of the file) */
   if (dim == 2) {
-    GmshCall(G.gmshOptionSetNumber("Mesh.Algorithm", 5, &ierr_gmsh), "set Mesh.Algorithm");
-    GmshCall(G.gmshOptionSetNumber("Mesh.Smoothing", 0, &ierr_gmsh), "set Mesh.Smoothing");
+    GmshCall(gmsh_api.gmshOptionSetNumber("Mesh.Algorithm", 5, &ierr_gmsh), "set Mesh.Algorithm");
+    GmshCall(gmsh_api.gmshOptionSetNumber("Mesh.Smoothing", 0, &ierr_gmsh), "set Mesh.Smoothing");
   }
-  GmshCall(view = G.gmshViewAdd("size", -1, &ierr_gmsh), "add the size view");
-  GmshCall(G.gmshViewAddListData(view, dim == 2 ? "ST" : "SS", (int)ncells, data, (size_t)(ncells * nv * 4), &ierr_gmsh), "fill the size view");
-  GmshCall(field = G.gmshModelMeshFieldAdd("PostView", -1, &ierr_gmsh), "add the size field");
-  GmshCall(G.gmshModelMeshFieldSetNumber(field, "ViewTag", view, &ierr_gmsh), "set the size field's view");
-  GmshCall(G.gmshModelMeshFieldSetAsBackgroundMesh(field, &ierr_gmsh), "set the background mesh");
-  GmshCall(G.gmshModelMeshGenerate((int)dim, &ierr_gmsh), "mesh the model");
+  GmshCall(view = gmsh_api.gmshViewAdd("size", -1, &ierr_gmsh), "add the size view");
+  GmshCall(gmsh_api.gmshViewAddListData(view, dim == 2 ? "ST" : "SS", (int)ncells, data, (size_t)(ncells * nv * 4), &ierr_gmsh),
+           "fill the size view");
+  GmshCall(field = gmsh_api.gmshModelMeshFieldAdd("PostView", -1, &ierr_gmsh), "add the size field");
+  GmshCall(gmsh_api.gmshModelMeshFieldSetNumber(field, "ViewTag", view, &ierr_gmsh), "set the size field's view");
+  GmshCall(gmsh_api.gmshModelMeshFieldSetAsBackgroundMesh(field, &ierr_gmsh), "set the background mesh");
+  GmshCall(gmsh_api.gmshModelMeshGenerate((int)dim, &ierr_gmsh), "mesh the model");
   if (out)
-    GmshCall(G.gmshWrite(out, &ierr_gmsh), "write the mesh");
+    GmshCall(gmsh_api.gmshWrite(out, &ierr_gmsh), "write the mesh");
   else
-    PetscCall(GmshTakeMesh(dim, made));
-  GmshCall(G.gmshFinalize(&ierr_gmsh), "finish");
+    PetscCall(MeshSimplicesFromGmsh(dim, made));
+  GmshCall(gmsh_api.gmshFinalize(&ierr_gmsh), "finish");
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -566,7 +342,7 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
       char       *specific = NULL;
       int         ierr_gmsh;
 
-      if (G.gmshFinalize) G.gmshFinalize(&ierr_gmsh); /* whatever state Gmsh was left in */
+      if (gmsh_api.gmshFinalize) gmsh_api.gmshFinalize(&ierr_gmsh); /* whatever state Gmsh was left in */
       PetscCall(PetscErrorMessage(failed, &text, &specific));
       PetscCall(PetscStrncpy(why, specific && specific[0] ? specific : text, sizeof(why)));
       if (out[0]) (void)unlink(out);
