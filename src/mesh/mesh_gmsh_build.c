@@ -38,18 +38,23 @@ static PetscInt GmshTypeNodes(int type)
   }
 }
 
-/* n more entries of m PetscInts each in *a, of capacity *cap entries (doubled as needed), after *len of them. */
-static PetscErrorCode GrowInts(PetscInt **a, PetscInt *cap, PetscInt len, PetscInt n, PetscInt m)
+/* Room for n more elements of m nodes each in *nodes and their sets in *set, of capacity *cap elements (doubled as
+   needed), after len of them. */
+static PetscErrorCode GrowElements(PetscInt **nodes, PetscInt **set, PetscInt *cap, PetscInt len, PetscInt n, PetscInt m)
 {
-  PetscInt *grown;
+  PetscInt *grown_nodes, *grown_set;
 
   PetscFunctionBeginUser;
   if (len + n <= *cap) PetscFunctionReturn(PETSC_SUCCESS);
   *cap = PetscMax(2 * *cap, len + n);
-  PetscCall(PetscMalloc1(*cap * m, &grown));
-  PetscCall(PetscArraycpy(grown, *a, len * m));
-  PetscCall(PetscFree(*a));
-  *a = grown;
+  PetscCall(PetscMalloc1(*cap * m, &grown_nodes));
+  PetscCall(PetscMalloc1(*cap, &grown_set));
+  PetscCall(PetscArraycpy(grown_nodes, *nodes, len * m));
+  PetscCall(PetscArraycpy(grown_set, *set, len));
+  PetscCall(PetscFree(*nodes));
+  PetscCall(PetscFree(*set));
+  *nodes = grown_nodes;
+  *set   = grown_set;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -62,7 +67,7 @@ PetscErrorCode MeshSimplicesFromGmsh(PetscInt dim, MeshSimplices *s)
   size_t    *node_tags = NULL, nnodes = 0, ncoord = 0, npar = 0, ngroups = 0;
   double    *xyz = NULL, *par = NULL, save_all = 0.0;
   int       *groups = NULL;
-  PetscInt  *index, *vertex, tag_max = 0, ccap = 0, fcap = 0, ccap_set = 0, fcap_set = 0;
+  PetscInt  *index, *vertex, tag_max = 0, ccap = 0, fcap = 0;
   PetscBool *used;
 
   PetscFunctionBeginUser;
@@ -111,14 +116,8 @@ PetscErrorCode MeshSimplicesFromGmsh(PetscInt dim, MeshSimplices *s)
         const PetscBool cell = (PetscBool)(d == (int)dim), face = (PetscBool)(d == (int)dim - 1);
 
         PetscCheck(nn > 0, PETSC_COMM_SELF, PETSC_ERR_SUP, "Gmsh made elements of type %d (first-order simplices only)", types[t]);
-        if (cell) {
-          PetscCall(GrowInts(&s->cells, &ccap, s->ncells, count, nn));
-          PetscCall(GrowInts(&s->cell_set, &ccap_set, s->ncells, count, 1));
-        }
-        if (face) {
-          PetscCall(GrowInts(&s->faces, &fcap, s->nfaces, count, nn));
-          PetscCall(GrowInts(&s->face_set, &fcap_set, s->nfaces, count, 1));
-        }
+        if (cell) PetscCall(GrowElements(&s->cells, &s->cell_set, &ccap, s->ncells, count, nn));
+        if (face) PetscCall(GrowElements(&s->faces, &s->face_set, &fcap, s->nfaces, count, nn));
         for (PetscInt i = 0; i < count; ++i) {
           for (PetscInt k = 0; k < nn; ++k) {
             const size_t   tag = enodes[t][i * nn + k];
