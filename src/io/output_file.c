@@ -2,9 +2,10 @@
    directory and renamed over the target only when complete, the XDMF file before the HDF5 file (so no new .h5 ever
    stands without its .xdmf), under a lock of the directory (so two runs writing the same output leave the pair of
    one run) and with SIGTERM/SIGINT deferred until both are renamed (so a signal leaves the old pair or the new one). A failure, an exit on
-   error or a signal removes the temporaries. A target that exists and is not a regular file (a directory, a device,
-   a FIFO, a symbolic link) is refused before the solve. */
+   error or a signal removes the temporaries (a failure or an exit also the files MPI-IO made beside them). A target that exists and is not a regular
+   file (a directory, a device, a FIFO, a symbolic link) is refused before the solve. */
 #define _DEFAULT_SOURCE /* POSIX and BSD calls (mkstemp, lstat, sigaction, flock) under -std=c99 */
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
@@ -26,6 +27,42 @@ static void OutputFileRemoveTemps(void)
 {
   for (int i = 0; i < OUTPUT_MAX_TEMPS; ++i)
     if (output_temps[i][0]) (void)unlink(output_temps[i]); /* async-signal-safe */
+}
+
+/* The files MPI-IO makes beside a file it opens, named after it: Open MPI's shared file pointer keeps there a lock file
+   (NAME-JOB-PID.lock, its sharedfp component "lockedfile") or a data and a metadata file per rank (NAME.data.R and
+   NAME.metadata.R, "individual"), and removes them when the file is closed. Open MPI takes "sm", which keeps none,
+   unless it cannot (it fell back to "lockedfile" while another run of the test suite ran beside); a write that fails
+   on a full disk then ends without that close, and they would stay in the output's directory. A temporary's name is
+   unique (mkstemp()), so every entry whose name extends it with '-' or '.' is one of them. At exit and after a
+   failure, not from a signal handler: opendir() is not async-signal-safe. */
+static void OutputFileRemoveCompanions(void)
+{
+  for (int i = 0; i < OUTPUT_MAX_TEMPS; ++i) {
+    char           dir[PETSC_MAX_PATH_LEN], *slash;
+    const char    *base;
+    size_t         n;
+    DIR           *d;
+    struct dirent *e;
+
+    if (!output_temps[i][0]) continue;
+    memcpy(dir, output_temps[i], sizeof(dir));
+    slash = strrchr(dir, '/'); /* always there: "DIR/.signorini-XXXXXX" */
+    if (!slash) continue;
+    *slash = '\0';
+    base   = slash + 1;
+    n      = strlen(base);
+    if (!(d = opendir(dir))) continue;
+    while ((e = readdir(d)))
+      if (!strncmp(e->d_name, base, n) && (e->d_name[n] == '-' || e->d_name[n] == '.')) (void)unlinkat(dirfd(d), e->d_name, 0);
+    (void)closedir(d);
+  }
+}
+
+static void OutputFileCleanUpAtExit(void)
+{
+  OutputFileRemoveCompanions();
+  OutputFileRemoveTemps();
 }
 
 /* The termination signals may be delivered to any thread of the process (Open MPI, PMIx and OpenBLAS start threads of
@@ -74,7 +111,7 @@ PetscErrorCode OutputFileInstallCleanup(void)
   mask        = umask(0);
   output_mode = 0666 & ~mask;
   (void)umask(mask);
-  PetscCheck(atexit(OutputFileRemoveTemps) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "atexit() failed");
+  PetscCheck(atexit(OutputFileCleanUpAtExit) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "atexit() failed");
   memset(&sa, 0, sizeof(sa));
   sa.sa_handler = OutputFileSignalHandler;
   sigemptyset(&sa.sa_mask);
@@ -215,7 +252,10 @@ PetscErrorCode OutputFileDiscardTemps(MPI_Comm comm)
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
   OutputFileEnterCritical();
-  if (rank == 0) OutputFileRemoveTemps();
+  if (rank == 0) {
+    OutputFileRemoveCompanions();
+    OutputFileRemoveTemps();
+  }
   memset(output_temps, 0, sizeof(output_temps));
   OutputFileLeaveCritical();
   PetscFunctionReturn(PETSC_SUCCESS);
