@@ -7,24 +7,36 @@ import subprocess
 
 import pytest
 
-from harness import BIN, ENV, OUT, ROOT
+from harness import BIN, ENV, OUT, OUT_ROOT, ROOT
+
+
+def pytest_configure(config):
+    """Once per session, before any test, in the process that leads it (pytest-xdist's controller, which starts its
+    workers after this, or pytest alone): builds bin/signorini as `make test` does before pytest, so that `python3 -m
+    pytest tests` works on its own, and deletes and makes anew tests/out, the root of every test's output. A worker
+    (config.workerinput) does neither: two builds at once would race, and a worker's wipe would delete the files of
+    the tests the other worker is running."""
+    if hasattr(config, "workerinput"):
+        return
+    p = subprocess.run(["make", "--no-print-directory", "bin/signorini"], cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
+                       stderr=subprocess.STDOUT, text=True)
+    if p.returncode != 0:
+        pytest.exit(f"make bin/signorini failed:\n{p.stdout[-3000:]}", returncode=1)
+    shutil.rmtree(OUT_ROOT, ignore_errors=True)
+    os.makedirs(OUT_ROOT)
 
 
 @pytest.fixture(scope="session", autouse=True)
 def solver():
-    """Builds bin/signorini (as `make test` does before pytest), so that `python3 -m pytest tests` works on its own."""
-    p = subprocess.run(["make", "--no-print-directory", "bin/signorini"], cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
-                       stderr=subprocess.STDOUT, text=True)
-    assert p.returncode == 0, f"make bin/signorini failed:\n{p.stdout[-3000:]}"
+    """bin/signorini, built by pytest_configure()."""
     assert os.access(BIN, os.X_OK), f"{BIN} not built"
     return BIN
 
 
 @pytest.fixture(scope="session", autouse=True)
 def out_root():
-    """tests/out, the root of every test's output, deleted and made anew once per session."""
-    shutil.rmtree(OUT, ignore_errors=True)
-    os.makedirs(OUT)
+    """tests/out (made anew by pytest_configure()), or a worker's own directory under it."""
+    os.makedirs(OUT, exist_ok=True)
     return OUT
 
 

@@ -10,7 +10,10 @@ from signorini.mpirun import MPI_ENV, run_mpi, tail  # noqa: E402
 from signorini.runs import read_output, vertex_order  # noqa: E402
 
 BIN = os.path.join(ROOT, "bin", "signorini")
-OUT = os.path.join(ROOT, "tests", "out")
+# tests/out, the root of every test's output; under pytest-xdist (make test runs the suite on as many workers as cores)
+# each worker writes under tests/out/gwN, so that two tests running at once never share a file's name
+OUT_ROOT = os.path.join(ROOT, "tests", "out")
+OUT = os.path.join(OUT_ROOT, os.environ["PYTEST_XDIST_WORKER"]) if os.environ.get("PYTEST_XDIST_WORKER") else OUT_ROOT
 ENV = dict(os.environ, **MPI_ENV)  # for the programs the tests start themselves (make, the scripts, test_fuzz.py's direct runs)
 TIMEOUT = 600  # seconds a run of the solver may take
 

@@ -19,12 +19,12 @@ CASES = {
     "nodal_3d_grid_sequence": (1, ["-dm_plex_dim", 3, "-dm_plex_box_faces", "2,2,2", "-penalty_quadrature", "nodal", "-contact_grid_sequence", 1], 0),
     "mms_sweep_metis_np2": (2, ["-scene", "mms", "-dm_plex_box_faces", "8,8", "-penalty_eps0_sweep", "1,0.01", "-partitioner", "metis"], 0),
     "quads_p2_fe_assembly": (1, ["-dm_plex_simplex", 0, "-dm_plex_box_faces", "4,4", "-displacement_petscspace_degree", 2], 0),
-    "reference_vi": (1, ["-dm_plex_box_faces", "8,8", "-contact_method", "vi", "-reference", "tests/out/asan/square_penalty.h5"], 0),
+    "reference_vi": (1, ["-dm_plex_box_faces", "8,8", "-contact_method", "vi", "-reference", os.path.relpath(os.path.join(OUT, "asan", "square_penalty.h5"), ROOT)], 0),
     # GAMG with its coarse-level updates, the eps sweep with its step guess, Eisenstat-Walker's forcing terms
     "gamg_update_sweep_np2": (2, ["-dm_plex_box_faces", "16,16", "-options_file", "options/solvers/gamg.yaml", "-penalty_eps0_sweep", "1,0.1,0.01"], 0),
     "geometric_multigrid": (1, ["-dm_plex_box_faces", "16,16", "-contact_coarse_levels", 2, "-options_file", "options/solvers/mg.yaml"], 0),
     # the general scene on a Gmsh mesh with named faces: every boundary family, a body force, a curved obstacle
-    "gmsh_names_cylinder": (1, ["-scene", "general", "-dm_plex_filename", "tests/out/asan/named_square.msh", "-contact_faces", "bottom",
+    "gmsh_names_cylinder": (1, ["-scene", "general", "-dm_plex_filename", os.path.relpath(os.path.join(OUT, "asan", "named_square.msh"), ROOT), "-contact_faces", "bottom",
                                 "-bc_clamp", "top", "-bc_clamp_top_translate", "0,-0.01", "-bc_slip", "left", "-bc_slip_left_components", 0,
                                 "-bc_traction", "right", "-bc_traction_right", "0.01,0", "-body_force", "0,-0.01", "-obstacle", "cylinder",
                                 "-obstacle_center", "0.5,-2", "-obstacle_radius", 2], 0),
@@ -40,7 +40,7 @@ CASES = {
     # the closed form checked against it, the SBAIJ copy of K for the penalty Jacobian with its Cholesky factorization
     "graded_gmsh_fe_check_np2": (2, ["-options_file", "options/cylinder.yaml", "-dm_plex_filename", "options/meshes/disk_graded.msh",
                                      "-assembly", "fe", "-assembly_check", "-contact_condition_estimate",
-                                     "-output", "tests/out/asan/graded_gmsh_fe_check_np2.h5"], 0),  # after the file's own output: its folder may not exist
+                                     "-output", os.path.relpath(os.path.join(OUT, "asan", "graded_gmsh_fe_check_np2.h5"), ROOT)], 0),  # after the file's own output: its folder may not exist
     "sbaij_nodal_continuation": (1, ["-dm_plex_box_faces", "8,8", "-dm_mat_type", "sbaij", "-penalty_quadrature", "nodal", "-penalty_eps0", 1e-4], 0),
     "bars_mms_np2": (2, ["-scene", "mms", "-dm_plex_box_faces", "16,16", "-bars"], 0),
     "bars_3d_grid_sequence_nodal": (1, ["-dm_plex_dim", 3, "-dm_plex_box_faces", "2,2,2", "-penalty_quadrature", "nodal", "-contact_grid_sequence", 2,
