@@ -20,11 +20,17 @@ and the largest pressure) and the force of a 17th cycle, its rigid cylinder of r
 cycle's bar of each quantity against its true error (the recovered peak pressure_peak too, which the runs record
 beside the nodal maximum).
 
+With --hand-bars, the hand-graded meshes are also solved as a user without a closed form would show their error: with
+-bars -contact_grid_sequence 2 (the mesh and two uniform refinements of it, the answer on the finest, each quantity's
+bar from the three; docs/estimate.md, "Error bars of the quantities"), from a coarser grading too (HAND_BARS_GRADES),
+since the finest level has 16 times the unknowns; for each TOL, the fewest unknowns whose bars of the force, the
+largest pressure and the width are all within TOL, timed side by side with the adaptive run.
+
 With --radius R the rigid cylinder's radius is R and its depth 0.001 / R, which keeps a: the closed form neglects terms of
 order a / R (with R = 1 it stays 0.25% from this model on any mesh; with R = 10, 0.03%: docs/hertz.md), so the 0.3%
 rung is checked at R = 10 (make accuracy-ladder-fine).
 
-    /usr/bin/python3 scripts/accuracy_ladder.py [--tols 0.03,0.01] [--pairs 3] [--no-coverage] [--radius 1]
+    /usr/bin/python3 scripts/accuracy_ladder.py [--tols 0.03,0.01] [--pairs 3] [--no-coverage] [--radius 1] [--hand-bars]
 """
 import argparse
 import os
@@ -52,6 +58,40 @@ EVERY_CYCLE = ["-accuracy", "1e-12", "-accuracy_quantity", QUANTITIES]
 # the coverage series' indenter: radius 10 at the same a, where the closed form holds to 0.03% (at radius 1, 0.25%, the
 # size of the late cycles' errors: make hertz-curvature)
 COVERAGE_RADIUS = 10.0
+# --hand-bars: the hand-graded family from coarser gradings on, each mesh refined twice by -bars
+HAND_BARS_GRADES = [(0.008, 0.1), (0.004, 0.1)] + st.INDENTER_GRADES
+HAND_BARS = ["-bars", "-contact_grid_sequence", "2"]
+BARS_QUANTITIES = {"contact_force": "contact_force_y", "pressure_max": "pressure_max", "contact_size": "contact_size"}
+
+
+def hand_bars(args, tols, adaptive):
+    """--hand-bars: the hand-graded meshes with their own bars (-bars on the mesh and two refinements of it); for each
+    TOL, the fewest unknowns whose bars are all within TOL, timed side by side with the adaptive run. Markdown lines."""
+    runs = []
+    for h_near, grade in HAND_BARS_GRADES:
+        mesh = os.path.join(args.outdir, f"block10_h{h_near:g}_grade{grade:g}.msh")
+        st.write_graded_block(mesh, h_near, grade)
+        out = os.path.join(args.outdir, f"graded_bars_h{h_near:g}_grade{grade:g}.h5")
+        cmd = hertz.command(CASE, mesh, "eps=h/10", out, radius=args.radius)[3:] + HAND_BARS
+        solve(cmd)
+        a = read_run(out)
+        rel = {q: float(a.get(f"qoi_{k}_bar", "nan")) / abs(float(a[f"qoi_{k}"])) for q, k in BARS_QUANTITIES.items()}  # NaN: no bar (qoi_NAME_note says why)
+        runs.append((f"{h_near:g}, G {grade:g}", cmd, int(a["n_dofs"]), rel))
+        print(f"hand-graded h_near {h_near:g} grade {grade:g} with -bars: {runs[-1][2]} unknowns", flush=True)
+    runs.sort(key=lambda r: r[2])
+    md = ["", "Hand-graded meshes with their own bars (`-bars -contact_grid_sequence 2`: the mesh and two uniform refinements, "
+          "the answer and the unknowns the finest's; NaN: no bar, the three levels outside the asymptotic range):", "",
+          "| h_near, G | unknowns | force's bar | largest pressure's bar | width's bar |", "|---|---|---|---|---|"]
+    md += [f"| {h} | {n} | " + " | ".join(f"{rel[q]:.2%}" for q in BARS_QUANTITIES) + " |" for h, _, n, rel in runs]
+    md += ["", "| TOL | adaptive unknowns | adaptive time (s) | fewest hand-graded unknowns with bars within TOL | its time (s) | adaptive / hand-graded |",
+           "|---|---|---|---|---|---|"]
+    for tol in tols:
+        cmd, a, t_once = adaptive[tol]
+        best = next((r for r in runs if all(v <= tol for v in r[3].values())), None)  # NaN <= tol is False
+        t_ad, t_hd = paired_medians(cmd, best[1] if best else None, args.pairs, once=t_once)
+        md.append(f"| {tol:g} | {a['n_dofs']} | {t_ad:.2f} | " + (f"{best[0]}: {best[2]} | {t_hd:.2f} | {t_ad / t_hd:.2f} |" if best
+                                                                   else f"none up to {runs[-1][2]} | | |"))
+    return md
 
 
 def coverage(outdir, coarse, radius=COVERAGE_RADIUS):
@@ -91,6 +131,7 @@ def main():
     ap.add_argument("--outdir", default=os.path.join(ROOT, "output", "accuracy_ladder"))
     ap.add_argument("--no-coverage", dest="coverage", action="store_false", help="skip the bars' coverage over every cycle")
     ap.add_argument("--radius", type=float, default=hertz.RADIUS, help="the rigid cylinder's radius (its depth 0.001 / radius keeps a)")
+    ap.add_argument("--hand-bars", action="store_true", help="also solve the hand-graded meshes with their own bars (-bars), as a user without a closed form would, and time the fewest within each TOL")
     args = ap.parse_args()
     os.makedirs(args.outdir, exist_ok=True)
     tols = sorted((float(t) for t in args.tols.split(",")), reverse=True)
@@ -141,6 +182,8 @@ def main():
             "| TOL | unknowns | reached | force | largest pressure | width | covered | time (s) | fewest hand-graded unknowns within TOL (h_near, G: unknowns) | its time (s) | adaptive / hand-graded |",
             "|---|---|---|---|---|---|---|---|---|---|---|"] + md + ["", "Hand-graded meshes (size h_near + G r up to 0.5), one solve each:", "",
                                                                      "| h_near, G | unknowns | force | largest pressure | width |", "|---|---|---|---|---|"] + hand_md
+    if args.hand_bars:
+        text += hand_bars(args, tols, adaptive)
     if args.coverage:
         cov = coverage(args.outdir, coarse)
         write_text(os.path.join(args.outdir, "coverage.csv"), csv_text(["run", "quantity", "cycles_with_bar", "covered", "min_bar_over_error",
