@@ -9,6 +9,7 @@ fewest unknowns within TOL, timed side by side with the adaptive run (--pairs al
 output/accuracy_remesh/accuracy_remesh.md and .csv.
 
     /usr/bin/python3 scripts/accuracy_remesh.py [--cases cylinder,sphere] [--tols 0.03,0.01] [--tols-3d 0.1] [--pairs 3] [--radius 1]
+    /usr/bin/python3 scripts/accuracy_remesh.py --cases sphere-indenter --hand-bars 0.04,0.02,0.01  (the graded meshes with their own bars)
 """
 import argparse
 import os
@@ -20,7 +21,7 @@ from signorini.mpirun import paired_medians, timing_text  # noqa: E402
 from signorini.mpirun import timed_or_exit as solve  # noqa: E402
 from signorini.paths import ROOT  # noqa: E402
 from signorini.report import csv_text, write_text  # noqa: E402
-from signorini.runs import accuracy_bars  # noqa: E402
+from signorini.runs import accuracy_bars, own_bars  # noqa: E402
 from signorini.runs import read_cycles as cycles  # noqa: E402
 from signorini.runs import read_run  # noqa: E402
 
@@ -29,6 +30,40 @@ from signorini.runs import read_run  # noqa: E402
 QUANTITIES = {2: ("contact_force", "pressure_max", "contact_size"), 3: ("contact_force", "pressure_peak", "contact_size")}
 COARSE = {"cylinder": (geometry.quarter_disk, 0.1), "sphere": (geometry.quarter_sphere, 0.2), "sphere-indenter": (geometry.quarter_block, 0.2)}
 SOLVER = {"cylinder": [], "sphere": hertz.GAMG_3D, "sphere-indenter": hertz.GAMG_3D}
+
+
+# -bars' quantities beside -accuracy's in 3D: its largest pressure is the nodal maximum
+BARS_QUANTITIES = {"contact_force": "contact_force_z", "pressure_max": "pressure_max", "contact_size": "contact_size"}
+
+
+def hand_bars(args, case, adaptive, tols):
+    """--hand-bars: make hertz's graded meshes of the case with their own bars (-bars on the mesh and two uniform
+    refinements of it, whose finest has 64 times its unknowns); for each TOL, the fewest unknowns whose bars are all
+    within TOL, timed side by side with the adaptive run. Markdown lines."""
+    runs = []
+    for h_near in (float(v) for v in args.hand_bars.split(",")):
+        mesh = os.path.join(args.outdir, f"{case}_graded_{h_near:g}.msh")
+        hertz.write_mesh(case, h_near, mesh)
+        out = os.path.join(args.outdir, f"{case}_graded_bars_{h_near:g}.h5")
+        cmd = hertz.command(case, mesh, "eps=h/10", out, radius=args.radius)[3:] + SOLVER[case] + ["-bars", "-contact_grid_sequence", "2"]
+        solve(cmd)
+        a = read_run(out)
+        runs.append((h_near, cmd, int(a["n_dofs"]), own_bars(a, BARS_QUANTITIES.values())))
+        print(f"{case} hand-graded h_near {h_near:g} with -bars: {runs[-1][2]} unknowns", flush=True)
+    runs.sort(key=lambda r: r[2])
+    md = ["", f"{case}: make hertz's graded meshes with their own bars (`-bars -contact_grid_sequence 2`: the mesh and two uniform "
+          "refinements, the answer and the unknowns the finest's; NaN: no bar, the three levels outside the asymptotic range):", "",
+          "| h_near | unknowns | force's bar | largest pressure's bar | size's bar |", "|---|---|---|---|---|"]
+    md += [f"| {h:g} | {n} | " + " | ".join(f"{b[k]:.2%}" for k in BARS_QUANTITIES.values()) + " |" for h, _, n, b in runs]
+    md += ["", "| TOL | adaptive unknowns | adaptive time (s) | fewest hand-graded unknowns with bars within TOL | its time (s) | adaptive / hand-graded |",
+           "|---|---|---|---|---|---|"]
+    for tol in tols:
+        cmd, a, _, _, t_once = adaptive[tol]
+        best = next((r for r in runs if all(v <= tol for v in r[3].values())), None)  # NaN <= tol is False
+        t_ad, t_hd = paired_medians(cmd, best[1] if best else None, args.pairs, once=t_once)
+        md.append(f"| {tol:g} | {int(a['n_dofs'])} | {t_ad:.2f} | " + (f"{best[0]:g}: {best[2]} | {t_hd:.2f} | {t_ad / t_hd:.2f} |" if best
+                                                                       else f"none up to {runs[-1][2]} | | |"))
+    return md
 
 
 def main():
@@ -43,8 +78,14 @@ def main():
     ap.add_argument("--hand-h-near", default=None, help="the hand-graded meshes' h_near, comma-separated (default: make hertz's, the case's)")
     ap.add_argument("--hand-h-far", type=float, default=None,
                     help="the hand-graded meshes' far-field size (default: make hertz's, 0.2 on the sphere, whose force stands 3%% off)")
+    ap.add_argument("--hand-bars", default=None,
+                    help="sphere-indenter: make hertz's graded meshes at these h_near (comma-separated) solved with their own bars "
+                         "(-bars -contact_grid_sequence 2), as a user without a closed form would show the error")
     ap.add_argument("--peak-2d", action="store_true", help="ask for the recovered peak (pressure_peak) in 2D too, instead of the nodal maximum")
     args = ap.parse_args()
+    if args.hand_bars and args.cases != "sphere-indenter":
+        ap.error("--hand-bars takes --cases sphere-indenter alone: the curved bodies' uniform refinements keep their first mesh's "
+                 "facets, whose error -bars cannot see")
     os.makedirs(args.outdir, exist_ok=True)
     rows, md = [], []
     for case in args.cases.split(","):
@@ -98,12 +139,14 @@ def main():
             e = hertz.quantity_errors(case, b, force_ref, args.radius, quantities)
             md.append(f"| {case} hand-graded h_near {h_near:g} | | | {int(b['n_dofs'])} | | " + " | ".join(f"{e[q]:+.3%}" for q in quantities)
                       + f" | {m['a_error']:+.3%}, {m['p0_error']:+.3%} | | | | | |")
+    if args.hand_bars:
+        md += hand_bars(args, case, adaptive, tols)
     header = ["case", "tol", "cycles", "n_dofs", "reached", "time", "pressure", "err_force", "err_pressure", "err_contact_size", "bar_force",
               "bar_pressure", "bar_contact_size", "a_error", "p0_error", "covered", "hand_h_near", "hand_n_dofs", "hand_time", "time_ratio"]
     write_text(os.path.join(args.outdir, "accuracy_remesh.csv"), csv_text(header, rows))
     text = ["# -accuracy by remeshing the Gmsh model on make hertz's curved bodies (eps = h/10)", "",
             f"`/usr/bin/python3 scripts/accuracy_remesh.py --cases {args.cases} --tols {args.tols} --tols-3d {args.tols_3d} --pairs {args.pairs} --radius {args.radius:g}"
-            + (f" --hand-h-near {args.hand_h_near}" if args.hand_h_near else "") + (" --peak-2d" if args.peak_2d else "") + (f" --hand-h-far {args.hand_h_far:g}" if args.hand_h_far else "") + f"`. The cylinder starts "
+            + (f" --hand-h-near {args.hand_h_near}" if args.hand_h_near else "") + (" --peak-2d" if args.peak_2d else "") + (f" --hand-h-far {args.hand_h_far:g}" if args.hand_h_far else "") + (f" --hand-bars {args.hand_bars}" if args.hand_bars else "") + f"`. The cylinder starts "
             "from a uniform h = 0.1, the sphere from 0.2. Errors: the largest pressure (the nodal maximum in 2D, the recovered peak "
             "pressure_peak in 3D) and the size (2D half-width, 3D quarter area) against "
             "the closed form at the run's force, the force against the finest run's; in brackets the run's bar (relative); make hertz's "

@@ -109,6 +109,12 @@ def accuracy_bars(attrs, quantities):
     return {q: float(attrs[f"accuracy_{q}_bar"]) / abs(float(attrs[f"accuracy_{q}_value"])) for q in quantities}
 
 
+def own_bars(attrs, names):
+    """-bars' bars relative to their values, from a run's /run attributes: {name: bar / |value|} for the qoi names
+    (contact_force_y, pressure_max, contact_size, ...), NaN where the three levels gave no bar (qoi_NAME_note says why)."""
+    return {n: float(attrs.get(f"qoi_{n}_bar", "nan")) / abs(float(attrs[f"qoi_{n}"])) for n in names}
+
+
 def read_output(path):
     """(attrs, fields) of the output `path`: the /run attributes with bytes decoded (numbers stay numpy scalars), and
     {name: array} of /vertex_fields in the file's vertex order (a load path's: its last step), plus "x":
