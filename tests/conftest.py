@@ -15,8 +15,8 @@ def pytest_configure(config):
     workers after this, or pytest alone): builds bin/signorini as `make test` does before pytest, so that `python3 -m
     pytest tests` works on its own, and deletes and makes anew tests/out, the root of every test's output. A worker
     (config.workerinput) does neither: two builds at once would race, and a worker's wipe would delete the files of
-    the tests the other worker is running."""
-    if hasattr(config, "workerinput"):
+    the tests the other worker is running. Nor does --collect-only, which runs nothing."""
+    if hasattr(config, "workerinput") or config.option.collectonly:
         return
     p = subprocess.run(["make", "--no-print-directory", "bin/signorini"], cwd=ROOT, env=ENV, stdout=subprocess.PIPE,
                        stderr=subprocess.STDOUT, text=True)
