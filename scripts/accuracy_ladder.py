@@ -42,7 +42,7 @@ from signorini import geometry, hertz  # noqa: E402
 from signorini.mpirun import paired_medians, timing_text  # noqa: E402
 from signorini.mpirun import timed_or_exit as solve  # noqa: E402
 from signorini.paths import ROOT  # noqa: E402
-from signorini.report import csv_text, write_text  # noqa: E402
+from signorini.report import csv_text, own_bars_table, write_text  # noqa: E402
 from signorini.runs import accuracy_bars, own_bars  # noqa: E402
 from signorini.runs import read_cycles as cycles  # noqa: E402
 from signorini.runs import read_run  # noqa: E402
@@ -61,7 +61,7 @@ COVERAGE_RADIUS = 10.0
 # --hand-bars: the hand-graded family from coarser gradings on, each mesh refined twice by -bars
 HAND_BARS_GRADES = [(0.008, 0.1), (0.004, 0.1)] + st.INDENTER_GRADES
 HAND_BARS = ["-bars", "-contact_grid_sequence", "2"]
-BARS_QUANTITIES = {"contact_force": "contact_force_y", "pressure_max": "pressure_max", "contact_size": "contact_size"}
+BARS_QUANTITIES = ("contact_force_y", "pressure_max", "contact_size")  # -bars' names of -accuracy's quantities
 
 
 def hand_bars(args, tols, adaptive):
@@ -75,24 +75,12 @@ def hand_bars(args, tols, adaptive):
         cmd = hertz.command(CASE, mesh, "eps=h/10", out, radius=args.radius)[3:] + HAND_BARS
         solve(cmd)
         a = read_run(out)
-        own = own_bars(a, BARS_QUANTITIES.values())
-        rel = {q: own[k] for q, k in BARS_QUANTITIES.items()}
-        runs.append((f"{h_near:g}, G {grade:g}", cmd, int(a["n_dofs"]), rel))
+        runs.append((f"{h_near:g}, G {grade:g}", cmd, int(a["n_dofs"]), own_bars(a, BARS_QUANTITIES)))
         print(f"hand-graded h_near {h_near:g} grade {grade:g} with -bars: {runs[-1][2]} unknowns", flush=True)
-    runs.sort(key=lambda r: r[2])
-    md = ["", "Hand-graded meshes with their own bars (`-bars -contact_grid_sequence 2`: the mesh and two uniform refinements, "
-          "the answer and the unknowns the finest's; NaN: no bar, the three levels outside the asymptotic range):", "",
-          "| h_near, G | unknowns | force's bar | largest pressure's bar | width's bar |", "|---|---|---|---|---|"]
-    md += [f"| {h} | {n} | " + " | ".join(f"{rel[q]:.2%}" for q in BARS_QUANTITIES) + " |" for h, _, n, rel in runs]
-    md += ["", "| TOL | adaptive unknowns | adaptive time (s) | fewest hand-graded unknowns with bars within TOL | its time (s) | adaptive / hand-graded |",
-           "|---|---|---|---|---|---|"]
-    for tol in tols:
-        cmd, a, t_once = adaptive[tol]
-        best = next((r for r in runs if all(v <= tol for v in r[3].values())), None)  # NaN <= tol is False
-        t_ad, t_hd = paired_medians(cmd, best[1] if best else None, args.pairs, once=t_once)
-        md.append(f"| {tol:g} | {a['n_dofs']} | {t_ad:.2f} | " + (f"{best[0]}: {best[2]} | {t_hd:.2f} | {t_ad / t_hd:.2f} |" if best
-                                                                   else f"none up to {runs[-1][2]} | | |"))
-    return md
+    intro = ("Hand-graded meshes (h_near, G) with their own bars (`-bars -contact_grid_sequence 2`: the mesh and two uniform refinements, "
+             "the answer and the unknowns the finest's; NaN: no bar, the three levels outside the asymptotic range):")
+    return own_bars_table(runs, ["force's bar", "largest pressure's bar", "width's bar"], intro, tols,
+                          {tol: (cmd, int(a["n_dofs"]), t_once) for tol, (cmd, a, t_once) in adaptive.items()}, args.pairs)
 
 
 def coverage(outdir, coarse, radius=COVERAGE_RADIUS):

@@ -20,7 +20,7 @@ from signorini import geometry, hertz  # noqa: E402
 from signorini.mpirun import paired_medians, timing_text  # noqa: E402
 from signorini.mpirun import timed_or_exit as solve  # noqa: E402
 from signorini.paths import ROOT  # noqa: E402
-from signorini.report import csv_text, write_text  # noqa: E402
+from signorini.report import csv_text, own_bars_table, write_text  # noqa: E402
 from signorini.runs import accuracy_bars, own_bars  # noqa: E402
 from signorini.runs import read_cycles as cycles  # noqa: E402
 from signorini.runs import read_run  # noqa: E402
@@ -32,8 +32,8 @@ COARSE = {"cylinder": (geometry.quarter_disk, 0.1), "sphere": (geometry.quarter_
 SOLVER = {"cylinder": [], "sphere": hertz.GAMG_3D, "sphere-indenter": hertz.GAMG_3D}
 
 
-# -bars' quantities beside -accuracy's in 3D: its largest pressure is the nodal maximum
-BARS_QUANTITIES = {"contact_force": "contact_force_z", "pressure_max": "pressure_max", "contact_size": "contact_size"}
+# -bars' names of -accuracy's quantities in 3D: its largest pressure is the nodal maximum
+BARS_QUANTITIES = ("contact_force_z", "pressure_max", "contact_size")
 
 
 def hand_bars(args, case, adaptive, tols):
@@ -48,22 +48,12 @@ def hand_bars(args, case, adaptive, tols):
         cmd = hertz.command(case, mesh, "eps=h/10", out, radius=args.radius)[3:] + SOLVER[case] + ["-bars", "-contact_grid_sequence", "2"]
         solve(cmd)
         a = read_run(out)
-        runs.append((h_near, cmd, int(a["n_dofs"]), own_bars(a, BARS_QUANTITIES.values())))
+        runs.append((f"h_near {h_near:g}", cmd, int(a["n_dofs"]), own_bars(a, BARS_QUANTITIES)))
         print(f"{case} hand-graded h_near {h_near:g} with -bars: {runs[-1][2]} unknowns", flush=True)
-    runs.sort(key=lambda r: r[2])
-    md = ["", f"{case}: make hertz's graded meshes with their own bars (`-bars -contact_grid_sequence 2`: the mesh and two uniform "
-          "refinements, the answer and the unknowns the finest's; NaN: no bar, the three levels outside the asymptotic range):", "",
-          "| h_near | unknowns | force's bar | largest pressure's bar | size's bar |", "|---|---|---|---|---|"]
-    md += [f"| {h:g} | {n} | " + " | ".join(f"{b[k]:.2%}" for k in BARS_QUANTITIES.values()) + " |" for h, _, n, b in runs]
-    md += ["", "| TOL | adaptive unknowns | adaptive time (s) | fewest hand-graded unknowns with bars within TOL | its time (s) | adaptive / hand-graded |",
-           "|---|---|---|---|---|---|"]
-    for tol in tols:
-        cmd, a, _, _, t_once = adaptive[tol]
-        best = next((r for r in runs if all(v <= tol for v in r[3].values())), None)  # NaN <= tol is False
-        t_ad, t_hd = paired_medians(cmd, best[1] if best else None, args.pairs, once=t_once)
-        md.append(f"| {tol:g} | {int(a['n_dofs'])} | {t_ad:.2f} | " + (f"{best[0]:g}: {best[2]} | {t_hd:.2f} | {t_ad / t_hd:.2f} |" if best
-                                                                       else f"none up to {runs[-1][2]} | | |"))
-    return md
+    intro = (f"{case}: make hertz's graded meshes with their own bars (`-bars -contact_grid_sequence 2`: the mesh and two uniform "
+             "refinements, the answer and the unknowns the finest's; NaN: no bar, the three levels outside the asymptotic range):")
+    return own_bars_table(runs, ["force's bar", "largest pressure's bar", "size's bar"], intro, tols,
+                          {tol: (cmd, int(a["n_dofs"]), t_once) for tol, (cmd, a, _, _, t_once) in adaptive.items()}, args.pairs)
 
 
 def main():

@@ -3,6 +3,8 @@ import csv
 import io
 import os
 
+from .mpirun import paired_medians
+
 
 # ------------------------------------------------------------------------------ CSV
 
@@ -74,3 +76,25 @@ def write_lines(path, lines):
     """A text file of `lines`, each ended by a newline."""
     with open(path, "w") as fh:
         fh.write("\n".join(lines) + "\n")
+
+
+# ------------------------------------------------------------------------------ hand-graded meshes with their own bars
+
+def own_bars_table(runs, names, intro, tols, adaptive, pairs):
+    """Markdown lines of the hand-graded meshes solved with their own bars (-bars) against -accuracy (the --hand-bars of
+    scripts/accuracy_ladder.py and accuracy_remesh.py): runs, (label, command, unknowns, {name: relative bar, NaN where
+    none}); names, the bars' column titles in that dict's order; adaptive, {tol: (command, unknowns, time once)}. For
+    each TOL, the run with the fewest unknowns whose bars are all within TOL, timed side by side with the adaptive run
+    (paired_medians(), `pairs` alternated pairs)."""
+    runs = sorted(runs, key=lambda r: r[2])
+    md = ["", intro, "", "| mesh | unknowns | " + " | ".join(names) + " |", md_rule(2 + len(names))]
+    md += [f"| {label} | {n} | " + " | ".join(f"{v:.2%}" for v in bars.values()) + " |" for label, _, n, bars in runs]
+    md += ["", "| TOL | adaptive unknowns | adaptive time (s) | fewest hand-graded unknowns with bars within TOL | its time (s) | adaptive / hand-graded |",
+           md_rule(6)]
+    for tol in tols:
+        cmd, n_dofs, t_once = adaptive[tol]
+        best = next((r for r in runs if all(v <= tol for v in r[3].values())), None)  # NaN <= tol is False
+        t_ad, t_hd = paired_medians(cmd, best[1] if best else None, pairs, once=t_once)
+        md.append(f"| {tol:g} | {n_dofs} | {t_ad:.2f} | " + (f"{best[0]}: {best[2]} | {t_hd:.2f} | {t_ad / t_hd:.2f} |" if best
+                                                           else f"none up to {runs[-1][2]} | | |"))
+    return md

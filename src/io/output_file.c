@@ -32,8 +32,9 @@ static void OutputFileRemoveTemps(void)
 /* The files MPI-IO makes beside a file it opens, named after it: Open MPI's shared file pointer keeps there a lock file
    (NAME-JOB-PID.lock, its sharedfp component "lockedfile") or a data and a metadata file per rank (NAME.data.R and
    NAME.metadata.R, "individual"), and removes them when the file is closed. Open MPI takes "sm", which keeps none,
-   unless it cannot (it fell back to "lockedfile" while another run of the test suite ran beside); a write that fails
-   on a full disk then ends without that close, and they would stay in the output's directory. A temporary's name is
+   unless it cannot (its file in Open MPI's session directory cannot be made: the test suite's isolated singletons once
+   took that directory from under each other); a write that fails on a full disk then ends without that close, and
+   they would stay in the output's directory. A temporary's name is
    unique (mkstemp()), so every entry whose name extends it with '-' or '.' is one of them. At exit and after a
    failure, not from a signal handler: opendir() is not async-signal-safe. */
 static void OutputFileRemoveCompanions(void)
