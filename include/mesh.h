@@ -69,6 +69,7 @@ PetscErrorCode MeshClosureCheck(DM dm, PetscInt *differences, PetscBool *by_dept
 
 /* mesh_check.c: what the discretization cannot handle, refused before anything is assembled */
 PetscErrorCode MeshCheckFile(DM dm, const char filename[]);
+PetscErrorCode MeshOrientCells(DM dm, const char what[], PetscInt *nreflected);
 PetscErrorCode MeshCountInteriorFaces(DM dm, PetscInt n, const PetscInt faces[], PetscInt *ninterior);
 PetscErrorCode MeshCountCurvedRidges(DM dm, PetscInt *count, PetscReal x[3]);
 

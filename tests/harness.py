@@ -63,9 +63,10 @@ def run(args, name, np_=1, expect_rc=0, output=None):
     return text, out
 
 
-def refused(args, name, message):
-    """Runs the solver on input it must refuse: the message in its output, and no output file written."""
-    out, h5 = run(args, name, expect_rc=None)
+def refused(args, name, message, np_=1):
+    """Runs the solver on input it must refuse: exit status 2 (README: the input was refused), the message in its
+    output, and no output file written."""
+    out, h5 = run(args, name, np_=np_, expect_rc=2)
     assert message in out, f"'{message}' not in the output of {args}:\n{out[-1500:]}"
     assert not os.path.exists(h5)
 

@@ -225,6 +225,19 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
         *dm = dist;
       }
     }
+    {
+      PetscInt nreflected, ncells_all;
+
+      PetscCall(MeshOrientCells(*dm, filename, &nreflected)); /* cells listed clockwise reflected (mesh_orient.c), before any integral */
+      PetscCall(DMPlexGetHeightStratum(*dm, 0, &cStart, &cEnd));
+      ncells_all = cEnd - cStart;
+      PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ncells_all, 1, MPIU_INT, MPI_SUM, comm));
+      if (nreflected)
+        PetscCall(PetscPrintf(comm,
+                              "  mesh: %" PetscInt_FMT " of the %" PetscInt_FMT
+                              " cells of %s are listed with the reversed orientation (clockwise in 2D); each was reflected to det J > 0\n",
+                              nreflected, ncells_all, filename));
+    }
     PetscCall(
         MeshCountCurvedRidges(*dm, &curved_ridges, curved_x)); /* the file's own boundary before any refinement (a parallel read: once consistent) */
   } else if (simplex)
@@ -285,7 +298,10 @@ PetscErrorCode MeshReadRemeshedFile(MPI_Comm comm, const char filename[], DM *dm
 PetscErrorCode MeshDistributeRemeshed(const char what[], DM *dm)
 {
   PetscFunctionBeginUser;
+  PetscInt nreflected;
+
   PetscCall(MeshCheckFile(*dm, what));
+  PetscCall(MeshOrientCells(*dm, what, &nreflected)); /* a model whose surfaces turn clockwise gives clockwise cells */
   PetscCall(MeshPartitionDistribute(MESH_PARTITIONER_METIS, dm));
   PetscCall(DMPlexDistributeSetDefault(*dm, PETSC_FALSE));
   PetscCall(PetscObjectSetName((PetscObject)*dm, "mesh"));
