@@ -99,6 +99,7 @@ PetscBool      ContactHasFrames(Contact ct);
    multiplier pushes). */
 PetscBool      ContactCanAugment(Contact ct);
 PetscErrorCode ContactAugment(Contact ct, DM dm, Vec u, PetscBool apply, PetscReal *change);
+PetscErrorCode ContactForgetMultipliers(Contact ct); /* all multipliers zero: the state of a zero load (nothing for the other types) */
 
 /* The state of the contact nodes at an iterate (contact_set.c) */
 PetscErrorCode ContactCountActive(Contact ct, Vec X, PetscReal tol_scale, PetscBool update, PetscInt *active, PetscInt *entered, PetscInt *left);

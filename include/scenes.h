@@ -24,6 +24,7 @@ PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene);
 PetscErrorCode SceneCheckLoadPath(MPI_Comm comm, const Scene *scene, const char what[]);
 PetscErrorCode SceneSetLoadFactor(Scene *scene, PetscReal t);
 PetscErrorCode SceneSetObstaclePosition(Scene *scene, PetscReal s);
+PetscBool      SceneForceControlled(const Scene *scene);
 
 /* scenes/fingerprint.c: the problem as one string, for -reference */
 #define SCENE_FINGERPRINT_LEN 4096

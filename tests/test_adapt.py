@@ -125,7 +125,11 @@ BAD_ADAPT = {"quads": (SQUARE + ["-dm_plex_simplex", 0, "-adapt_cycles", 1], "-a
              "no_estimate": (SQUARE + ["-estimate", "false", "-adapt_cycles", 1], "cannot run with -estimate false"),
              "fraction": (SQUARE + ["-adapt_cycles", 1, "-adapt_fraction", 0], "-adapt_fraction must lie in (0, 1]"),
              "negative": (SQUARE + ["-adapt_cycles", -1], "-adapt_cycles must be >= 0"),
-             "mg": (SQUARE + ["-options_file", "options/solvers/mg.yaml", "-adapt_cycles", 1], "-adapt_cycles with -pc_type mg")}
+             "mg": (SQUARE + ["-options_file", "options/solvers/mg.yaml", "-adapt_cycles", 1], "-adapt_cycles with -pc_type mg"),
+             # the cycles adapted at the given translation and force control ran on the last mesh only: the bars printed
+             # (force 0.000121727 +- 6.3e-8) were of another state than the one written (force 1.0e-4)
+             "force": (INDENT + ["-obstacle_translate", "0,-0.01", "-obstacle_force", "0.01", "-accuracy", 0.1],
+                       "-adapt_cycles and -accuracy with -obstacle_force are not supported yet")}
 
 
 @pytest.mark.parametrize("case", BAD_ADAPT)

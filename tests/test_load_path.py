@@ -306,3 +306,65 @@ def test_bad_force_control_refused(outdir, extra, message):
     rc, text = solve(INDENT + extra, output=out)
     assert rc != 0 and message in text, text[-2000:]
     assert not os.path.exists(out)
+
+
+UNLOAD = ["-load_path", "0.5,1,0.3,0"]
+
+
+@pytest.mark.parametrize("np_", [1, 2])
+@pytest.mark.parametrize("drive", ["displacement", "force", "al"])
+def test_a_path_that_unloads_to_zero_ends_at_rest(outdir, np_, drive):
+    """A path back to the factor 0: every datum is zero there, so the solution is u = 0 and the obstacle exerts no force;
+    recognised (0 Newton steps, u = 0 exactly, no warning), by displacement, by force (the obstacle withdrawn until it
+    no longer presses; /run keeps obstacle_force, the last step's target 0) and with the augmented Lagrangian (its
+    multipliers back to 0). Before, force control wrote the factor-0 step with the last step's state (force 3e-3,
+    converged), displacement took 5 Newton steps to reach |u| = 1e-60 and warned of penetrating nodes, and the augmented
+    Lagrangian ended with a force of 2.4e-6."""
+    extra = {"displacement": [], "force": ["-obstacle_force", "0.01"], "al": ["-contact_method", "al", "-contact_penetration_tol", "1e-5"]}[drive]
+    out, h5 = run(INDENT + ["-obstacle_translate", "0,-0.01"] + extra + UNLOAD, "unload", np_=np_, output=os.path.join(outdir, "unload.h5"))
+    st = steps(h5)
+    attrs, fields = load(h5)
+    assert st["converged"].all() and list(st["factor"]) == [0.5, 1, 0.3, 0]
+    assert st["contact_force"][2] > 0 and st["contact_force"][3] == 0.0 and st["energy"][3] == 0.0
+    assert np.all(fields["displacement"] == 0.0)
+    assert attrs["contact_force"] == 0.0 and attrs["converged"] == 1
+    assert "WARNING" not in out, out[-2000:]
+    if drive == "force":
+        assert attrs["obstacle_force"] == 0.0
+        assert attrs["obstacle_translate_y"] >= 0.0  # at or behind the unloaded position, where the cylinder just touches
+    else:
+        assert st["newton_its"][3] == 0
+
+
+def test_force_control_releases_an_overlapping_obstacle(outdir):
+    """The cylinder placed 0.005 into the block: at the factor 0 force control withdraws it until no point of the block
+    lies inside it, behind the overlap (the obstacle at least 0.005 back, translate_y >= 0.005) but not far behind it
+    (within a tenth of the overlap); the body is then at rest, u = 0."""
+    args = [a if a != "0.5,1.5" else "0.5,1.495" for a in INDENT]
+    out, h5 = run(args + ["-obstacle_translate", "0,-0.01", "-obstacle_force", "0.01"] + UNLOAD, "release", output=os.path.join(outdir, "release.h5"))
+    st = steps(h5)
+    attrs, fields = load(h5)
+    assert st["converged"].all()
+    assert st["contact_force"][3] == 0.0 and st["penetration_max"][3] <= 0.0
+    assert 0.005 <= attrs["obstacle_translate_y"] <= 0.0055, attrs["obstacle_translate_y"]
+    assert np.all(fields["displacement"] == 0.0)
+
+
+@pytest.mark.parametrize("np_", [1, 2])
+def test_force_control_in_3d_along_an_unloading_path(outdir, np_):
+    """A sphere pressed into a 3D box by force, loading to F and unloading to F/2: the force along the motion equals
+    each target to 1e-8, and the displacement-driven run at each position found gives that force to 1e-6; 2 ranks as 1."""
+    F = 0.002
+    box = ["-scene", "general", "-dm_plex_dim", "3", "-dm_plex_box_faces", "8,8,8", "-contact_faces", "2", "-bc_clamp", "1", "-obstacle", "sphere",
+           "-obstacle_center", "0.5,0.5,1.5", "-obstacle_radius", "0.5", "-snes_rtol", "1e-12", "-contact_monitor", "0"]
+    _, h5 = run(box + ["-obstacle_translate", "0,0,-0.01", "-obstacle_force", F, "-load_path", "0.5,1,0.5"], "force3d", np_=np_,
+                output=os.path.join(outdir, "force3d.h5"))
+    st = steps(h5)
+    assert st["converged"].all()
+    targets = st["factor"] * F
+    assert np.all(np.abs(-st["contact_force_z"] - targets) <= 1e-8 * targets), (st["contact_force_z"], targets)
+    for k in (1, 2):
+        _, d = run(box + ["-obstacle_translate", vec([0.0, 0.0, st["obstacle_translate_z"][k]])], f"depth3d_{k}", np_=np_,
+                   output=os.path.join(outdir, f"depth3d_{k}.h5"))
+        force = -load(d)[0]["contact_force_z"]
+        assert abs(force - targets[k]) <= 1e-6 * targets[k], (k, force, targets[k])

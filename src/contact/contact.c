@@ -434,6 +434,13 @@ PetscErrorCode ContactAugment(Contact ct, DM dm, Vec u, PetscBool apply, PetscRe
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+PetscErrorCode ContactForgetMultipliers(Contact ct)
+{
+  PetscFunctionBeginUser;
+  if (ct->ops.forget) PetscCall((*ct->ops.forget)(ct));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode ContactSameActivity(Contact ct, DM dm, Vec X, Vec Y, PetscBool *same)
 {
   PetscFunctionBeginUser;

@@ -544,10 +544,22 @@ static PetscErrorCode ContactAugment_AL(Contact ct, DM dm, Vec X, PetscBool appl
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The multipliers of a zero load: the solution u = 0 holds lambda = 0 at every node (the shifts kept from the last load
+   state would push the body off the obstacle, and Uzawa would take them down by a constant factor an update). */
+static PetscErrorCode ContactForget_AL(Contact ct)
+{
+  Contact_Penalty *pen = (Contact_Penalty *)ct->data;
+
+  PetscFunctionBeginUser;
+  if (pen->shift) PetscCall(PetscArrayzero(pen->shift, ct->set.n + 1));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode ContactCreate_AL(Contact ct)
 {
   PetscFunctionBeginUser;
   PetscCall(ContactCreate_Penalty(ct));
   ct->ops.augment = ContactAugment_AL;
+  ct->ops.forget  = ContactForget_AL;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -381,8 +381,8 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     PetscCall(PetscSNPrintf(name, sizeof(name), "obstacle_translate_%c", "xyz"[c]));
     PetscCall(WriteRealAttr(v, name, user->scene.obstacle.translate[c]));
   }
-  if (user->scene.obstacle.force > 0.0) {
-    PetscCall(WriteRealAttr(v, "obstacle_force", user->scene.obstacle.force)); /* the target (the last step's) */
+  if (SceneForceControlled(&user->scene)) {
+    PetscCall(WriteRealAttr(v, "obstacle_force", user->scene.obstacle.force)); /* the target (the last step's: 0 at the factor 0) */
     PetscCall(WriteIntAttr(v, "force_control_its", s->force_control_its));
   }
   {

@@ -51,6 +51,12 @@ PetscErrorCode SceneSetLoadFactor(Scene *scene, PetscReal t)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Whether the obstacle is driven by a force (-obstacle_force), at any load factor: the factor 0 makes its target 0. */
+PetscBool SceneForceControlled(const Scene *scene)
+{
+  return (PetscBool)((scene->full_load.kept ? scene->full_load.force : scene->obstacle.force) > 0.0);
+}
+
 /* The obstacle at the translation s times the unit direction of its full translation (force control, load_path.c;
    after SceneSetLoadFactor(), which keeps it). */
 PetscErrorCode SceneSetObstaclePosition(Scene *scene, PetscReal s)

@@ -24,6 +24,7 @@
 #include "estimate.h"
 #include "mesh.h"
 #include "physics.h"
+#include "scenes.h"
 #include "solver.h"
 #include "verify.h"
 
@@ -140,6 +141,12 @@ PetscErrorCode AdaptCheck(DM dm, const AppCtx *user)
   PetscCheck(copt->n_sweep <= 1, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles with -penalty_eps0_sweep is not supported yet");
   PetscCheck(copt->penetration_tol <= 0.0, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles with -contact_penetration_tol is not supported yet");
   PetscCheck(!opt->load_path.n, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles with a load path (-load_steps, -load_path) is not supported yet");
+  /* the cycles adapt the mesh to the solution at the obstacle's given translation, and force control would move it on
+     the last mesh only: the bars printed would belong to another state than the one written */
+  PetscCheck(!SceneForceControlled(&user->scene), comm, PETSC_ERR_USER_INPUT,
+             "-adapt_cycles and -accuracy with -obstacle_force are not supported yet: the cycles adapt to one position of the obstacle, and "
+             "force control would move it on the last mesh only, so that the bars would be those of another state than the one written; give "
+             "the obstacle's translation instead (a force-controlled run on a fixed mesh reports the translation it found)");
   PetscCheck(!opt->verify.reference[0], comm, PETSC_ERR_USER_INPUT,
              "-adapt_cycles with -reference is not supported: the reference is on another mesh");
   PetscCheck(!is_mg, comm, PETSC_ERR_USER_INPUT,

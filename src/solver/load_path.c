@@ -50,7 +50,7 @@ PetscErrorCode LoadPathSetUp(MPI_Comm comm, AppCtx *user)
   const char           *what = opt->load_path.n ? "-load_steps and -load_path" : "-obstacle_force";
 
   PetscFunctionBeginUser;
-  if (!opt->load_path.n && !(user->scene.obstacle.force > 0.0)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!opt->load_path.n && !SceneForceControlled(&user->scene)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactGetOptions(user->contact, &copt));
   PetscCall(SceneCheckLoadPath(comm, &user->scene, what));
   PetscCheck(ContactHasPenalty(user->contact) || !(user->scene.obstacle.force > 0.0), comm, PETSC_ERR_USER_INPUT,
@@ -103,6 +103,23 @@ static void ForceAlong(const AppCtx *user, PetscReal *f, PetscReal *s)
   Along(user, user->rec.stats.contact_force_vector, user->scene.obstacle.translate, f, s);
 }
 
+/* The force's local power of the obstacle's position, from the last two steps (1.5 for a sphere's indentation), in
+   [1, 3]; 1 before there are two. */
+static PetscReal ForcePower(const AppCtx *user)
+{
+  PetscReal power = 1.0;
+
+  if (user->rec.nsteps >= 2) {
+    PetscReal         f1, s1, f2, s2;
+    const StepRecord *st = &user->rec.steps[user->rec.nsteps - 2];
+
+    Along(user, st[0].q.force, st[0].obstacle_translate, &f1, &s1);
+    Along(user, st[1].q.force, st[1].obstacle_translate, &f2, &s2);
+    if (f1 > 0.0 && f2 > f1 && s1 > 0.0 && s2 > s1) power = PetscMin(PetscMax(PetscLogReal(f2 / f1) / PetscLogReal(s2 / s1), 1.0), 3.0);
+  }
+  return power;
+}
+
 #define FORCE_CONTROL_RTOL 1e-8 /* |F - target| / target at which the position is found */
 #define FORCE_CONTROL_MAX_ITS 60
 #define FORCE_CONTROL_SOLVE_TOL 1e-2 /* each position's Newton residual, relative to FORCE_CONTROL_RTOL times the target */
@@ -129,23 +146,15 @@ static void ForceAlong(const AppCtx *user, PetscReal *f, PetscReal *s)
    the solve fails or the target is not reached in FORCE_CONTROL_MAX_ITS positions; *its counts the positions solved. */
 static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscReal target, PetscBool *ok, PetscInt *its)
 {
-  PetscReal f, s, f_prev = 0.0, s_prev = 0.0, s_lo = 0.0, f_lo = 0.0, s_hi = 0.0, f_hi = 0.0, atol, rtol, stol, power = 1.0;
+  PetscReal f, s, f_prev = 0.0, s_prev = 0.0, s_lo = 0.0, f_lo = 0.0, s_hi = 0.0, f_hi = 0.0, atol, rtol, stol, power;
   PetscBool have_lo = PETSC_FALSE, have_hi = PETSC_FALSE;
   PetscInt  side = 0, maxit, maxf; /* side: the bracket's end kept last time (Illinois) */
   Vec       u_prev, dir;
 
   PetscFunctionBeginUser;
-  *ok  = PETSC_FALSE;
-  *its = 0;
-  if (user->rec.nsteps >= 2) { /* the force's local power of the position, from the last two steps: 1.5 for a sphere's indentation */
-    PetscReal f1, s1, f2, s2;
-
-    const StepRecord *st = &user->rec.steps[user->rec.nsteps - 2];
-
-    Along(user, st[0].q.force, st[0].obstacle_translate, &f1, &s1);
-    Along(user, st[1].q.force, st[1].obstacle_translate, &f2, &s2);
-    if (f1 > 0.0 && f2 > f1 && s1 > 0.0 && s2 > s1) power = PetscMin(PetscMax(PetscLogReal(f2 / f1) / PetscLogReal(s2 / s1), 1.0), 3.0);
-  }
+  *ok   = PETSC_FALSE;
+  *its  = 0;
+  power = ForcePower(user);
   PetscCall(VecDuplicate(u, &u_prev)); /* the solution at s_prev: u = 0 at s = 0, before the obstacle presses */
   PetscCall(VecDuplicate(u, &dir));
   PetscCall(VecZeroEntries(u_prev));
@@ -205,6 +214,57 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Force control to a zero target (a path that unloads to the factor 0): the obstacle withdrawn until it exerts no
+   force at all. The state is then unique, the body under its other loads as if the obstacle were not there, while the
+   position is any at which the obstacle does not press; the one found is the onset of the contact as the force's power
+   law F = C (s - s0)^p puts it (the power p of the last two steps), a little behind it (FORCE_CONTROL_RELEASE of the
+   last move), so that the nodes the obstacle just touches there are free. The first move assumes the onset at the
+   obstacle's unloaded position s = 0, as the first move to a positive force does; after it, the onset through the last
+   two positions with a force, (s_a - s0) / (s_b - s0) = (f_a / f_b)^(1/p). The target is reached where the force is
+   zero to the last bit and no node or point of the rule lies inside the obstacle (a node the rule's points miss may
+   still overlap it: that is no release); behind the onset the state is u = 0 where the other loads are zero too. Before, the step at the factor 0 was not solved: it was written
+   with the last step's state (force 3e-5 where the target was 0). */
+#define FORCE_CONTROL_RELEASE 1e-6
+
+static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u, PetscBool *ok, PetscInt *its)
+{
+  const PetscReal power = ForcePower(user);
+  PetscReal       f, s, f_prev = 0.0, s_prev = 0.0;
+  PetscBool       have_prev = PETSC_FALSE;
+
+  PetscFunctionBeginUser;
+  *ok  = PETSC_FALSE;
+  *its = 0;
+  PetscCall(PostprocessContact(dm, user, u));
+  ForceAlong(user, &f, &s);
+  for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && user->rec.stats.converged; ++it) {
+    PetscReal s_next, move, d;
+
+    PetscCall(ContactMaxPenetration(user->contact, dm, u, &d));
+    if (!(f > 0.0) && d <= 0.0) { /* no force, and no point inside the obstacle */
+      *ok = PETSC_TRUE;
+      break;
+    }
+    if (!have_prev) s_next = s > 0.0 ? 0.0 : s - PetscMax(PetscAbsReal(s), 1.0); /* the onset where the first move to a force puts it */
+    else {
+      const PetscReal r = PetscPowReal(f_prev / f, 1.0 / power);
+
+      s_next = r != 1.0 ? (s_prev - r * s) / (1.0 - r) : PetscMin(s, s_prev) - PetscAbsReal(s - s_prev);
+      if (!(s_next < PetscMin(s, s_prev))) s_next = PetscMin(s, s_prev) - PetscAbsReal(s - s_prev); /* the law gives no onset behind both */
+    }
+    move = PetscAbsReal(s_next - s);
+    s_next -= FORCE_CONTROL_RELEASE * move;
+    s_prev = s, f_prev = f, have_prev = PETSC_TRUE;
+    PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
+    PetscCall(ProblemUpdateData(dm, user));
+    PetscCall(SolverSolveWarm(snes, user, u, "force control"));
+    PetscCall(PostprocessContact(dm, user, u));
+    ForceAlong(user, &f, &s);
+    ++*its;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The step just solved at factor t: its quantities (PostprocessContact()), its solves' records from first_record on
    (summed: force control solves several positions) and its state at the vertices (OutputStateFields(): the output's
    time series). */
@@ -244,8 +304,9 @@ static PetscErrorCode LoadPathForce(DM dm, AppCtx *user, SNES snes, Vec u, Petsc
 
   PetscFunctionBeginUser;
   *ok = PETSC_TRUE;
-  if (!(user->scene.obstacle.force > 0.0) || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(ForceControlSolve(dm, user, snes, u, user->scene.obstacle.force, ok, &its));
+  if (!SceneForceControlled(&user->scene) || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
+  if (user->scene.obstacle.force > 0.0) PetscCall(ForceControlSolve(dm, user, snes, u, user->scene.obstacle.force, ok, &its));
+  else PetscCall(ForceControlRelease(dm, user, snes, u, ok, &its)); /* the factor 0 */
   user->rec.stats.force_control_its += its;
   if (!*ok && user->rec.stats.converged) {
     PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm),
@@ -269,7 +330,7 @@ static PetscErrorCode LoadPathForce(DM dm, AppCtx *user, SNES snes, Vec u, Petsc
 PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 {
   const LoadPathOptions *lp    = &user->opt->load_path;
-  const PetscBool        force = (PetscBool)(user->scene.obstacle.force > 0.0);
+  const PetscBool        force = SceneForceControlled(&user->scene);
   Vec                    prev = NULL, dir = NULL;
   PetscInt               first = 0;
   PetscBool              ok;
@@ -311,7 +372,7 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 PetscErrorCode LoadPathView(MPI_Comm comm, const AppCtx *user)
 {
   PetscFunctionBeginUser;
-  if (user->scene.obstacle.force > 0.0) {
+  if (SceneForceControlled(&user->scene)) {
     PetscReal f, s;
 
     ForceAlong(user, &f, &s);

@@ -414,6 +414,33 @@ PetscErrorCode SolverStartFromCoarser(const AppCtx *user, SolverStart *start)
    multiple and may not converge. A warm start from the solution for a nearby eps (the sweep) needs no continuation;
    one from a coarser mesh's (nested iteration) runs it from that guess: below h/100 its new contact nodes, between an
    active and a free coarse one, start far off on the 1/eps scale. */
+/* Whether the load state is zero: no load, body force or prescribed displacement (r0 = F_bulk(0) plus the loads, zero
+   to the last bit) and no point of Gamma_C inside the obstacle at u = 0 (no initial overlap). Then u = 0 is the
+   solution, and the only one (the energy is strictly convex on the admissible set): its residual is exactly zero, no
+   point presses, and every multiplier is zero. A step of a load path at the factor 0 is such a state; solved from the
+   last step's solution, Newton took 5 to 10 steps to drive |u| from 1e-3 to round-off (1e-60), and the round-off's
+   penetrations of 1e-63 raised the contact-resolution warning. */
+static PetscErrorCode SolverZeroData(DM dm, AppCtx *user, PetscBool *zero)
+{
+  PetscReal r0;
+
+  PetscFunctionBeginUser;
+  *zero = PETSC_FALSE;
+  PetscCall(VecNorm(user->prob.r0, NORM_INFINITY, &r0));
+  if (r0 != 0.0) PetscFunctionReturn(PETSC_SUCCESS);
+  {
+    Vec       zero_u;
+    PetscReal d;
+
+    PetscCall(VecDuplicate(user->prob.r0, &zero_u));
+    PetscCall(VecZeroEntries(zero_u));
+    PetscCall(ContactMaxPenetration(user->contact, dm, zero_u, &d));
+    PetscCall(VecDestroy(&zero_u));
+    *zero = (PetscBool)(d <= 0.0);
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
 {
   const PetscBool       warm = (PetscBool)(start != SOLVER_START_ZERO);
@@ -429,6 +456,15 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
   PetscCall(ContactGetEps(user->contact, &eps_target));
   PetscCall(ContactGetPenaltyScale(user->contact, &eps_start));
   if (!warm) PetscCall(VecZeroEntries(u));
+  {
+    PetscBool zero;
+
+    PetscCall(SolverZeroData(dm, user, &zero));
+    if (zero) { /* u = 0 exactly: the SNES finds |F| = 0 at its start and stops there, converged in no step */
+      PetscCall(VecZeroEntries(u));
+      PetscCall(ContactForgetMultipliers(user->contact));
+    }
+  }
   PetscCall(MultigridSetUpPC(snes, user)); /* -pc_type mg: the levels of the meshes solved so far */
   user->prob.sctx->warm = warm;
   PetscCall(PetscTime(&t0));
