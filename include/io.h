@@ -4,6 +4,7 @@
 
 /* output_file.c */
 PetscErrorCode OutputFileInstallCleanup(void);
+PetscErrorCode OutputFileStageSignalNote(MPI_Comm comm, const char note[]);
 PetscErrorCode OutputFileSplitPath(const char path[], char dir[], size_t dlen, char base[], size_t blen);
 PetscErrorCode OutputFileXdmfName(const char h5[], char xdmf[], size_t len);
 PetscErrorCode OutputFileCheckTarget(MPI_Comm comm, const char path[], PetscBool create_dir);

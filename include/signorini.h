@@ -372,8 +372,16 @@ typedef struct {
 typedef enum { ACCURACY_ENERGY, ACCURACY_FORCE, ACCURACY_PRESSURE, ACCURACY_SIZE, ACCURACY_PEAK, ACCURACY_NUM } AccuracyQuantity;
 extern const char *const AccuracyQuantities[];
 /* Why the cycles stopped (/run adapt_stop): -accuracy reached, the cycles of -adapt_cycles done, the mesh at
-   -adapt_max_dofs, a failed solve, or nothing left to refine (a zero estimate). */
-typedef enum { ADAPT_STOP_ACCURACY, ADAPT_STOP_CYCLES, ADAPT_STOP_MAX_DOFS, ADAPT_STOP_SOLVE_FAILED, ADAPT_STOP_NOTHING_MARKED } AdaptStop;
+   -adapt_max_dofs, a failed solve, or nothing left to refine (a zero estimate); "interrupted" in the output each
+   finished cycle writes while the run goes on, which stays where a signal ends the run. */
+typedef enum {
+  ADAPT_STOP_ACCURACY,
+  ADAPT_STOP_CYCLES,
+  ADAPT_STOP_MAX_DOFS,
+  ADAPT_STOP_SOLVE_FAILED,
+  ADAPT_STOP_NOTHING_MARKED,
+  ADAPT_STOP_INTERRUPTED
+} AdaptStop;
 extern const char *const AdaptStops[];
 typedef struct {
   PetscInt  cycles;                    /* 0: no adaptive refinement; with -accuracy, the most cycles */
@@ -502,3 +510,6 @@ typedef struct {
   Multigrid         mg; /* the interpolations between the nested meshes solved so far */
   RunRecord         rec;
 } AppCtx;
+
+/* The writer of the run's output (io/output_hdf5.c's OutputWriteHDF5()), which main() hands to the adaptive cycles */
+typedef PetscErrorCode (*OutputWriter)(DM, const AppCtx *, Vec);

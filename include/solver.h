@@ -57,7 +57,7 @@ PetscErrorCode EpsSweepTangent(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, P
 /* adapt.c: -adapt_cycles, the adaptive refinement driven by the error estimate */
 PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad);
 PetscErrorCode AdaptCheck(DM dm, const AppCtx *user);
-PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
+PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter write);
 PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user);
 PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u); /* penetration_tol.c: -contact_penetration_tol */
 

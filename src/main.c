@@ -169,8 +169,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(PetscTime(&t1));
   user.rec.stats.time_setup = t1 - t0;
 
-  PetscCall(GridSequenceSolve(&dm, &user, &snes, &u)); /* one solve without nested iteration */
-  PetscCall(AdaptSolve(&dm, &user, &snes, &u));        /* -adapt_cycles: refined where the estimate is largest */
+  PetscCall(GridSequenceSolve(&dm, &user, &snes, &u));           /* one solve without nested iteration */
+  PetscCall(AdaptSolve(&dm, &user, &snes, &u, OutputWriteHDF5)); /* -adapt_cycles: refined where the estimate is largest; each cycle written */
   PetscCall(EpsSweepSolve(dm, &user, snes, u));
   PetscCall(PenetrationTolSolve(dm, &user, snes, u)); /* -contact_penetration_tol: eps lowered until the penetration is reached */
   PetscCall(LoadPathSolve(dm, &user, snes, u));       /* the steps after the first, each from the last */

@@ -22,7 +22,7 @@ typedef struct {
   PetscErrorCode (*load)(Contact, DM);                                               /* after the set's gaps changed, ContactSetLoad() (NULL: none) */
   PetscErrorCode (*frame)(Contact, Vec, PetscBool to_solver);                        /* v <- Q^T v or Q v, the SNES's own frame (NULL: none) */
   PetscErrorCode (*augment)(Contact, DM, Vec u, PetscBool apply, PetscReal *change); /* the multipliers' update at u (NULL: none) */
-  PetscErrorCode (*forget)(Contact); /* the multipliers set to zero (NULL: none) */
+  PetscErrorCode (*forget)(Contact);                                                 /* the multipliers set to zero (NULL: none) */
   PetscErrorCode (*view)(Contact, PetscViewer);                                      /* the type's part of the summary line */
 } ContactOps;
 

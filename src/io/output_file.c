@@ -72,8 +72,15 @@ static void OutputFileCleanUpAtExit(void)
 static volatile sig_atomic_t output_critical = 0; /* the main thread is creating temporaries or renaming the pair */
 static volatile sig_atomic_t output_pending  = 0; /* a termination signal that arrived meanwhile */
 
+/* What a termination signal says before the process dies of it, on rank 0: which output the run leaves (an adaptive run
+   that wrote its last finished cycle, adapt.c). The note is staged before a write and becomes the one said when the
+   write's files are in place (OutputFileCommit()), so that it always names what the output holds. */
+static char   output_note[1024], output_note_staged[1024];
+static size_t output_note_len = 0;
+
 static void OutputFileDie(int sig)
 {
+  if (output_note_len) (void)!write(STDERR_FILENO, output_note, output_note_len); /* async-signal-safe */
   OutputFileRemoveTemps();
   (void)signal(sig, SIG_DFL);
   (void)raise(sig); /* die of the signal, as without the handler */
@@ -118,6 +125,17 @@ PetscErrorCode OutputFileInstallCleanup(void)
   sigemptyset(&sa.sa_mask);
   for (size_t i = 0; i < output_nsignals; ++i)
     PetscCheck(sigaction(output_signals[i], &sa, NULL) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "sigaction() failed");
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Stages the note a termination signal prints once the next output is in place (rank 0 keeps it; "" says nothing). */
+PetscErrorCode OutputFileStageSignalNote(MPI_Comm comm, const char note[])
+{
+  PetscMPIInt rank;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  if (rank == 0) PetscCall(PetscStrncpy(output_note_staged, note, sizeof(output_note_staged)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -288,6 +306,11 @@ PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, cha
       (void)flock(dfd, LOCK_UN);
       (void)close(dfd);
     }
+    if (!err) { /* the files in place: the note staged for them is the one a signal says from now on */
+      memcpy(output_note, output_note_staged, sizeof(output_note));
+      output_note_len = strnlen(output_note, sizeof(output_note) - 1);
+    }
+    output_note_staged[0] = '\0';
     OutputFileLeaveCritical();
   }
   PetscCallMPI(MPI_Bcast(&err, 1, MPI_INT, 0, comm));

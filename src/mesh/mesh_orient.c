@@ -13,7 +13,7 @@
    coordinates are untouched (the cell has no support to update), and on a mesh that needs no reflection nothing
    changes. det J is taken at the cell's center, which for a simplex is its one value; a quadrilateral or hexahedron
    whose det J changes sign inside (a non-convex or tangled cell) is refused, as is a cell of zero volume. */
-#include "mesh.h"
+#include "mesh.h" /* MeshOrientCells() only: nothing of mesh.c is called here (mesh.c calls this file) */
 
 /* det J of cell c at its center, and for a tensor cell the smallest and largest det J at its vertices' reference points
    (the corners, where a bilinear or trilinear map is most distorted). */
@@ -63,6 +63,31 @@ static PetscErrorCode CellDeterminants(DM dm, PetscInt c, PetscBool simplex, Pet
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The diameter of cell c: its largest vertex-to-vertex distance. */
+static PetscErrorCode CellDiameter(DM dm, PetscInt c, PetscReal *diam)
+{
+  DM           cdm;
+  Vec          coords;
+  PetscScalar *xc = NULL;
+  PetscInt     n, cdim;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetCoordinateDim(dm, &cdim));
+  PetscCall(DMGetCoordinateDM(dm, &cdm));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(DMPlexVecGetClosure(cdm, NULL, coords, c, &n, &xc)); /* the vertices' coordinates */
+  *diam = 0.0;
+  for (PetscInt i = 0; i < n / cdim; ++i)
+    for (PetscInt j = i + 1; j < n / cdim; ++j) {
+      PetscReal d2 = 0.0;
+
+      for (PetscInt d = 0; d < cdim; ++d) d2 += PetscSqr(PetscRealPart(xc[i * cdim + d] - xc[j * cdim + d]));
+      *diam = PetscMax(*diam, PetscSqrtReal(d2));
+    }
+  PetscCall(DMPlexVecRestoreClosure(cdm, NULL, coords, c, &n, &xc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The centroid of the first of the local cells marked (cell >= 0) on the lowest rank that has one, on every rank. */
 static PetscErrorCode FirstMarkedCentroid(DM dm, PetscInt cell, PetscReal x[3])
 {
@@ -105,13 +130,14 @@ PetscErrorCode MeshOrientCells(DM dm, const char what[], PetscInt *nreflected)
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMGetCoordinatesLocalSetUp(dm)); /* collective: a mesh just distributed (a parallel HDF5 read) has none yet */
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(DMPlexIsSimplex(dm, &simplex));
   for (PetscInt c = cStart; c < cEnd; ++c) {
-    PetscReal det, det_min, det_max, diam;
+    PetscReal det, det_min, det_max, diam = 0.0;
 
     PetscCall(CellDeterminants(dm, c, simplex, &det, &det_min, &det_max));
-    PetscCall(MeshCellDiameter(dm, c, &diam));
+    PetscCall(CellDiameter(dm, c, &diam));
     if (!(PetscAbsReal(det) > 1e-12 * PetscPowRealInt(diam, dim))) { /* zero to round-off, or not finite */
       if (bad < 0) bad = c;
       ++counts[1];
@@ -138,7 +164,8 @@ PetscErrorCode MeshOrientCells(DM dm, const char what[], PetscInt *nreflected)
 
     PetscCall(FirstMarkedCentroid(dm, bad, x));
     SETERRQ(comm, PETSC_ERR_USER_INPUT,
-            "The mesh %s has %" PetscInt_FMT " cell(s) of zero volume, the first at (%.6g, %.6g, %.6g): their vertices are collinear or coplanar, so that "
+            "The mesh %s has %" PetscInt_FMT
+            " cell(s) of zero volume, the first at (%.6g, %.6g, %.6g): their vertices are collinear or coplanar, so that "
             "their stiffness is singular; remove or mend them in the mesh generator",
             what, counts[1], (double)x[0], (double)x[1], (double)x[2]);
   }
@@ -147,7 +174,8 @@ PetscErrorCode MeshOrientCells(DM dm, const char what[], PetscInt *nreflected)
 
     PetscCall(FirstMarkedCentroid(dm, tangled, x));
     SETERRQ(comm, PETSC_ERR_USER_INPUT,
-            "The mesh %s has %" PetscInt_FMT " tangled cell(s), the first at (%.6g, %.6g, %.6g): the Jacobian changes sign inside them (a non-convex or "
+            "The mesh %s has %" PetscInt_FMT
+            " tangled cell(s), the first at (%.6g, %.6g, %.6g): the Jacobian changes sign inside them (a non-convex or "
             "self-intersecting quadrilateral or hexahedron), which no order of their vertices mends; mesh them again",
             what, counts[2], (double)x[0], (double)x[1], (double)x[2]);
   }

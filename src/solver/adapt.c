@@ -22,6 +22,7 @@
    stop, never what they compute. */
 #include "contact.h"
 #include "estimate.h"
+#include "io.h"
 #include "mesh.h"
 #include "physics.h"
 #include "scenes.h"
@@ -30,7 +31,8 @@
 
 #define ADAPT_ACCURACY_CYCLES 40 /* -accuracy's most cycles unless -adapt_cycles says */
 
-const char *const AdaptStops[] = {"accuracy", "cycles", "max_dofs", "solve_failed", "nothing_marked", "AdaptStop", "ADAPT_STOP_", NULL};
+const char *const AdaptStops[] = {"accuracy",  "cycles",      "max_dofs", "solve_failed", "nothing_marked", "interrupted",
+                                  "AdaptStop", "ADAPT_STOP_", NULL};
 
 PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
 {
@@ -45,7 +47,6 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
   ad->accuracy        = 0.0;
   ad->newton_fraction = 0.0;
   ad->mark_edge       = PETSC_TRUE;
-  ad->monitor         = PETSC_FALSE;
   ad->max_dofs        = 0;
   PetscOptionsBegin(comm, NULL, "Adaptive refinement", "Signorini");
   PetscCall(PetscOptionsInt(
@@ -72,6 +73,7 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
                              "With -accuracy on the contact size, refine the cells along the contact zone's edge too while its one-cell band, "
                              "the floor of the size's bar, is above the tolerance",
                              NULL, ad->mark_edge, &ad->mark_edge, NULL));
+  ad->monitor = (PetscBool)(ad->accuracy > 0.0 || ad->cycles > 0); /* a long run prints a line per cycle by default */
   PetscCall(PetscOptionsBool("-adapt_monitor",
                              "Print a line for each adaptive cycle as it ends: its unknowns, estimate, solve, time and, with -accuracy, the bars "
                              "asked for",
@@ -384,7 +386,29 @@ static PetscReal AdaptFraction(const AdaptOptions *ad, const PetscBool target[],
   return 0.5;
 }
 
-PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
+/* Cycle k finished and another follows: the output written now, with /run adapt_stop = interrupted, so that a run
+   ended by a signal (Ctrl-C, a scheduler's SIGTERM at its time limit) keeps its last finished cycle, its /cycles and
+   its bars, and says so as it dies (OutputFileStageSignalNote()); the run's final write replaces it. The writes cost
+   one output per cycle, about what the run's own write costs each time, while a cycle's solve and mesh cost more:
+   the meshes grow by a factor each cycle, so that all the writes together cost about a final write or two. */
+static PetscErrorCode AdaptCheckpoint(DM dm, AppCtx *user, Vec u, PetscInt k, OutputWriter write)
+{
+  const CycleRecord *c = &user->rec.cycles[k];
+  char               note[1024];
+
+  PetscFunctionBeginUser;
+  if (!write) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscSNPrintf(note, sizeof(note),
+                          "signorini: interrupted during adaptive cycle %" PetscInt_FMT ": %s holds cycle %" PetscInt_FMT " (%" PetscInt_FMT
+                          " dofs), the last one finished, with /run adapt_stop = interrupted\n",
+                          k + 1, user->opt->output, k, c->n_dofs));
+  PetscCall(OutputFileStageSignalNote(PetscObjectComm((PetscObject)dm), note));
+  user->rec.adapt_stop = ADAPT_STOP_INTERRUPTED;
+  PetscCall(write(dm, user, u));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter write)
 {
   const AdaptOptions *ad = &user->opt->adapt;
   PetscInt            dim;
@@ -405,7 +429,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     DMLabel        marked = NULL;
     PetscLogDouble t0, t1;
     SolverStart    start;
-    PetscBool      at_max;
+    PetscBool      at_max, done;
 
     PetscCall(AdaptRecord(*dm, user, *u, k));
     PetscCall(AdaptQuantitiesAtSmallerEps(*dm, user, *snes, *u, c));
@@ -424,10 +448,12 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     PetscCall(PetscTime(&t0)); /* the cycle: its mesh, its solve (the first solve for cycle 0), estimate and marking */
     c->time_cycle = (t0 - t_last) + (k == 0 ? c->time_solve : 0.0);
     t_last        = t0;
-    PetscCall(AdaptMonitor(PetscObjectComm((PetscObject)*dm), ad, user->rec.accuracy_target, c, k));
+    done          = (PetscBool)(c->accurate || !user->rec.stats.converged || at_max || k == ad->cycles ||
+                       (!c->marked && !c->marked_edge && !c->unseen));                      /* done, or a zero estimate: nothing to refine */
+    if (!done) PetscCall(AdaptCheckpoint(*dm, user, *u, k, write));                                  /* what a signal during the next cycle leaves */
+    PetscCall(AdaptMonitor(PetscObjectComm((PetscObject)*dm), ad, user->rec.accuracy_target, c, k)); /* once it is written */
     PetscCall(AdaptWarnEnergyAlone(PetscObjectComm((PetscObject)*dm), ad, user->rec.accuracy_target, c, k, &warned_energy));
-    if (c->accurate || !user->rec.stats.converged || at_max || k == ad->cycles ||
-        (!c->marked && !c->marked_edge && !c->unseen)) { /* done, or a zero estimate: nothing to refine */
+    if (done) {
       user->rec.adapt_stop = c->accurate                  ? ADAPT_STOP_ACCURACY
                              : !user->rec.stats.converged ? ADAPT_STOP_SOLVE_FAILED
                              : at_max                     ? ADAPT_STOP_MAX_DOFS

@@ -222,8 +222,8 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
    obstacle's unloaded position s = 0, as the first move to a positive force does; after it, the onset through the last
    two positions with a force, (s_a - s0) / (s_b - s0) = (f_a / f_b)^(1/p). The target is reached where the force is
    zero to the last bit and no node or point of the rule lies inside the obstacle (a node the rule's points miss may
-   still overlap it: that is no release); behind the onset the state is u = 0 where the other loads are zero too. Before, the step at the factor 0 was not solved: it was written
-   with the last step's state (force 3e-5 where the target was 0). */
+   still overlap it: that is no release); behind the onset the state is u = 0 where the other loads are zero too. Before, the step at the factor 0 was
+   not solved: it was written with the last step's state (force 3e-5 where the target was 0). */
 #define FORCE_CONTROL_RELEASE 1e-6
 
 static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u, PetscBool *ok, PetscInt *its)
@@ -245,7 +245,8 @@ static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u,
       *ok = PETSC_TRUE;
       break;
     }
-    if (!have_prev) s_next = s > 0.0 ? 0.0 : s - PetscMax(PetscAbsReal(s), 1.0); /* the onset where the first move to a force puts it */
+    if (!have_prev)
+      s_next = s > 0.0 ? 0.0 : s - PetscMax(PetscAbsReal(s), 1.0); /* the onset where the first move to a force puts it */
     else {
       const PetscReal r = PetscPowReal(f_prev / f, 1.0 / power);
 
@@ -305,8 +306,10 @@ static PetscErrorCode LoadPathForce(DM dm, AppCtx *user, SNES snes, Vec u, Petsc
   PetscFunctionBeginUser;
   *ok = PETSC_TRUE;
   if (!SceneForceControlled(&user->scene) || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
-  if (user->scene.obstacle.force > 0.0) PetscCall(ForceControlSolve(dm, user, snes, u, user->scene.obstacle.force, ok, &its));
-  else PetscCall(ForceControlRelease(dm, user, snes, u, ok, &its)); /* the factor 0 */
+  if (user->scene.obstacle.force > 0.0)
+    PetscCall(ForceControlSolve(dm, user, snes, u, user->scene.obstacle.force, ok, &its));
+  else
+    PetscCall(ForceControlRelease(dm, user, snes, u, ok, &its)); /* the factor 0 */
   user->rec.stats.force_control_its += its;
   if (!*ok && user->rec.stats.converged) {
     PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm),
