@@ -7,6 +7,7 @@
 int OptionsFilesCheckYAML(int argc, char **argv);
 
 /* options_check.c */
+PetscErrorCode OptionsCheckEnum(MPI_Comm comm, const char name[], const char *const list[], PetscBool array);
 PetscErrorCode OptionsCheckFinite(MPI_Comm comm, const char name[], PetscReal value);
 PetscErrorCode OptionsCheckFiniteArray(MPI_Comm comm, const char name[], PetscInt n, const PetscReal values[]);
 PetscErrorCode OptionsCountListValues(const char name[], PetscInt *n);

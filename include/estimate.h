@@ -16,6 +16,7 @@ PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DM
 /* cycle_bars.c: the bars of -accuracy's quantities on the adaptive cycles */
 #define CYCLE_EPS_RATIO 10.0 /* the quantities' penalty parts on a cycle: their values at eps / CYCLE_EPS_RATIO (src/solver/adapt.c) */
 PetscErrorCode CycleBarsCompute(AppCtx *user, PetscInt dim, PetscInt last);
+PetscReal      CycleBarsPenaltyPart(const CycleRecord *c, PetscInt k);
 PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nunseen, PetscReal *force);
 PetscErrorCode EstimateMarkContactEdge(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nmarked);
 

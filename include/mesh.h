@@ -125,6 +125,7 @@ PetscErrorCode                  MeshTransferDestroy(MeshTransfer *tr);
 /* mesh_remesh.c: the Gmsh model meshed again with a size per cell of dm (-adapt_model), or the box of the options
    (model "" and box); with loc (dm's local field), *tr carries it to the new mesh */
 PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const PetscReal size[], Vec loc, DM *remeshed, MeshTransfer *tr);
+PetscErrorCode MeshRemeshCheckModel(DM dm, const char model[]);
 
 /* mesh_partition.c */
 PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm);

@@ -372,15 +372,17 @@ typedef struct {
 typedef enum { ACCURACY_ENERGY, ACCURACY_FORCE, ACCURACY_PRESSURE, ACCURACY_SIZE, ACCURACY_PEAK, ACCURACY_NUM } AccuracyQuantity;
 extern const char *const AccuracyQuantities[];
 /* Why the cycles stopped (/run adapt_stop): -accuracy reached, the cycles of -adapt_cycles done, the mesh at
-   -adapt_max_dofs, a failed solve, or nothing left to refine (a zero estimate); "interrupted" in the output each
-   finished cycle writes while the run goes on, which stays where a signal ends the run. */
+   -adapt_max_dofs, a failed solve, nothing left to refine (a zero estimate), or a fixed eps whose penalty part of a bar
+   is above the tolerance (no refinement lowers it); "interrupted" in the output each finished cycle writes while the
+   run goes on, which stays where a signal ends the run. */
 typedef enum {
   ADAPT_STOP_ACCURACY,
   ADAPT_STOP_CYCLES,
   ADAPT_STOP_MAX_DOFS,
   ADAPT_STOP_SOLVE_FAILED,
   ADAPT_STOP_NOTHING_MARKED,
-  ADAPT_STOP_INTERRUPTED
+  ADAPT_STOP_INTERRUPTED,
+  ADAPT_STOP_FIXED_EPS
 } AdaptStop;
 extern const char *const AdaptStops[];
 typedef struct {

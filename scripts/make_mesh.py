@@ -42,6 +42,9 @@ def main(argv=None):
     args = parser.parse_args(argv)
     h_far = args.h_far if args.h_far is not None else DEFAULTS[args.shape][0] * args.radius
     h_near = args.h_near if args.h_near is not None else DEFAULTS[args.shape][1] * args.radius
+    for path in (args.output, args.model):  # as the solver makes its output's directory: output/x.msh on a fresh clone
+        if path and os.path.dirname(path):
+            os.makedirs(os.path.dirname(path), exist_ok=True)
     try:
         SHAPES[args.shape](args.output, radius=args.radius, h_far=h_far, h_near=h_near, width=args.width, near=args.near, grade=args.grade,
                             model=args.model)

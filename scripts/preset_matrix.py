@@ -29,7 +29,7 @@ PRESETS = {
     "mumps": ["-options_file", os.path.join(ROOT, "options", "solvers", "mumps.yaml")],
 }
 COLUMNS = ["case", "preset", "eps0", "ranks", "partitioner", "converged", "reason", "newton", "ksp", "pc_builds", "pc_breakdowns",
-           "wall"]
+           "contact_force", "wall"]
 
 
 def run_one(case, mesh, preset, eps0, ranks, partitioner, outdir):
@@ -44,7 +44,8 @@ def run_one(case, mesh, preset, eps0, ranks, partitioner, outdir):
         return row, cmd
     a = read_run(out)
     row.update(converged=int(a["converged"]), reason=a["snes_reason_code"], newton=a["newton_its_total"],
-               ksp=a["ksp_its_total"], pc_builds=a.get("pc_builds"), pc_breakdowns=a.get("pc_breakdowns", 0))
+               ksp=a["ksp_its_total"], pc_builds=a.get("pc_builds"), pc_breakdowns=a.get("pc_breakdowns", 0),
+               contact_force=f"{a['contact_force']:.12g}")
     return row, cmd
 
 

@@ -7,6 +7,7 @@ apart too, and its mesh part at the order 1); the energy's bar is the error esti
 a 10 x 10 block (where the closed form is a reference to about 0.2%, docs/estimate.md), on 2 ranks
 against 1, on a mesh that does not see the contact, and on the refusals."""
 
+import os
 import re
 
 import h5py
@@ -378,3 +379,28 @@ def test_the_newton_stop_on_the_steps_energy_norm_stays_within_its_fraction_of_t
 def test_a_newton_fraction_outside_zero_one_is_refused():
     refused(MMS + ["-accuracy", 0.1, "-accuracy_newton_fraction", 1.5], "newton_fraction_bad",
             "-accuracy_newton_fraction is a fraction of the error estimate in [0, 1), got 1.5")
+
+
+def test_a_fixed_eps_whose_penalty_part_holds_a_bar_stops_the_cycles(outdir):
+    """-accuracy 0.05 at -penalty_eps 0.05 on the manufactured solution: the force's and the largest pressure's penalty
+    parts stay at 5% and 11% to 15% however fine the mesh (13 cycles to 102,954 unknowns measured, docs/estimate.md),
+    so the cycles stop at the second cycle with bars whose penalty part is above the tolerance (adapt_stop fixed_eps,
+    not reached), recomputed from /cycles, and the run says so. At -penalty_eps 1e-4 the rule never fires and the run
+    reaches 0.2. Before, the cycles went on to 4.2 million unknowns."""
+    out, h5 = run(MMS + ["-dm_plex_box_faces", "8,8", "-accuracy", 0.05, "-penalty_eps", 0.05], "fixed_eps", output=os.path.join(outdir, "fixed.h5"))
+    attrs, _ = load(h5)
+    assert attrs["adapt_stop"] == "fixed_eps" and attrs["accuracy_reached"] == 0
+    assert "at the fixed eps of -penalty_eps it does not fall" in out
+    c = cycles(h5)
+    order = {"contact_force": 1.0, "pressure_max": 1.0, "contact_size": 0.5}
+
+    def above(k):
+        return [q for q, r in order.items() if not np.isnan(c[f"{q}_bar"][k]) and
+                abs(c[f"{q}_value"][k] - c[f"{q}_value_eps"][k]) * (1 + 3 / (10**r - 1)) > 0.05 * abs(c[f"{q}_value"][k])]
+
+    last = len(c["n_dofs"]) - 1
+    assert set(above(last)) & set(above(last - 1)), (above(last), above(last - 1))
+    assert not (set(above(last - 1)) & set(above(last - 2))), "stopped a cycle late"
+    _, h5 = run(MMS + ["-dm_plex_box_faces", "8,8", "-accuracy", 0.2, "-penalty_eps", 1e-4], "small_fixed_eps", output=os.path.join(outdir, "small.h5"))
+    attrs, _ = load(h5)
+    assert attrs["adapt_stop"] == "accuracy" and attrs["accuracy_reached"] == 1

@@ -218,3 +218,22 @@ def test_p1_section_is_petscs(outdir, quarter_disk, case, np_):
     assert log.count("section check: the global section is equal to PetscSectionCreateGlobalSection()'s, "
                      "the section SF equal to PetscSFSetGraphSection()'s") == 1, log[-2000:]
     assert load(h5)[0]["converged"] == 1
+
+
+@pytest.mark.parametrize("order", ["6,3,2", "3,6,2", "2,3,6"])
+def test_each_slip_reacts_only_along_what_it_fixes(outdir, order):
+    """The 3D patch test with its three slips listed in any order: the planes x = 0 (u_x fixed), y = 0 (u_y) and the
+    top (u_z) share the nodes of their edges, and each set's reaction has only its fixed component, the uniaxial
+    stress's -s along x on x = 0 and zero on the others, whatever the order. Before, the first listed set took every
+    fixed component of a shared node: listed 3,6,2, the plane y = 0 pushed along x with a part of x = 0's reaction."""
+    s = 0.05
+    args = patch_args(3, "traction", s, 0.01)
+    args[args.index("6,3,2")] = order
+    _, h5 = run(args, "slip_order", output=os.path.join(outdir, f"slip_{order}.h5"))
+    attrs, _ = load(h5)
+    for ident, comp in (("6", "x"), ("3", "y"), ("2", "z")):
+        for other in "xyz":
+            if other != comp:
+                assert attrs[f"reaction_slip_{ident}_{other}"] == 0.0, (ident, other, attrs[f"reaction_slip_{ident}_{other}"])
+    assert abs(attrs["reaction_slip_6_x"] + s) < 1e-10, attrs["reaction_slip_6_x"]
+    assert abs(attrs["reaction_slip_3_y"]) < 1e-10 and abs(attrs["reaction_slip_2_z"]) < 1e-10

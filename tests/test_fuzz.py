@@ -119,11 +119,12 @@ class Sites:
     """Draws each site's value, good or, while the problem's fault budget lasts and with probability 1/6, bad."""
 
     def __init__(self, draw, faults):
-        self.draw, self.faults = draw, faults
+        self.draw, self.faults, self.used = draw, faults, 0
 
     def __call__(self, good, bad):
         if self.faults > 0 and self.draw(st.integers(0, 5)) == 0:
             self.faults -= 1
+            self.used += 1
             return self.draw(bad), True
         return self.draw(good), False
 
@@ -139,7 +140,8 @@ def plain(text, length):
 
 @st.composite
 def problems(draw):
-    """(dim, options, the resultant of the applied loads or None where a load is not a plain finite value)."""
+    """(dim, options, the resultant of the applied loads or None where a load is not a plain finite value, whether a
+    fault was drawn)."""
     dim = draw(st.sampled_from([2, 2, 3]))
     site = Sites(draw, draw(st.sampled_from([0, 0, 1, 1, 2])))
     opts = {"-scene": "general", "-dm_plex_dim": str(dim)}
@@ -229,6 +231,7 @@ def problems(draw):
         opts["-poisson_ratio"], _ = site(good_real(-0.5, 0.45), st.sampled_from(["0.5", "0.6", "-1", "-1.5", "nan", "x"]))
     if site.faults > 0 and draw(st.integers(0, 5)) == 0:
         opts[draw(st.sampled_from(["-bc_clam", "-contact_face", "-snes_rtoll", "-obstacle_radious", "-penalty_eps_0"]))] = "1"
+        site.used += 1
     if draw(st.integers(0, 2)) == 0:  # other units: E times 10^a, every load times 10^b (the displacement 10^(b-a))
         scale_e, scale_load = 10.0 ** draw(st.integers(-6, 16)), 10.0 ** draw(st.integers(-9, 12))
         for key in list(opts):
@@ -241,12 +244,12 @@ def problems(draw):
         if "-young_modulus" not in opts:
             opts["-young_modulus"] = f"{scale_e:g}"
         load = load * scale_load
-    return dim, opts, (load if known else None)
+    return dim, opts, (load if known else None), site.used > 0
 
 
 # ---- the properties -------------------------------------------------------------------------------------------------
 
-def check_run(meshes, dim, opts, load, name):
+def check_run(meshes, dim, opts, load, name, faulty=True):
     out = os.path.join(FUZZ, name + ".h5")
     for path in (out, out[:-3] + ".xdmf"):
         if os.path.exists(path):
@@ -275,6 +278,7 @@ def check_run(meshes, dim, opts, load, name):
             assert np.all(np.isfinite(values)), f"non-finite {key}: {command}"
     if p.returncode == 3:
         assert attrs["converged"] == 0, f"exit 3 but written as converged: {command}"
+        assert faulty, f"a draw without a fault did not converge: {command}\n{text[-3000:]}"
         return "diverged"
     assert attrs["converged"] == 1, command
     force = np.array([attrs.get(f"contact_force_{c}", 0.0) for c in "xyz"[:dim]])
@@ -301,8 +305,8 @@ def fuzz(meshes, examples, seed_name, seed):
     @settings(max_examples=examples, deadline=None, database=None, print_blob=True, suppress_health_check=list(HealthCheck))
     @given(problems())
     def property_(problem):
-        dim, opts, load = problem
-        outcome = check_run(meshes, dim, opts, load, seed_name)
+        dim, opts, load, faulty = problem
+        outcome = check_run(meshes, dim, opts, load, seed_name, faulty)
         OUTCOMES.setdefault(seed_name, {}).setdefault(outcome, 0)
         OUTCOMES[seed_name][outcome] += 1
 

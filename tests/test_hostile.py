@@ -152,6 +152,13 @@ OPTION_CASES = [
     ("vi_with_gamg", ["-contact_method", "vi", "-pc_type", "gamg"], "-pc_type gamg cannot follow the reduced system"),
     ("vi_with_mg", ["-contact_method", "vi", "-pc_type", "mg"], "-pc_type mg cannot follow the reduced system"),
     ("p1_assembly_on_p2", ["-displacement_petscspace_degree", 2, "-assembly", "p1"], "-assembly p1 needs P1 displacements"),
+    # the whole value and the option named: PETSc's reader said "Unknown option plane,cylind" and "Input string 210 GPa has no
+    # numeric value", and listed no choice for a misspelled quantity
+    ("two_obstacles", ["-obstacle", "plane,cylinder"], "-obstacle plane,cylinder: -obstacle takes one value (one of plane, sphere, cylinder), not a list"),
+    ("obstacle_typo", ["-obstacle", "cilinder"], "-obstacle: unknown value 'cilinder' (did you mean cylinder?); the values are plane, sphere, cylinder"),
+    ("modulus_with_unit", ["-young_modulus", "210 GPa"], "-young_modulus 210 GPa: Input string 210 GPa has no numeric value"),
+    ("quantity_typo", ["-accuracy", 0.1, "-accuracy_quantity", "energy,contact_forse"],
+     "-accuracy_quantity: unknown value 'contact_forse' (did you mean contact_force?); the values are energy, contact_force, pressure_max"),
 ]
 @pytest.mark.parametrize("name,args,message", OPTION_CASES, ids=[c[0] for c in OPTION_CASES])
 def test_hostile_option(case_dir, name, args, message):
@@ -199,6 +206,9 @@ FILE_CASES = [
      lambda f: f"signorini: error: -options_file '{f}': the options file cannot be opened (No such file or directory)"),
     ("malformed_yaml", "malformed.yaml", write_text("scene: square\n  bad: [unclosed\n"), lambda f: ["-options_file", f],
      lambda f: f"the options file '{f}' is not valid YAML: mapping values are not allowed in this context at line 2"),
+    # PETSc kept the second value of a key given twice without a word
+    ("yaml_key_twice", "twice.yaml", write_text("scene: square\nyoung_modulus: 2\npoisson_ratio: 0.3\nyoung_modulus: 3\n"), lambda f: ["-options_file", f],
+     lambda f: f"the options file '{f}' gives the key 'young_modulus' twice, at lines 2 and 4"),
 ]
 # the cases also given the file by its path relative to the working directory (the repository root), as typed: the
 # file is found, and the message names it as given

@@ -319,12 +319,11 @@ def test_a_3d_mesh_file_without_its_model_is_refused(sphere):
 
 
 def test_a_model_gmsh_cannot_read_is_an_error_naming_it(disk, tmp_path):
-    """A broken model fails at the first remesh with Gmsh's own message, a non-zero exit and no output file."""
+    """A broken model is refused before the first solve with Gmsh's own message, exit 2 and no output file."""
     mesh, _ = disk
     bad = tmp_path / "broken.geo"
     bad.write_text('SetFactory("OpenCASCADE");\nMerge "nothing.brep";\nPhysical Surface("body", 10) = {1};\n')
-    out, h5 = run(case_args("cylinder", mesh) + ["-adapt_model", str(bad), "-adapt_cycles", 1], "remesh_broken", expect_rc=None)
-    assert "-adapt_model" in out and "Gmsh failed" in out and not os.path.exists(h5), out[-1500:]
+    refused(case_args("cylinder", mesh) + ["-adapt_model", str(bad), "-adapt_cycles", 1], "remesh_broken", "Gmsh failed to read the model")
 
 
 MMS3 = ["-options_file", "options/mms.yaml", "-contact_monitor", "0", "-dm_plex_dim", 3, "-dm_plex_box_faces", "4,4,4"]
@@ -389,10 +388,10 @@ def test_marking_the_zone_edge_in_3d_on_two_ranks_gives_the_one_rank_cycles():
 
 @pytest.mark.parametrize("petsc_read", [False, True])
 def test_a_model_that_is_not_the_meshs_is_refused(petsc_read, disk, tmp_path, monkeypatch):
-    """The block's model given for the disk's mesh: the remeshed mesh lacks the disk's face set "top" (3), and the run
-    stops at the first remesh with an error naming the model and the face set, before any solve on it, whether the
-    mesh is taken from Gmsh's API or (-mesh_remeshed_petsc_read) from the file Gmsh writes to PETSc's temporary
-    directory (PETSC_TMP), which is removed all the same."""
+    """The block's model given for the disk's mesh: refused before the first solve (MeshRemeshCheckModel()), its
+    bounding box not the mesh's, whether the mesh would be taken from Gmsh's API or (-mesh_remeshed_petsc_read) from
+    the file Gmsh writes to PETSc's temporary directory (PETSC_TMP), which stays empty. Before, the first remesh found
+    the disk's face set "top" (3) missing, after a solve."""
     mesh, _ = disk
     block_model = str(tmp_path / "block.geo")
     geometry.block(str(tmp_path / "block.msh"), radius=1.0, h_far=0.2, h_near=0.2, width=0.5, model=block_model)
@@ -401,8 +400,28 @@ def test_a_model_that_is_not_the_meshs_is_refused(petsc_read, disk, tmp_path, mo
     monkeypatch.setenv("PETSC_TMP", str(tmp))
     refused(case_args("cylinder", mesh) + ["-adapt_model", block_model, "-adapt_cycles", 1] + (["-mesh_remeshed_petsc_read"] if petsc_read else []),
             f"remesh_bad_model_{int(petsc_read)}",
-            f"-adapt_model {block_model}: the mesh Gmsh made of the model has no face in the face set 3")
+            f"-adapt_model {block_model}: the model spans [-1., 1e-07] along y, the mesh [0., 1.]: is it the model of the mesh?")
     assert not list(tmp.iterdir()), list(tmp.iterdir())
+
+
+@pytest.mark.parametrize("case", ["renumbered", "msh", "unreadable", "dimension"])
+def test_a_model_the_cycles_cannot_remesh_is_refused_before_the_solve(case, disk, sphere, tmp_path):
+    """Each refused before the first solve, exit 2, nothing written: the disk's own model with its physical group "top"
+    renumbered (3 -> 7: the mesh's face set 3 is no group of the model; before, refused at the first remesh), the mesh
+    file given as the model (before, 40 cycles that refined nothing), a model Gmsh cannot read (before, Gmsh's error
+    after the first solve, PETSc's block and MPI_ABORT), and the sphere's 3D model for the disk's 2D mesh."""
+    mesh, model = disk
+    text = open(model).read().replace(f'Merge "disk.brep"', f'Merge "{os.path.join(os.path.dirname(model), "disk.brep")}"')
+    given = {"renumbered": str(tmp_path / "renumbered.geo"), "msh": mesh, "unreadable": str(tmp_path / "broken.geo"), "dimension": sphere[1]}[case]
+    if case == "renumbered":
+        open(given, "w").write(text.replace('Physical Curve("top", 3)', 'Physical Curve("top", 7)'))
+    if case == "unreadable":
+        open(given, "w").write('SetFactory("OpenCASCADE");\nMerge "nothing.brep";\nPhysical Surface("body", 10) = {1};\n')
+    message = {"renumbered": "the model has no physical group of curves numbered 3, the mesh's face set 3",
+               "msh": "is a mesh file, not a model", "unreadable": "Gmsh failed to read the model",
+               "dimension": "the model is 3D and the mesh 2D"}[case]
+    refused(case_args("cylinder", mesh) + ["-adapt_model", given, "-accuracy", 0.1], f"model_{case}", f"-adapt_model {given}")
+    refused(case_args("cylinder", mesh) + ["-adapt_model", given, "-accuracy", 0.1], f"model_{case}", message)
 
 
 @pytest.mark.parametrize("np_", [1, 2])

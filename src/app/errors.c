@@ -9,6 +9,7 @@
    level of main(). A refusal checked on every rank (a communicator of all the ranks) ends every rank cleanly; one
    checked on one rank alone aborts the others. */
 #define _DEFAULT_SOURCE /* usleep() */
+#include <ctype.h>
 #include <unistd.h>
 #include "app.h"
 
@@ -72,11 +73,36 @@ static void NameOptionsWithValue(const char mess[], char out[], size_t len)
   }
   (void)PetscSNPrintf(out, len, "%s", mess);
   if (!value[0] || PetscOptionsGetAll(NULL, &all) || !all) return;
-  for (char *tok = strtok(all, " "), *prev = NULL; tok; prev = tok, tok = strtok(NULL, " ")) /* "-name value -name value ..." */
-    if (prev && prev[0] == '-' && ListHasItem(tok, value)) {
-      if (names[0]) (void)PetscStrlcat(names, " and ", sizeof(names));
-      (void)PetscStrlcat(names, prev, sizeof(names));
+  /* "-name value -name value ...": a name is a word that starts with '-' and a letter, its value the words up to the
+     next name, spaces kept ("-young_modulus 210 GPa": the value "210 GPa", which a split at every space missed) */
+  for (char *c = all; *c;) {
+    char *name, *val, *next;
+
+    while (*c == ' ') ++c;
+    if (!(c[0] == '-' && isalpha((unsigned char)c[1]))) {
+      c += strcspn(c, " ");
+      continue;
     }
+    name = c;
+    c += strcspn(c, " ");
+    if (*c) *c++ = 0;
+    val = c;
+    for (next = c; *next; next += strcspn(next, " ")) {
+      while (*next == ' ') ++next;
+      if (next[0] == '-' && isalpha((unsigned char)next[1])) break;
+    }
+    c = next;
+    if (next > val && next[-1] == ' ') { /* the value ends before the spaces that lead to the next name */
+      char *e = next;
+
+      while (e > val && e[-1] == ' ') --e;
+      *e = 0;
+    }
+    if (ListHasItem(val, value) || !strcmp(val, value)) {
+      if (names[0]) (void)PetscStrlcat(names, " and ", sizeof(names));
+      (void)PetscStrlcat(names, name, sizeof(names));
+    }
+  }
   (void)PetscFree(all);
   if (names[0]) (void)PetscSNPrintf(out, len, "%s %s: %s", names, value, mess);
 }

@@ -1,5 +1,6 @@
 /* Checks of option values shared by the modules' *GetOptions: every real option must be a finite number
    (PETSc parses "inf" and "nan" as reals, which would run a whole solve into NaN without naming the option). */
+#define _POSIX_C_SOURCE 200809L /* strtok_r under -std=c99 */
 #include <string.h>
 
 #include "app.h"
@@ -191,6 +192,45 @@ static PetscErrorCode AppendWithSuggestion(const char name[], char list[], size_
     PetscCall(PetscStrlcat(list, " (did you mean ", len));
     PetscCall(PetscStrlcat(list, best, len));
     PetscCall(PetscStrlcat(list, "?)", len));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Refuses a value of the enum option name (or, with array, an item of its comma-separated list) that is not one of
+   PETSc's enum list's names, before PETSc's reader sees it: that reader cuts the value at the longest name's length
+   ("Unknown option plane,cylind") and lists no nearest name ("Unknown enum value 'contact_forse'"). The message gives
+   the whole value, the names, and the nearest one; a list given to a single-valued option is said to be one. */
+PetscErrorCode OptionsCheckEnum(MPI_Comm comm, const char name[], const char *const list[], PetscBool array)
+{
+  char      value[1024], names[512] = "", *item, *save = NULL;
+  PetscBool set;
+  PetscInt  n = 0;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscOptionsGetString(NULL, NULL, name, value, sizeof(value), &set));
+  if (!set || !value[0]) PetscFunctionReturn(PETSC_SUCCESS);
+  while (list[n]) ++n;
+  n -= 2; /* PETSc's enum list ends with the type's name, its prefix and NULL */
+  for (PetscInt k = 0; k < n; ++k) {
+    PetscCall(PetscStrlcat(names, k ? ", " : "", sizeof(names)));
+    PetscCall(PetscStrlcat(names, list[k], sizeof(names)));
+  }
+  PetscCheck(array || !strchr(value, ','), comm, PETSC_ERR_USER_INPUT, "%s %s: %s takes one value (one of %s), not a list", name, value, name, names);
+  for (item = strtok_r(value, ",", &save); item; item = strtok_r(NULL, ",", &save)) {
+    PetscBool   found  = PETSC_FALSE;
+    const char *best   = NULL;
+    PetscInt    best_d = PETSC_MAX_INT;
+
+    for (PetscInt k = 0; k < n && !found; ++k) {
+      const PetscInt d = EditDistance(item, list[k]);
+
+      PetscCall(PetscStrcasecmp(item, list[k], &found));
+      if (d < best_d) best_d = d, best = list[k];
+    }
+    if (found) continue;
+    if (best && best_d <= PetscMax(2, (PetscInt)strlen(item) / 3))
+      SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s: unknown value '%s' (did you mean %s?); the values are %s", name, item, best, names);
+    SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s: unknown value '%s'; the values are %s", name, item, names);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -41,7 +41,39 @@ static int CheckReadable(const char option[], const char file[], int print)
   return 1;
 }
 
-/* 0 if the file parses, 1 after printing the problem. */
+/* The first key given twice in one mapping of the document, from node on: its node (0: none) and the line of its first
+   use. PETSc's reader keeps the last value of a key given twice without a word; a user who wrote young_modulus twice
+   meant one of them. */
+static int DuplicateKey(yaml_document_t *doc, yaml_node_t *node, unsigned long *first_line)
+{
+  if (!node) return 0;
+  if (node->type == YAML_SEQUENCE_NODE)
+    for (yaml_node_item_t *it = node->data.sequence.items.start; it < node->data.sequence.items.top; ++it) {
+      const int dup = DuplicateKey(doc, yaml_document_get_node(doc, *it), first_line);
+
+      if (dup) return dup;
+    }
+  if (node->type != YAML_MAPPING_NODE) return 0;
+  for (yaml_node_pair_t *a = node->data.mapping.pairs.start; a < node->data.mapping.pairs.top; ++a) {
+    yaml_node_t *ka  = yaml_document_get_node(doc, a->key);
+    const int    dup = DuplicateKey(doc, yaml_document_get_node(doc, a->value), first_line);
+
+    if (dup) return dup;
+    if (!ka || ka->type != YAML_SCALAR_NODE) continue;
+    for (yaml_node_pair_t *b = node->data.mapping.pairs.start; b < a; ++b) {
+      yaml_node_t *kb = yaml_document_get_node(doc, b->key);
+
+      if (kb && kb->type == YAML_SCALAR_NODE && kb->data.scalar.length == ka->data.scalar.length &&
+          !memcmp(kb->data.scalar.value, ka->data.scalar.value, ka->data.scalar.length)) {
+        *first_line = (unsigned long)kb->start_mark.line + 1;
+        return a->key;
+      }
+    }
+  }
+  return 0;
+}
+
+/* 0 if the file parses and gives no key twice, 1 after printing the problem. */
 static int CheckYAMLFile(const char file[], int print)
 {
   yaml_parser_t   parser;
@@ -60,7 +92,22 @@ static int CheckYAMLFile(const char file[], int print)
     fprintf(stderr, "signorini: error: the options file '%s' is not valid YAML: %s at line %lu, column %lu\n", file,
             parser.problem ? parser.problem : "parse error", (unsigned long)parser.problem_mark.line + 1,
             (unsigned long)parser.problem_mark.column + 1);
-  if (!bad) yaml_document_delete(&doc);
+  if (!bad) {
+    unsigned long first = 0;
+    const int     dup   = DuplicateKey(&doc, yaml_document_get_root_node(&doc), &first);
+
+    if (dup) {
+      yaml_node_t *key = yaml_document_get_node(&doc, dup);
+
+      bad = 1;
+      if (print)
+        fprintf(stderr,
+                "signorini: error: the options file '%s' gives the key '%.*s' twice, at lines %lu and %lu: PETSc would keep the second without a "
+                "word; give it once\n(-error_verbose prints PETSc's error report)\n",
+                file, (int)key->data.scalar.length, (const char *)key->data.scalar.value, first, (unsigned long)key->start_mark.line + 1);
+    }
+    yaml_document_delete(&doc);
+  }
   yaml_parser_delete(&parser);
   (void)fclose(fp);
   return bad;

@@ -181,6 +181,15 @@ static PetscReal SizeBar(const CycleRecord c[], PetscInt last, PetscInt dim)
   return Bar(c, ACCURACY_SIZE, last, dim, CYCLE_ORDER_SIZE_MESH) + PenaltyPart(&c[last], ACCURACY_SIZE, CYCLE_ORDER_SIZE);
 }
 
+/* The penalty's part of quantity k's bar on cycle c, NaN where the cycle has no value at eps / R; for the energy, the
+   estimate's penalty part. At a fixed eps (-penalty_eps) it tends to the penalty problem's own error as the mesh is
+   refined, and no refinement takes it below the tolerance (adapt.c). */
+PetscReal CycleBarsPenaltyPart(const CycleRecord *c, PetscInt k)
+{
+  if (k == ACCURACY_ENERGY) return c->estimate_penalty;
+  return PenaltyPart(c, k, k == ACCURACY_SIZE ? CYCLE_ORDER_SIZE : 1.0);
+}
+
 /* The last cycle's values and bars; the earlier cycles' values are those of the earlier calls, one per cycle. */
 PetscErrorCode CycleBarsCompute(AppCtx *user, PetscInt dim, PetscInt last)
 {

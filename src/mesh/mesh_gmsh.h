@@ -13,6 +13,7 @@
   X(gmshModelAdd)                          \
   X(gmshModelAddPhysicalGroup)             \
   X(gmshModelGetBoundingBox)               \
+  X(gmshModelGetDimension)                 \
   X(gmshModelGetEntities)                  \
   X(gmshModelGetPhysicalGroups)            \
   X(gmshModelGetPhysicalGroupsForEntity)   \

@@ -220,8 +220,11 @@ static PetscErrorCode AddFixedRowsP1(DM dm, AppCtx *user, Vec u, Vec locF)
 
 /* The reaction of each clamp and slip face set, the force its support exerts on the body: the sum, over the fixed
    components of the points of its faces, of the residual K u - f (bulk and loads), which the support balances. Each cell adds to the local residual
-   of one rank only, so the local sums add up over the ranks. A point on two such face sets counts for the first listed. reaction[i][c]: of the i-th
-   boundary condition (zero for the loads). */
+   of one rank only, so the local sums add up over the ranks. A set's reaction has only the components it fixes: a point on two such face sets (the
+   edge between two symmetry planes of a 3D quarter model, x = 0 fixing u_x and y = 0 fixing u_y) gives each component of its residual to the
+   first listed set that fixes that component, so that whatever the order the plane x = 0 pushes along x only (before, the first listed took the
+   point's every fixed component, and x = 0 "pushed" along y with 7.6e-7). A component two sets fix there (a clamp and a slip) counts for the first
+   listed. reaction[i][c]: of the i-th boundary condition (zero for the loads). */
 PetscErrorCode BoundaryComputeReactions(DM dm, AppCtx *user, Vec u, PetscReal reaction[][3])
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
@@ -248,13 +251,17 @@ PetscErrorCode BoundaryComputeReactions(DM dm, AppCtx *user, Vec u, PetscReal re
     PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
     PetscCall(BoundaryAddLoadsLocal(dm, user, locF));
   }
-  PetscCall(PetscBTCreate(pEnd - pStart, &seen));
+  PetscCall(PetscBTCreate(3 * (pEnd - pStart), &seen)); /* a point's component given to a set already */
   PetscCall(VecGetArrayRead(locF, &f));
   for (PetscInt i = 0; i < bcs->n; ++i) {
     PetscInt *faces, nf;
 
+    PetscBool fixes[3] = {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE};
+
     for (PetscInt c = 0; c < 3; ++c) local[i][c] = 0.0;
     if (bcs->bc[i].kind != BC_CLAMP && bcs->bc[i].kind != BC_SLIP) continue;
+    for (PetscInt m = 0; m < bcs->bc[i].ncomp; ++m) fixes[bcs->bc[i].comps[m]] = PETSC_TRUE;
+    if (bcs->bc[i].kind == BC_CLAMP) fixes[0] = fixes[1] = fixes[2] = PETSC_TRUE;
     PetscCall(MeshGetBoundaryFaces(dm, bcs->bc[i].id, &nf, &faces));
     for (PetscInt k = 0; k < nf; ++k) {
       PetscInt *closure = NULL, ncl;
@@ -265,12 +272,12 @@ PetscErrorCode BoundaryComputeReactions(DM dm, AppCtx *user, Vec u, PetscReal re
         const PetscInt *cind;
         PetscInt        cdof, off;
 
-        if (PetscBTLookupSet(seen, p - pStart)) continue;
         PetscCall(PetscSectionGetConstraintDof(lsec, p, &cdof));
         if (!cdof) continue;
         PetscCall(PetscSectionGetConstraintIndices(lsec, p, &cind));
         PetscCall(PetscSectionGetOffset(lsec, p, &off));
-        for (PetscInt m = 0; m < cdof; ++m) local[i][cind[m]] += PetscRealPart(f[off + cind[m]]);
+        for (PetscInt m = 0; m < cdof; ++m)
+          if (fixes[cind[m]] && !PetscBTLookupSet(seen, 3 * (p - pStart) + cind[m])) local[i][cind[m]] += PetscRealPart(f[off + cind[m]]);
       }
       PetscCall(DMPlexRestoreTransitiveClosure(dm, faces[k], PETSC_TRUE, &ncl, &closure));
     }

@@ -64,6 +64,7 @@ PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(OptionsCheckEnum(comm, "-obstacle", ObstacleTypes, PETSC_FALSE)); /* one obstacle per run, named in full */
   PetscOptionsBegin(comm, NULL, "Rigid obstacle", "Signorini");
   PetscCall(PetscOptionsEnum("-obstacle", "Rigid obstacle: plane, sphere (the body stays outside a ball), cylinder (in 2D a disk)", NULL,
                              ObstacleTypes, (PetscEnum)obs->type, (PetscEnum *)&obs->type, &type_set));

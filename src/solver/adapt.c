@@ -20,6 +20,7 @@
    refined, so the cycles stop at the first that reaches it (its growth over N is one cycle's); where -accuracy is not
    reached there, the summary says so, and /run adapt_stop records why the cycles stopped. It decides where the cycles
    stop, never what they compute. */
+#include "app.h"
 #include "contact.h"
 #include "estimate.h"
 #include "io.h"
@@ -31,8 +32,8 @@
 
 #define ADAPT_ACCURACY_CYCLES 40 /* -accuracy's most cycles unless -adapt_cycles says */
 
-const char *const AdaptStops[] = {"accuracy",  "cycles",      "max_dofs", "solve_failed", "nothing_marked", "interrupted",
-                                  "AdaptStop", "ADAPT_STOP_", NULL};
+const char *const AdaptStops[] = {"accuracy",    "cycles",    "max_dofs",  "solve_failed", "nothing_marked",
+                                  "interrupted", "fixed_eps", "AdaptStop", "ADAPT_STOP_",  NULL};
 
 PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
 {
@@ -48,6 +49,7 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
   ad->newton_fraction = 0.0;
   ad->mark_edge       = PETSC_TRUE;
   ad->max_dofs        = 0;
+  PetscCall(OptionsCheckEnum(comm, "-accuracy_quantity", AccuracyQuantities, PETSC_TRUE)); /* a misspelled quantity named, with the nearest */
   PetscOptionsBegin(comm, NULL, "Adaptive refinement", "Signorini");
   PetscCall(PetscOptionsInt(
       "-adapt_cycles",
@@ -153,6 +155,7 @@ PetscErrorCode AdaptCheck(DM dm, const AppCtx *user)
              "-adapt_cycles with -reference is not supported: the reference is on another mesh");
   PetscCheck(!is_mg, comm, PETSC_ERR_USER_INPUT,
              "-adapt_cycles with -pc_type mg is not supported yet: use GAMG (options/solvers/gamg.yaml) or MUMPS");
+  PetscCall(MeshRemeshCheckModel(dm, opt->adapt.model)); /* a model the cycles could not remesh, before the first solve */
   PetscCheck(opt->adapt.model[0] || !user->box.from_file || user->box.curved_ridges < MESH_CURVED_RIDGES_MIN, comm, PETSC_ERR_USER_INPUT,
              "-adapt_cycles: the mesh file's boundary turns by less than 20 degrees at %" PetscInt_FMT
              " of its vertices (one at %g, %g), a curved boundary's chords: the refinement would split them on the chords, and the "
@@ -386,6 +389,32 @@ static PetscReal AdaptFraction(const AdaptOptions *ad, const PetscBool target[],
   return 0.5;
 }
 
+/* Whether -accuracy cannot be reached at the fixed eps of -penalty_eps (or -penalty_eps_power 0): a quantity asked for
+   whose bar's penalty part alone is above the tolerance on this cycle and the one before, both cycles with a bar
+   (CycleBarsPenaltyPart()). The mesh's part falls with the cycles, the penalty's tends to the penalty problem's own
+   error, which a fixed eps keeps: the manufactured solution from 8 x 8 at -penalty_eps 0.05 and -accuracy 0.05 kept
+   the force's penalty part at 4.95% to 5.36% and the largest pressure's at 11% to 15% over 13 cycles up to 102,954
+   unknowns, its bars at 5.3% and 11% there. Returns the first such quantity (-1: none). */
+static PetscInt FixedEpsHolds(const AppCtx *user, const PetscBool target[], PetscInt k)
+{
+  const ContactOptions *copt = NULL;
+  const AdaptOptions   *ad   = &user->opt->adapt;
+
+  if (!(ad->accuracy > 0.0) || k < 1 || !ContactHasPenalty(user->contact)) return -1;
+  if (ContactGetOptions(user->contact, &copt) || !copt || !(copt->eps_fixed > 0.0 || copt->eps_power == 0.0)) return -1;
+  for (PetscInt q = 0; q < ACCURACY_NUM; ++q) {
+    PetscBool above = target[q];
+
+    for (PetscInt m = k - 1; m <= k && above; ++m) {
+      const CycleRecord *c = &user->rec.cycles[m];
+
+      above = (PetscBool)(!PetscIsNanReal(c->bar[q]) && CycleBarsPenaltyPart(c, q) > ad->accuracy * PetscAbsReal(c->value[q]));
+    }
+    if (above) return q;
+  }
+  return -1;
+}
+
 /* Cycle k finished and another follows: the output written now, with /run adapt_stop = interrupted, so that a run
    ended by a signal (Ctrl-C, a scheduler's SIGTERM at its time limit) keeps its last finished cycle, its /cycles and
    its bars, and says so as it dies (OutputFileStageSignalNote()); the run's final write replaces it. The writes cost
@@ -430,6 +459,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     PetscLogDouble t0, t1;
     SolverStart    start;
     PetscBool      at_max, done;
+    PetscInt       fixed_eps;
 
     PetscCall(AdaptRecord(*dm, user, *u, k));
     PetscCall(AdaptQuantitiesAtSmallerEps(*dm, user, *snes, *u, c));
@@ -439,7 +469,8 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     c->accurate    = Accurate(ad, user->rec.accuracy_target, c);
     c->marked_edge = 0;
     at_max         = (PetscBool)(ad->max_dofs > 0 && c->n_dofs >= ad->max_dofs);
-    if (!c->accurate && k < ad->cycles && user->rec.stats.converged && !at_max) {
+    fixed_eps      = c->accurate ? -1 : FixedEpsHolds(user, user->rec.accuracy_target, k);
+    if (!c->accurate && k < ad->cycles && user->rec.stats.converged && !at_max && fixed_eps < 0) {
       PetscCall(EstimateMark(*dm, &user->rec.estimate, user->rec.adapt_fraction, &marked, &c->marked));
       if (ad->mark_edge && ad->accuracy > 0.0 && user->rec.accuracy_target[ACCURACY_SIZE] &&
           c->q.contact_size_band > ad->accuracy * PetscAbsReal(c->q.contact_size))
@@ -448,7 +479,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     PetscCall(PetscTime(&t0)); /* the cycle: its mesh, its solve (the first solve for cycle 0), estimate and marking */
     c->time_cycle = (t0 - t_last) + (k == 0 ? c->time_solve : 0.0);
     t_last        = t0;
-    done          = (PetscBool)(c->accurate || !user->rec.stats.converged || at_max || k == ad->cycles ||
+    done          = (PetscBool)(c->accurate || !user->rec.stats.converged || at_max || fixed_eps >= 0 || k == ad->cycles ||
                        (!c->marked && !c->marked_edge && !c->unseen));                      /* done, or a zero estimate: nothing to refine */
     if (!done) PetscCall(AdaptCheckpoint(*dm, user, *u, k, write));                                  /* what a signal during the next cycle leaves */
     PetscCall(AdaptMonitor(PetscObjectComm((PetscObject)*dm), ad, user->rec.accuracy_target, c, k)); /* once it is written */
@@ -457,8 +488,19 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
       user->rec.adapt_stop = c->accurate                  ? ADAPT_STOP_ACCURACY
                              : !user->rec.stats.converged ? ADAPT_STOP_SOLVE_FAILED
                              : at_max                     ? ADAPT_STOP_MAX_DOFS
+                             : fixed_eps >= 0             ? ADAPT_STOP_FIXED_EPS
                              : k == ad->cycles            ? ADAPT_STOP_CYCLES
                                                           : ADAPT_STOP_NOTHING_MARKED;
+      if (fixed_eps >= 0) {
+        const PetscReal part = CycleBarsPenaltyPart(c, fixed_eps);
+
+        PetscCall(
+            PetscPrintf(PetscObjectComm((PetscObject)*dm),
+                        "  -accuracy %g: the penalty's part of the %s bar, %.2g%% of it, is above the tolerance on this cycle and the one "
+                        "before; at the fixed eps of -penalty_eps it does not fall as the mesh is refined, so the cycles stop at cycle %" PetscInt_FMT
+                        ": give a smaller -penalty_eps, or -penalty_eps0 (eps = eps0 h / E follows the mesh), or -contact_method vi\n",
+                        (double)ad->accuracy, AccuracyQuantities[fixed_eps], (double)(100.0 * part / PetscAbsReal(c->value[fixed_eps])), k));
+      }
       PetscCall(DMLabelDestroy(&marked));
       break;
     }
@@ -516,7 +558,10 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
       PetscCall(PetscPrintf(
           comm, "  WARNING: accuracy %g not reached after %" PetscInt_FMT " cycles (%" PetscInt_FMT " dofs)%s%s%s; the last cycle's bars:\n",
           (double)ad->accuracy, user->rec.ncycles - 1, c->n_dofs, UnseenHolds(ad, c) ? ": the mesh does not see the contact at some nodes" : "",
-          !c->converged ? ": the last solve failed" : "", user->rec.adapt_stop == ADAPT_STOP_MAX_DOFS ? ": the mesh reached -adapt_max_dofs" : ""));
+          !c->converged ? ": the last solve failed" : "",
+          user->rec.adapt_stop == ADAPT_STOP_MAX_DOFS    ? ": the mesh reached -adapt_max_dofs"
+          : user->rec.adapt_stop == ADAPT_STOP_FIXED_EPS ? ": the fixed eps's penalty part of a bar is above the tolerance (-penalty_eps)"
+                                                         : ""));
     for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
       if (!user->rec.accuracy_target[k]) continue;
       if (PetscIsNanReal(c->bar[k]))
