@@ -338,7 +338,7 @@ def test_adaptive_eps_is_one_value_on_the_contact_boundary(big_block):
 BAD = {"zero": (MMS + ["-accuracy", 0, "-accuracy_quantity", "energy"], "-accuracy_quantity needs -accuracy TOL"),
        "one": (MMS + ["-accuracy", 1.5], "-accuracy is a relative error in (0, 1)"),
        "no_cycles": (MMS + ["-accuracy", 0.1, "-adapt_cycles", 0], "-adapt_cycles 0 leaves it no cycle"),
-       "name": (MMS + ["-accuracy", 0.1, "-accuracy_quantity", "force"], "Unknown enum value 'force' for -accuracy_quantity"),
+       "name": (MMS + ["-accuracy", 0.1, "-accuracy_quantity", "force"], "-accuracy_quantity: unknown value 'force' (did you mean contact_force?); the values are energy, contact_force"),
        "quads": (MMS + ["-dm_plex_simplex", 0, "-accuracy", 0.1], "-adapt_cycles refines triangles and tetrahedra only, not quadrilaterals"),
        "max_dofs": (MMS + ["-accuracy", 0.1, "-adapt_max_dofs", -3], "-adapt_max_dofs must be >= 0 (0: no limit), got -3")}
 

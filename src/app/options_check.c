@@ -228,6 +228,13 @@ PetscErrorCode OptionsCheckEnum(MPI_Comm comm, const char name[], const char *co
       if (d < best_d) best_d = d, best = list[k];
     }
     if (found) continue;
+    if (!(best && best_d <= PetscMax(2, (PetscInt)strlen(item) / 3))) { /* no close spelling: the one name holding it ("force") */
+      PetscInt holding = 0;
+
+      for (PetscInt k = 0; k < n; ++k)
+        if (strstr(list[k], item)) ++holding, best = list[k];
+      if (holding == 1) best_d = 0;
+    }
     if (best && best_d <= PetscMax(2, (PetscInt)strlen(item) / 3))
       SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s: unknown value '%s' (did you mean %s?); the values are %s", name, item, best, names);
     SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s: unknown value '%s'; the values are %s", name, item, names);
