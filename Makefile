@@ -23,7 +23,7 @@ SRC = $(wildcard src/*.c src/*/*.c)
 OBJ = $(SRC:src/%.c=build/%.o)
 BIN = bin/signorini
 
-.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path penetration-tol estimates adapt-hertz accuracy-ladder accuracy-ladder-fine hertz-curvature accuracy-remesh work-precision bench format clean
+.PHONY: all deps run test test-long asan rates extremes tradeoff hertz hertz-path penetration-tol incompressible estimates adapt-hertz accuracy-ladder accuracy-ladder-fine hertz-curvature accuracy-remesh work-precision bench format clean
 STUDIES = rates2d rates3d epspower2d epsrefine2d
 all: $(BIN)
 
@@ -117,6 +117,11 @@ hertz-path: deps
 penetration-tol: deps
 	@$(MAKE) --no-print-directory $(BIN)
 	$(PYTHON) scripts/penetration_tol.py
+
+# P1 near incompressibility on make hertz's cylinder against the closed form (bench/incompressible.md, docs/hertz.md)
+incompressible: deps
+	@$(MAKE) --no-print-directory $(BIN)
+	$(PYTHON) scripts/incompressible.py --out bench/incompressible.md
 
 # The a posteriori estimate (docs/estimate.md): effectivity on the manufactured solutions, its penalty part against SNESVI,
 # the error density on Hertz: output/estimates/estimates.{md,csv}, penalty.csv, hertz.csv, effectivity.png, hertz_density.png

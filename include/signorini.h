@@ -260,6 +260,7 @@ typedef struct {
 #define CONTACT_CHECK_ZONE_CELLS_3D 6.0 /*   in 3D (bench/zone_resolution_3d.md) */
 #define CONTACT_CHECK_UNSEEN_SHARE 1e-3 /* unseen contact is warned of where the penalty law would put this part of the force on it */
 #define MESH_CURVED_RIDGES_MIN 3        /* a mesh file's boundary turning by a small angle at this many ridges is curved (MeshCountCurvedRidges()) */
+#define CONTACT_CHECK_LOCKING_NU 0.45   /* P1/Q1 with a Poisson ratio from this one on is warned of (scripts/incompressible.py) */
 typedef struct {
   PetscBool geometry_checked, resolution_checked;
   PetscReal overlap_cells;      /* largest initial overlap -g/h at Gamma_C's vertices, h the diameter of the face's cell */
@@ -275,6 +276,8 @@ typedef struct {
   PetscInt  curved_refined;     /* a mesh file's curved boundary (MeshBox.curved_ridges) that the solver refined on its chords: its ridges, */
   PetscInt  curved_refinements; /*   the refinements (-dm_refine and -contact_grid_sequence), */
   PetscReal curved_x[3];        /*   and one of the ridges */
+  PetscReal locking_nu;         /* the Poisson ratio of a P1/Q1 body from CONTACT_CHECK_LOCKING_NU on (0: none), */
+  PetscReal locking_eps_ratio;  /*   and with the penalty's eps from E, (lambda + 2 mu) / E (0 otherwise) */
 } ContactChecks;
 
 /* The quantities users read of a solution (PostprocessContact()), whose error bars -bars estimates (src/estimate/bars.c). */

@@ -5,12 +5,22 @@
      that starts inside the obstacle, and the part where the obstacle's normal (from the body into the obstacle)
      points into the body, against the outward normal of the face: an obstacle facing away from the body, or a plane
      behind it, which the penalty pushes the body through.
+   - Before the solve, the material: P1 and Q1 lock as nu -> 1/2. On make hertz's elastic cylinder against the closed
+     form at each run's force, with SNESVI (scripts/incompressible.py, docs/hertz.md, "Nearly incompressible bodies"),
+     the largest nodal pressure is 0.8% to 1.1% off at nu = 0.45, 1.5% to 2.8% at 0.48, 1.9% to 4.8% at 0.49 and 19%
+     at 0.499, and it does not fall as the mesh is refined (the nodal tractions oscillate); the half-width is 0.1% to
+     0.4% off at 0.45 and 12.8% at 0.499 on the coarsest mesh. At nu = 0.3 both are within 0.15%. So a P1/Q1 body from
+     nu = 0.45 on is warned of, with the cure: quadratic elements, whose half-width stays within 0.9% up to 0.499 (their
+     pressure at the vertices is no traction, so that it is not compared); and where the penalty takes eps from E, eps is
+     (lambda + 2 mu) / E times softer than the body (167 at nu = 0.499), which -penalty_eps_modulus pwave restores
+     (its largest pressure within 0.6 points of SNESVI's at every nu measured, against 9 points with eps from E at 0.499).
    - After the solve, the resolution: how many cells span the contact zone along Gamma_C (the faces where the contact
      acts at every node: their number in 2D, the diameter in cells of a round zone of that many faces in 3D), warned
      below 4 in 2D and 6 in 3D, where the Gauss rule's force is within about 2% and 3% of a fine mesh's. A zone of a
      few cells is a discretization artefact: the force and the penetration no longer follow eps (docs/running.md,
      "Warnings"; the thresholds are measured by scripts/zone_resolution.py, bench/zone_resolution.md and
      bench/zone_resolution_3d.md). */
+#include "contact.h"
 #include "mesh.h"
 #include "obstacle.h"
 #include "physics.h"
@@ -30,6 +40,18 @@ PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
       ck->curved_refined     = user->box.curved_ridges;
       ck->curved_refinements = refinements;
       for (PetscInt d = 0; d < 3; ++d) ck->curved_x[d] = user->box.curved_x[d];
+    }
+  }
+  { /* a nearly incompressible P1/Q1 body (see the head of the file) */
+    const Material *mat = &user->opt->material;
+
+    if (user->opt->degree == 1 && mat->poisson_ratio >= CONTACT_CHECK_LOCKING_NU) {
+      const ContactOptions *copt;
+
+      ck->locking_nu = mat->poisson_ratio;
+      PetscCall(ContactGetOptions(user->contact, &copt));
+      if (ContactHasPenalty(user->contact) && copt->modulus == PENALTY_MODULUS_YOUNG)
+        ck->locking_eps_ratio = (mat->lambda + 2.0 * mat->mu) / mat->young_modulus;
     }
   }
   if (ContactIsNone(user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
@@ -223,6 +245,24 @@ PetscErrorCode ContactChecksWarnings(MPI_Comm comm, const ContactChecks *ck, Pet
                             "not the curved body's (the Hertz cylinder meshed at h = 0.05 and refined 3 times: its contact width 25%% short); "
                             "mesh finer with Gmsh instead\n",
                             ck->curved_refined, (double)ck->curved_x[0], (double)ck->curved_x[1], (double)ck->curved_x[2], ck->curved_refinements));
+  }
+  if (ck->locking_nu > 0.0) {
+    char eps[256] = "";
+
+    if (ck->locking_eps_ratio > 0.0)
+      PetscCall(PetscSNPrintf(eps, sizeof(eps),
+                              "; the penalty's eps = h/E is %.3g times softer than the body's lambda + 2 mu, which -penalty_eps_modulus pwave "
+                              "restores",
+                              (double)ck->locking_eps_ratio));
+    ++n;
+    if (print)
+      PetscCall(
+          PetscPrintf(comm,
+                      "  WARNING: nu = %g: linear elements lock as nu -> 1/2, and the contact pressure with them (the Hertz cylinder's "
+                      "largest pressure 1%% off at nu = 0.45, 2%% to 5%% at 0.49, 19%% at 0.499, not falling as the mesh is refined); "
+                      "quadratic elements (-displacement_petscspace_degree 2) keep its half-width within 1%% up to nu = 0.499, where linear ones "
+                      "are 12.8%% short%s\n",
+                      (double)ck->locking_nu, eps));
   }
   if (nwarnings) *nwarnings = n;
   PetscFunctionReturn(PETSC_SUCCESS);
