@@ -258,6 +258,7 @@ typedef struct {
 #define CONTACT_CHECK_OVERLAP_RATIO 0.1 /*   and than this part of the overlapped part's width is warned of */
 #define CONTACT_CHECK_ZONE_CELLS_2D 4.0 /* a contact zone spanning fewer cells is warned of (bench/zone_resolution.md) */
 #define CONTACT_CHECK_ZONE_CELLS_3D 6.0 /*   in 3D (bench/zone_resolution_3d.md) */
+#define CONTACT_CHECK_STRIP_ASPECT 3.0  /* a 3D zone this many times longer than wide is a strip, a line contact: the 2D threshold */
 #define CONTACT_CHECK_UNSEEN_SHARE 1e-3 /* unseen contact is warned of where the penalty law would put this part of the force on it */
 #define MESH_CURVED_RIDGES_MIN 3        /* a mesh file's boundary turning by a small angle at this many ridges is curved (MeshCountCurvedRidges()) */
 #define CONTACT_CHECK_LOCKING_NU 0.45   /* P1/Q1 with a Poisson ratio from this one on is warned of (scripts/incompressible.py) */
@@ -270,6 +271,9 @@ typedef struct {
   PetscInt  zone_faces;         /* faces of Gamma_C whose every node carries contact force */
   PetscReal zone_cells;         /* cells across the contact zone: zone_faces in 2D, sqrt(2 zone_faces / pi) in 3D */
   PetscReal zone_limit;         /* fewer cells are warned of: CONTACT_CHECK_ZONE_CELLS_2D or _3D */
+  PetscReal zone_width_cells;   /* 3D: the zone's narrowest width in cells (a strip's), from its faces' second moments */
+  PetscBool zone_pressed;       /* some node of Gamma_C carries contact force (the zone may span no whole face) */
+  PetscBool zone_strip;         /* 3D: the zone is CONTACT_CHECK_STRIP_ASPECT times longer than wide, a line contact */
   PetscInt  unseen_nodes;       /* contact nodes that penetrate while the rule exerts no force on them (ContactUnseenNodes()), */
   PetscReal unseen_force;       /*   the force the penalty law would put on them, */
   PetscReal unseen_share;       /*   and its part of the force's magnitude (PETSC_INFINITY where the force is zero) */
@@ -306,6 +310,7 @@ typedef struct {
   PetscReal           residual_start;           /* |F| at the start of the last Newton solve */
   PetscInt            continuation_stages;      /* solves of the eps sequence before the target eps (0: none) */
   PetscInt            force_control_its;        /* positions of the obstacle solved by force control (-obstacle_force), all steps */
+  PetscBool           force_control_failed;     /*   the target not reached, though every solve converged */
   PetscInt            penetration_tol_solves;   /* solves at the values of eps of -contact_penetration_tol (0 without it) */
   PetscReal           penetration_tol_measured; /*   the largest penetration at the nodes and the rule's points it ended with */
   PetscInt            active_set_cycles;        /* active-set cycles detected (and damped) in the Newton iterations */
@@ -323,6 +328,7 @@ typedef struct {
   PetscReal           time_setup, time_solve, time_total;
   PetscInt            active_vertices;
   PetscReal           max_penetration, contact_force, energy;
+  PetscBool           penetration_between;       /* max_penetration is the finer quadrature's, between the rule's points (PostprocessPenetration()) */
   PetscReal           pressure_max;              /* the largest nodal contact pressure */
   PetscReal           contact_size;              /* the contact zone's width (2D) or area (3D), PostprocessContactSize() */
   PetscReal           contact_size_band;         /*   and the one-cell strip along its edge (its resolution on the mesh) */

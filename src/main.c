@@ -42,8 +42,13 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
   if (s->pc_finest_updates) PetscCall(PetscPrintf(comm, " (and %" PetscInt_FMT " of the finest level only)", s->pc_finest_updates));
   PetscCall(PetscPrintf(comm, ", |F| = %g%s\n", (double)s->residual_norm,
                         s->roundoff_stop ? " (stopped at round-off: -snes_rtol asks for less than double precision can reach)" : ""));
-  PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g, contact force %g, energy %.10g\n",
-                        s->active_vertices, (double)s->max_penetration, (double)s->contact_force, (double)s->energy));
+  PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g%s, contact force %g, energy %.10g\n",
+                        s->active_vertices, (double)s->max_penetration,
+                        s->penetration_between
+                            ? " (between the nodes and the rule's points, where a curved obstacle cuts the straight faces by about "
+                              "h^2/8R, which eps does not reduce)"
+                            : "",
+                        (double)s->contact_force, (double)s->energy));
   if (!PetscIsNanReal(user->rec.errors.h1))
     PetscCall(PetscPrintf(comm, "  error against the exact solution: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n",
                           (double)user->rec.errors.h1, (double)user->rec.errors.l2, (double)user->rec.errors.pressure_l2,
@@ -209,7 +214,10 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(PrintSummary(dm, &user, u));
   PetscCall(OutputWriteHDF5(dm, &user, u));
   PetscCall(PetscPrintf(comm, "  output: %s\n", opt.output));
-  if (!user.rec.stats.converged && user.rec.stats.reason > 0)
+  if (!user.rec.stats.converged && user.rec.stats.force_control_failed)
+    PetscCall(PetscPrintf(comm, "ERROR: force control did not reach -obstacle_force %g (above: why); written with converged = 0\n",
+                          (double)user.scene.obstacle.force));
+  else if (!user.rec.stats.converged && user.rec.stats.reason > 0)
     PetscCall(PetscPrintf(comm,
                           "ERROR: the nonlinear solve failed: it stopped with %s after %" PetscInt_FMT
                           " Newton steps at residual %g, which fell neither by -snes_rtol from %g nor to round-off for the load %g; written with "

@@ -404,3 +404,14 @@ def test_a_fixed_eps_whose_penalty_part_holds_a_bar_stops_the_cycles(outdir):
     _, h5 = run(MMS + ["-dm_plex_box_faces", "8,8", "-accuracy", 0.2, "-penalty_eps", 1e-4], "small_fixed_eps", output=os.path.join(outdir, "small.h5"))
     attrs, _ = load(h5)
     assert attrs["adapt_stop"] == "accuracy" and attrs["accuracy_reached"] == 1
+
+
+def test_accuracy_where_nothing_touches_says_the_solution_is_zero(outdir):
+    """No load and an obstacle above the body, out of reach: u = 0 exactly; -accuracy says the solution is zero, and
+    prints no relative bar of a zero (before: "energy 0 +- 0 (-nan%)")."""
+    args = ["-scene", "general", "-dm_plex_box_faces", "16,8", "-contact_faces", "3", "-bc_clamp", "1", "-obstacle", "plane", "-obstacle_point",
+            "0,1.5", "-obstacle_normal", "0,1", "-contact_monitor", "0", "-accuracy", 0.1]
+    out, h5 = run(args, "nothing_touches", output=os.path.join(outdir, "zero.h5"))
+    assert "the solution is zero" in out and "nan" not in out.lower(), out[-2000:]
+    attrs, fields = load(h5)
+    assert attrs["accuracy_reached"] == 0 and np.all(fields["displacement"] == 0.0)

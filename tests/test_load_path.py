@@ -380,3 +380,17 @@ def test_a_body_resting_on_the_foundation_unloaded_is_at_rest(outdir):
     assert st["converged"].all() and st["contact_force"][0] > 0
     assert st["contact_force"][1] == 0.0 and st["contact_size"][1] == 0.0 and st["penetration_max"][1] <= 0.0
     assert "WARNING" not in out, out[-2000:]
+
+
+@pytest.mark.parametrize("obstacle", [["-obstacle", "cylinder", "-obstacle_center", "0.5,1.5", "-obstacle_radius", "0.5"],
+                                      ["-obstacle", "plane", "-obstacle_point", "0,1", "-obstacle_normal", "0,1"]], ids=["cylinder", "plane"])
+def test_a_force_out_of_reach_is_said_so(outdir, obstacle):
+    """-obstacle_force 1000 on the unit block (E = 1): the secant would throw the obstacle through the body (before, the
+    indenter went 16,410 units through a block 10 deep and stopped 'stalled' with a force of 1e-57). The obstacle moves
+    at most the body's depth along its direction, the run says the target is out of reach (the cylinder's force falls
+    once it passes through; the plane at the whole depth presses with less), and fails: exit 3, converged = 0."""
+    args = ["-scene", "general", "-dm_plex_box_faces", "16,8", "-contact_faces", "3", "-bc_clamp", "1", "-contact_monitor", "0"] + obstacle
+    out, h5 = run(args + ["-obstacle_translate", "0,-0.01", "-obstacle_force", "1000"], "out_of_reach", expect_rc=3, output=os.path.join(outdir, "reach.h5"))
+    assert "the force 1000 is out of reach" in out.replace("1000.", "1000") and "ERROR: force control did not reach -obstacle_force" in out, out[-2000:]
+    attrs, _ = load(h5)
+    assert attrs["converged"] == 0 and -1.0 - 1e-12 <= attrs["obstacle_translate_y"] < 0

@@ -47,8 +47,9 @@ def test_readme_prints_what_its_commands_print(tmp_path):
                 p = subprocess.run([sys.executable] + words[1:], cwd=ROOT, env=ENV, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
                 assert p.returncode == 0, p.stdout
             elif words[0] == "bin/signorini":
-                args = words[1:] + (["-dm_plex_filename", mesh] if mesh else [])
-                out, _ = run(args, "readme_" + os.path.basename(words[-1]).split(".")[0], output=os.path.join(OUT, "readme.h5"))
+                h5 = os.path.join(OUT, "readme.h5")  # after the options file, whose own -output it overrides
+                args = words[1:] + (["-dm_plex_filename", mesh] if mesh else []) + ["-output", h5]
+                out, _ = run(args, "readme_" + os.path.basename(words[-1]).split(".")[0], output=h5)
                 got = [g.strip() for g in out.split("\n")]  # README's block without the summary's indentation
                 for line in printed:
                     assert line.strip() in got, f"README prints {line!r}, which `{cmd}` does not:\n{out[-2500:]}"

@@ -425,6 +425,7 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     if (s->checks.resolution_checked) {
       PetscCall(WriteIntAttr(v, "contact_zone_faces", s->checks.zone_faces));
       PetscCall(WriteRealAttr(v, "contact_zone_cells", s->checks.zone_cells));
+      if (s->checks.zone_strip) PetscCall(WriteRealAttr(v, "contact_zone_width_cells", s->checks.zone_width_cells)); /* a line contact's */
       PetscCall(WriteIntAttr(v, "contact_unseen_nodes", s->checks.unseen_nodes));  /* penetrating with no force from the rule, */
       PetscCall(WriteRealAttr(v, "contact_unseen_force", s->checks.unseen_force)); /* the law's force there: a warning above a share */
     }

@@ -107,6 +107,30 @@ PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The eigenvalues of a symmetric 3 x 3 matrix, largest first, in closed form (the trigonometric solution of its
+   characteristic cubic, Smith, CACM 4, 1961). */
+static void SymmetricEigenvalues(const PetscReal C[3][3], PetscReal e[3])
+{
+  const PetscReal p1 = C[0][1] * C[0][1] + C[0][2] * C[0][2] + C[1][2] * C[1][2], q = (C[0][0] + C[1][1] + C[2][2]) / 3.0;
+  const PetscReal p2 = PetscSqr(C[0][0] - q) + PetscSqr(C[1][1] - q) + PetscSqr(C[2][2] - q) + 2.0 * p1, p = PetscSqrtReal(p2 / 6.0);
+  PetscReal       B[3][3], r, phi, e1, e3;
+
+  if (p == 0.0) { /* a multiple of the identity */
+    e[0] = e[1] = e[2] = q;
+    return;
+  }
+  for (PetscInt a = 0; a < 3; ++a)
+    for (PetscInt b = 0; b < 3; ++b) B[a][b] = (C[a][b] - (a == b ? q : 0.0)) / p;
+  r    = 0.5 * (B[0][0] * (B[1][1] * B[2][2] - B[1][2] * B[2][1]) - B[0][1] * (B[1][0] * B[2][2] - B[1][2] * B[2][0]) +
+             B[0][2] * (B[1][0] * B[2][1] - B[1][1] * B[2][0]));
+  phi  = r <= -1.0 ? PETSC_PI / 3.0 : r >= 1.0 ? 0.0 : PetscAcosReal(r) / 3.0;
+  e1   = q + 2.0 * p * PetscCosReal(phi);                        /* the largest */
+  e3   = q + 2.0 * p * PetscCosReal(phi + 2.0 * PETSC_PI / 3.0); /* the smallest */
+  e[0] = e1;
+  e[1] = 3.0 * q - e1 - e3;
+  e[2] = e3;
+}
+
 static int ComparePoints(const void *a, const void *b)
 {
   const PetscInt x = *(const PetscInt *)a, y = *(const PetscInt *)b;
@@ -124,8 +148,8 @@ PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user, Vec u)
   MPI_Comm          comm = PetscObjectComm((PetscObject)dm);
   ContactChecks    *ck   = &user->rec.stats.checks;
   const ContactSet *cs;
-  PetscInt          dim, nzone = 0, (*pairs)[2];
-  PetscReal         floor = 0.0;
+  PetscInt          dim, nzone = 0, pressed = 0, (*pairs)[2];
+  PetscReal         floor = 0.0, moments[10] = {0}; /* area, its first moments, its second moments xx, xy, xz, yy, yz, zz */
 
   PetscFunctionBeginUser;
   if (ContactIsNone(user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
@@ -169,15 +193,51 @@ PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user, Vec u)
       }
       PetscCall(DMPlexRestoreTransitiveClosure(dm, faces[i], PETSC_TRUE, &ncl, &closure));
       nzone += nodes > 0 && acting == nodes;
+      pressed += acting;
+      if (dim == 3 && nodes > 0 && acting == nodes) { /* the zone's second moments, for its width (below) */
+        PetscReal n[3], xc[3], area;
+
+        PetscCall(MeshFaceOutwardGeometry(dm, faces[i], dim, n, xc, &area));
+        moments[0] += area;
+        for (PetscInt a = 0, k = 4; a < 3; ++a) {
+          moments[1 + a] += area * xc[a];
+          for (PetscInt b = a; b < 3; ++b, ++k) moments[k] += area * xc[a] * xc[b];
+        }
+      }
     }
     PetscCall(PetscFree(faces));
   }
   PetscCall(PetscFree(pairs));
   PetscCall(MPIU_Allreduce(&nzone, &ck->zone_faces, 1, MPIU_INT, MPI_SUM, comm));
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &pressed, 1, MPIU_INT, MPI_SUM, comm));
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, moments, 10, MPIU_REAL, MPIU_SUM, comm));
+  ck->zone_pressed = (PetscBool)(pressed > 0);
   /* in 3D, the diameter in cells of a round zone of that many faces: n faces of area s^2/2 (s the face's size, the leg of
-     a right triangle) cover pi D^2 / 4 = n s^2 / 2, so D / s = sqrt(2 n / pi) */
-  ck->zone_cells         = dim == 2 ? (PetscReal)ck->zone_faces : PetscSqrtReal(2.0 * (PetscReal)ck->zone_faces / PETSC_PI);
-  ck->zone_limit         = dim == 2 ? CONTACT_CHECK_ZONE_CELLS_2D : CONTACT_CHECK_ZONE_CELLS_3D;
+     a right triangle) cover pi D^2 / 4 = n s^2 / 2, so D / s = sqrt(2 n / pi). A zone that is no disk (a rigid
+     cylinder's line contact on a block: a strip two cells wide, which the round zone's count took for 8 cells across)
+     is as many cells across as its narrowest width where it is a strip, CONTACT_CHECK_STRIP_ASPECT times longer than
+     wide: its width and length 4 sqrt(lambda), lambda the middle and the largest eigenvalue of the faces' second moments
+     about their centroid (the smallest is across a flat or gently curved zone's thickness; a disk's 4 sqrt(r^2/4) is
+     its diameter, a strip's 4 sqrt(w^2/12) 1.15 times its width w). A rounder zone keeps the round count, the measure
+     of the thresholds (a quarter of a round zone, as a symmetric model meshes it, is 1.4 times longer than wide, and
+     on a dozen faces the second moments' width fell 16% short of the round count). */
+  ck->zone_cells = dim == 2 ? (PetscReal)ck->zone_faces : PetscSqrtReal(2.0 * (PetscReal)ck->zone_faces / PETSC_PI);
+  if (dim == 3 && ck->zone_faces > 0 && moments[0] > 0.0) {
+    const PetscReal A = moments[0], s = PetscSqrtReal(2.0 * A / (PetscReal)ck->zone_faces);
+    PetscReal       c[3], C[3][3], e[3], width, length;
+
+    for (PetscInt a = 0; a < 3; ++a) c[a] = moments[1 + a] / A;
+    for (PetscInt a = 0, k = 4; a < 3; ++a)
+      for (PetscInt b = a; b < 3; ++b, ++k) C[a][b] = C[b][a] = moments[k] / A - c[a] * c[b];
+    SymmetricEigenvalues(C, e);
+    width                = 4.0 * PetscSqrtReal(PetscMax(e[1], 0.0));
+    length               = 4.0 * PetscSqrtReal(PetscMax(e[0], 0.0));
+    ck->zone_width_cells = width / s;
+    ck->zone_strip       = (PetscBool)(ck->zone_faces >= 6 && length >= CONTACT_CHECK_STRIP_ASPECT * width); /* 6: a strip a cell wide, 3 long */
+    if (ck->zone_strip) ck->zone_cells = ck->zone_width_cells;
+  }
+  /* a strip (a line contact) is a 2D contact in its cross-section: the 2D threshold on its width */
+  ck->zone_limit         = dim == 2 || ck->zone_strip ? CONTACT_CHECK_ZONE_CELLS_2D : CONTACT_CHECK_ZONE_CELLS_3D;
   ck->resolution_checked = PETSC_TRUE;
   PetscCall(ContactUnseenNodes(user->contact, u, NULL, &ck->unseen_nodes, &ck->unseen_force));
   {
@@ -211,7 +271,7 @@ PetscErrorCode ContactChecksWarnings(MPI_Comm comm, const ContactChecks *ck, Pet
                             "behind it (-obstacle_normal is the normal from the body into the obstacle)\n",
                             (double)(100.0 * ck->away_fraction)));
   }
-  if (ck->resolution_checked && ck->zone_faces > 0 && ck->zone_cells < ck->zone_limit) {
+  if (ck->resolution_checked && ck->zone_pressed && ck->zone_cells < ck->zone_limit) { /* zone_faces 0: a node or an edge alone presses */
     ++n;
     if (print)
       PetscCall(PetscPrintf(comm,

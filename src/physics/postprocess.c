@@ -116,7 +116,9 @@ void PostprocessGetQuantities(const AppCtx *user, Quantities *q)
 PetscErrorCode PostprocessPenetration(AppCtx *user)
 {
   PetscFunctionBeginUser;
-  if (!PetscIsNanReal(user->rec.errors.penetration_max))
-    user->rec.stats.max_penetration = PetscMax(user->rec.stats.max_penetration, user->rec.errors.penetration_max);
+  if (!PetscIsNanReal(user->rec.errors.penetration_max) && user->rec.errors.penetration_max > user->rec.stats.max_penetration) {
+    user->rec.stats.max_penetration     = user->rec.errors.penetration_max;
+    user->rec.stats.penetration_between = PETSC_TRUE;
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

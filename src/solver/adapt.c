@@ -344,6 +344,8 @@ static PetscErrorCode AdaptMonitor(MPI_Comm comm, const AdaptOptions *ad, const 
       if (!target[q]) continue;
       if (PetscIsNanReal(c->bar[q]))
         PetscCall(PetscPrintf(comm, " %s --", AccuracyQuantities[q]));
+      else if (c->value[q] == 0.0) /* a zero solution: no relative bar */
+        PetscCall(PetscPrintf(comm, " %s 0 +- %g", AccuracyQuantities[q], (double)c->bar[q]));
       else
         PetscCall(PetscPrintf(comm, " %s %.2g%%", AccuracyQuantities[q], (double)(100.0 * c->bar[q] / PetscAbsReal(c->value[q]))));
     }
@@ -548,7 +550,13 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
   if (user->rec.adapt_stop == ADAPT_STOP_MAX_DOFS && !(ad->accuracy > 0.0))
     PetscCall(PetscPrintf(comm, "  the cycles stopped at -adapt_max_dofs %" PetscInt_FMT ": the last mesh has %" PetscInt_FMT " dofs\n", ad->max_dofs,
                           user->rec.cycles[user->rec.ncycles - 1].n_dofs));
-  if (ad->accuracy > 0.0) {
+  if (ad->accuracy > 0.0 && user->rec.cycles[user->rec.ncycles - 1].norm == 0.0 && user->rec.cycles[user->rec.ncycles - 1].estimate == 0.0) {
+    /* u = 0 exactly (no load, no contact): every quantity and its error are zero, and no bar is relative to anything */
+    PetscCall(PetscPrintf(comm,
+                          "  WARNING: -accuracy %g: the solution is zero (no load acts and the obstacle does not press on the body: u = 0 exactly, "
+                          "with no error to refine); check the loads and the obstacle's position\n",
+                          (double)ad->accuracy));
+  } else if (ad->accuracy > 0.0) {
     const CycleRecord *c = &user->rec.cycles[user->rec.ncycles - 1];
 
     if (c->accurate)

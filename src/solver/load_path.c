@@ -120,6 +120,41 @@ static PetscReal ForcePower(const AppCtx *user)
   return power;
 }
 
+/* The body's depth along the obstacle's direction of motion: the extent of its vertices' projections on it, over all
+   ranks. Force control moves the obstacle at most that far from its unloaded position: beyond, it would pass through
+   the body (the gap and the normal are taken at the undeformed position), and a target that needs more is out of the
+   small-deformation model's reach (-obstacle_force 1000 on a block 10 deep threw the indenter 16,410 units and
+   stalled with a force of 1e-57). */
+static PetscErrorCode BodyDepth(DM dm, const AppCtx *user, PetscReal *depth)
+{
+  const PetscReal   *dir = user->scene.full_load.translate;
+  Vec                coords;
+  const PetscScalar *x;
+  PetscInt           n, cdim;
+  PetscReal          len = 0.0, range[2] = {PETSC_MAX_REAL, PETSC_MAX_REAL}; /* -min and max of the projections */
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetCoordinateDim(dm, &cdim));
+  for (PetscInt c = 0; c < cdim; ++c) len += PetscSqr(dir[c]);
+  len = PetscSqrtReal(len);
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(VecGetLocalSize(coords, &n));
+  PetscCall(VecGetArrayRead(coords, &x));
+  range[1] = -PETSC_MAX_REAL;
+  for (PetscInt i = 0; i < n / cdim; ++i) {
+    PetscReal p = 0.0;
+
+    for (PetscInt c = 0; c < cdim; ++c) p += PetscRealPart(x[i * cdim + c]) * dir[c] / len;
+    range[0] = PetscMin(range[0], p);
+    range[1] = PetscMax(range[1], p);
+  }
+  PetscCall(VecRestoreArrayRead(coords, &x));
+  range[0] = -range[0];
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, range, 2, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
+  *depth = range[0] + range[1];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 #define FORCE_CONTROL_RTOL 1e-8 /* |F - target| / target at which the position is found */
 #define FORCE_CONTROL_MAX_ITS 60
 #define FORCE_CONTROL_SOLVE_TOL 1e-2 /* each position's Newton residual, relative to FORCE_CONTROL_RTOL times the target */
@@ -146,7 +181,7 @@ static PetscReal ForcePower(const AppCtx *user)
    the solve fails or the target is not reached in FORCE_CONTROL_MAX_ITS positions; *its counts the positions solved. */
 static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscReal target, PetscBool *ok, PetscInt *its)
 {
-  PetscReal f, s, f_prev = 0.0, s_prev = 0.0, s_lo = 0.0, f_lo = 0.0, s_hi = 0.0, f_hi = 0.0, atol, rtol, stol, power;
+  PetscReal f, s, f_prev = 0.0, s_prev = 0.0, s_lo = 0.0, f_lo = 0.0, s_hi = 0.0, f_hi = 0.0, atol, rtol, stol, power, depth = PETSC_MAX_REAL;
   PetscBool have_lo = PETSC_FALSE, have_hi = PETSC_FALSE;
   PetscInt  side = 0, maxit, maxf; /* side: the bracket's end kept last time (Illinois) */
   Vec       u_prev, dir;
@@ -162,6 +197,7 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
   if (user->prob.load_norm > 0.0)
     PetscCall(SNESSetTolerances(snes, atol, PetscMin(rtol, FORCE_CONTROL_SOLVE_TOL * FORCE_CONTROL_RTOL * target / user->prob.load_norm), stol, maxit,
                                 maxf));
+  PetscCall(BodyDepth(dm, user, &depth));
   PetscCall(PostprocessContact(dm, user, u));
   ForceAlong(user, &f, &s);
   for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && user->rec.stats.converged; ++it) {
@@ -169,6 +205,13 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
 
     if (PetscAbsReal(f - target) <= FORCE_CONTROL_RTOL * target) {
       *ok = PETSC_TRUE;
+      break;
+    }
+    if (it && s > s_prev && f < f_prev && f < target) { /* the force falls as the obstacle moves on: it passes through the body */
+      PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm),
+                            "  force control: the force %g is out of reach: moved on from %g to %g along its direction, the obstacle presses with "
+                            "%g instead of %g, so that it passes through the body, beyond the small-deformation model (a smaller -obstacle_force?)\n",
+                            (double)target, (double)s_prev, (double)s, (double)f, (double)f_prev));
       break;
     }
     if (it && f == f_prev && s != s_prev) { /* the solve did not move: the force is as exact as the Newton tolerance */
@@ -199,6 +242,16 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
       if (f < target && s_next > s + 4.0 * PetscAbsReal(move) && it) s_next = s + 4.0 * PetscAbsReal(move);
     } else
       s_next = s_lo + (target - f_lo) * (s_hi - s_lo) / (f_hi - f_lo); /* regula falsi in the bracket */
+    if (s_next > depth) {                                              /* no deeper than the body (BodyDepth()) */
+      if (s >= depth * (1.0 - 1e-12) && f < target) {
+        PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm),
+                              "  force control: the force %g is out of reach: with the obstacle moved by the body's whole depth along its "
+                              "direction (%g) it presses with %g; the small-deformation model cannot press further (a smaller -obstacle_force?)\n",
+                              (double)target, (double)depth, (double)f));
+        break;
+      }
+      s_next = depth;
+    }
     PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
     PetscCall(ProblemUpdateData(dm, user));
     PetscCall(SolverSecantStart(snes, dm, user, u, u_prev, dir, (PetscBool)(s != s_prev), s != s_prev ? (s_next - s) / (s - s_prev) : 0.0, 1.0));
@@ -313,9 +366,10 @@ static PetscErrorCode LoadPathForce(DM dm, AppCtx *user, SNES snes, Vec u, Petsc
   user->rec.stats.force_control_its += its;
   if (!*ok && user->rec.stats.converged) {
     PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm),
-                          "  force control: the force %g was not reached in %" PetscInt_FMT " positions of the obstacle\n",
+                          "  force control: the force %g was not reached in %" PetscInt_FMT " position(s) of the obstacle\n",
                           (double)user->scene.obstacle.force, its));
-    user->rec.stats.converged = PETSC_FALSE;
+    user->rec.stats.converged            = PETSC_FALSE;
+    user->rec.stats.force_control_failed = PETSC_TRUE;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
