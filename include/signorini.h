@@ -391,7 +391,8 @@ typedef enum {
   ADAPT_STOP_SOLVE_FAILED,
   ADAPT_STOP_NOTHING_MARKED,
   ADAPT_STOP_INTERRUPTED,
-  ADAPT_STOP_FIXED_EPS
+  ADAPT_STOP_FIXED_EPS,
+  ADAPT_STOP_MAX_MEMORY
 } AdaptStop;
 extern const char *const AdaptStops[];
 typedef struct {
@@ -404,6 +405,9 @@ typedef struct {
   PetscBool mark_edge;                 /* -adapt_mark_edge: with -accuracy on the size, refine along the zone's edge too */
   PetscBool monitor;                   /* -adapt_monitor: a line for each cycle as it ends */
   PetscInt  max_dofs;                  /* -adapt_max_dofs: no mesh with this many unknowns or more is refined (0: no limit) */
+  PetscReal max_memory;                /* -adapt_max_memory: the run's memory over all ranks, MB, that no cycle is predicted past */
+  PetscBool max_memory_given;          /*   given, or the default (AdaptDefaultMemory()) */
+  PetscReal memory_base;               /* what the ranks held at the options phase, MB summed (AdaptBaseMemory()) */
 } AdaptOptions;
 
 /* One cycle of the adaptive refinement (/cycles in the output): the mesh, the estimate of its solution and the true
@@ -427,6 +431,7 @@ typedef struct {
   PetscReal  time_solve;
   PetscReal  time_mesh;  /* s: this cycle's mesh from the last (refined or remeshed) and its problem's set-up (0 for the first) */
   PetscReal  time_cycle; /* s: the whole cycle, its mesh, solve, estimate and marking (cycle 0: the first solve on) */
+  PetscReal  memory_mb;  /* the run's resident memory at this cycle's end, MB summed over the ranks */
   PetscBool  converged;
 } CycleRecord;
 

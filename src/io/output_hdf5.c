@@ -672,6 +672,7 @@ static PetscErrorCode WriteCycles(MPI_Comm comm, const AppCtx *user, PetscViewer
   CYCLE_COLUMN("time_solve", c[i].time_solve);
   CYCLE_COLUMN("time_mesh", c[i].time_mesh);
   CYCLE_COLUMN("time_cycle", c[i].time_cycle);
+  CYCLE_COLUMN("memory_mb", c[i].memory_mb);
   CYCLE_COLUMN("converged", c[i].converged ? 1.0 : 0.0);
 #undef CYCLE_COLUMN
   PetscCall(PetscViewerHDF5PopGroup(v));

@@ -20,6 +20,7 @@
    refined, so the cycles stop at the first that reaches it (its growth over N is one cycle's); where -accuracy is not
    reached there, the summary says so, and /run adapt_stop records why the cycles stopped. It decides where the cycles
    stop, never what they compute. */
+#include <sys/resource.h>
 #include "app.h"
 #include "contact.h"
 #include "estimate.h"
@@ -32,8 +33,54 @@
 
 #define ADAPT_ACCURACY_CYCLES 40 /* -accuracy's most cycles unless -adapt_cycles says */
 
-const char *const AdaptStops[] = {"accuracy",    "cycles",    "max_dofs",  "solve_failed", "nothing_marked",
-                                  "interrupted", "fixed_eps", "AdaptStop", "ADAPT_STOP_",  NULL};
+const char *const AdaptStops[] = {"accuracy",  "cycles",      "max_dofs", "solve_failed", "nothing_marked", "interrupted", "fixed_eps", "max_memory",
+                                  "AdaptStop", "ADAPT_STOP_", NULL};
+
+/* The default memory budget of the cycles, MB over all ranks: ADAPT_MEMORY_SHARE of what each rank's node had available
+   at the start (/proc/meminfo's MemAvailable, shared by the ranks on the node) plus what the rank held then. Without a
+   budget a 2D quarter disk at -accuracy 0.003 grew to 14 GB and was killed by the kernel, its finished cycles lost. */
+#define ADAPT_MEMORY_SHARE 0.8
+
+/* What the ranks hold at the start, MB summed: the libraries and PETSc's set-up, which do not grow with the mesh. */
+static PetscErrorCode AdaptBaseMemory(MPI_Comm comm, PetscReal *mb)
+{
+  PetscLogDouble rss = 0.0;
+  PetscReal      mine;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemoryGetCurrentUsage(&rss));
+  mine = (PetscReal)rss / 1048576.0;
+  PetscCall(MPIU_Allreduce(&mine, mb, 1, MPIU_REAL, MPIU_SUM, comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode AdaptDefaultMemory(MPI_Comm comm, PetscReal *mb)
+{
+  MPI_Comm       node;
+  PetscMPIInt    on_node;
+  PetscLogDouble rss = 0.0;
+  PetscReal      mine, available = 0.0;
+  FILE          *fp;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_split_type(comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node));
+  PetscCallMPI(MPI_Comm_size(node, &on_node));
+  PetscCallMPI(MPI_Comm_free(&node));
+  if ((fp = fopen("/proc/meminfo", "r"))) {
+    char line[256];
+
+    while (fgets(line, sizeof(line), fp)) {
+      double kb;
+
+      if (sscanf(line, "MemAvailable: %lf kB", &kb) == 1) available = (PetscReal)kb / 1024.0;
+    }
+    (void)fclose(fp);
+  }
+  PetscCall(PetscMemoryGetCurrentUsage(&rss));
+  mine = available > 0.0 ? ADAPT_MEMORY_SHARE * (available / on_node + (PetscReal)rss / 1048576.0) : 0.0; /* 0: not known, no budget */
+  PetscCall(MPIU_Allreduce(&mine, mb, 1, MPIU_REAL, MPIU_SUM, comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
 PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
 {
@@ -84,6 +131,11 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
                             "Refine no mesh with this many unknowns or more: the cycles stop there, as a budget (0: no limit; the last mesh "
                             "may exceed it by one cycle's growth)",
                             NULL, ad->max_dofs, &ad->max_dofs, NULL));
+  ad->max_memory = 0.0;
+  PetscCall(PetscOptionsReal("-adapt_max_memory",
+                             "Refine no mesh whose cycle is predicted to take more memory than this, MB over all ranks (default: 80% of the memory "
+                             "available at the start; 0: no limit)",
+                             NULL, ad->max_memory, &ad->max_memory, &ad->max_memory_given));
   ad->model[0] = '\0';
   PetscCall(PetscOptionsString(
       "-adapt_model",
@@ -98,6 +150,10 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
   }
   PetscCheck(ad->cycles >= 0, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles must be >= 0, got %" PetscInt_FMT, ad->cycles);
   PetscCheck(ad->max_dofs >= 0, comm, PETSC_ERR_USER_INPUT, "-adapt_max_dofs must be >= 0 (0: no limit), got %" PetscInt_FMT, ad->max_dofs);
+  PetscCall(OptionsCheckFinite(comm, "-adapt_max_memory", ad->max_memory));
+  PetscCheck(ad->max_memory >= 0.0, comm, PETSC_ERR_USER_INPUT, "-adapt_max_memory must be >= 0 MB (0: no limit), got %g", (double)ad->max_memory);
+  if (!ad->max_memory_given && (ad->cycles > 0 || ad->accuracy > 0.0)) PetscCall(AdaptDefaultMemory(comm, &ad->max_memory));
+  if (ad->cycles > 0 || ad->accuracy > 0.0) PetscCall(AdaptBaseMemory(comm, &ad->memory_base));
   PetscCheck(!fraction_given || (ad->fraction > 0.0 && ad->fraction <= 1.0), comm, PETSC_ERR_USER_INPUT, "-adapt_fraction must lie in (0, 1], got %g",
              (double)ad->fraction);
   PetscCheck(ad->accuracy >= 0.0 && ad->accuracy < 1.0, comm, PETSC_ERR_USER_INPUT, "-accuracy is a relative error in (0, 1), got %g",
@@ -417,6 +473,37 @@ static PetscInt FixedEpsHolds(const AppCtx *user, const PetscBool target[], Pets
   return -1;
 }
 
+/* The run's resident memory now, at a cycle's end (its mesh, its operators and its factorization held), MB summed over
+   the ranks. Not the peak so far: a transient peak of the start (107 MB as the test suite's singletons start) hid the
+   cycles' growth below it, up to 17,206 unknowns there. */
+static PetscErrorCode AdaptCycleMemory(MPI_Comm comm, PetscReal *mb)
+{
+  PetscLogDouble rss = 0.0;
+  PetscReal      mine;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscMemoryGetCurrentUsage(&rss));
+  mine = (PetscReal)rss / 1048576.0;
+  PetscCall(MPIU_Allreduce(&mine, mb, 1, MPIU_REAL, MPIU_SUM, comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The memory the next cycle is predicted to take, MB over all ranks, from the last two cycles' peaks: the part that
+   grows with the mesh, m_k - m_(k-1), scaled as N^p from the last cycle's N_(k-1) -> N_k to the next N_(k+1) = g N_k
+   (g the last growth of the unknowns), p = 1.2 in 2D and 4/3 in 3D, a sparse direct factorization's fill (n log n and
+   n^(4/3) on 2D and 3D meshes), which bounds an iterative solver's. The difference leaves out what does not grow with
+   the mesh (the libraries, MUMPS's and PETSc's set-up: 50 to 100 MB, most of it loaded after the options phase). */
+static void AdaptPredictMemory(const AppCtx *user, PetscInt k, PetscInt dim, PetscReal *mb, PetscReal *growth)
+{
+  const CycleRecord *c = user->rec.cycles;
+  const PetscReal    p = dim == 3 ? 4.0 / 3.0 : 1.2, g = PetscMax((PetscReal)c[k].n_dofs / (PetscReal)c[k - 1].n_dofs, 1.0);
+  const PetscReal    nk = PetscPowReal((PetscReal)c[k].n_dofs, p), nk1 = PetscPowReal((PetscReal)c[k - 1].n_dofs, p), next = nk * PetscPowReal(g, p);
+  const PetscReal    grown = PetscMax(c[k].memory_mb - c[k - 1].memory_mb, 0.0);
+
+  *growth = g;
+  *mb     = c[k].memory_mb + (nk > nk1 ? grown * (next - nk) / (nk - nk1) : 0.0);
+}
+
 /* Cycle k finished and another follows: the output written now, with /run adapt_stop = interrupted, so that a run
    ended by a signal (Ctrl-C, a scheduler's SIGTERM at its time limit) keeps its last finished cycle, its /cycles and
    its bars, and says so as it dies (OutputFileStageSignalNote()); the run's final write replaces it. The writes cost
@@ -460,8 +547,9 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     DMLabel        marked = NULL;
     PetscLogDouble t0, t1;
     SolverStart    start;
-    PetscBool      at_max, done;
+    PetscBool      at_max, done, at_memory;
     PetscInt       fixed_eps;
+    PetscReal      next_mb = 0.0, growth = 1.0;
 
     PetscCall(AdaptRecord(*dm, user, *u, k));
     PetscCall(AdaptQuantitiesAtSmallerEps(*dm, user, *snes, *u, c));
@@ -472,7 +560,13 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     c->marked_edge = 0;
     at_max         = (PetscBool)(ad->max_dofs > 0 && c->n_dofs >= ad->max_dofs);
     fixed_eps      = c->accurate ? -1 : FixedEpsHolds(user, user->rec.accuracy_target, k);
-    if (!c->accurate && k < ad->cycles && user->rec.stats.converged && !at_max && fixed_eps < 0) {
+    PetscCall(AdaptCycleMemory(PetscObjectComm((PetscObject)*dm), &c->memory_mb));
+    at_memory = PETSC_FALSE;
+    if (!c->accurate && !at_max && fixed_eps < 0 && k < ad->cycles && ad->max_memory > 0.0 && k > 0) { /* from the first measured growth */
+      AdaptPredictMemory(user, k, dim, &next_mb, &growth);
+      at_memory = (PetscBool)(next_mb > ad->max_memory);
+    }
+    if (!c->accurate && k < ad->cycles && user->rec.stats.converged && !at_max && fixed_eps < 0 && !at_memory) {
       PetscCall(EstimateMark(*dm, &user->rec.estimate, user->rec.adapt_fraction, &marked, &c->marked));
       if (ad->mark_edge && ad->accuracy > 0.0 && user->rec.accuracy_target[ACCURACY_SIZE] &&
           c->q.contact_size_band > ad->accuracy * PetscAbsReal(c->q.contact_size))
@@ -481,7 +575,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     PetscCall(PetscTime(&t0)); /* the cycle: its mesh, its solve (the first solve for cycle 0), estimate and marking */
     c->time_cycle = (t0 - t_last) + (k == 0 ? c->time_solve : 0.0);
     t_last        = t0;
-    done          = (PetscBool)(c->accurate || !user->rec.stats.converged || at_max || fixed_eps >= 0 || k == ad->cycles ||
+    done          = (PetscBool)(c->accurate || !user->rec.stats.converged || at_max || fixed_eps >= 0 || at_memory || k == ad->cycles ||
                        (!c->marked && !c->marked_edge && !c->unseen));                      /* done, or a zero estimate: nothing to refine */
     if (!done) PetscCall(AdaptCheckpoint(*dm, user, *u, k, write));                                  /* what a signal during the next cycle leaves */
     PetscCall(AdaptMonitor(PetscObjectComm((PetscObject)*dm), ad, user->rec.accuracy_target, c, k)); /* once it is written */
@@ -491,8 +585,16 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
                              : !user->rec.stats.converged ? ADAPT_STOP_SOLVE_FAILED
                              : at_max                     ? ADAPT_STOP_MAX_DOFS
                              : fixed_eps >= 0             ? ADAPT_STOP_FIXED_EPS
+                             : at_memory                  ? ADAPT_STOP_MAX_MEMORY
                              : k == ad->cycles            ? ADAPT_STOP_CYCLES
                                                           : ADAPT_STOP_NOTHING_MARKED;
+      if (at_memory)
+        PetscCall(PetscPrintf(PetscObjectComm((PetscObject)*dm),
+                              "  the next cycle would take about %.0f MB (the last cycle's growth of memory scaled by its growth of the unknowns, "
+                              "%.2g, to the power of a direct factorization's fill), more than -adapt_max_memory %.0f MB%s: the cycles stop at cycle "
+                              "%" PetscInt_FMT "\n",
+                              (double)next_mb, (double)growth, (double)ad->max_memory,
+                              ad->max_memory_given ? "" : " (80% of the memory available at the start)", k));
       if (fixed_eps >= 0) {
         const PetscReal part = CycleBarsPenaltyPart(c, fixed_eps);
 
@@ -567,9 +669,10 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
           comm, "  WARNING: accuracy %g not reached after %" PetscInt_FMT " cycles (%" PetscInt_FMT " dofs)%s%s%s; the last cycle's bars:\n",
           (double)ad->accuracy, user->rec.ncycles - 1, c->n_dofs, UnseenHolds(ad, c) ? ": the mesh does not see the contact at some nodes" : "",
           !c->converged ? ": the last solve failed" : "",
-          user->rec.adapt_stop == ADAPT_STOP_MAX_DOFS    ? ": the mesh reached -adapt_max_dofs"
-          : user->rec.adapt_stop == ADAPT_STOP_FIXED_EPS ? ": the fixed eps's penalty part of a bar is above the tolerance (-penalty_eps)"
-                                                         : ""));
+          user->rec.adapt_stop == ADAPT_STOP_MAX_DOFS     ? ": the mesh reached -adapt_max_dofs"
+          : user->rec.adapt_stop == ADAPT_STOP_MAX_MEMORY ? ": the next cycle would exceed -adapt_max_memory"
+          : user->rec.adapt_stop == ADAPT_STOP_FIXED_EPS  ? ": the fixed eps's penalty part of a bar is above the tolerance (-penalty_eps)"
+                                                          : ""));
     for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
       if (!user->rec.accuracy_target[k]) continue;
       if (PetscIsNanReal(c->bar[k]))
