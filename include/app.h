@@ -9,6 +9,7 @@ int OptionsFilesCheckYAML(int argc, char **argv);
 /* options_check.c */
 PetscErrorCode OptionsCheckEnum(MPI_Comm comm, const char name[], const char *const list[], PetscBool array);
 PetscErrorCode OptionsCheckFinite(MPI_Comm comm, const char name[], PetscReal value);
+PetscErrorCode OptionsPathWhere(const char path[], char where[], size_t len);
 PetscErrorCode OptionsCheckFiniteArray(MPI_Comm comm, const char name[], PetscInt n, const PetscReal values[]);
 PetscErrorCode OptionsCountListValues(const char name[], PetscInt *n);
 PetscErrorCode OptionsCheckPrefixesUsed(MPI_Comm comm, const char prefixes[]);

@@ -132,6 +132,14 @@ BAD_ADAPT = {"quads": (SQUARE + ["-dm_plex_simplex", 0, "-adapt_cycles", 1], "-a
                        "-adapt_cycles and -accuracy with -obstacle_force are not supported yet")}
 
 
+def test_a_model_without_cycles_is_refused(tmp_path):
+    """-adapt_model is read by the cycles alone: beside -bars, or alone, it was accepted and ignored."""
+    model = tmp_path / "square.geo"
+    model.write_text('Point(1) = {0, 0, 0};\n')
+    for extra in ([], ["-bars"]):
+        refused(SQUARE + ["-adapt_model", str(model)] + extra, "model_alone", f"-adapt_model {model} is the model that -adapt_cycles and -accuracy mesh")
+
+
 @pytest.mark.parametrize("case", BAD_ADAPT)
 def test_adaptive_cycles_refuse_what_they_cannot_do(case):
     args, message = BAD_ADAPT[case]

@@ -117,11 +117,12 @@ def series(args, sizes, name):
 
 
 def test_effectivity_is_stable_on_the_manufactured_solution():
-    """2D mms on four meshes: effectivity = estimate / exact energy-norm error between 1 and 10 (a reliable estimate, not
-    a wild one), varying by at most 1.5x, and the estimate converging at the exact error's observed rate within 0.1."""
+    """2D mms on four meshes: effectivity = estimate / exact energy-norm error in a band about the measured 4.4 to 4.8
+    (3 to 7: above 1, a reliable estimate, and a change of the estimator by half fails it), varying by at most 1.5x,
+    and the estimate converging at the exact error's observed rate within 0.1."""
     r = series([], ["16,16", "32,32", "64,64", "128,128"], "estimate_mms")
     eff = r[:, 1] / r[:, 2]
-    assert np.all((eff > 1) & (eff < 10)), eff
+    assert np.all((eff > 3) & (eff < 7)), eff
     assert eff.max() / eff.min() <= 1.5, eff
     rate_est = np.polyfit(np.log(r[:, 0]), np.log(r[:, 1]), 1)[0]
     rate_err = np.polyfit(np.log(r[:, 0]), np.log(r[:, 2]), 1)[0]
@@ -140,22 +141,23 @@ def test_effectivity_does_not_depend_on_the_poisson_ratio():
 
 
 def test_effectivity_in_3d():
+    """The 3D mms on 4^3 and 8^3: the effectivity in a band about the measured 6.0 to 6.7 (4 to 9)."""
     r = series(["-dm_plex_dim", "3"], ["4,4,4", "8,8,8"], "estimate_mms3d")
     eff = r[:, 1] / r[:, 2]
-    assert np.all((eff > 1) & (eff < 10)), eff
+    assert np.all((eff > 4) & (eff < 9)), eff
 
 
 @pytest.mark.parametrize("rule", ["nodal", "gauss"])
 def test_penalty_part_follows_the_distance_to_snesvi(rule):
     """At a fixed mesh, the penalty part of the estimate against the energy-norm distance of the penalty solution to
-    SNESVI's (the -reference norms) from eps = h to h/1000: within a factor 3 at every eps (measured: 1.3)."""
+    SNESVI's (the -reference norms) from eps = h to h/1000: between 1 and 1.7 at every eps (measured: 1.29 to 1.38)."""
     _, vi = run(["-scene", "mms", "-dm_plex_box_faces", "32,32", "-contact_method", "vi"], f"estimate_vi_{rule}")
     for eps0 in (1, 0.01, 0.001):
         _, h5 = run(["-scene", "mms", "-dm_plex_box_faces", "32,32", "-penalty_quadrature", rule, "-penalty_eps0", eps0, "-reference", vi],
                     f"estimate_pen_{rule}_{eps0}")
         _, parts, a = estimate_of(h5)
         ratio = parts["penalty"] / a["reference_error_energy"]
-        assert 1 / 3 <= ratio <= 3, (eps0, ratio)
+        assert 1.0 <= ratio <= 1.7, (eps0, ratio)
 
 
 def test_same_estimate_on_two_ranks():

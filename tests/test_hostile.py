@@ -15,7 +15,7 @@ import subprocess
 import numpy as np
 import pytest
 
-from harness import OUT, ROOT, command, run, solve, write_gmsh_cube, write_gmsh_square
+from harness import OUT, ROOT, command, refused, run, solve, write_gmsh_cube, write_gmsh_square
 
 HOSTILE = os.path.join(OUT, "hostile")
 SMALL = ["-dm_plex_box_faces", "4,4"]
@@ -480,3 +480,14 @@ def test_tolerance_below_round_off_ends_converged_at_round_off(hostile_dir):
     assert b["converged"] == 1 and b["stopped_at_roundoff"] == 0
     assert abs(a["contact_force"] / b["contact_force"] - 1) < 1e-8
     assert np.abs(f["displacement"] - g["displacement"]).max() <= 1e-8 * np.abs(g["displacement"]).max()
+
+
+def test_a_missing_file_given_by_a_relative_path_says_where_it_was_looked_for(case_dir):
+    """A relative path in an options file is taken from the working directory, as PETSc takes every path: the refusal
+    says so, naming the directory (before, it named the path alone, and a mesh kept beside its options file seemed lost)."""
+    d = case_dir("relative_in_options")
+    opts = os.path.join(d, "problem.yaml")
+    with open(opts, "w") as fh:
+        fh.write("scene: square\ndm_plex_filename: beside_the_options.msh\n")
+    refused(["-options_file", opts], "relative_in_options",
+            f"Mesh file 'beside_the_options.msh' (-dm_plex_filename) does not exist or cannot be read (a relative path, taken from the working directory {ROOT}")

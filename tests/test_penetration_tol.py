@@ -64,7 +64,7 @@ def test_penetration_ladder(outdir, name):
 @pytest.mark.parametrize("name", ["square", "cylinder-indenter"])
 def test_augmented_lagrangian_tends_to_snesvi(outdir, name):
     """The augmented Lagrangian's fixed point is the exact nodal contact: its distance to SNESVI (max |u_al - u_vi| /
-    max |u_vi|) falls with the tolerance d = 1e-4 and 1e-6 times max |u_vi|: at most 30 d / max |u_vi| (measured 0.77 and
+    max |u_vi|) falls with the tolerance d = 1e-4 and 1e-6 times max |u_vi|: at most 2 d / max |u_vi| (measured 0.77 and
     0.77 on the square, 0.55 and 0.67 on the cylinder indenter) and 30 times lower at the smaller d, with eps kept at h/E."""
     import numpy as np
 
@@ -81,7 +81,7 @@ def test_augmented_lagrangian_tends_to_snesvi(outdir, name):
         assert attrs["converged"] == 1 and attrs["method"] == "al" and attrs["penalty_quadrature"] == "nodal"
         dist[k] = np.max(np.abs(fields["displacement"] - u_vi)) / scale
         print(f"al: d = 1e-{k} max|u_vi|: distance to SNESVI {dist[k]:.3e} = {dist[k] * 10.0 ** k:.2f} d / max|u_vi|")
-        assert dist[k] <= 30 * 10.0 ** -k, (k, dist)
+        assert dist[k] <= 2 * 10.0 ** -k, (k, dist)  # measured 0.55 to 0.77 d / max|u_vi|
     assert dist[6] < dist[4] / 30, dist
 
 

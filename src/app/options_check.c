@@ -1,6 +1,7 @@
 /* Checks of option values shared by the modules' *GetOptions: every real option must be a finite number
    (PETSc parses "inf" and "nan" as reals, which would run a whole solve into NaN without naming the option). */
-#define _POSIX_C_SOURCE 200809L /* strtok_r under -std=c99 */
+#define _POSIX_C_SOURCE 200809L /* strtok_r, getcwd under -std=c99 */
+#include <unistd.h>
 #include <string.h>
 
 #include "app.h"
@@ -239,6 +240,20 @@ PetscErrorCode OptionsCheckEnum(MPI_Comm comm, const char name[], const char *co
       SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s: unknown value '%s' (did you mean %s?); the values are %s", name, item, best, names);
     SETERRQ(comm, PETSC_ERR_USER_INPUT, "%s: unknown value '%s'; the values are %s", name, item, names);
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* For a message about a file given by an option: where a relative path was looked for ("" for an absolute one). PETSc
+   takes a path in an options file, as on the command line, from the working directory, not from the options file's
+   directory, which a user who keeps a mesh beside its options file may expect. */
+PetscErrorCode OptionsPathWhere(const char path[], char where[], size_t len)
+{
+  char cwd[PETSC_MAX_PATH_LEN];
+
+  PetscFunctionBeginUser;
+  where[0] = '\0';
+  if (path[0] == '/' || !getcwd(cwd, sizeof(cwd))) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscSNPrintf(where, len, " (a relative path, taken from the working directory %s, also in an options file)", cwd));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

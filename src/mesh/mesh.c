@@ -121,8 +121,11 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
   if (has_file) {
     PetscBool exists;
 
+    char where[PETSC_MAX_PATH_LEN + 96];
+
     PetscCall(PetscTestFile(filename, 'r', &exists));
-    PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "Mesh file '%s' (-dm_plex_filename) does not exist or cannot be read", filename);
+    PetscCall(OptionsPathWhere(filename, where, sizeof(where)));
+    PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "Mesh file '%s' (-dm_plex_filename) does not exist or cannot be read%s", filename, where);
   }
   if (!has_file) {
     char      what[64];

@@ -146,7 +146,10 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
     PetscBool exists;
 
     PetscCall(PetscTestFile(ad->model, 'r', &exists));
-    PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "-adapt_model: the Gmsh model '%s' does not exist or cannot be read", ad->model);
+    char where[PETSC_MAX_PATH_LEN + 96];
+
+    PetscCall(OptionsPathWhere(ad->model, where, sizeof(where)));
+    PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "-adapt_model: the Gmsh model '%s' does not exist or cannot be read%s", ad->model, where);
   }
   PetscCheck(ad->cycles >= 0, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles must be >= 0, got %" PetscInt_FMT, ad->cycles);
   PetscCheck(ad->max_dofs >= 0, comm, PETSC_ERR_USER_INPUT, "-adapt_max_dofs must be >= 0 (0: no limit), got %" PetscInt_FMT, ad->max_dofs);
@@ -169,6 +172,10 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
     PetscCheck(!cycles_given || ad->cycles > 0, comm, PETSC_ERR_USER_INPUT, "-accuracy refines adaptively: -adapt_cycles 0 leaves it no cycle");
     if (!cycles_given) ad->cycles = ADAPT_ACCURACY_CYCLES;
   }
+  PetscCheck(!ad->model[0] || ad->cycles > 0, comm, PETSC_ERR_USER_INPUT,
+             "-adapt_model %s is the model that -adapt_cycles and -accuracy mesh again at each cycle; without them nothing reads it (-bars "
+             "refines the mesh itself, -dm_refine too): give -accuracy TOL or -adapt_cycles N, or leave -adapt_model out",
+             ad->model);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

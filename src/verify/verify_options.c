@@ -1,5 +1,6 @@
 /* Options of the verification: the accurate quadrature rule of the error norms and weak data, and -reference. */
 #include <string.h>
+#include "app.h"
 #include "verify.h"
 
 /* An HDF5 file starts with its 8-byte signature (the project's files have no user block). */
@@ -42,7 +43,10 @@ PetscErrorCode VerifyGetOptions(MPI_Comm comm, VerifyOptions *opts)
 
     PetscCheck(opts->reference[0], comm, PETSC_ERR_USER_INPUT, "-reference needs a file name");
     PetscCall(PetscTestFile(opts->reference, 'r', &exists));
-    PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "Reference file '%s' (-reference) does not exist or cannot be read", opts->reference);
+    char where[PETSC_MAX_PATH_LEN + 96];
+
+    PetscCall(OptionsPathWhere(opts->reference, where, sizeof(where)));
+    PetscCheck(exists, comm, PETSC_ERR_USER_INPUT, "Reference file '%s' (-reference) does not exist or cannot be read%s", opts->reference, where);
     PetscCall(VerifyCheckHDF5Signature(comm, opts->reference));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
