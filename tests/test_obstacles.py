@@ -108,3 +108,18 @@ def test_two_ranks_curved_contact(outdir, case, method):
     assert np.max(np.abs(u1 - u2)) < 1e-9 * np.max(np.abs(u1))
     assert r1["active_vertices"] == r2["active_vertices"] > 3
     assert abs(r1["contact_force"] / r2["contact_force"] - 1) < 1e-9
+
+
+@pytest.mark.parametrize("case,h_near,tol", [("cylinder", 0.004, 0.005), ("sphere", 0.01, 0.01)])
+def test_snesvi_reproduces_hertz_on_curved_bodies(tmp_path, case, h_near, tol):
+    """SNESVI, the exact constraint, on make hertz's elastic cylinder and sphere against Hertz's closed form at the
+    run's force: the half-width (or radius) a and the peak pressure p0 within 0.5% in 2D and 1% in 3D (measured -0.14%
+    and -0.14% on the cylinder at h = 0.004, -0.55% and +0.25% on the sphere at h = 0.01; docs/hertz.md). Before, no
+    test read SNESVI's pressure on a curved body against the closed form."""
+    from signorini.mpirun import run_mpi
+    mesh, out = str(tmp_path / f"{case}.msh"), str(tmp_path / f"{case}_vi.h5")
+    hertz.write_mesh(case, h_near, mesh)
+    r = run_mpi(hertz.command(case, mesh, "vi", out, ranks=1), timeout=600)
+    assert r.returncode == 0, r.output[-2000:]
+    m = hertz.measure(case, out)
+    assert abs(m["a_error"]) < tol and abs(m["p0_error"]) < tol, (m["a_error"], m["p0_error"])

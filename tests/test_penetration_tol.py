@@ -22,6 +22,19 @@ def problems(outdir):
             "sphere-indenter": hertz.command("sphere-indenter", sphere, "eps=h", "unused")[4:-2]}
 
 
+def closed_form_penetration(args, x, u):
+    """u . n - g at the points x with displacements u under the rigid cylinder (2D) or sphere of the run's options: its
+    centre c moved by -obstacle_translate, its radius R; g = |x - c| - R, n = (c - x) / |x - c| (from the body into it)."""
+    import numpy as np
+
+    opt = lambda name: np.array([float(v) for v in args[args.index(name) + 1].split(",")])  # noqa: E731
+    c = opt("-obstacle_center") + opt("-obstacle_translate")
+    R = float(args[args.index("-obstacle_radius") + 1])
+    r = c[None, :] - x
+    dist = np.linalg.norm(r, axis=1)
+    return np.sum(u * r / dist[:, None], axis=1) - (dist - R)
+
+
 @pytest.mark.parametrize("name", ["square", "square-nodal", "cylinder-indenter", "sphere-indenter", "square-al", "cylinder-indenter-al"])
 def test_penetration_ladder(outdir, name):
     """d = 1e-1, 1e-3, 1e-5 times the plain run's largest penetration (eps = h/E; the graded meshes' h near the contact
@@ -50,6 +63,11 @@ def test_penetration_ladder(outdir, name):
         assert int(attrs["penetration_tol_solves"]) >= 2 and float(attrs["penetration_tol"]) == d
         on = fields["contact_boundary"] > 0.5
         assert np.max(-fields["normal_gap"][on]) <= measured * (1 + 1e-9)  # the nodes' penetration, g - u_n = -(u_n - g)
+        if "indenter" in name:  # and recomputed from the displacement and the rigid body's closed form, not the code's gap
+            pen = closed_form_penetration(args, fields["x"][on], fields["displacement"][on])
+            assert pen.max() <= d * (1 + 1e-9), (k, pen.max(), d)
+            if al:  # the nodal rule's points are the nodes: the code's measure is this one
+                assert abs(pen.max() - measured) <= 1e-9 * measured, (pen.max(), measured)
         if name.startswith("square"):
             assert float(attrs["max_penetration"]) <= d
     if al:  # eps stays; the multipliers move the answer to the exact contact's: checked against SNESVI below
