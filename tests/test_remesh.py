@@ -144,7 +144,7 @@ def test_the_mesh_taken_from_gmsh_is_petscs_reading_of_its_file(case, disk):
     c, r = cycles(direct), cycles(petsc)
     assert len(c["n_dofs"]) == (5 if case == "cylinder" else 3) and np.all(np.diff(c["n_dofs"]) > 0), c["n_dofs"]
     for key in c:
-        if not key.startswith("time"):
+        if not key.startswith("time") and key != "memory_mb":  # the clock and the resident memory vary from run to run
             assert np.array_equal(c[key], r[key], equal_nan=True), key
 
 
@@ -183,7 +183,7 @@ Mesh.SaveAll = 1;
     c, r = cycles(direct), cycles(petsc)
     assert len(c["n_cells"]) == 3 and np.all(np.diff(c["n_cells"]) > 0) and np.all(c["contact_force_value"] > 0), (c["n_cells"], c["contact_force_value"])
     for key in c:
-        if not key.startswith("time"):
+        if not key.startswith("time") and key != "memory_mb":  # the clock and the resident memory vary from run to run
             assert np.array_equal(c[key], r[key], equal_nan=True), key
 
 
