@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from harness import load, run, solve
+from signorini import hertz
 
 SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "false", "-snes_rtol", "1e-12"]
 # a cylinder pressed into the top of a clamped block: the contact zone grows with the indentation (a curved gap)
@@ -394,3 +395,21 @@ def test_a_force_out_of_reach_is_said_so(outdir, obstacle):
     assert "the force 1000 is out of reach" in out.replace("1000.", "1000") and "ERROR: force control did not reach -obstacle_force" in out, out[-2000:]
     attrs, _ = load(h5)
     assert attrs["converged"] == 0 and -1.0 - 1e-12 <= attrs["obstacle_translate_y"] < 0
+
+
+def test_hertz_along_a_force_controlled_path(outdir):
+    """make hertz's cylinder indenter (h_near 0.002, eps = h/100) driven by force along 0.5, 1, 0.5 of the force the
+    depth 0.001 gives: at each step the half-width and the peak pressure are within 1% of Hertz's closed form at the
+    step's force (measured +0.37% and -0.49% at 0.5, +0.25% and -0.36% at 1), and the unloading step is the loading
+    step at the same force (frictionless elasticity has no history)."""
+    mesh = os.path.join(outdir, "ci.msh")
+    hertz.write_mesh("cylinder-indenter", 0.002, mesh)
+    _, direct = run(hertz.command("cylinder-indenter", mesh, "eps=h/100", "unused")[4:-2], "hertz_depth", output=os.path.join(outdir, "d.h5"))
+    force = abs(load(direct)[0]["contact_force_y"])
+    _, h5 = run(hertz.command("cylinder-indenter", mesh, "eps=h/100", "unused")[4:-2] + ["-obstacle_force", repr(force), "-load_path", "0.5,1,0.5"],
+                "hertz_force", output=os.path.join(outdir, "f.h5"))
+    rows = hertz.path_rows("cylinder-indenter", h5)
+    assert [r["converged"] for r in rows] == [1, 1, 1]
+    for r in rows:
+        assert abs(r["a_error"]) < 0.01 and abs(r["p0_error"]) < 0.01, r
+    assert abs(rows[2]["load"] - rows[0]["load"]) <= 1e-8 * rows[0]["load"] and abs(rows[2]["a_h"] - rows[0]["a_h"]) <= 1e-6 * rows[0]["a_h"]
