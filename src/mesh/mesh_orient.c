@@ -15,50 +15,47 @@
    whose det J changes sign inside (a non-convex or tangled cell) is refused, as is a cell of zero volume. */
 #include "mesh.h" /* MeshOrientCells() only: nothing of mesh.c is called here (mesh.c calls this file) */
 
-/* det J of cell c at its center, and for a tensor cell the smallest and largest det J at its vertices' reference points
-   (the corners, where a bilinear or trilinear map is most distorted). */
-static PetscErrorCode CellDeterminants(DM dm, PetscInt c, PetscBool simplex, PetscReal *det_center, PetscReal *det_min, PetscReal *det_max)
+/* The points at which a tensor cell's det J is taken: its corners, where a bilinear or trilinear map is most
+   distorted, then its center (NULL for simplices, whose det J is one value). */
+static PetscErrorCode CornerQuadrature(PetscInt dim, PetscBool simplex, PetscQuadrature *q)
 {
-  PetscInt  dim;
-  PetscReal v[3], J[9], invJ[9], detJ;
+  const PetscInt ncorners = dim == 2 ? 4 : 8;
+  PetscReal     *p, *w;
 
   PetscFunctionBeginUser;
-  PetscCall(DMGetDimension(dm, &dim));
-  if (simplex) {
-    PetscCall(DMPlexComputeCellGeometryAffineFEM(dm, c, v, J, invJ, &detJ));
-    *det_center = *det_min = *det_max = detJ;
+  *q = NULL;
+  if (simplex) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc1((ncorners + 1) * dim, &p)); /* apart: PetscQuadratureDestroy() frees each */
+  PetscCall(PetscMalloc1(ncorners + 1, &w));
+  for (PetscInt k = 0; k < ncorners; ++k)
+    for (PetscInt d = 0; d < dim; ++d) p[k * dim + d] = (k >> d) & 1 ? 1.0 : -1.0;
+  for (PetscInt d = 0; d < dim; ++d) p[ncorners * dim + d] = 0.0; /* the center, last */
+  for (PetscInt k = 0; k <= ncorners; ++k) w[k] = 1.0;
+  PetscCall(PetscQuadratureCreate(PETSC_COMM_SELF, q));
+  PetscCall(PetscQuadratureSetData(*q, dim, 1, ncorners + 1, p, w)); /* q owns p and w */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* det J of cell c at its center, and its smallest and largest at the points of q (a tensor cell's corners; a
+   simplex's one value where q is NULL). */
+static PetscErrorCode CellDeterminants(DM dm, PetscInt c, PetscQuadrature q, PetscReal *det_center, PetscReal *det_min, PetscReal *det_max)
+{
+  PetscReal v[8 * 3 + 3], J[9 * 9], invJ[9 * 9], dets[9];
+  PetscInt  npoints;
+
+  PetscFunctionBeginUser;
+  if (!q) {
+    PetscCall(DMPlexComputeCellGeometryAffineFEM(dm, c, v, J, invJ, &dets[0]));
+    *det_center = *det_min = *det_max = dets[0];
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  {
-    PetscQuadrature q;
-    PetscReal       pts[8 * 3 + 3], wts[9], dets[9];
-    const PetscInt  ncorners = dim == 2 ? 4 : 8;
-    PetscReal      *vv, *JJ, *iJ;
-
-    for (PetscInt k = 0; k < ncorners; ++k)
-      for (PetscInt d = 0; d < dim; ++d) pts[k * dim + d] = (k >> d) & 1 ? 1.0 : -1.0;
-    for (PetscInt d = 0; d < dim; ++d) pts[ncorners * dim + d] = 0.0; /* the center, last */
-    for (PetscInt k = 0; k <= ncorners; ++k) wts[k] = 1.0;
-    PetscCall(PetscQuadratureCreate(PETSC_COMM_SELF, &q));
-    {
-      PetscReal *p, *w;
-
-      PetscCall(PetscMalloc1((ncorners + 1) * dim, &p)); /* apart: PetscQuadratureDestroy() frees each */
-      PetscCall(PetscMalloc1(ncorners + 1, &w));
-      PetscCall(PetscArraycpy(p, pts, (ncorners + 1) * dim));
-      PetscCall(PetscArraycpy(w, wts, ncorners + 1));
-      PetscCall(PetscQuadratureSetData(q, dim, 1, ncorners + 1, p, w)); /* q owns p and w */
-    }
-    PetscCall(PetscMalloc3((ncorners + 1) * dim, &vv, (ncorners + 1) * dim * dim, &JJ, (ncorners + 1) * dim * dim, &iJ));
-    PetscCall(DMPlexComputeCellGeometryFEM(dm, c, q, vv, JJ, iJ, dets));
-    PetscCall(PetscFree3(vv, JJ, iJ));
-    PetscCall(PetscQuadratureDestroy(&q));
-    *det_center = dets[ncorners];
-    *det_min = *det_max = dets[0];
-    for (PetscInt k = 1; k < ncorners; ++k) {
-      *det_min = PetscMin(*det_min, dets[k]);
-      *det_max = PetscMax(*det_max, dets[k]);
-    }
+  PetscCall(PetscQuadratureGetData(q, NULL, NULL, &npoints, NULL, NULL));
+  PetscCall(DMPlexComputeCellGeometryFEM(dm, c, q, v, J, invJ, dets));
+  *det_center = dets[npoints - 1];
+  *det_min = *det_max = dets[0];
+  for (PetscInt k = 1; k < npoints - 1; ++k) {
+    *det_min = PetscMin(*det_min, dets[k]);
+    *det_max = PetscMax(*det_max, dets[k]);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -124,19 +121,21 @@ static PetscErrorCode FirstMarkedCentroid(DM dm, PetscInt cell, PetscReal x[3])
    what names the mesh. */
 PetscErrorCode MeshOrientCells(DM dm, const char what[], PetscInt *nreflected)
 {
-  MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
-  PetscInt  cStart, cEnd, dim, counts[3] = {0, 0, 0}, bad = -1, tangled = -1;
-  PetscBool simplex;
+  MPI_Comm        comm = PetscObjectComm((PetscObject)dm);
+  PetscInt        cStart, cEnd, dim, counts[3] = {0, 0, 0}, bad = -1, tangled = -1;
+  PetscBool       simplex;
+  PetscQuadrature q;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMGetCoordinatesLocalSetUp(dm)); /* collective: a mesh just distributed (a parallel HDF5 read) has none yet */
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(DMPlexIsSimplex(dm, &simplex));
+  PetscCall(CornerQuadrature(dim, simplex, &q));
   for (PetscInt c = cStart; c < cEnd; ++c) {
     PetscReal det, det_min, det_max, diam = 0.0;
 
-    PetscCall(CellDeterminants(dm, c, simplex, &det, &det_min, &det_max));
+    PetscCall(CellDeterminants(dm, c, q, &det, &det_min, &det_max));
     PetscCall(CellDiameter(dm, c, &diam));
     if (!(PetscAbsReal(det) > 1e-12 * PetscPowRealInt(diam, dim))) { /* zero to round-off, or not finite */
       if (bad < 0) bad = c;
@@ -152,12 +151,13 @@ PetscErrorCode MeshOrientCells(DM dm, const char what[], PetscInt *nreflected)
       PetscReal det_after, dmin, dmax;
 
       PetscCall(DMPlexOrientPoint(dm, c, -1)); /* a reflection of every polytope: its closure in the reversed sense */
-      PetscCall(CellDeterminants(dm, c, simplex, &det_after, &dmin, &dmax));
+      PetscCall(CellDeterminants(dm, c, q, &det_after, &dmin, &dmax));
       PetscCheck(det_after > 0.0 && dmin > 0.0, PETSC_COMM_SELF, PETSC_ERR_PLIB, "Cell %" PetscInt_FMT " still has det J = %g after its reflection",
                  c, (double)det_after);
       ++counts[0];
     }
   }
+  PetscCall(PetscQuadratureDestroy(&q));
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, counts, 3, MPIU_INT, MPI_SUM, comm));
   if (counts[1]) {
     PetscReal x[3];
