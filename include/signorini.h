@@ -407,7 +407,6 @@ typedef struct {
   PetscInt  max_dofs;                  /* -adapt_max_dofs: no mesh with this many unknowns or more is refined (0: no limit) */
   PetscReal max_memory;                /* -adapt_max_memory: the run's memory over all ranks, MB, that no cycle is predicted past */
   PetscBool max_memory_given;          /*   given, or the default (AdaptDefaultMemory()) */
-  PetscReal memory_base;               /* what the ranks held at the options phase, MB summed (AdaptBaseMemory()) */
 } AdaptOptions;
 
 /* One cycle of the adaptive refinement (/cycles in the output): the mesh, the estimate of its solution and the true

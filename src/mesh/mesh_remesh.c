@@ -281,10 +281,9 @@ static PetscErrorCode GmshCheckModel(const char model[], PetscInt dim, const Pet
 }
 
 /* Refuses, before any solve, a model the cycles could not remesh as the mesh's body: a mesh file given in its place
-   (a .msh opens in Gmsh as a discrete model that remeshing cannot refine: 40 cycles refined nothing), a model Gmsh
-   cannot read (before, Gmsh's error came after the first solve, with PETSc's whole block and MPI_ABORT), one of another
+   (a .msh opens in Gmsh as a discrete model, which remeshing cannot refine), a model Gmsh cannot read, one of another
    dimension, one whose bounding box is not the mesh's (another body), and one without a physical group for each face
-   set of the mesh (before, the first remesh found it). The box's tolerance is MESH_MODEL_BOX_TOL of its extent: a
+   set of the mesh (CheckFaceSets() checks the remeshed mesh again). The box's tolerance is MESH_MODEL_BOX_TOL of its extent: a
    curved boundary's mesh lies inside its model by about h^2 / 8R. */
 PetscErrorCode MeshRemeshCheckModel(DM dm, const char model[])
 {

@@ -222,9 +222,8 @@ static PetscErrorCode AddFixedRowsP1(DM dm, AppCtx *user, Vec u, Vec locF)
    components of the points of its faces, of the residual K u - f (bulk and loads), which the support balances. Each cell adds to the local residual
    of one rank only, so the local sums add up over the ranks. A set's reaction has only the components it fixes: a point on two such face sets (the
    edge between two symmetry planes of a 3D quarter model, x = 0 fixing u_x and y = 0 fixing u_y) gives each component of its residual to the
-   first listed set that fixes that component, so that whatever the order the plane x = 0 pushes along x only (before, the first listed took the
-   point's every fixed component, and x = 0 "pushed" along y with 7.6e-7). A component two sets fix there (a clamp and a slip) counts for the first
-   listed. reaction[i][c]: of the i-th boundary condition (zero for the loads). */
+   first listed set that fixes that component, so that whatever the order the plane x = 0 pushes along x only. A component two sets fix there (a
+   clamp and a slip) counts for the first listed. reaction[i][c]: of the i-th boundary condition (zero for the loads). */
 PetscErrorCode BoundaryComputeReactions(DM dm, AppCtx *user, Vec u, PetscReal reaction[][3])
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);

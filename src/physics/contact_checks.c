@@ -5,15 +5,11 @@
      that starts inside the obstacle, and the part where the obstacle's normal (from the body into the obstacle)
      points into the body, against the outward normal of the face: an obstacle facing away from the body, or a plane
      behind it, which the penalty pushes the body through.
-   - Before the solve, the material: P1 and Q1 lock as nu -> 1/2. On make hertz's elastic cylinder against the closed
-     form at each run's force, with SNESVI (scripts/incompressible.py, docs/hertz.md, "Nearly incompressible bodies"),
-     the largest nodal pressure is 0.8% to 1.1% off at nu = 0.45, 1.5% to 2.8% at 0.48, 1.9% to 4.8% at 0.49 and 19%
-     at 0.499, and it does not fall as the mesh is refined (the nodal tractions oscillate); the half-width is 0.1% to
-     0.4% off at 0.45 and 12.8% at 0.499 on the coarsest mesh. At nu = 0.3 both are within 0.15%. So a P1/Q1 body from
-     nu = 0.45 on is warned of, with the cure: quadratic elements, whose half-width stays within 0.9% up to 0.499 (their
-     pressure at the vertices is no traction, so that it is not compared); and where the penalty takes eps from E, eps is
-     (lambda + 2 mu) / E times softer than the body (167 at nu = 0.499), which -penalty_eps_modulus pwave restores
-     (its largest pressure within 0.6 points of SNESVI's at every nu measured, against 9 points with eps from E at 0.499).
+   - Before the solve, the material: P1 and Q1 lock as nu -> 1/2, and their nodal tractions oscillate, so that the
+     largest pressure is off by a part that refinement does not reduce; from nu = CONTACT_CHECK_LOCKING_NU on it is
+     above 1% on make hertz's cylinder (scripts/incompressible.py; docs/hertz.md, "Nearly incompressible bodies"). Such
+     a body is warned of, with the cure: quadratic elements; and where the penalty takes eps from E, eps is
+     (lambda + 2 mu) / E times softer than the body, which -penalty_eps_modulus pwave restores.
    - After the solve, the resolution: how many cells span the contact zone along Gamma_C (the faces where the contact
      acts at every node: their number in 2D, the diameter in cells of a round zone of that many faces in 3D), warned
      below 4 in 2D and 6 in 3D, where the Gauss rule's force is within about 2% and 3% of a fine mesh's. A zone of a
@@ -219,8 +215,8 @@ PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user, Vec u)
      wide: its width and length 4 sqrt(lambda), lambda the middle and the largest eigenvalue of the faces' second moments
      about their centroid (the smallest is across a flat or gently curved zone's thickness; a disk's 4 sqrt(r^2/4) is
      its diameter, a strip's 4 sqrt(w^2/12) 1.15 times its width w). A rounder zone keeps the round count, the measure
-     of the thresholds (a quarter of a round zone, as a symmetric model meshes it, is 1.4 times longer than wide, and
-     on a dozen faces the second moments' width fell 16% short of the round count). */
+     the thresholds were set with: a quarter of a round zone, as a symmetric model meshes it, is 1.4 times longer than
+     wide, and on a few faces the second moments' width falls short of the round count. */
   ck->zone_cells = dim == 2 ? (PetscReal)ck->zone_faces : PetscSqrtReal(2.0 * (PetscReal)ck->zone_faces / PETSC_PI);
   if (dim == 3 && ck->zone_faces > 0 && moments[0] > 0.0) {
     const PetscReal A = moments[0], s = PetscSqrtReal(2.0 * A / (PetscReal)ck->zone_faces);

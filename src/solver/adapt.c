@@ -37,22 +37,9 @@ const char *const AdaptStops[] = {"accuracy",  "cycles",      "max_dofs", "solve
                                   "AdaptStop", "ADAPT_STOP_", NULL};
 
 /* The default memory budget of the cycles, MB over all ranks: ADAPT_MEMORY_SHARE of what each rank's node had available
-   at the start (/proc/meminfo's MemAvailable, shared by the ranks on the node) plus what the rank held then. Without a
-   budget a 2D quarter disk at -accuracy 0.003 grew to 14 GB and was killed by the kernel, its finished cycles lost. */
+   at the start (/proc/meminfo's MemAvailable, shared by the ranks on the node) plus what the rank held then, so that
+   the cycles stop before the kernel kills the run (docs/options.md). */
 #define ADAPT_MEMORY_SHARE 0.8
-
-/* What the ranks hold at the start, MB summed: the libraries and PETSc's set-up, which do not grow with the mesh. */
-static PetscErrorCode AdaptBaseMemory(MPI_Comm comm, PetscReal *mb)
-{
-  PetscLogDouble rss = 0.0;
-  PetscReal      mine;
-
-  PetscFunctionBeginUser;
-  PetscCall(PetscMemoryGetCurrentUsage(&rss));
-  mine = (PetscReal)rss / 1048576.0;
-  PetscCall(MPIU_Allreduce(&mine, mb, 1, MPIU_REAL, MPIU_SUM, comm));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
 
 static PetscErrorCode AdaptDefaultMemory(MPI_Comm comm, PetscReal *mb)
 {
@@ -156,7 +143,6 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
   PetscCall(OptionsCheckFinite(comm, "-adapt_max_memory", ad->max_memory));
   PetscCheck(ad->max_memory >= 0.0, comm, PETSC_ERR_USER_INPUT, "-adapt_max_memory must be >= 0 MB (0: no limit), got %g", (double)ad->max_memory);
   if (!ad->max_memory_given && (ad->cycles > 0 || ad->accuracy > 0.0)) PetscCall(AdaptDefaultMemory(comm, &ad->max_memory));
-  if (ad->cycles > 0 || ad->accuracy > 0.0) PetscCall(AdaptBaseMemory(comm, &ad->memory_base));
   PetscCheck(!fraction_given || (ad->fraction > 0.0 && ad->fraction <= 1.0), comm, PETSC_ERR_USER_INPUT, "-adapt_fraction must lie in (0, 1], got %g",
              (double)ad->fraction);
   PetscCheck(ad->accuracy >= 0.0 && ad->accuracy < 1.0, comm, PETSC_ERR_USER_INPUT, "-accuracy is a relative error in (0, 1), got %g",
@@ -457,9 +443,7 @@ static PetscReal AdaptFraction(const AdaptOptions *ad, const PetscBool target[],
 /* Whether -accuracy cannot be reached at the fixed eps of -penalty_eps (or -penalty_eps_power 0): a quantity asked for
    whose bar's penalty part alone is above the tolerance on this cycle and the one before, both cycles with a bar
    (CycleBarsPenaltyPart()). The mesh's part falls with the cycles, the penalty's tends to the penalty problem's own
-   error, which a fixed eps keeps: the manufactured solution from 8 x 8 at -penalty_eps 0.05 and -accuracy 0.05 kept
-   the force's penalty part at 4.95% to 5.36% and the largest pressure's at 11% to 15% over 13 cycles up to 102,954
-   unknowns, its bars at 5.3% and 11% there. Returns the first such quantity (-1: none). */
+   error, which a fixed eps keeps (docs/estimate.md, "A fixed eps"). Returns the first such quantity (-1: none). */
 static PetscInt FixedEpsHolds(const AppCtx *user, const PetscBool target[], PetscInt k)
 {
   const ContactOptions *copt = NULL;
@@ -481,8 +465,8 @@ static PetscInt FixedEpsHolds(const AppCtx *user, const PetscBool target[], Pets
 }
 
 /* The run's resident memory now, at a cycle's end (its mesh, its operators and its factorization held), MB summed over
-   the ranks. Not the peak so far: a transient peak of the start (107 MB as the test suite's singletons start) hid the
-   cycles' growth below it, up to 17,206 unknowns there. */
+   the ranks. Not the peak so far, which a transient of the start can hold above the first cycles' memory, so that
+   their growth would not show. */
 static PetscErrorCode AdaptCycleMemory(MPI_Comm comm, PetscReal *mb)
 {
   PetscLogDouble rss = 0.0;
@@ -495,11 +479,11 @@ static PetscErrorCode AdaptCycleMemory(MPI_Comm comm, PetscReal *mb)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The memory the next cycle is predicted to take, MB over all ranks, from the last two cycles' peaks: the part that
+/* The memory the next cycle is predicted to take, MB over all ranks, from the memory at the last two cycles' ends: the part that
    grows with the mesh, m_k - m_(k-1), scaled as N^p from the last cycle's N_(k-1) -> N_k to the next N_(k+1) = g N_k
    (g the last growth of the unknowns), p = 1.2 in 2D and 4/3 in 3D, a sparse direct factorization's fill (n log n and
    n^(4/3) on 2D and 3D meshes), which bounds an iterative solver's. The difference leaves out what does not grow with
-   the mesh (the libraries, MUMPS's and PETSc's set-up: 50 to 100 MB, most of it loaded after the options phase). */
+   the mesh: the libraries and the set-up, much of it loaded after the options phase. */
 static void AdaptPredictMemory(const AppCtx *user, PetscInt k, PetscInt dim, PetscReal *mb, PetscReal *growth)
 {
   const CycleRecord *c = user->rec.cycles;
@@ -515,11 +499,8 @@ static void AdaptPredictMemory(const AppCtx *user, PetscInt k, PetscInt dim, Pet
    ended by a signal (Ctrl-C, a scheduler's SIGTERM at its time limit) keeps a finished cycle, its /cycles and its
    bars, and says so as it dies (OutputFileStageSignalNote()); the run's final write replaces it. A cycle is written
    where the cycles since the last write took ADAPT_CHECKPOINT_RATIO times that write's time (the first always), so
-   that the writes cost at most about 1/ADAPT_CHECKPOINT_RATIO of the run: written at every cycle, the 2D indenter's
-   11 cycles to 62,182 unknowns took 1.13 times as long as without the writes (3.50 s against 2.91 s, medians of 7
-   alternated runs), the small cycles' writes as dear as their solves; at the ratio 20, 1.035 times the run that writes
-   its first cycle alone (medians of 7 alternated runs, 2.68 s against 2.67 s). A long run's cycles, each far dearer than
-   a write, are each written. */
+   that the writes cost at most about 1/ADAPT_CHECKPOINT_RATIO of the run (docs/running.md); the small first cycles'
+   writes cost as much as their solves, while a long run's cycles, each far dearer than a write, are each written. */
 #define ADAPT_CHECKPOINT_RATIO 20.0
 static PetscErrorCode AdaptCheckpoint(DM dm, AppCtx *user, Vec u, PetscInt k, OutputWriter write)
 {

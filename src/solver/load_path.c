@@ -123,8 +123,7 @@ static PetscReal ForcePower(const AppCtx *user)
 /* The body's depth along the obstacle's direction of motion: the extent of its vertices' projections on it, over all
    ranks. Force control moves the obstacle at most that far from its unloaded position: beyond, it would pass through
    the body (the gap and the normal are taken at the undeformed position), and a target that needs more is out of the
-   small-deformation model's reach (-obstacle_force 1000 on a block 10 deep threw the indenter 16,410 units and
-   stalled with a force of 1e-57). */
+   small-deformation model's reach. */
 static PetscErrorCode BodyDepth(DM dm, const AppCtx *user, PetscReal *depth)
 {
   const PetscReal   *dir = user->scene.full_load.translate;
@@ -275,8 +274,7 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
    obstacle's unloaded position s = 0, as the first move to a positive force does; after it, the onset through the last
    two positions with a force, (s_a - s0) / (s_b - s0) = (f_a / f_b)^(1/p). The target is reached where the force is
    zero to the last bit and no node or point of the rule lies inside the obstacle (a node the rule's points miss may
-   still overlap it: that is no release); behind the onset the state is u = 0 where the other loads are zero too. Before, the step at the factor 0 was
-   not solved: it was written with the last step's state (force 3e-5 where the target was 0). */
+   still overlap it: that is no release); behind the onset the state is u = 0 where the other loads are zero too. */
 #define FORCE_CONTROL_RELEASE 1e-6
 
 static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u, PetscBool *ok, PetscInt *its)
@@ -303,7 +301,7 @@ static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u,
     else {
       const PetscReal r = PetscPowReal(f_prev / f, 1.0 / power);
 
-      s_next = r != 1.0 ? (s_prev - r * s) / (1.0 - r) : PetscMin(s, s_prev) - PetscAbsReal(s - s_prev);
+      s_next = r != 1.0 ? (s_prev - r * s) / (1.0 - r) : PETSC_MAX_REAL;
       if (!(s_next < PetscMin(s, s_prev))) s_next = PetscMin(s, s_prev) - PetscAbsReal(s - s_prev); /* the law gives no onset behind both */
     }
     move = PetscAbsReal(s_next - s);

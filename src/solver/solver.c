@@ -417,9 +417,8 @@ PetscErrorCode SolverStartFromCoarser(const AppCtx *user, SolverStart *start)
 /* Whether the load state is zero: no load, body force or prescribed displacement (r0 = F_bulk(0) plus the loads, zero
    to the last bit) and no point of Gamma_C inside the obstacle at u = 0 (no initial overlap). Then u = 0 is the
    solution, and the only one (the energy is strictly convex on the admissible set): its residual is exactly zero, no
-   point presses, and every multiplier is zero. A step of a load path at the factor 0 is such a state; solved from the
-   last step's solution, Newton took 5 to 10 steps to drive |u| from 1e-3 to round-off (1e-60), and the round-off's
-   penetrations of 1e-63 raised the contact-resolution warning. */
+   point presses, and every multiplier is zero. A step of a load path at the factor 0 is such a state: from the last
+   step's solution Newton would take steps down to round-off, whose penetrations raise the contact warnings. */
 static PetscErrorCode SolverZeroData(DM dm, AppCtx *user, PetscBool *zero)
 {
   PetscReal r0;
