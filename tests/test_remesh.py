@@ -243,8 +243,9 @@ def test_the_recovered_peak_pressure_reaches_a_tolerance_the_nodal_maximum_scatt
     (pressure_peak: the quadratic fitted to the nodes in contact around the largest's, at its own largest): it stops within the
     tolerance with the peak within its bar of the closed form at the run's force and within 1% of it; over the last
     three cycles the peak stays within 1% of the closed form while the nodal maximum is at least twice as far (measured
-    -0.52%, +0.54%, +0.14% against +5.5%, +3.0%, +2.1%); the bar is at least twice the fit's resolution (its deviation,
-    src/estimate/cycle_bars.c); and the peak is the fit numpy makes of the last mesh's fields."""
+    -0.52%, +0.54%, +0.14% against +5.5%, +3.0%, +2.1%); on every cycle with a bar the bar covers the peak's error
+    against the closed form (measured 0.004, 0.16, 0.06 times it); and the peak is the fit numpy makes of the last
+    mesh's fields."""
     mesh, model = sphere
     args = case_args("sphere", mesh) + hertz.GAMG_3D + ["-adapt_model", model, "-accuracy", 0.1, "-accuracy_quantity",
                                                          "contact_force,pressure_peak,contact_size"]
@@ -255,8 +256,8 @@ def test_the_recovered_peak_pressure_reaches_a_tolerance_the_nodal_maximum_scatt
     err_peak, err_nodal = c["pressure_peak"] / p0 - 1, c["pressure_max"] / p0 - 1
     assert abs(err_peak[-1]) * p0[-1] <= a["accuracy_pressure_peak_bar"], (err_peak[-1], a["accuracy_pressure_peak_bar"] / p0[-1])
     assert np.all(np.abs(err_peak[-3:]) <= 0.01) and np.all(np.abs(err_nodal[-3:]) >= 2 * np.abs(err_peak[-3:])), (err_peak, err_nodal)
-    has_bar = np.isfinite(c["pressure_peak_bar"])
-    assert has_bar.sum() >= 2 and np.all(c["pressure_peak_bar"][has_bar] >= 2 * c["pressure_peak_resolution"][has_bar])
+    has_bar = np.isfinite(c["pressure_peak_bar"])  # every bar covers the peak's error against the closed form
+    assert has_bar.sum() >= 2 and np.all(np.abs(c["pressure_peak"] - p0)[has_bar] <= c["pressure_peak_bar"][has_bar]), (err_peak, c["pressure_peak_bar"] / p0)
     peak, se = recovered_peak(h5, 20)
     assert abs(a["pressure_peak"] / peak - 1) < 1e-10 and abs(a["pressure_peak_resolution"] / se - 1) < 1e-8, (a["pressure_peak"], peak, se)
 
