@@ -491,3 +491,30 @@ def test_a_missing_file_given_by_a_relative_path_says_where_it_was_looked_for(ca
         fh.write("scene: square\ndm_plex_filename: beside_the_options.msh\n")
     refused(["-options_file", opts], "relative_in_options",
             f"Mesh file 'beside_the_options.msh' (-dm_plex_filename) does not exist or cannot be read (a relative path, taken from the working directory {ROOT}")
+
+
+@pytest.mark.parametrize("np_", [1, 2])
+def test_a_later_obstacle_overrides_an_options_file_s(case_dir, np_):
+    """Later options override earlier ones, the obstacle's type too: an options file with a cylinder (-obstacle_center,
+    -obstacle_radius) and -obstacle plane after it on the command line solve the plane, the file's cylinder options
+    named in one line as ignored, and give the answer of a file without them (before, the cylinder's options were
+    refused as never used). A misspelled option is still refused, and a name no obstacle type reads in 2D
+    (-obstacle_axis) too."""
+    from harness import load
+    d = case_dir(f"obstacle_override_np{np_}")
+    common = "scene: general\ndm_plex_box_faces: 8,8\ncontact_faces: 1\nbc_clamp: 3\nbc_clamp_3_translate: 0,-0.01\n"
+    with open(os.path.join(d, "cylinder.yaml"), "w") as fh:
+        fh.write(common + "obstacle: cylinder\nobstacle_center: 0.5,-1\nobstacle_radius: 1\n")
+    with open(os.path.join(d, "plain.yaml"), "w") as fh:
+        fh.write(common)
+    plane = ["-obstacle", "plane", "-obstacle_point", "0,-0.002", "-obstacle_normal", "0,-1"]
+    out, h5 = run(["-options_file", os.path.join(d, "cylinder.yaml")] + plane, f"hostile/obstacle_override_np{np_}", np_=np_)
+    assert out.count("note: -obstacle plane does not use -obstacle_center -obstacle_radius") == 1, out
+    a, f = load(h5)
+    b, g = load(run(["-options_file", os.path.join(d, "plain.yaml")] + plane, f"hostile/obstacle_override_plain_np{np_}", np_=np_)[1])
+    assert a["obstacle"] == b["obstacle"] == "plane" and a["contact_force"] > 0, (a["obstacle"], a["contact_force"])
+    assert a["contact_force"] == b["contact_force"] and np.array_equal(f["displacement"], g["displacement"])
+    refused(["-options_file", os.path.join(d, "cylinder.yaml")] + plane + ["-obstacle_centre", "0,0"], f"obstacle_override_typo_np{np_}",
+            "never used (misspelled, or for a face set or obstacle not in use? see -help): -obstacle_centre (did you mean -obstacle_center?)", np_=np_)
+    refused(["-options_file", os.path.join(d, "cylinder.yaml"), "-obstacle_axis", "0,1"], f"obstacle_override_axis_np{np_}",
+            "never used (misspelled, or for a face set or obstacle not in use? see -help): -obstacle_axis", np_=np_)

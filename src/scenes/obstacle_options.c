@@ -54,6 +54,41 @@ static PetscErrorCode Normalize(MPI_Comm comm, const char name[], PetscInt dim, 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The geometry options of the obstacle types other than the one in use, in dim: an options file's cylinder, say, whose
+   -obstacle a later -obstacle plane overrides (later options override earlier ones). The type in use does not read
+   them, so that the typo check would refuse them; they are instead marked read and named in one line, as PETSc leaves
+   a KSP type's options unused under another type. A name no type reads in dim (-obstacle_axis in 2D) is still refused
+   as a typo. */
+static PetscErrorCode IgnoreOtherTypesOptions(MPI_Comm comm, ObstacleType type, PetscInt dim)
+{
+  const struct {
+    const char *name;
+    PetscBool   read[3]; /* by plane, sphere, cylinder */
+    PetscInt    min_dim;
+  } geometry[] = {
+      {"-obstacle_point", {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, 2}, {"-obstacle_normal", {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, 2},
+      {"-obstacle_center", {PETSC_FALSE, PETSC_TRUE, PETSC_TRUE}, 2}, {"-obstacle_radius", {PETSC_FALSE, PETSC_TRUE, PETSC_TRUE}, 2},
+      {"-obstacle_axis", {PETSC_FALSE, PETSC_FALSE, PETSC_TRUE}, 3},
+  };
+  char list[256] = "";
+
+  PetscFunctionBeginUser;
+  for (size_t k = 0; k < sizeof(geometry) / sizeof(geometry[0]); ++k) {
+    PetscBool set;
+
+    if (geometry[k].read[type] || dim < geometry[k].min_dim) continue;
+    PetscCall(PetscOptionsHasName(NULL, NULL, geometry[k].name, &set)); /* marks it read */
+    if (!set) continue;
+    PetscCall(PetscStrlcat(list, " ", sizeof(list)));
+    PetscCall(PetscStrlcat(list, geometry[k].name, sizeof(list)));
+  }
+  if (list[0])
+    PetscCall(PetscPrintf(
+        comm, "note: -obstacle %s does not use%s (another obstacle type's options, as an options file's that a later -obstacle overrides): ignored\n",
+        ObstacleTypes[type], list));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
 {
   MPI_Comm   comm = PetscObjectComm((PetscObject)dm);
@@ -110,5 +145,6 @@ PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
     }
   }
   PetscOptionsEnd();
+  PetscCall(IgnoreOtherTypesOptions(comm, obs->type, dim));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
