@@ -381,9 +381,10 @@ typedef struct {
 typedef enum { ACCURACY_ENERGY, ACCURACY_FORCE, ACCURACY_PRESSURE, ACCURACY_SIZE, ACCURACY_PEAK, ACCURACY_NUM } AccuracyQuantity;
 extern const char *const AccuracyQuantities[];
 /* Why the cycles stopped (/run adapt_stop): -accuracy reached, the cycles of -adapt_cycles done, the mesh at
-   -adapt_max_dofs, a failed solve, nothing left to refine (a zero estimate), or a fixed eps whose penalty part of a bar
-   is above the tolerance (no refinement lowers it); "interrupted" in the output each finished cycle writes while the
-   run goes on, which stays where a signal ends the run. */
+   -adapt_max_dofs, a failed solve, nothing left to refine (a zero estimate), a fixed eps whose penalty part of a bar
+   is above the tolerance (no refinement lowers it), the next cycle past -adapt_max_memory, or a tolerance whose bar
+   falls too slowly to reach it within that memory (AdaptOutOfReach()); "interrupted" in the output each finished cycle
+   writes while the run goes on, which stays where a signal ends the run. */
 typedef enum {
   ADAPT_STOP_ACCURACY,
   ADAPT_STOP_CYCLES,
@@ -392,11 +393,13 @@ typedef enum {
   ADAPT_STOP_NOTHING_MARKED,
   ADAPT_STOP_INTERRUPTED,
   ADAPT_STOP_FIXED_EPS,
-  ADAPT_STOP_MAX_MEMORY
+  ADAPT_STOP_MAX_MEMORY,
+  ADAPT_STOP_OUT_OF_REACH
 } AdaptStop;
 extern const char *const AdaptStops[];
 typedef struct {
   PetscInt  cycles;                    /* 0: no adaptive refinement; with -accuracy, the most cycles */
+  PetscBool run_to_budget;             /* -adapt_cycles or -adapt_max_dofs given: no stop for a tolerance out of reach */
   PetscReal fraction;                  /* -adapt_fraction (0: the default, AdaptSolve()'s) */
   PetscReal accuracy;                  /* -accuracy: the relative error asked for (0: none), */
   PetscBool target[ACCURACY_NUM];      /*   of these quantities (-accuracy_quantity; all false: the default, AdaptTargets()) */

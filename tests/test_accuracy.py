@@ -465,3 +465,44 @@ def test_a_memory_budget_stops_the_cycles_before_they_exceed_it(outdir):
     _, h5 = run(args + ["-adapt_max_memory", 0, "-adapt_max_dofs", int(c["n_dofs"][-1]) + 1], "memory_unbounded", output=os.path.join(outdir, "more.h5"))
     b, _ = load(h5)
     assert len(cycles(h5)["n_dofs"]) == len(c["n_dofs"]) + 1 and b["peak_memory_total_mb"] > 1.05 * 150, b["peak_memory_total_mb"]
+
+
+def test_a_tolerance_out_of_reach_within_the_memory_budget_stops_the_cycles():
+    """README's 3D box at -accuracy 0.1 on the energy alone, whose bar falls like N^(-1/3) in 3D, with a budget of
+    2,000 MB: once three cycles have bars over a growth of 2^3 in unknowns, the rate of the bar's envelope (its smallest
+    value so far against the first bar) puts the tolerance at a mesh predicted to take more than 4 times the budget, and
+    the cycles stop there (/run adapt_stop out_of_reach, not reached), saying the rate, the unknowns and the memory it
+    would take (AdaptOutOfReach()), recomputed here from /cycles; the cycle before did not. The cycles are those of the
+    same run given -adapt_cycles, which runs on to its budget: the rule decides where the cycles stop, never what they
+    compute."""
+    base = ["-dm_plex_dim", 3, "-accuracy", 0.1, "-accuracy_quantity", "energy", "-adapt_max_memory", 2000, "-contact_monitor", 0]
+    out, h5 = run(base, "accuracy_out_of_reach")
+    a, _ = load(h5)
+    c = cycles(h5)
+    assert a["adapt_stop"] == "out_of_reach" and a["accuracy_reached"] == 0, a["adapt_stop"]
+    n, rel, mem = c["n_dofs"], c["energy_bar"] / np.abs(c["energy_value"]), c["memory_mb"]
+
+    def need(k):
+        """(rate, unknowns, MB) of the rule at cycle k, or None before it applies."""
+        bars = [m for m in range(k + 1) if np.isfinite(rel[m])]
+        if len(bars) < 3 or n[k] < 8 * n[bars[0]] or min(rel[bars]) <= 0.1:
+            return None
+        envelope = min(rel[bars])
+        r = np.log(rel[bars[0]] / envelope) / np.log(n[k] / n[bars[0]])
+        unknowns = n[k] * (envelope / 0.1) ** (1 / r)
+        grown = max(mem[k] - mem[k - 1], 0.0)
+        return r, unknowns, mem[k] + grown * (unknowns ** (4 / 3) - n[k] ** (4 / 3)) / (n[k] ** (4 / 3) - n[k - 1] ** (4 / 3))
+
+    k = len(n) - 1
+    r, unknowns, mb = need(k)
+    assert mb > 4 * 2000 and 0.2 <= r <= 0.5, (r, unknowns, mb)  # the energy's order in 3D, 1/3
+    assert need(k - 1) is None or need(k - 1)[2] <= 4 * 2000, need(k - 1)
+    m = re.search(r"-accuracy 0.1 out of reach: the bar of energy fell as N\^\(-(\S+)\) over the cycles with bars \((\S+)% at cycle (\d+)\); at "
+                  r"that rate it reaches the tolerance at about (\S+) unknowns, about (\S+) MB, more than 4 times -adapt_max_memory 2000 MB", out)
+    assert m and int(m[3]) == k, out[-2500:]
+    assert abs(float(m[1]) / r - 1) < 0.05 and abs(float(m[4]) / unknowns - 1) < 0.05 and abs(float(m[5]) / mb - 1) < 0.05, (m.groups(), r, unknowns, mb)
+    assert "a bar falls too slowly to reach it within -adapt_max_memory" in out
+    _, h5_on = run(base + ["-adapt_cycles", k + 1], "accuracy_out_of_reach_cycles")
+    on = cycles(h5_on)
+    assert load(h5_on)[0]["adapt_stop"] == "cycles" and np.array_equal(on["n_dofs"][: k + 1], n), (on["n_dofs"], n)
+    assert np.allclose(on["estimate"][: k + 1], c["estimate"], rtol=1e-12, atol=0)

@@ -22,7 +22,7 @@ CYCLES_BEFORE_SIGNAL = 6
 def interrupted_run(h5, np_, sig):
     """Runs -accuracy 0.001 (about 14 cycles) and sends sig once the monitor's line of cycle CYCLES_BEFORE_SIGNAL is
     out; returns (exit status, console output)."""
-    cmd = ([BIN] if np_ == 1 else ["mpiexec", "-n", str(np_), BIN]) + INDENT + ["-accuracy", "0.001", "-output", h5]
+    cmd = ([BIN] if np_ == 1 else ["mpiexec", "-n", str(np_), BIN]) + INDENT + ["-accuracy", "0.001", "-adapt_cycles", "40", "-output", h5]
     env = {**os.environ, **MPI_ENV, **(SINGLETON_ENV if np_ == 1 else {})}
     proc = subprocess.Popen(cmd, cwd=ROOT, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True)
     lines, t0 = [], time.monotonic()

@@ -33,8 +33,8 @@
 
 #define ADAPT_ACCURACY_CYCLES 40 /* -accuracy's most cycles unless -adapt_cycles says */
 
-const char *const AdaptStops[] = {"accuracy",  "cycles",      "max_dofs", "solve_failed", "nothing_marked", "interrupted", "fixed_eps", "max_memory",
-                                  "AdaptStop", "ADAPT_STOP_", NULL};
+const char *const AdaptStops[] = {"accuracy",  "cycles",     "max_dofs",     "solve_failed", "nothing_marked", "interrupted",
+                                  "fixed_eps", "max_memory", "out_of_reach", "AdaptStop",    "ADAPT_STOP_",    NULL};
 
 /* The default memory budget of the cycles, MB over all ranks: ADAPT_MEMORY_SHARE of what each rank's node had available
    at the start (/proc/meminfo's MemAvailable, shared by the ranks on the node) plus what the rank held then, so that
@@ -143,6 +143,7 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
   PetscCall(OptionsCheckFinite(comm, "-adapt_max_memory", ad->max_memory));
   PetscCheck(ad->max_memory >= 0.0, comm, PETSC_ERR_USER_INPUT, "-adapt_max_memory must be >= 0 MB (0: no limit), got %g", (double)ad->max_memory);
   if (!ad->max_memory_given && (ad->cycles > 0 || ad->accuracy > 0.0)) PetscCall(AdaptDefaultMemory(comm, &ad->max_memory));
+  ad->run_to_budget = (PetscBool)(cycles_given || ad->max_dofs > 0);
   PetscCheck(!fraction_given || (ad->fraction > 0.0 && ad->fraction <= 1.0), comm, PETSC_ERR_USER_INPUT, "-adapt_fraction must lie in (0, 1], got %g",
              (double)ad->fraction);
   PetscCheck(ad->accuracy >= 0.0 && ad->accuracy < 1.0, comm, PETSC_ERR_USER_INPUT, "-accuracy is a relative error in (0, 1), got %g",
@@ -486,15 +487,67 @@ static PetscErrorCode AdaptCycleMemory(MPI_Comm comm, PetscReal *mb)
    (g the last growth of the unknowns), p = 1.2 in 2D and 4/3 in 3D, a sparse direct factorization's fill (n log n and
    n^(4/3) on 2D and 3D meshes), which bounds an iterative solver's. The difference leaves out what does not grow with
    the mesh: the libraries and the set-up, much of it loaded after the options phase. */
+static PetscReal AdaptMemoryAt(const AppCtx *user, PetscInt k, PetscInt dim, PetscReal n)
+{
+  const CycleRecord *c  = user->rec.cycles;
+  const PetscReal    p  = dim == 3 ? 4.0 / 3.0 : 1.2;
+  const PetscReal    nk = PetscPowReal((PetscReal)c[k].n_dofs, p), nk1 = PetscPowReal((PetscReal)c[k - 1].n_dofs, p), at = PetscPowReal(n, p);
+  const PetscReal    grown = PetscMax(c[k].memory_mb - c[k - 1].memory_mb, 0.0);
+
+  return c[k].memory_mb + (nk > nk1 ? grown * (at - nk) / (nk - nk1) : 0.0);
+}
+
 static void AdaptPredictMemory(const AppCtx *user, PetscInt k, PetscInt dim, PetscReal *mb, PetscReal *growth)
 {
   const CycleRecord *c = user->rec.cycles;
-  const PetscReal    p = dim == 3 ? 4.0 / 3.0 : 1.2, g = PetscMax((PetscReal)c[k].n_dofs / (PetscReal)c[k - 1].n_dofs, 1.0);
-  const PetscReal    nk = PetscPowReal((PetscReal)c[k].n_dofs, p), nk1 = PetscPowReal((PetscReal)c[k - 1].n_dofs, p), next = nk * PetscPowReal(g, p);
-  const PetscReal    grown = PetscMax(c[k].memory_mb - c[k - 1].memory_mb, 0.0);
 
-  *growth = g;
-  *mb     = c[k].memory_mb + (nk > nk1 ? grown * (next - nk) / (nk - nk1) : 0.0);
+  *growth = PetscMax((PetscReal)c[k].n_dofs / (PetscReal)c[k - 1].n_dofs, 1.0);
+  *mb     = AdaptMemoryAt(user, k, dim, *growth * (PetscReal)c[k].n_dofs);
+}
+
+/* Whether -accuracy is out of reach within -adapt_max_memory: a quantity asked for whose bar falls so slowly with the
+   cycles that, at the rate it fell, it reaches the tolerance only on a mesh predicted (AdaptMemoryAt()) to take more
+   than ADAPT_REACH_MARGIN times the memory budget, so that the cycles would end at the budget anyway, not reached.
+   The rate: with b_j the relative bar of the first cycle j with a bar and e_k the smallest relative bar up to cycle k
+   (the envelope, so that a bar's scatter from cycle to cycle, the recovered peak's on tetrahedra, does not read as a
+   stall), e_k = b_j (N_k / N_j)^(-r), and the tolerance T needs N = N_k (e_k / T)^(1/r) unknowns; r <= 0 needs an
+   infinite mesh. The rate is taken once at least three cycles have bars and the unknowns grew 2^dim times over them,
+   and the margin covers its extrapolation. A run given -adapt_cycles or -adapt_max_dofs runs on to them (the user's
+   budget). Returns the quantity that needs the largest mesh (-1: none), that mesh's unknowns, its memory and its rate. */
+#define ADAPT_REACH_MARGIN 4.0
+static PetscInt AdaptOutOfReach(const AppCtx *user, const PetscBool target[], PetscInt k, PetscInt dim, PetscReal *n_need, PetscReal *mb_need,
+                                PetscReal *rate)
+{
+  const AdaptOptions *ad    = &user->opt->adapt;
+  const CycleRecord  *c     = user->rec.cycles;
+  PetscInt            worst = -1;
+
+  *n_need = *mb_need = *rate = 0.0;
+  if (!(ad->accuracy > 0.0) || ad->run_to_budget || !(ad->max_memory > 0.0) || k < 1) return -1;
+  for (PetscInt q = 0; q < ACCURACY_NUM; ++q) {
+    PetscInt  first = -1, nbars = 0;
+    PetscReal envelope = PETSC_MAX_REAL, r, n;
+
+    if (!target[q] || c[k].value[q] == 0.0 || !(c[k].bar[q] > ad->accuracy * PetscAbsReal(c[k].value[q]))) continue;
+    for (PetscInt m = 0; m <= k; ++m) {
+      if (PetscIsNanReal(c[m].bar[q]) || c[m].value[q] == 0.0) continue;
+      if (first < 0) first = m;
+      envelope = PetscMin(envelope, c[m].bar[q] / PetscAbsReal(c[m].value[q]));
+      ++nbars;
+    }
+    if (nbars < 3 || (PetscReal)c[k].n_dofs < PetscPowReal(2.0, dim) * (PetscReal)c[first].n_dofs || envelope <= ad->accuracy) continue;
+    r = PetscLogReal(c[first].bar[q] / PetscAbsReal(c[first].value[q]) / envelope) /
+        PetscLogReal((PetscReal)c[k].n_dofs / (PetscReal)c[first].n_dofs);
+    n = r > 0.0 ? (PetscReal)c[k].n_dofs * PetscPowReal(envelope / ad->accuracy, 1.0 / r) : PETSC_INFINITY;
+    if (worst < 0 || n > *n_need) {
+      worst   = q;
+      *n_need = n;
+      *rate   = r;
+    }
+  }
+  if (worst < 0) return -1;
+  *mb_need = PetscIsInfReal(*n_need) ? PETSC_INFINITY : AdaptMemoryAt(user, k, dim, *n_need);
+  return *mb_need > ADAPT_REACH_MARGIN * ad->max_memory ? worst : -1;
 }
 
 /* Cycle k finished and another follows: the output written now, with /run adapt_stop = interrupted, so that a run
@@ -543,8 +596,8 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     PetscLogDouble t0, t1;
     SolverStart    start;
     PetscBool      at_max, done, at_memory;
-    PetscInt       fixed_eps;
-    PetscReal      next_mb = 0.0, growth = 1.0;
+    PetscInt       fixed_eps, unreachable = -1;
+    PetscReal      next_mb = 0.0, growth = 1.0, n_need = 0.0, mb_need = 0.0, rate = 0.0;
 
     PetscCall(AdaptRecord(*dm, user, *u, k));
     PetscCall(AdaptQuantitiesAtSmallerEps(*dm, user, *snes, *u, c));
@@ -560,8 +613,9 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     if (!c->accurate && !at_max && fixed_eps < 0 && k < ad->cycles && ad->max_memory > 0.0 && k > 0) { /* from the first measured growth */
       AdaptPredictMemory(user, k, dim, &next_mb, &growth);
       at_memory = (PetscBool)(next_mb > ad->max_memory);
+      if (!at_memory) unreachable = AdaptOutOfReach(user, user->rec.accuracy_target, k, dim, &n_need, &mb_need, &rate);
     }
-    if (!c->accurate && k < ad->cycles && user->rec.stats.converged && !at_max && fixed_eps < 0 && !at_memory) {
+    if (!c->accurate && k < ad->cycles && user->rec.stats.converged && !at_max && fixed_eps < 0 && !at_memory && unreachable < 0) {
       PetscCall(EstimateMark(*dm, &user->rec.estimate, user->rec.adapt_fraction, &marked, &c->marked));
       if (ad->mark_edge && ad->accuracy > 0.0 && user->rec.accuracy_target[ACCURACY_SIZE] &&
           c->q.contact_size_band > ad->accuracy * PetscAbsReal(c->q.contact_size))
@@ -570,7 +624,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     PetscCall(PetscTime(&t0)); /* the cycle: its mesh, its solve (the first solve for cycle 0), estimate and marking */
     c->time_cycle = (t0 - t_last) + (k == 0 ? c->time_solve : 0.0);
     t_last        = t0;
-    done          = (PetscBool)(c->accurate || !user->rec.stats.converged || at_max || fixed_eps >= 0 || at_memory || k == ad->cycles ||
+    done = (PetscBool)(c->accurate || !user->rec.stats.converged || at_max || fixed_eps >= 0 || at_memory || unreachable >= 0 || k == ad->cycles ||
                        (!c->marked && !c->marked_edge && !c->unseen)); /* done, or a zero estimate: nothing to refine */
     ck_since += c->time_cycle;
     if (!done && (ck_cost == 0.0 || ck_since >= ADAPT_CHECKPOINT_RATIO * ck_cost)) { /* what a signal during the next cycles leaves */
@@ -590,6 +644,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
                              : at_max                     ? ADAPT_STOP_MAX_DOFS
                              : fixed_eps >= 0             ? ADAPT_STOP_FIXED_EPS
                              : at_memory                  ? ADAPT_STOP_MAX_MEMORY
+                             : unreachable >= 0           ? ADAPT_STOP_OUT_OF_REACH
                              : k == ad->cycles            ? ADAPT_STOP_CYCLES
                                                           : ADAPT_STOP_NOTHING_MARKED;
       if (at_memory)
@@ -599,6 +654,22 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
                               "%" PetscInt_FMT "\n",
                               (double)next_mb, (double)growth, (double)ad->max_memory,
                               ad->max_memory_given ? "" : " (80% of the memory available at the start)", k));
+      if (unreachable >= 0) {
+        char need[128];
+
+        if (PetscIsInfReal(n_need))
+          PetscCall(PetscSNPrintf(need, sizeof(need), "it does not fall, and no mesh reaches the tolerance"));
+        else
+          PetscCall(
+              PetscSNPrintf(need, sizeof(need), "it reaches the tolerance at about %.2g unknowns, about %.2g MB", (double)n_need, (double)mb_need));
+        PetscCall(PetscPrintf(PetscObjectComm((PetscObject)*dm),
+                              "  -accuracy %g out of reach: the bar of %s fell as N^(-%.2g) over the cycles with bars (%.2g%% at cycle %" PetscInt_FMT
+                              "); at that rate %s, more than %d times -adapt_max_memory %.0f MB%s: the cycles stop at cycle %" PetscInt_FMT
+                              " (-adapt_cycles N or -adapt_max_dofs N runs on to that budget)\n",
+                              (double)ad->accuracy, AccuracyQuantities[unreachable], (double)rate,
+                              (double)(100.0 * c->bar[unreachable] / PetscAbsReal(c->value[unreachable])), k, need, (int)ADAPT_REACH_MARGIN,
+                              (double)ad->max_memory, ad->max_memory_given ? "" : " (80% of the memory available at the start)", k));
+      }
       if (fixed_eps >= 0) {
         const PetscReal part = CycleBarsPenaltyPart(c, fixed_eps);
 
@@ -673,10 +744,11 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
           comm, "  WARNING: accuracy %g not reached after %" PetscInt_FMT " cycles (%" PetscInt_FMT " dofs)%s%s%s; the last cycle's bars:\n",
           (double)ad->accuracy, user->rec.ncycles - 1, c->n_dofs, UnseenHolds(ad, c) ? ": the mesh does not see the contact at some nodes" : "",
           !c->converged ? ": the last solve failed" : "",
-          user->rec.adapt_stop == ADAPT_STOP_MAX_DOFS     ? ": the mesh reached -adapt_max_dofs"
-          : user->rec.adapt_stop == ADAPT_STOP_MAX_MEMORY ? ": the next cycle would exceed -adapt_max_memory"
-          : user->rec.adapt_stop == ADAPT_STOP_FIXED_EPS  ? ": the fixed eps's penalty part of a bar is above the tolerance (-penalty_eps)"
-                                                          : ""));
+          user->rec.adapt_stop == ADAPT_STOP_MAX_DOFS       ? ": the mesh reached -adapt_max_dofs"
+          : user->rec.adapt_stop == ADAPT_STOP_MAX_MEMORY   ? ": the next cycle would exceed -adapt_max_memory"
+          : user->rec.adapt_stop == ADAPT_STOP_FIXED_EPS    ? ": the fixed eps's penalty part of a bar is above the tolerance (-penalty_eps)"
+          : user->rec.adapt_stop == ADAPT_STOP_OUT_OF_REACH ? ": a bar falls too slowly to reach it within -adapt_max_memory"
+                                                            : ""));
     for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
       if (!user->rec.accuracy_target[k]) continue;
       if (PetscIsNanReal(c->bar[k]))
