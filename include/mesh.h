@@ -125,6 +125,9 @@ PetscErrorCode                  MeshTransferDestroy(MeshTransfer *tr);
 /* mesh_remesh.c: the Gmsh model meshed again with a size per cell of dm (-adapt_model), or the box of the options
    (model "" and box); with loc (dm's local field), *tr carries it to the new mesh */
 PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const PetscReal size[], Vec loc, DM *remeshed, MeshTransfer *tr);
+/* which "Face Sets" values a face carries on some rank (present[v], v < n) */
+PetscErrorCode MeshFaceSetValues(DM dm, PetscInt *n, PetscBool **present);
+/* mesh_model_check.c: a model the cycles could not remesh as the mesh's body, refused before the first solve */
 PetscErrorCode MeshRemeshCheckModel(DM dm, const char model[]);
 
 /* mesh_partition.c */

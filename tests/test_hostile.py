@@ -498,8 +498,9 @@ def test_a_later_obstacle_overrides_an_options_file_s(case_dir, np_):
     """Later options override earlier ones, the obstacle's type too: an options file with a cylinder (-obstacle_center,
     -obstacle_radius) and -obstacle plane after it on the command line solve the plane, the file's cylinder options
     named in one line as ignored, and give the answer of a file without them (before, the cylinder's options were
-    refused as never used). A misspelled option is still refused, and a name no obstacle type reads in 2D
-    (-obstacle_axis) too."""
+    refused as never used). A misspelled option is still refused, and so are another type's option on the command
+    line itself (tests/test_boundary.py: -obstacle plane -obstacle_radius 1) and a name no obstacle type reads in 2D
+    (-obstacle_axis)."""
     from harness import load
     d = case_dir(f"obstacle_override_np{np_}")
     common = "scene: general\ndm_plex_box_faces: 8,8\ncontact_faces: 1\nbc_clamp: 3\nbc_clamp_3_translate: 0,-0.01\n"

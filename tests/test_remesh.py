@@ -6,6 +6,7 @@ on the model's curved surface, -accuracy ends within the tolerance of the closed
 refusals."""
 
 import os
+import re
 
 import h5py
 import numpy as np
@@ -427,6 +428,34 @@ def test_a_model_the_cycles_cannot_remesh_is_refused_before_the_solve(case, disk
                "dimension": "the model is 3D and the mesh 2D"}[case]
     refused(case_args("cylinder", mesh) + ["-adapt_model", given, "-accuracy", 0.1], f"model_{case}", f"-adapt_model {given}")
     refused(case_args("cylinder", mesh) + ["-adapt_model", given, "-accuracy", 0.1], f"model_{case}", message)
+
+
+CHORD_MODEL = """// The quarter disk's chord: the triangle (0,0), (1,1), (0,1), with the quarter disk's bounding box and groups
+Point(1) = {0, 0, 0}; Point(2) = {1, 1, 0}; Point(3) = {0, 1, 0};
+Line(1) = {1, 2}; Line(2) = {2, 3}; Line(3) = {3, 1};
+Curve Loop(1) = {1, 2, 3}; Plane Surface(1) = {1};
+Physical Curve("contact", 1) = {1}; Physical Curve("top", 3) = {2}; Physical Curve("symmetry_x", 4) = {3};
+Physical Surface("body", 10) = {1};
+"""
+
+
+@pytest.mark.parametrize("np_", [1, 2])
+def test_a_model_of_another_body_in_the_same_box_with_the_same_groups_is_refused(disk, tmp_path, np_):
+    """The triangle under the quarter disk's arc, with the disk's bounding box and physical groups: the bounding box
+    and the groups pass, but the mesh's boundary does not lie on it (MeshRemeshCheckModel(): each boundary vertex
+    within a tenth of its face's longest edge of the model's entities of its face set's group). Refused before the
+    first solve, naming the vertex farthest off, on 1 and 2 ranks (where the faces between the ranks are no boundary);
+    the disk's own model passes there."""
+    mesh, model = disk
+    chord = tmp_path / "chord.geo"
+    chord.write_text(CHORD_MODEL)
+    args = case_args("cylinder", mesh) + ["-adapt_cycles", 1]
+    refused(args + ["-adapt_model", str(chord)], f"model_chord_np{np_}", f"-adapt_model {chord}: the mesh's boundary vertex (", np_=np_)
+    out, _ = run(args + ["-adapt_model", str(chord)], f"model_chord_text_np{np_}", np_=np_, expect_rc=2)
+    m = re.search(r"of face set 1, lies (\S+) from the model's physical group 1 \(more than a tenth of its face's longest edge, (\S+)\)", out)
+    assert m and float(m[1]) > 0.1 * float(m[2]) and float(m[1]) <= 1 - 2 ** -0.5 + 1e-9, out[-1500:]  # the arc is at most 1 - cos 45 deg off its chord
+    _, h5 = run(args + ["-adapt_model", model], f"model_own_np{np_}", np_=np_)
+    assert load(h5)[0]["converged"] == 1 and len(cycles(h5)["n_dofs"]) == 2
 
 
 @pytest.mark.parametrize("np_", [1, 2])

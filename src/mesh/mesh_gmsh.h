@@ -13,8 +13,10 @@
   X(gmshModelAdd)                          \
   X(gmshModelAddPhysicalGroup)             \
   X(gmshModelGetBoundingBox)               \
+  X(gmshModelGetClosestPoint)              \
   X(gmshModelGetDimension)                 \
   X(gmshModelGetEntities)                  \
+  X(gmshModelGetEntitiesForPhysicalGroup)  \
   X(gmshModelGetPhysicalGroups)            \
   X(gmshModelGetPhysicalGroupsForEntity)   \
   X(gmshModelGetPhysicalName)              \

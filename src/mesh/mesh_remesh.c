@@ -33,8 +33,6 @@
 #include <unistd.h>
 #include "mesh_gmsh.h"
 
-#define MESH_MODEL_BOX_TOL 0.05 /* the mesh's bounding box within this fraction of the model's extent */
-
 /* The 3D box of the options as a Gmsh model (a 2D box is refined by PETSc, AdaptSolve()): an OpenCASCADE box, its
    sides' physical groups numbered as PETSc numbers them (MeshBoxFaceId(), found by their bounding boxes), the body 10. */
 static PetscErrorCode GmshBoxModel(const MeshBox *box)
@@ -185,7 +183,7 @@ static PetscErrorCode SortCells(PetscInt ncells, PetscInt nv, double data[])
 }
 
 /* The "Face Sets" values the faces of dm carry, over all ranks: present[v] for v < *n (free with PetscFree). */
-static PetscErrorCode FaceSetValues(DM dm, PetscInt *n, PetscBool **present)
+PetscErrorCode MeshFaceSetValues(DM dm, PetscInt *n, PetscBool **present)
 {
   DMLabel         label;
   IS              is = NULL;
@@ -224,8 +222,8 @@ static PetscErrorCode CheckFaceSets(DM dm, DM remeshed, const char model[])
   PetscBool *old_sets, *new_sets;
 
   PetscFunctionBeginUser;
-  PetscCall(FaceSetValues(dm, &n_old, &old_sets));
-  PetscCall(FaceSetValues(remeshed, &n_new, &new_sets));
+  PetscCall(MeshFaceSetValues(dm, &n_old, &old_sets));
+  PetscCall(MeshFaceSetValues(remeshed, &n_new, &new_sets));
   for (PetscInt i = 0; i < n_old; ++i)
     PetscCheck(!old_sets[i] || (i < n_new && new_sets[i]), PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT,
                "-adapt_model %s: the mesh Gmsh made of the model has no face in the face set %" PetscInt_FMT
@@ -233,113 +231,6 @@ static PetscErrorCode CheckFaceSets(DM dm, DM remeshed, const char model[])
                model[0] ? model : "(the box of the options)", i);
   PetscCall(PetscFree(old_sets));
   PetscCall(PetscFree(new_sets));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* Rank 0's part of MeshRemeshCheckModel(): the model opened, its dimension, its bounding box and which of the face sets
-   in need (need[v] for v < n) are no physical group of its faces; why[] says what is wrong ("" if nothing). */
-static PetscErrorCode GmshCheckModel(const char model[], PetscInt dim, const PetscReal lo[], const PetscReal hi[], PetscInt n, const PetscBool need[],
-                                     char why[], size_t len)
-{
-  int   *dimtags = NULL, mdim;
-  size_t ntags   = 0;
-  double bb[6];
-
-  PetscFunctionBeginUser;
-  why[0] = '\0';
-  PetscCall(MeshGmshLoad());
-  GmshCall(gmsh_api.gmshInitialize(0, NULL, 0, &ierr_gmsh), "start");
-  GmshCall(gmsh_api.gmshOptionSetNumber("General.Terminal", 0, &ierr_gmsh), "set General.Terminal");
-  GmshCall(gmsh_api.gmshOpen(model, &ierr_gmsh), "read the model");
-  GmshCall(mdim = gmsh_api.gmshModelGetDimension(&ierr_gmsh), "get the model's dimension");
-  if (mdim != (int)dim) {
-    PetscCall(PetscSNPrintf(why, len, "the model is %dD and the mesh %" PetscInt_FMT "D", mdim, dim));
-    GmshCall(gmsh_api.gmshFinalize(&ierr_gmsh), "finish");
-    PetscFunctionReturn(PETSC_SUCCESS);
-  }
-  GmshCall(gmsh_api.gmshModelGetBoundingBox(-1, -1, &bb[0], &bb[1], &bb[2], &bb[3], &bb[4], &bb[5], &ierr_gmsh), "bound the model");
-  for (PetscInt d = 0; d < dim && !why[0]; ++d) {
-    const PetscReal extent = PetscMax(hi[d] - lo[d], bb[3 + d] - bb[d]), tol = MESH_MODEL_BOX_TOL * extent + 1e-6;
-
-    if (PetscAbsReal(bb[d] - lo[d]) > tol || PetscAbsReal(bb[3 + d] - hi[d]) > tol)
-      PetscCall(
-          PetscSNPrintf(why, len, "the model spans [%g, %g] along %c, the mesh [%g, %g]", bb[d], bb[3 + d], "xyz"[d], (double)lo[d], (double)hi[d]));
-  }
-  GmshCall(gmsh_api.gmshModelGetPhysicalGroups(&dimtags, &ntags, (int)dim - 1, &ierr_gmsh), "list the model's physical groups");
-  for (PetscInt v = 0; v < n && !why[0]; ++v) {
-    PetscBool found = PETSC_FALSE;
-
-    if (!need[v]) continue;
-    for (size_t i = 0; i < ntags / 2 && !found; ++i) found = (PetscBool)(dimtags[2 * i + 1] == (int)v);
-    if (!found)
-      PetscCall(PetscSNPrintf(why, len, "the model has no physical group of %s numbered %" PetscInt_FMT ", the mesh's face set %" PetscInt_FMT,
-                              dim == 2 ? "curves" : "surfaces", v, v));
-  }
-  if (dimtags) gmsh_api.gmshFree(dimtags);
-  GmshCall(gmsh_api.gmshFinalize(&ierr_gmsh), "finish");
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* Refuses, before any solve, a model the cycles could not remesh as the mesh's body: a mesh file given in its place
-   (a .msh opens in Gmsh as a discrete model, which remeshing cannot refine), a model Gmsh cannot read, one of another
-   dimension, one whose bounding box is not the mesh's (another body), and one without a physical group for each face
-   set of the mesh (CheckFaceSets() checks the remeshed mesh again). The box's tolerance is MESH_MODEL_BOX_TOL of its extent: a
-   curved boundary's mesh lies inside its model by about h^2 / 8R. */
-PetscErrorCode MeshRemeshCheckModel(DM dm, const char model[])
-{
-  MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
-  PetscMPIInt rank;
-  PetscInt    dim, n;
-  PetscBool  *need, msh;
-  PetscReal   lo[3] = {PETSC_MAX_REAL, PETSC_MAX_REAL, PETSC_MAX_REAL}, hi[3] = {PETSC_MIN_REAL, PETSC_MIN_REAL, PETSC_MIN_REAL};
-  char        why[1024] = "";
-  int         failed    = 0;
-
-  PetscFunctionBeginUser;
-  if (!model[0]) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscStrendswith(model, ".msh", &msh));
-  PetscCheck(!msh, comm, PETSC_ERR_USER_INPUT,
-             "-adapt_model %s is a mesh file, not a model: Gmsh cannot remesh a mesh finer; give the body's model (.geo; scripts/make_mesh.py "
-             "--model FILE.geo writes the model of its meshes)",
-             model);
-  PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  PetscCall(DMGetDimension(dm, &dim));
-  {
-    Vec                coords;
-    const PetscScalar *x;
-    PetscInt           nloc, cdim;
-
-    PetscCall(DMGetCoordinateDim(dm, &cdim));
-    PetscCall(DMGetCoordinatesLocal(dm, &coords));
-    PetscCall(VecGetLocalSize(coords, &nloc));
-    PetscCall(VecGetArrayRead(coords, &x));
-    for (PetscInt i = 0; i < nloc / cdim; ++i)
-      for (PetscInt d = 0; d < cdim; ++d) {
-        lo[d] = PetscMin(lo[d], PetscRealPart(x[i * cdim + d]));
-        hi[d] = PetscMax(hi[d], PetscRealPart(x[i * cdim + d]));
-      }
-    PetscCall(VecRestoreArrayRead(coords, &x));
-    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, lo, 3, MPIU_REAL, MPIU_MIN, comm));
-    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, hi, 3, MPIU_REAL, MPIU_MAX, comm));
-  }
-  PetscCall(FaceSetValues(dm, &n, &need));
-  if (rank == 0) {
-    PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-    failed = GmshCheckModel(model, dim, lo, hi, n, need, why, sizeof(why));
-    PetscCall(PetscPopErrorHandler());
-    if (failed) {
-      const char *text     = NULL;
-      char       *specific = NULL;
-      int         ierr_gmsh;
-
-      if (gmsh_api.gmshFinalize) gmsh_api.gmshFinalize(&ierr_gmsh);
-      PetscCall(PetscErrorMessage(failed, &text, &specific));
-      PetscCall(PetscStrncpy(why, specific && specific[0] ? specific : text, sizeof(why)));
-    }
-  }
-  PetscCall(PetscFree(need));
-  PetscCallMPI(MPI_Bcast(why, sizeof(why), MPI_CHAR, 0, comm));
-  PetscCheck(!why[0], comm, PETSC_ERR_USER_INPUT, "-adapt_model %s: %s: is it the model of the mesh?", model, why);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -54,12 +54,27 @@ static PetscErrorCode Normalize(MPI_Comm comm, const char name[], PetscInt dim, 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The geometry options of the obstacle types other than the one in use, in dim: an options file's cylinder, say, whose
-   -obstacle a later -obstacle plane overrides (later options override earlier ones). The type in use does not read
-   them, so that the typo check would refuse them; they are instead marked read and named in one line, as PETSc leaves
-   a KSP type's options unused under another type. A name no type reads in dim (-obstacle_axis in 2D) is still refused
-   as a typo. */
-static PetscErrorCode IgnoreOtherTypesOptions(MPI_Comm comm, ObstacleType type, PetscInt dim)
+/* Whether -name is on the command line itself (not in an options file it names). */
+static PetscErrorCode OnCommandLine(const char name[], PetscBool *on)
+{
+  int    argc;
+  char **args;
+
+  PetscFunctionBeginUser;
+  *on = PETSC_FALSE;
+  PetscCall(PetscGetArgs(&argc, &args));
+  for (int i = 1; i < argc && !*on; ++i) PetscCall(PetscStrcmp(args[i], name, on));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The geometry options of the obstacle types other than the one in use, in dim, where the command line's -obstacle
+   overrides an options file's (later options override earlier ones): the file's cylinder options under the command
+   line's -obstacle plane. The type in use does not read them, so that the typo check would refuse them; they are
+   instead marked read and named in one line, as PETSc leaves a KSP type's options unused under another type. Another
+   type's option given on the command line itself (-obstacle plane -obstacle_radius 1), or in a file whose type the
+   command line does not override, is still refused as unused, and so is a name no type reads in dim (-obstacle_axis
+   in 2D). */
+static PetscErrorCode OtherTypesGetOptions(MPI_Comm comm, ObstacleType type, PetscInt dim)
 {
   const struct {
     const char *name;
@@ -70,22 +85,27 @@ static PetscErrorCode IgnoreOtherTypesOptions(MPI_Comm comm, ObstacleType type, 
       {"-obstacle_center", {PETSC_FALSE, PETSC_TRUE, PETSC_TRUE}, 2}, {"-obstacle_radius", {PETSC_FALSE, PETSC_TRUE, PETSC_TRUE}, 2},
       {"-obstacle_axis", {PETSC_FALSE, PETSC_FALSE, PETSC_TRUE}, 3},
   };
-  char list[256] = "";
+  char      list[256] = "";
+  PetscBool overridden;
 
   PetscFunctionBeginUser;
-  for (size_t k = 0; k < sizeof(geometry) / sizeof(geometry[0]); ++k) {
-    PetscBool set;
+  PetscCall(OnCommandLine("-obstacle", &overridden));
+  for (size_t k = 0; k < sizeof(geometry) / sizeof(geometry[0]) && overridden; ++k) {
+    PetscBool set, given_here;
 
     if (geometry[k].read[type] || dim < geometry[k].min_dim) continue;
+    PetscCall(OnCommandLine(geometry[k].name, &given_here));
+    if (given_here) continue;
     PetscCall(PetscOptionsHasName(NULL, NULL, geometry[k].name, &set)); /* marks it read */
     if (!set) continue;
     PetscCall(PetscStrlcat(list, " ", sizeof(list)));
     PetscCall(PetscStrlcat(list, geometry[k].name, sizeof(list)));
   }
   if (list[0])
-    PetscCall(PetscPrintf(
-        comm, "note: -obstacle %s does not use%s (another obstacle type's options, as an options file's that a later -obstacle overrides): ignored\n",
-        ObstacleTypes[type], list));
+    PetscCall(PetscPrintf(comm,
+                          "note: -obstacle %s does not use%s (another obstacle type's options, from an options file whose -obstacle the command line "
+                          "overrides): ignored\n",
+                          ObstacleTypes[type], list));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -145,6 +165,6 @@ PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
     }
   }
   PetscOptionsEnd();
-  PetscCall(IgnoreOtherTypesOptions(comm, obs->type, dim));
+  PetscCall(OtherTypesGetOptions(comm, obs->type, dim));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
