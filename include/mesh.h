@@ -129,6 +129,8 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
 PetscErrorCode MeshFaceSetValues(DM dm, PetscInt *n, PetscBool **present);
 /* mesh_model_check.c: a model the cycles could not remesh as the mesh's body, refused before the first solve */
 PetscErrorCode MeshRemeshCheckModel(DM dm, const char model[]);
+/* mesh_remesh_caps.c: caps over the boundary faces of MeshRemesh()'s size view (cells of nv vertices, 4 nv doubles each) */
+PetscErrorCode MeshRemeshViewCaps(PetscInt ncells, PetscInt nv, PetscInt dim, const double data[], PetscInt *ncaps, double **caps);
 
 /* mesh_partition.c */
 PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm);

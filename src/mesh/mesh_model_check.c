@@ -149,6 +149,49 @@ static PetscErrorCode GmshCheckBoundaryOnModel(PetscInt dim, PetscInt n, const d
     }
     if (tags) gmsh_api.gmshFree(tags);
   }
+  /* a vertex where the group's entity ends (the end of an arc, a face's edge in 3D): Gmsh's closest point of the
+     entity may miss that end (the half disk's 180-degree arc from its end gave its other end), so such a vertex is
+     taken against the model's points, by their bounding boxes' centres, and in 3D its curves too */
+  for (int d = 0; d < (int)dim - 1; ++d) {
+    int     *low  = NULL;
+    size_t   nlow = 0;
+    PetscInt m    = 0;
+
+    for (PetscInt i = 0; i < n; ++i)
+      if (dist[i] > data[i * MESH_MODEL_PER + 4]) {
+        for (PetscInt k = 0; k < 3; ++k) pts[3 * m + k] = data[i * MESH_MODEL_PER + k];
+        which[m++] = i;
+      }
+    if (!m) break;
+    GmshCall(gmsh_api.gmshModelGetEntities(&low, &nlow, d, &ierr_gmsh), "list the model's points and curves");
+    for (size_t e = 0; e < nlow / 2; ++e) {
+      double bb[6], *closest = NULL, *param = NULL;
+      size_t nc = 0, np = 0;
+
+      if (d == 0) {
+        GmshCall(gmsh_api.gmshModelGetBoundingBox(0, low[2 * e + 1], &bb[0], &bb[1], &bb[2], &bb[3], &bb[4], &bb[5], &ierr_gmsh),
+                 "locate a model point");
+        for (PetscInt j = 0; j < m; ++j) {
+          const double r = PetscSqrtReal(PetscSqr(0.5 * (bb[0] + bb[3]) - pts[3 * j]) + PetscSqr(0.5 * (bb[1] + bb[4]) - pts[3 * j + 1]) +
+                                         PetscSqr(0.5 * (bb[2] + bb[5]) - pts[3 * j + 2]));
+
+          dist[which[j]] = PetscMin(dist[which[j]], r);
+        }
+        continue;
+      }
+      GmshCall(gmsh_api.gmshModelGetClosestPoint(d, low[2 * e + 1], pts, (size_t)(3 * m), &closest, &nc, &param, &np, &ierr_gmsh),
+               "find the model's closest points");
+      for (PetscInt j = 0; j < m && 3 * (size_t)j + 2 < nc; ++j) {
+        const double r = PetscSqrtReal(PetscSqr(closest[3 * j] - pts[3 * j]) + PetscSqr(closest[3 * j + 1] - pts[3 * j + 1]) +
+                                       PetscSqr(closest[3 * j + 2] - pts[3 * j + 2]));
+
+        dist[which[j]] = PetscMin(dist[which[j]], r);
+      }
+      if (closest) gmsh_api.gmshFree(closest);
+      if (param) gmsh_api.gmshFree(param);
+    }
+    if (low) gmsh_api.gmshFree(low);
+  }
   for (PetscInt i = 0; i < n; ++i) {
     const double tol = data[i * MESH_MODEL_PER + 4], off = dist[i] / PetscMax(tol, 1e-300);
 

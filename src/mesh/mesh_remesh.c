@@ -327,15 +327,22 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
     if (rank == 0) PetscCall(PetscFree2(counts_u, displs_u));
   }
   if (rank == 0) {
-    char tmp[PETSC_MAX_PATH_LEN];
+    char     tmp[PETSC_MAX_PATH_LEN];
+    PetscInt ncaps;
+    double  *caps, *view;
 
-    PetscCall(SortCells(total / per, nv, all));
+    PetscCall(MeshRemeshViewCaps(total / per, nv, dim, all, &ncaps, &caps)); /* the view over the model's bulge too */
+    PetscCall(PetscMalloc1(total + ncaps * per + 1, &view));
+    PetscCall(PetscArraycpy(view, all, total));
+    PetscCall(PetscArraycpy(view + total, caps, ncaps * per));
+    PetscCall(PetscFree(caps));
+    PetscCall(SortCells(total / per + ncaps, nv, view));
     if (box->petsc_read) { /* for comparison: Gmsh writes the mesh, PETSc's reader reads it */
       PetscCall(PetscGetTmp(PETSC_COMM_SELF, tmp, sizeof(tmp)));
       PetscCall(PetscSNPrintf(out, sizeof(out), "%s/signorini-remesh-%d.msh", tmp, (int)getpid()));
     }
     PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-    failed = GmshRemesh(model, box, dim, total / per, nv, all, out[0] ? out : NULL, &made);
+    failed = GmshRemesh(model, box, dim, total / per + ncaps, nv, view, out[0] ? out : NULL, &made);
     PetscCall(PetscPopErrorHandler());
     if (failed) {
       const char *text     = NULL;
@@ -349,6 +356,7 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
       PetscCall(MeshSimplicesReset(&made));
     }
     PetscCall(PetscFree(all));
+    PetscCall(PetscFree(view));
     PetscCall(PetscFree2(counts, displs));
   }
   PetscCallMPI(MPI_Bcast(&failed, 1, MPI_INT, 0, comm));
