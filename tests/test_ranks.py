@@ -2,10 +2,12 @@
 (more ranks than the machine's cores: mpiexec oversubscribes, signorini.mpirun.MPI_ENV), its /run quantities, its
 cycles', steps' and bars' rows, to the solver's tolerance. 2 ranks are checked feature by feature in the other test
 files; 3 and 4 split the meshes across more interfaces (a vertex shared by three or four ranks, a contact zone cut in
-three), where the sums over the ranks, the marking, the remeshing and the reactions must still agree.
+three), where the sums over the ranks, the marking, the remeshing and the reactions must still agree. -bars on the
+16 x 16 box needs its two coarser boxes on 3 ranks too, whose 8 rows do not split evenly over them: they are built in
+uneven slabs there (src/mesh/mesh.c; before, -bars was refused on 3 ranks where 1, 2 and 4 ran it).
 
-Measured relative differences, 3 and 4 ranks against 1: at most 2e-9 over the /run quantities compared (the
-iterative solves' tolerance: -snes_rtol 1e-8 on the Newton residual), the cycles' unknowns equal."""
+Measured relative differences of the /run quantities compared, 3 and 4 ranks against 1: at most 1.2e-12 (the indenter's
+adapted penetration on 3 ranks); the cycles' unknowns equal. The tolerance is the solves', 1e-6."""
 import numpy as np
 import pytest
 
@@ -27,7 +29,7 @@ FEATURES = {
     "quadrilaterals": (["-dm_plex_simplex", 0, "-dm_plex_box_faces", "16,16", "-contact_monitor", 0], ()),
     "p2": (["-dm_plex_box_faces", "8,8", "-displacement_petscspace_degree", 2, "-contact_monitor", 0], ()),
     "box3d": (["-dm_plex_dim", 3, "-dm_plex_box_faces", "6,6,6", "-contact_monitor", 0], ()),
-    "bars": (MMS + ["-dm_plex_box_faces", "8,8", "-bars"], ("bars",)),
+    "bars": (MMS + ["-dm_plex_box_faces", "16,16", "-bars"], ("bars",)),
     "accuracy_refined": (INDENT + ["-obstacle_translate", "0,-0.01", "-accuracy", 0.05], ("cycles",)),
     "accuracy_box3d": (MMS + ["-dm_plex_dim", 3, "-dm_plex_box_faces", "4,4,4", "-accuracy", 0.8, "-accuracy_quantity", "energy"], ("cycles",)),
     "load_path_unloading": (INDENT + ["-obstacle_translate", "0,-0.01", "-load_path", "0.5,1,0.3,0"], ("steps",)),
@@ -79,7 +81,7 @@ def test_a_feature_on_3_and_4_ranks_gives_the_1_rank_answer(feature, disk_model)
             for key in ("contact_force_value", "estimate"):
                 assert np.allclose(c1[key], cn[key], rtol=RTOL, atol=1e-14), (feature, np_, key, c1[key], cn[key])
         if "steps" in tables:
-            s1, sn = read_steps(one), read_steps(many)
+            s1, sn = read_steps(one)[0], read_steps(many)[0]
             assert np.array_equal(s1["converged"], sn["converged"]) and s1["converged"].all(), (feature, np_)
             for key in ("contact_force_y", "obstacle_translate_y", "energy"):
                 scale = np.abs(s1[key]).max() + 1e-14

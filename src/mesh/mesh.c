@@ -160,7 +160,8 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
       coarse = coarse_request;
     } else if (coarse_request < 0 && nests) {
       /* halvings while the rows split evenly over the ranks (each rank's slabs as many rows); in 3D, where the coarsest
-         box would then be too large to factor, halvings into uneven whole rows (68^3 on 2 ranks: 17^3 in slabs of 8 and
+         box would then be too large to factor, and where -bars needs its coarser boxes (16 x 16 on 3 ranks: 8 rows do
+         not split evenly, 4 uneven rows of 4 x 4 do), halvings into uneven whole rows (68^3 on 2 ranks: 17^3 in slabs of 8 and
          9 rows, the final box's of 32 and 36, rather than 34^3 or no nesting; 40^3 stays at 10^3 in even slabs: from
          5^3, slabs of 2 and 3 rows made the final box's 16 and 24 and the run 1.4 times slower) */
       for (PetscInt pass = 0; pass < 2; ++pass) {
@@ -179,7 +180,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
         if (dim == 3 && coarse_faces[2] > 0 && coarse >= coarse_min_levels)
           for (PetscInt d = 0; d < dim; ++d)
             if (faces[d] >> coarse > coarse_faces[2]) coarse = 0; /* its factorization would be dear */
-        if (coarse > 0 || dim != 3 || size == 1) break;
+        if (coarse >= coarse_min_levels && (coarse > 0 || dim != 3 || size == 1)) break;
       }
     }
     for (PetscInt d = 0; d < dim; ++d) faces[d] >>= coarse;
