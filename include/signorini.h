@@ -353,6 +353,8 @@ typedef struct {
   Quantities level[BARS_LEVELS - 1];
   PetscReal  level_h[BARS_LEVELS - 1];
   PetscBool  eps_done;           /* the second eps was solved (the penalty method) */
+  PetscBool  remeshed;           /* the levels are the Gmsh model meshed again at halved sizes (-adapt_model), not nested */
+  PetscReal  eps_levels;         /*   and then the one eps of all three levels (0: the nested levels' rule) */
   PetscReal  eps, eps_second;    /* the run's eps on level[BARS_EPS_LEVEL] and the second one */
   Quantities eps_level;          /* that level's quantities at eps_second */
   PetscInt   n;                  /* the quantities, after BarsCompute(): */

@@ -133,7 +133,8 @@ BAD_ADAPT = {"quads": (SQUARE + ["-dm_plex_simplex", 0, "-adapt_cycles", 1], "-a
 
 
 def test_a_model_without_cycles_is_refused(tmp_path):
-    """-adapt_model is read by the cycles alone: beside -bars, or alone, it was accepted and ignored."""
+    """-adapt_model is read by the cycles and by -bars's levels of -contact_grid_sequence (tests/test_bars.py): alone, or
+    beside -bars without such levels, it was accepted and ignored; refused now."""
     model = tmp_path / "square.geo"
     model.write_text('Point(1) = {0, 0, 0};\n')
     for extra in ([], ["-bars"]):

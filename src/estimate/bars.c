@@ -299,8 +299,8 @@ PetscErrorCode BarsView(MPI_Comm comm, const ErrorBars *b)
 {
   PetscFunctionBeginUser;
   if (!b->n) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscPrintf(comm, "  error bars (mesh: three nested meshes, h to 4h, grid convergence index; eps: a second solve at eps/%d on 2h):\n",
-                        (int)BARS_EPS_RATIO));
+  PetscCall(PetscPrintf(comm, "  error bars (mesh: %s, h to 4h, grid convergence index; eps: a second solve at eps/%d on 2h):\n",
+                        b->remeshed ? "three meshes of the Gmsh model (-adapt_model) at halved sizes" : "three nested meshes", (int)BARS_EPS_RATIO));
   for (PetscInt k = 0; k < b->n; ++k) {
     if (PetscIsNanReal(b->bar[k]))
       PetscCall(PetscPrintf(comm, "    %-24s %.6g, no bar: %s\n", b->name[k], (double)b->value[k], b->note[k]));

@@ -30,7 +30,7 @@ PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
 
   PetscFunctionBeginUser;
   { /* a mesh file's curved boundary refined by the solver on its chords (-adapt_cycles refuses it: AdaptCheck()) */
-    const PetscInt refinements = user->box.refine + user->opt->solver.grid_sequence;
+    const PetscInt refinements = user->box.refine + (user->opt->adapt.model[0] ? 0 : user->opt->solver.grid_sequence); /* a model remeshes them */
 
     if (user->box.from_file && refinements > 0 && user->box.curved_ridges >= MESH_CURVED_RIDGES_MIN) {
       ck->curved_refined     = user->box.curved_ridges;

@@ -159,10 +159,6 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
     PetscCheck(!cycles_given || ad->cycles > 0, comm, PETSC_ERR_USER_INPUT, "-accuracy refines adaptively: -adapt_cycles 0 leaves it no cycle");
     if (!cycles_given) ad->cycles = ADAPT_ACCURACY_CYCLES;
   }
-  PetscCheck(!ad->model[0] || ad->cycles > 0, comm, PETSC_ERR_USER_INPUT,
-             "-adapt_model %s is the model that -adapt_cycles and -accuracy mesh again at each cycle; without them nothing reads it (-bars "
-             "refines the mesh itself, -dm_refine too): give -accuracy TOL or -adapt_cycles N, or leave -adapt_model out",
-             ad->model);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -176,11 +172,24 @@ PetscErrorCode AdaptCheck(DM dm, const AppCtx *user)
   PetscBool             simplex, is_mg;
 
   PetscFunctionBeginUser;
+  PetscCheck(!opt->adapt.model[0] || opt->adapt.cycles > 0 || (opt->bars && opt->solver.grid_sequence > 0), comm, PETSC_ERR_USER_INPUT,
+             "-adapt_model %s is the model that -adapt_cycles and -accuracy mesh again at each cycle, and -bars with -contact_grid_sequence at "
+             "each level; without them nothing reads it (-dm_refine refines the mesh itself): give -accuracy TOL, -adapt_cycles N or -bars "
+             "-contact_grid_sequence 2, or leave -adapt_model out",
+             opt->adapt.model);
+  PetscCall(PetscStrcmp(opt->solver.given.pc_type, PCMG, &is_mg));
+  if (!opt->adapt.cycles && opt->adapt.model[0]) { /* -bars's levels, remeshed */
+    PetscCall(DMPlexIsSimplex(dm, &simplex));
+    PetscCheck(simplex, comm, PETSC_ERR_USER_INPUT, "-bars with -adapt_model remeshes triangles and tetrahedra only");
+    PetscCheck(!is_mg, comm, PETSC_ERR_USER_INPUT,
+               "-bars with -adapt_model: the remeshed levels do not nest, which -pc_type mg needs: use GAMG or MUMPS");
+    PetscCheck(opt->degree == 1, comm, PETSC_ERR_USER_INPUT, "-bars with -adapt_model needs P1 displacements (the remeshed levels carry P1 fields)");
+    PetscCall(MeshRemeshCheckModel(dm, opt->adapt.model));
+  }
   if (!opt->adapt.cycles) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexIsSimplex(dm, &simplex));
   PetscCall(ContactGetOptions(user->contact, &copt));
-  PetscCall(PetscStrcmp(opt->solver.given.pc_type, PCMG, &is_mg));
   PetscCheck(simplex, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles refines triangles and tetrahedra only, not %s",
              dim == 3 ? "hexahedra" : "quadrilaterals");
   PetscCheck(dim == 2 || opt->adapt.model[0] || !user->box.from_file, comm, PETSC_ERR_USER_INPUT,

@@ -85,7 +85,7 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
    edge length, halved where marked, and Gmsh meshes the model with these sizes. The meshes do not nest: the last
    solution is carried to the new mesh by locating each new vertex in the old mesh (MeshTransferApply()), the next
    solve's start. */
-PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked)
+static PetscErrorCode Remesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked, PetscReal unmarked)
 {
   DM           fine;
   PetscReal   *size;
@@ -101,7 +101,7 @@ PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
 
     PetscCall(MeshCellMeanEdge(*dm, c, &size[c - cStart]));
     if (marked) PetscCall(DMLabelGetValue(marked, c, &value));
-    if (value == DM_ADAPT_REFINE) size[c - cStart] *= 0.5;
+    size[c - cStart] *= value == DM_ADAPT_REFINE ? 0.5 : unmarked;
   }
   PetscCall(LocalSolution(*dm, user, *u, &loc));
   PetscCall(VecDestroy(u));
@@ -116,6 +116,32 @@ PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   PetscCall(MeshTransferApply(tr, fine, loc));
   PetscCall(MeshTransferDestroy(&tr));
   PetscCall(TakeMesh(dm, fine, &loc, u));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked)
+{
+  PetscFunctionBeginUser;
+  PetscCall(Remesh(dm, user, snes, u, marked, 1.0));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -bars with the body's Gmsh model (-adapt_model): the levels of -contact_grid_sequence are the model meshed again at
+   half the cells' sizes (Remesh()), not the mesh refined on its chords, so that the finest level's body is the curved
+   body. The levels do not nest: the pressure's band, which carries the 2h level's nodal pressures to the final mesh's
+   nodes, is not given, and eps, one value on Gamma_C on each level (MeshSetContactCellSizes()), is the same on all
+   three, that of the first mesh's smallest contact cell halved at each level (GridSequenceBarsEps()), so that the
+   levels differ by their meshes alone: a remeshed level's own smallest cell does not halve with its sizes. */
+static PetscErrorCode GridSequenceRemeshHalf(DM *dm, AppCtx *user, SNES *snes, Vec *u)
+{
+  PetscFunctionBeginUser;
+  PetscCall(Remesh(dm, user, snes, u, NULL, 0.5));
+  user->rec.bars.remeshed = PETSC_TRUE;
+  if (user->rec.bars.pressure_recorded) {
+    PetscCall(PetscFree(user->rec.bars.pressure_levels[0]));
+    PetscCall(PetscFree(user->rec.bars.pressure_levels[1]));
+    user->rec.bars.pressure_recorded = PETSC_FALSE;
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -216,11 +242,19 @@ static PetscErrorCode GridSequenceBarsEps(SNES snes, AppCtx *user, PetscInt nlev
   DM                    dm;
 
   PetscFunctionBeginUser;
-  if (!user->opt->bars || !ContactHasPenalty(user->contact) || user->prob.level >= nlevels || user->prob.level < nlevels - (BARS_LEVELS - 1))
-    PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt->bars || !ContactHasPenalty(user->contact) || user->prob.level < nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactGetOptions(user->contact, &copt));
   if (copt->eps_fixed > 0.0) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetDM(snes, &dm));
+  if (user->opt->adapt.model[0]) { /* the remeshed levels' one eps, from the first bars level's own (GridSequenceRemeshHalf()) */
+    if (user->prob.level == nlevels - (BARS_LEVELS - 1)) {
+      PetscCall(ContactGetEps(user->contact, &eps));
+      user->rec.bars.eps_levels = eps * PetscPowReal(2.0, -(PetscReal)(BARS_LEVELS - 1) * copt->eps_power);
+    }
+    PetscCall(ContactSetEps(user->contact, dm, user->rec.bars.eps_levels));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  if (user->prob.level >= nlevels) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactGetEps(user->contact, &eps));
   PetscCall(ContactSetEps(user->contact, dm, eps * PetscPowReal(2.0, -(PetscReal)(nlevels - user->prob.level) * copt->eps_power)));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -303,8 +337,10 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
   const PetscInt nlevels = user->box.coarse_levels + user->opt->solver.grid_sequence;
 
   PetscFunctionBeginUser;
-  user->rec.bars.nlevels  = 0;
-  user->rec.bars.eps_done = PETSC_FALSE;
+  user->rec.bars.nlevels    = 0;
+  user->rec.bars.eps_done   = PETSC_FALSE;
+  user->rec.bars.remeshed   = PETSC_FALSE;
+  user->rec.bars.eps_levels = 0.0;
   PetscCall(GridSequenceSetTolerance(*snes, user));
   PetscCall(GridSequenceBarsEps(*snes, user, nlevels));
   PetscCall(SolverSolve(*snes, user, *u, SOLVER_START_ZERO));
@@ -319,7 +355,10 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
       PetscCall(PetscPrintf(PetscObjectComm((PetscObject)*dm), "  nested iteration: level %" PetscInt_FMT " failed (%s), the next starts from zero\n",
                             user->prob.level, SNESConvergedReasons[user->rec.stats.reason]));
     PetscCall(PetscTime(&t0));
-    PetscCall(GridSequenceRefine(dm, user, snes, u, NULL));
+    if (user->opt->bars && user->opt->adapt.model[0] && user->prob.level >= user->box.coarse_levels)
+      PetscCall(GridSequenceRemeshHalf(dm, user, snes, u));
+    else
+      PetscCall(GridSequenceRefine(dm, user, snes, u, NULL));
     PetscCall(PetscTime(&t1));
     user->prob.setup_time = t1 - t0; /* refinement, set-up and interpolation */
     user->rec.stats.time_setup += t1 - t0;
