@@ -3,6 +3,7 @@
    it reads the solution and the contact after the solve and writes RunRecord.estimate. */
 #pragma once
 #include "signorini.h"
+#include "mesh.h"
 
 /* estimate.c */
 PetscErrorCode EstimateGetOptions(MPI_Comm comm, RunOptions *opt);
@@ -24,5 +25,9 @@ PetscErrorCode EstimateMarkContactEdge(DM dm, AppCtx *user, Vec u, DMLabel *mark
 PetscErrorCode BarsCheck(MPI_Comm comm, const AppCtx *user);
 PetscErrorCode BarsReset(ErrorBars *b);
 PetscErrorCode BarsRecordPressure(DM dm, AppCtx *user, const PetscReal p_eps[], const PetscReal p_second[]);
+/* the recorded 2h pressure carried to a remeshed level (-bars with -adapt_model): made on dm, with a local vector
+   of its displacement's layout, then applied on the new mesh fine, with a local vector of its layout */
+PetscErrorCode BarsPressureTransferCreate(DM dm, AppCtx *user, Vec loc, MeshTransfer *tr);
+PetscErrorCode BarsPressureTransferApply(DM fine, AppCtx *user, Vec fine_loc, MeshTransfer *tr);
 PetscErrorCode BarsCompute(DM dm, AppCtx *user);
 PetscErrorCode BarsView(MPI_Comm comm, const ErrorBars *b);

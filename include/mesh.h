@@ -119,12 +119,13 @@ PetscErrorCode                 MeshLocatorDestroy(MeshLocator *locator);
 /* mesh_transfer.c: a P1 field carried from a mesh to its remeshing (the old cells on rank 0) */
 typedef struct _n_MeshTransfer *MeshTransfer;
 PetscErrorCode                  MeshTransferCreate(MPI_Comm comm, PetscInt dim, PetscInt ncells, PetscReal x[], PetscReal u[], MeshTransfer *tr);
+PetscErrorCode                  MeshTransferCreateFromField(DM dm, Vec loc, MeshTransfer *tr);
 PetscErrorCode                  MeshTransferApply(MeshTransfer tr, DM fine, Vec fine_loc);
 PetscErrorCode                  MeshTransferDestroy(MeshTransfer *tr);
 
 /* mesh_remesh.c: the Gmsh model meshed again with a size per cell of dm (-adapt_model), or the box of the options
-   (model "" and box); with loc (dm's local field), *tr carries it to the new mesh */
-PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const PetscReal size[], Vec loc, DM *remeshed, MeshTransfer *tr);
+   (model "" and box); a field of dm goes to the new mesh by MeshTransferCreateFromField(), made before */
+PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const PetscReal size[], DM *remeshed);
 /* which "Face Sets" values a face carries on some rank (present[v], v < n) */
 PetscErrorCode MeshFaceSetValues(DM dm, PetscInt *n, PetscBool **present);
 /* mesh_model_check.c: a model the cycles could not remesh as the mesh's body, refused before the first solve */

@@ -234,11 +234,8 @@ static PetscErrorCode CheckFaceSets(DM dm, DM remeshed, const char model[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const PetscReal size[], Vec loc, DM *remeshed, MeshTransfer *tr)
+PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const PetscReal size[], DM *remeshed)
 {
-  const PetscScalar *lu     = NULL;
-  PetscSection       lsec   = NULL;
-  PetscReal         *mine_u = NULL, *all_u = NULL, *all_x = NULL;
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
   PetscMPIInt        rank, nranks, count, *counts = NULL, *displs = NULL;
   PetscInt           dim, cStart, cEnd, pStart, nv, per, total = 0;
@@ -265,11 +262,6 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
   PetscCall(DMGetCoordinatesLocal(dm, &coords));
   PetscCall(VecGetArrayRead(coords, &xc));
   PetscCall(PetscCalloc1((cEnd - cStart) * per + 1, &mine));
-  if (loc) { /* the field at each cell's vertices, for the transfer */
-    PetscCall(DMGetLocalSection(dm, &lsec));
-    PetscCall(VecGetArrayRead(loc, &lu));
-    PetscCall(PetscCalloc1((cEnd - cStart) * nv * dim + 1, &mine_u));
-  }
   for (PetscInt c = cStart; c < cEnd; ++c) {
     double  *d = &mine[(c - cStart) * per];
     PetscInt verts[8], n;
@@ -282,17 +274,9 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
       PetscCall(PetscSectionGetOffset(csec, verts[k], &off));
       for (PetscInt j = 0; j < dim; ++j) d[j * nv + k] = PetscRealPart(xc[off + j]);
       d[3 * nv + k] = vsize ? vsize[verts[k] - pStart] : size[c - cStart];
-      if (loc) {
-        PetscInt ndof;
-
-        PetscCall(PetscSectionGetDof(lsec, verts[k], &ndof));
-        PetscCall(PetscSectionGetOffset(lsec, verts[k], &off));
-        for (PetscInt j = 0; j < dim && j < ndof; ++j) mine_u[((c - cStart) * nv + k) * dim + j] = PetscRealPart(lu[off + j]);
-      }
     }
   }
   PetscCall(VecRestoreArrayRead(coords, &xc));
-  if (loc) PetscCall(VecRestoreArrayRead(loc, &lu));
   PetscCall(PetscFree(vsize));
   PetscCall(PetscMPIIntCast((cEnd - cStart) * per, &count));
   if (rank == 0) PetscCall(PetscMalloc2(nranks, &counts, nranks, &displs));
@@ -306,26 +290,6 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
   }
   PetscCallMPI(MPI_Gatherv(mine, count, MPI_DOUBLE, all, counts, displs, MPI_DOUBLE, 0, comm));
   PetscCall(PetscFree(mine));
-  if (loc) { /* the same cells' fields, nv * dim values for per = 4 nv of the sizes' data */
-    PetscMPIInt count_u, *counts_u = NULL, *displs_u = NULL;
-
-    PetscCall(PetscMPIIntCast((cEnd - cStart) * nv * dim, &count_u));
-    if (rank == 0) {
-      PetscCall(PetscMalloc2(nranks, &counts_u, nranks, &displs_u));
-      for (PetscMPIInt r = 0; r < nranks; ++r) {
-        counts_u[r] = (PetscMPIInt)(counts[r] / per * nv * dim);
-        displs_u[r] = (PetscMPIInt)(displs[r] / per * nv * dim);
-      }
-      PetscCall(PetscMalloc1(total / per * nv * dim + 1, &all_u));
-      PetscCall(PetscMalloc1(total / per * nv * dim + 1, &all_x));
-      for (PetscInt c = 0; c < total / per; ++c) /* the vertices' positions, before the sort (the transfer takes any order) */
-        for (PetscInt k = 0; k < nv; ++k)
-          for (PetscInt j = 0; j < dim; ++j) all_x[(c * nv + k) * dim + j] = all[c * per + j * nv + k];
-    }
-    PetscCallMPI(MPI_Gatherv(mine_u, count_u, MPIU_REAL, all_u, counts_u, displs_u, MPIU_REAL, 0, comm));
-    PetscCall(PetscFree(mine_u));
-    if (rank == 0) PetscCall(PetscFree2(counts_u, displs_u));
-  }
   if (rank == 0) {
     char     tmp[PETSC_MAX_PATH_LEN];
     PetscInt ncaps;
@@ -374,7 +338,6 @@ PetscErrorCode MeshRemesh(DM dm, const char model[], const MeshBox *box, const P
   }
   PetscCall(MeshDistributeRemeshed(what, remeshed));
   PetscCall(CheckFaceSets(dm, *remeshed, model));
-  if (loc) PetscCall(MeshTransferCreate(comm, dim, total / per, all_x, all_u, tr)); /* which owns all_x and all_u (rank 0) */
   {
     MatType mtype;
 

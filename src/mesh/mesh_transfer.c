@@ -47,6 +47,75 @@ PetscErrorCode MeshTransferCreate(MPI_Comm comm, PetscInt dim, PetscInt ncells, 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The transfer of loc, a local P1 field of dm (each vertex's first dim components): dm's cells, their vertices and
+   the field at them gathered on rank 0, each rank's cells in its local order. Made before dm is remeshed. */
+PetscErrorCode MeshTransferCreateFromField(DM dm, Vec loc, MeshTransfer *tr)
+{
+  MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
+  PetscInt           dim, cStart, cEnd, nv, per, total = 0;
+  PetscSection       csec, lsec;
+  Vec                coords;
+  const PetscScalar *xc, *lu;
+  PetscReal         *mine, *all = NULL, *x = NULL, *u = NULL;
+  PetscMPIInt        rank, nranks, count, *counts = NULL, *displs = NULL;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCallMPI(MPI_Comm_size(comm, &nranks));
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
+  nv  = dim + 1;
+  per = 2 * nv * dim; /* a cell: its vertices' coordinates, then the field at them */
+  PetscCall(DMGetCoordinateSection(dm, &csec));
+  PetscCall(DMGetCoordinatesLocal(dm, &coords));
+  PetscCall(DMGetLocalSection(dm, &lsec));
+  PetscCall(VecGetArrayRead(coords, &xc));
+  PetscCall(VecGetArrayRead(loc, &lu));
+  PetscCall(PetscCalloc1((cEnd - cStart) * per + 1, &mine));
+  for (PetscInt c = cStart; c < cEnd; ++c) {
+    PetscReal *d = &mine[(c - cStart) * per];
+    PetscInt   verts[8], n;
+
+    PetscCall(MeshCellVertices(dm, c, verts, &n));
+    PetscCheck(n == nv, comm, PETSC_ERR_SUP, "the transfer to a remeshed mesh takes simplices (triangles, tetrahedra) only");
+    for (PetscInt k = 0; k < nv; ++k) {
+      PetscInt off, ndof;
+
+      PetscCall(PetscSectionGetOffset(csec, verts[k], &off));
+      for (PetscInt j = 0; j < dim; ++j) d[k * dim + j] = PetscRealPart(xc[off + j]);
+      PetscCall(PetscSectionGetDof(lsec, verts[k], &ndof));
+      PetscCall(PetscSectionGetOffset(lsec, verts[k], &off));
+      for (PetscInt j = 0; j < dim && j < ndof; ++j) d[nv * dim + k * dim + j] = PetscRealPart(lu[off + j]);
+    }
+  }
+  PetscCall(VecRestoreArrayRead(coords, &xc));
+  PetscCall(VecRestoreArrayRead(loc, &lu));
+  PetscCall(PetscMPIIntCast((cEnd - cStart) * per, &count));
+  if (rank == 0) PetscCall(PetscMalloc2(nranks, &counts, nranks, &displs));
+  PetscCallMPI(MPI_Gather(&count, 1, MPI_INT, counts, 1, MPI_INT, 0, comm));
+  if (rank == 0) {
+    for (PetscMPIInt r = 0; r < nranks; ++r) {
+      displs[r] = (PetscMPIInt)total;
+      total += counts[r];
+    }
+    PetscCall(PetscMalloc1(total + 1, &all));
+  }
+  PetscCallMPI(MPI_Gatherv(mine, count, MPIU_REAL, all, counts, displs, MPIU_REAL, 0, comm));
+  PetscCall(PetscFree(mine));
+  if (rank == 0) {
+    PetscCall(PetscMalloc1(total / 2 + 1, &x));
+    PetscCall(PetscMalloc1(total / 2 + 1, &u));
+    for (PetscInt c = 0; c < total / per; ++c) {
+      PetscCall(PetscArraycpy(&x[c * nv * dim], &all[c * per], nv * dim));
+      PetscCall(PetscArraycpy(&u[c * nv * dim], &all[c * per + nv * dim], nv * dim));
+    }
+    PetscCall(PetscFree(all));
+    PetscCall(PetscFree2(counts, displs));
+  }
+  PetscCall(MeshTransferCreate(comm, dim, total / per, x, u, tr)); /* which owns x and u (rank 0) */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode MeshTransferDestroy(MeshTransfer *tr)
 {
   PetscFunctionBeginUser;

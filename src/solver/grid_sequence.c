@@ -91,7 +91,7 @@ static PetscErrorCode Remesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel m
   PetscReal   *size;
   PetscInt     cStart, cEnd;
   Vec          loc;
-  MeshTransfer tr = NULL;
+  MeshTransfer tr = NULL, tr_p = NULL;
 
   PetscFunctionBeginUser;
   PetscCall(DMPlexGetHeightStratum(*dm, 0, &cStart, &cEnd));
@@ -104,9 +104,11 @@ static PetscErrorCode Remesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel m
     size[c - cStart] *= value == DM_ADAPT_REFINE ? 0.5 : unmarked;
   }
   PetscCall(LocalSolution(*dm, user, *u, &loc));
+  PetscCall(MeshTransferCreateFromField(*dm, loc, &tr));
+  if (user->rec.bars.pressure_recorded) PetscCall(BarsPressureTransferCreate(*dm, user, loc, &tr_p)); /* -bars's 2h pressure */
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
-  PetscCall(MeshRemesh(*dm, user->opt->adapt.model, &user->box, size, loc, &fine, &tr));
+  PetscCall(MeshRemesh(*dm, user->opt->adapt.model, &user->box, size, &fine));
   PetscCall(VecDestroy(&loc));
   PetscCall(PetscFree(size));
   user->prob.level++;
@@ -115,6 +117,7 @@ static PetscErrorCode Remesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel m
   PetscCall(DMCreateLocalVector(fine, &loc));
   PetscCall(MeshTransferApply(tr, fine, loc));
   PetscCall(MeshTransferDestroy(&tr));
+  if (tr_p) PetscCall(BarsPressureTransferApply(fine, user, loc, &tr_p));
   PetscCall(TakeMesh(dm, fine, &loc, u));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -128,8 +131,8 @@ PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
 
 /* -bars with the body's Gmsh model (-adapt_model): the levels of -contact_grid_sequence are the model meshed again at
    half the cells' sizes (Remesh()), not the mesh refined on its chords, so that the finest level's body is the curved
-   body. The levels do not nest: the pressure's band, which carries the 2h level's nodal pressures to the final mesh's
-   nodes, is not given, and eps, one value on Gamma_C on each level (MeshSetContactCellSizes()), is the same on all
+   body. The levels do not nest: the pressure's band carries the 2h level's nodal pressures to the final mesh's nodes
+   by the remeshing's transfer (BarsPressureTransferCreate()), and eps, one value on Gamma_C on each level (MeshSetContactCellSizes()), is the same on all
    three, that of the first mesh's smallest contact cell halved at each level (GridSequenceBarsEps()), so that the
    levels differ by their meshes alone: a remeshed level's own smallest cell does not halve with its sizes. */
 static PetscErrorCode GridSequenceRemeshHalf(DM *dm, AppCtx *user, SNES *snes, Vec *u)
@@ -137,11 +140,6 @@ static PetscErrorCode GridSequenceRemeshHalf(DM *dm, AppCtx *user, SNES *snes, V
   PetscFunctionBeginUser;
   PetscCall(Remesh(dm, user, snes, u, NULL, 0.5));
   user->rec.bars.remeshed = PETSC_TRUE;
-  if (user->rec.bars.pressure_recorded) {
-    PetscCall(PetscFree(user->rec.bars.pressure_levels[0]));
-    PetscCall(PetscFree(user->rec.bars.pressure_levels[1]));
-    user->rec.bars.pressure_recorded = PETSC_FALSE;
-  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
