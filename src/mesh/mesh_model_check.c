@@ -98,6 +98,27 @@ static PetscErrorCode BoundaryVertices(DM dm, PetscInt *n, double **data)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* dist[which[j]] <- the smaller of it and the distance of the point j of pts (m points, x, y, z each) to the model's
+   entity (edim, tag), by Gmsh's closest point on it. */
+static PetscErrorCode CloserTo(int edim, int tag, PetscInt m, double pts[], const PetscInt which[], double dist[])
+{
+  double *closest = NULL, *param = NULL;
+  size_t  nc = 0, np = 0;
+
+  PetscFunctionBeginUser;
+  GmshCall(gmsh_api.gmshModelGetClosestPoint(edim, tag, pts, (size_t)(3 * m), &closest, &nc, &param, &np, &ierr_gmsh),
+           "find the model's closest points");
+  for (PetscInt j = 0; j < m && 3 * (size_t)j + 2 < nc; ++j) {
+    const double r = PetscSqrtReal(PetscSqr(closest[3 * j] - pts[3 * j]) + PetscSqr(closest[3 * j + 1] - pts[3 * j + 1]) +
+                                   PetscSqr(closest[3 * j + 2] - pts[3 * j + 2]));
+
+    dist[which[j]] = PetscMin(dist[which[j]], r);
+  }
+  if (closest) gmsh_api.gmshFree(closest);
+  if (param) gmsh_api.gmshFree(param);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* Rank 0, with the model open: whether each boundary vertex (BoundaryVertices()) lies on the model, on the entities
    of the physical group its face carries (on any boundary entity of the model for a face without one), within its
    tolerance. Gmsh gives the closest point of each entity (OpenCASCADE projects onto a planar face's whole plane, so
@@ -131,22 +152,8 @@ static PetscErrorCode GmshCheckBoundaryOnModel(PetscInt dim, PetscInt n, const d
     if (!m) continue;
     if (v >= 0)
       GmshCall(gmsh_api.gmshModelGetEntitiesForPhysicalGroup((int)dim - 1, (int)v, &tags, &ntags, &ierr_gmsh), "list a physical group's entities");
-    for (size_t e = 0; e < (v >= 0 ? ntags : nall / 2); ++e) {
-      double *closest = NULL, *param = NULL;
-      size_t  nc = 0, np = 0;
-
-      GmshCall(gmsh_api.gmshModelGetClosestPoint((int)dim - 1, v >= 0 ? tags[e] : all[2 * e + 1], pts, (size_t)(3 * m), &closest, &nc, &param, &np,
-                                                 &ierr_gmsh),
-               "find the model's closest points");
-      for (PetscInt j = 0; j < m && 3 * (size_t)j + 2 < nc; ++j) {
-        const double r = PetscSqrtReal(PetscSqr(closest[3 * j] - pts[3 * j]) + PetscSqr(closest[3 * j + 1] - pts[3 * j + 1]) +
-                                       PetscSqr(closest[3 * j + 2] - pts[3 * j + 2]));
-
-        dist[which[j]] = PetscMin(dist[which[j]], r);
-      }
-      if (closest) gmsh_api.gmshFree(closest);
-      if (param) gmsh_api.gmshFree(param);
-    }
+    for (size_t e = 0; e < (v >= 0 ? ntags : nall / 2); ++e)
+      PetscCall(CloserTo((int)dim - 1, v >= 0 ? tags[e] : all[2 * e + 1], m, pts, which, dist));
     if (tags) gmsh_api.gmshFree(tags);
   }
   /* a vertex where the group's entity ends (the end of an arc, a face's edge in 3D): Gmsh's closest point of the
@@ -165,8 +172,7 @@ static PetscErrorCode GmshCheckBoundaryOnModel(PetscInt dim, PetscInt n, const d
     if (!m) break;
     GmshCall(gmsh_api.gmshModelGetEntities(&low, &nlow, d, &ierr_gmsh), "list the model's points and curves");
     for (size_t e = 0; e < nlow / 2; ++e) {
-      double bb[6], *closest = NULL, *param = NULL;
-      size_t nc = 0, np = 0;
+      double bb[6];
 
       if (d == 0) {
         GmshCall(gmsh_api.gmshModelGetBoundingBox(0, low[2 * e + 1], &bb[0], &bb[1], &bb[2], &bb[3], &bb[4], &bb[5], &ierr_gmsh),
@@ -179,16 +185,7 @@ static PetscErrorCode GmshCheckBoundaryOnModel(PetscInt dim, PetscInt n, const d
         }
         continue;
       }
-      GmshCall(gmsh_api.gmshModelGetClosestPoint(d, low[2 * e + 1], pts, (size_t)(3 * m), &closest, &nc, &param, &np, &ierr_gmsh),
-               "find the model's closest points");
-      for (PetscInt j = 0; j < m && 3 * (size_t)j + 2 < nc; ++j) {
-        const double r = PetscSqrtReal(PetscSqr(closest[3 * j] - pts[3 * j]) + PetscSqr(closest[3 * j + 1] - pts[3 * j + 1]) +
-                                       PetscSqr(closest[3 * j + 2] - pts[3 * j + 2]));
-
-        dist[which[j]] = PetscMin(dist[which[j]], r);
-      }
-      if (closest) gmsh_api.gmshFree(closest);
-      if (param) gmsh_api.gmshFree(param);
+      PetscCall(CloserTo(d, low[2 * e + 1], m, pts, which, dist));
     }
     if (low) gmsh_api.gmshFree(low);
   }
