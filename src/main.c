@@ -96,8 +96,8 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
 
 /* Peak resident set size of each rank, its maximum and sum over the ranks, in MB: the process's own high-water mark,
    VmHWM of /proc/self/status, where Linux has it. getrusage()'s ru_maxrss is kept across execve(), so that a run
-   started by a large process (a Python script holding its results: the test suite's workers, at 180 to 210 MB) reported
-   the starter's size, the resident set it had when it forked, as its own peak; ru_maxrss is the fallback. */
+   started by a large process (a Python script holding its results) would report the resident set the starter had
+   when it forked as its own peak (docs/output.md); ru_maxrss is the fallback. */
 static PetscErrorCode RecordPeakMemory(MPI_Comm comm, RunStats *s)
 {
   struct rusage ru;

@@ -6,6 +6,8 @@ import shutil
 import sys
 import tempfile
 
+import numpy as np
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 sys.path.insert(0, os.path.join(ROOT, "scripts"))
 import read_runs  # noqa: E402,F401  (tests/test_output.py tests the script through harness.read_runs)
@@ -80,6 +82,21 @@ def load(path):
 def sorted_by_position(fields, key):
     """Field values in a rank-independent vertex order (signorini.runs.vertex_order, as runs.vertex_fields())."""
     return fields[key][vertex_order(fields["x"])]
+
+
+def read_gmsh_simplices(path, dim):
+    """(vertices, cells) of a Gmsh mesh file of simplices, read with Gmsh's Python API."""
+    import gmsh
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.open(path)
+        tags, xs, _ = gmsh.model.mesh.getNodes()
+        index = {t: i for i, t in enumerate(tags)}
+        _, _, nodes = gmsh.model.mesh.getElements(dim)
+        return xs.reshape(-1, 3), np.array([index[n] for n in nodes[0]]).reshape(-1, dim + 1)
+    finally:
+        gmsh.finalize()
 
 
 def rotated(nodes, rotation):

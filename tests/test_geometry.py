@@ -6,11 +6,10 @@ import os
 import subprocess
 import sys
 
-import gmsh
 import numpy as np
 import pytest
 
-from harness import ENV, ROOT, load, run, sorted_by_position
+from harness import ENV, ROOT, load, read_gmsh_simplices, run, sorted_by_position
 
 MAKE_MESH = os.path.join(ROOT, "scripts", "make_mesh.py")
 SHAPES = {"half-disk": (2, {"contact": 1, "top": 3}), "quarter-sphere": (3, {"contact": 1, "top": 2, "symmetry_y": 3, "symmetry_x": 6})}
@@ -25,17 +24,9 @@ def make_mesh(shape, path, extra=()):
 
 def cell_sizes(path, dim):
     """(distance of each cell's centroid to the origin, largest edge of the cell), read back with Gmsh's API."""
-    gmsh.initialize()
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.open(path)
-        tags, coords, _ = gmsh.model.mesh.getNodes()
-        x = dict(zip(tags, coords.reshape(-1, 3)))
-        types, _, nodes = gmsh.model.mesh.getElements(dim)
-        nv = dim + 1
-        cells = np.array([[x[n] for n in c] for c in nodes[0].reshape(-1, nv)])
-    finally:
-        gmsh.finalize()
+    x, simplices = read_gmsh_simplices(path, dim)
+    nv = dim + 1
+    cells = x[simplices]
     r = np.linalg.norm(cells.mean(axis=1), axis=1)
     edges = np.max([np.linalg.norm(cells[:, i] - cells[:, j], axis=1) for i in range(nv) for j in range(i + 1, nv)], axis=0)
     return r, edges

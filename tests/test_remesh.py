@@ -12,7 +12,7 @@ import h5py
 import numpy as np
 import pytest
 
-from harness import load, refused, run
+from harness import load, read_gmsh_simplices, refused, run
 from signorini import geometry, hertz
 from signorini.runs import read_cycles as cycles
 
@@ -441,21 +441,6 @@ def curved_boundary_edges(x, cells, centre, radius):
     return np.array([np.linalg.norm(x[a] - x[b]) for a, b in edges])
 
 
-def gmsh_mesh(path, dim):
-    """(vertices, cells) of a Gmsh mesh file of simplices, read with Gmsh's Python API."""
-    import gmsh
-    gmsh.initialize()
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.open(path)
-        tags, xs, _ = gmsh.model.mesh.getNodes()
-        index = {t: i for i, t in enumerate(tags)}
-        _, _, nodes = gmsh.model.mesh.getElements(dim)
-        return xs.reshape(-1, 3), np.array([index[n] for n in nodes[0]]).reshape(-1, dim + 1)
-    finally:
-        gmsh.finalize()
-
-
 @pytest.mark.parametrize("case", ["half-disk", "sphere"])
 def test_a_remesh_never_coarsens_a_convex_boundary(tmp_path, case):
     """Coarse meshes of a half disk (h = 0.5: its 180-degree arc in 7 edges of 0.445) and of the quarter sphere (h = 0.4),
@@ -475,7 +460,7 @@ def test_a_remesh_never_coarsens_a_convex_boundary(tmp_path, case):
         centre, dim = np.array([0.0, 0.0, 1.0]), 3
     _, h5 = run(["-dm_plex_filename", mesh] + args + ["-contact_monitor", 0, "-adapt_model", model, "-adapt_cycles", 1, "-adapt_fraction", 0.05],
                 f"remesh_convex_{case}")
-    before = curved_boundary_edges(*gmsh_mesh(mesh, dim), centre, 1.0)
+    before = curved_boundary_edges(*read_gmsh_simplices(mesh, dim), centre, 1.0)
     with h5py.File(h5, "r") as f:
         after = curved_boundary_edges(f["geometry/vertices"][:], f["viz/topology/cells"][:], centre, 1.0)
     assert len(before) >= 7 and len(after) >= len(before), (len(before), len(after))

@@ -270,7 +270,7 @@ PetscErrorCode BarsRecordPressure(DM dm, AppCtx *user, const PetscReal p_eps[], 
    each new vertex takes the P1 field of the old cell that holds it), as the nested levels' interpolation carries them.
    The two values ride in the first two components of a vector of the displacement's layout. The fields are zero off
    Gamma_C, so that a new vertex of the curved boundary, a sagitta h^2 / 8R off the old chords, takes a share of the
-   interior's zero of the order of h / 8R (0.1% at h = 0.006, R = 1). */
+   interior's zero of the order of h / 8R. */
 PetscErrorCode BarsPressureTransferCreate(DM dm, AppCtx *user, Vec loc, MeshTransfer *tr)
 {
   ErrorBars   *b = &user->rec.bars;
@@ -332,10 +332,8 @@ PetscErrorCode BarsPressureTransferApply(DM fine, AppCtx *user, Vec fine_loc, Me
 
 /* The band at each node over its neighbours on Gamma_C: the largest of the node's own and of the nodes it shares a
    contact face with. A node's own two-level difference |p_h - p_2h| vanishes where the two profiles cross, which they
-   do near the zone's edge, while its error does not: against a fine SNESVI profile of the 2D Hertz indenter (make
-   hertz's block at h_near = 0.004, -contact_grid_sequence 2) the nodes' own bands covered 18 of 20 nodes (the
-   penalty at eps = h/10) and 14 of 16 (SNESVI), the worst at 0.57 times its error; over the neighbours all of them, at
-   1.4 to 1.6 times at the least and a median of 3.0 to 3.2 (docs/estimate.md). chart[] holds the band at every point
+   do near the zone's edge, while its error does not; the neighbours' largest covers it (docs/estimate.md, "The
+   pressure's band", measures both against a fine SNESVI profile). chart[] holds the band at every point
    of the chart (-1 where none), the owners' values at the ghosts; the result is the same on every rank. */
 static PetscErrorCode BandOverNeighbours(DM dm, const AppCtx *user, PetscReal chart[])
 {

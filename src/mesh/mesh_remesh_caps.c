@@ -1,15 +1,13 @@
 /* The size view's cover of the model's boundary (MeshRemesh()): the view Gmsh meshes the model with is made of the
    current mesh's cells, whose boundary is the chords of a curved boundary, and the model's curve bulges out of each
    chord by about h^2 / 8R. Gmsh's PostView field finds no cell of the view at a point outside them and gives it no
-   size of the view's: the model's arc then took sizes far above the mesh's (the half disk of radius 1 at h = 0.5, its
-   180-degree arc of 7 edges of 0.445, remeshed into 4 edges of up to 0.916), so that a remesh coarsened the boundary
-   the cycles had refined. Each boundary face of the view gets a cap outside the body: the triangle (2D) or
-   tetrahedron (3D) over the face whose apex lies CAP_HEIGHT times the face's longest edge out along its outward
-   normal, which covers a bulge of up to a quarter of the chord (an arc of about 110 degrees per chord). Its sizes are
-   the face's, at most the face's longest edge (the apex the smallest of them): a convex boundary, which lies in the
-   caps, is meshed no coarser than the mesh it comes from (a cell's size is its mean edge, longer than its boundary
-   face where the cell is stretched along the normal). In 3D the wedge between the caps of two boundary faces that share an
-   edge, over which a curved surface bulges too, is filled by the tetrahedron of the edge and the two apexes. */
+   size of the view's: the model's arc then takes sizes far above the mesh's, so that a remesh would coarsen the
+   boundary the cycles refined (docs/estimate.md, "Remeshing the Gmsh model", measures it). Each boundary face of the view gets a cap outside the
+   body: the triangle (2D) or tetrahedron (3D) over the face whose apex lies CAP_HEIGHT times the face's longest edge out along its outward normal,
+   which covers a bulge of up to a quarter of the chord (an arc of about 110 degrees per chord). Its sizes are the face's, at most the face's longest
+   edge (the apex the smallest of them): a convex boundary, which lies in the caps, is meshed no coarser than the mesh it comes from (a cell's size is
+   its mean edge, longer than its boundary face where the cell is stretched along the normal). In 3D the wedge between the caps of two boundary faces
+   that share an edge, over which a curved surface bulges too, is filled by the tetrahedron of the edge and the two apexes. */
 #include <stdlib.h>
 #include "mesh.h"
 

@@ -47,6 +47,33 @@ PetscErrorCode MeshTransferCreate(MPI_Comm comm, PetscInt dim, PetscInt ncells, 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* Each rank's n reals of mine gathered on rank 0 in the ranks' order: *all, *total of them, and the counts and
+   displacements that scatter values in that order back (rank 0; free with PetscFree() and PetscFree2()). */
+static PetscErrorCode GatherOnRoot(MPI_Comm comm, PetscInt n, const PetscReal mine[], PetscReal **all, PetscInt *total, PetscMPIInt **counts,
+                                   PetscMPIInt **displs)
+{
+  PetscMPIInt rank, nranks, count;
+
+  PetscFunctionBeginUser;
+  PetscCallMPI(MPI_Comm_rank(comm, &rank));
+  PetscCallMPI(MPI_Comm_size(comm, &nranks));
+  PetscCall(PetscMPIIntCast(n, &count));
+  *all    = NULL;
+  *total  = 0;
+  *counts = *displs = NULL;
+  if (rank == 0) PetscCall(PetscMalloc2(nranks, counts, nranks, displs));
+  PetscCallMPI(MPI_Gather(&count, 1, MPI_INT, *counts, 1, MPI_INT, 0, comm));
+  if (rank == 0) {
+    for (PetscMPIInt r = 0; r < nranks; ++r) {
+      (*displs)[r] = (PetscMPIInt)*total;
+      *total += (*counts)[r];
+    }
+    PetscCall(PetscMalloc1(*total + 1, all));
+  }
+  PetscCallMPI(MPI_Gatherv(mine, count, MPIU_REAL, *all, *counts, *displs, MPIU_REAL, 0, comm));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The transfer of loc, a local P1 field of dm (each vertex's first dim components): dm's cells, their vertices and
    the field at them gathered on rank 0, each rank's cells in its local order. Made before dm is remeshed. */
 PetscErrorCode MeshTransferCreateFromField(DM dm, Vec loc, MeshTransfer *tr)
@@ -57,11 +84,10 @@ PetscErrorCode MeshTransferCreateFromField(DM dm, Vec loc, MeshTransfer *tr)
   Vec                coords;
   const PetscScalar *xc, *lu;
   PetscReal         *mine, *all = NULL, *x = NULL, *u = NULL;
-  PetscMPIInt        rank, nranks, count, *counts = NULL, *displs = NULL;
+  PetscMPIInt        rank, *counts = NULL, *displs = NULL;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  PetscCallMPI(MPI_Comm_size(comm, &nranks));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   nv  = dim + 1;
@@ -90,17 +116,7 @@ PetscErrorCode MeshTransferCreateFromField(DM dm, Vec loc, MeshTransfer *tr)
   }
   PetscCall(VecRestoreArrayRead(coords, &xc));
   PetscCall(VecRestoreArrayRead(loc, &lu));
-  PetscCall(PetscMPIIntCast((cEnd - cStart) * per, &count));
-  if (rank == 0) PetscCall(PetscMalloc2(nranks, &counts, nranks, &displs));
-  PetscCallMPI(MPI_Gather(&count, 1, MPI_INT, counts, 1, MPI_INT, 0, comm));
-  if (rank == 0) {
-    for (PetscMPIInt r = 0; r < nranks; ++r) {
-      displs[r] = (PetscMPIInt)total;
-      total += counts[r];
-    }
-    PetscCall(PetscMalloc1(total + 1, &all));
-  }
-  PetscCallMPI(MPI_Gatherv(mine, count, MPIU_REAL, all, counts, displs, MPIU_REAL, 0, comm));
+  PetscCall(GatherOnRoot(comm, (cEnd - cStart) * per, mine, &all, &total, &counts, &displs));
   PetscCall(PetscFree(mine));
   if (rank == 0) {
     PetscCall(PetscMalloc1(total / 2 + 1, &x));
@@ -131,8 +147,8 @@ PetscErrorCode MeshTransferDestroy(MeshTransfer *tr)
 PetscErrorCode MeshTransferApply(MeshTransfer tr, DM fine, Vec fine_loc)
 {
   const PetscInt     dim = tr->dim;
-  PetscMPIInt        rank, nranks, count, *counts = NULL, *displs = NULL;
-  PetscInt           vStart, vEnd, n, total = 0;
+  PetscMPIInt        rank, count, *counts = NULL, *displs = NULL;
+  PetscInt           vStart, vEnd, n, total               = 0;
   PetscSection       sec, csec;
   Vec                coords;
   const PetscScalar *xc;
@@ -141,7 +157,6 @@ PetscErrorCode MeshTransferApply(MeshTransfer tr, DM fine, Vec fine_loc)
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_rank(tr->comm, &rank));
-  PetscCallMPI(MPI_Comm_size(tr->comm, &nranks));
   PetscCall(DMPlexGetDepthStratum(fine, 0, &vStart, &vEnd));
   n = vEnd - vStart;
   PetscCall(DMGetCoordinateSection(fine, &csec));
@@ -156,21 +171,15 @@ PetscErrorCode MeshTransferApply(MeshTransfer tr, DM fine, Vec fine_loc)
   }
   PetscCall(VecRestoreArrayRead(coords, &xc));
   PetscCall(PetscMPIIntCast(n * dim, &count));
-  if (rank == 0) PetscCall(PetscMalloc2(nranks, &counts, nranks, &displs));
-  PetscCallMPI(MPI_Gather(&count, 1, MPI_INT, counts, 1, MPI_INT, 0, tr->comm));
+  PetscCall(GatherOnRoot(tr->comm, n * dim, mine, &all, &total, &counts, &displs)); /* the new vertices' positions */
   if (rank == 0) {
-    for (PetscMPIInt r = 0; r < nranks; ++r) {
-      displs[r] = (PetscMPIInt)total;
-      total += counts[r];
-    }
-    PetscCall(PetscMalloc2(total + 1, &all, total + 1, &allv));
-  }
-  PetscCallMPI(MPI_Gatherv(mine, count, MPIU_REAL, all, counts, displs, MPIU_REAL, 0, tr->comm));
-  if (rank == 0)
+    PetscCall(PetscMalloc1(total + 1, &allv));
     for (PetscInt p = 0; p < total / dim; ++p) Evaluate(tr, &all[p * dim], &allv[p * dim]);
+  }
   PetscCallMPI(MPI_Scatterv(allv, counts, displs, MPIU_REAL, vals, count, MPIU_REAL, 0, tr->comm));
   if (rank == 0) {
-    PetscCall(PetscFree2(all, allv));
+    PetscCall(PetscFree(all));
+    PetscCall(PetscFree(allv));
     PetscCall(PetscFree2(counts, displs));
   }
   PetscCall(DMGetLocalSection(fine, &sec));

@@ -132,9 +132,10 @@ PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
 /* -bars with the body's Gmsh model (-adapt_model): the levels of -contact_grid_sequence are the model meshed again at
    half the cells' sizes (Remesh()), not the mesh refined on its chords, so that the finest level's body is the curved
    body. The levels do not nest: the pressure's band carries the 2h level's nodal pressures to the final mesh's nodes
-   by the remeshing's transfer (BarsPressureTransferCreate()), and eps, one value on Gamma_C on each level (MeshSetContactCellSizes()), is the same on
-   all three, that of the first mesh's smallest contact cell halved at each level (GridSequenceBarsEps()), so that the levels differ by their meshes
-   alone: a remeshed level's own smallest cell does not halve with its sizes. */
+   by the remeshing's transfer (BarsPressureTransferCreate()), and eps, one value on Gamma_C on each level
+   (MeshSetContactCellSizes()), is the same on all three: that of the first mesh's smallest contact cell halved at
+   each level (GridSequenceBarsEps()), so that the levels differ by their meshes alone (a remeshed level's own
+   smallest cell does not halve with its sizes). */
 static PetscErrorCode GridSequenceRemeshHalf(DM *dm, AppCtx *user, SNES *snes, Vec *u)
 {
   PetscFunctionBeginUser;
