@@ -88,7 +88,6 @@ typedef struct {
   PetscPointFunc f0_body;        /* volume residual term, -f, if not constant; it adds the -body_force of constants[] */
   ScenePointFn   exact;          /* exact solution, NULL if none; called with ctx = constants */
   ScenePointFn   exact_gradient; /* its gradient, G[i*dim+j] = du_i/dx_j (Nc = dim*dim); needed for the error norms */
-  ScenePointFn   exact_source;   /* with weak data: f = -div sigma(u_exact) (Nc = dim), for the error estimate; ctx = the kernels' constants[] */
   PetscBool      weak_data;      /* load from the exact solution: L(v) = a(u_exact, v) - int_Gamma_C sigma_n(u_exact) v_n */
   PetscBool      has_kink;       /* the exact solution is not smooth across the plane {x . kink_normal = kink_offset}: */
   PetscReal      kink_normal[3]; /*   the cells it cuts get the refined quadrature rule */

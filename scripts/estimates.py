@@ -4,7 +4,8 @@
 Usage: estimates.py [--outdir DIR] [--parts estimate,bars] [--check]
 
 1. Effectivity (estimate / exact energy-norm error) on the manufactured solution, 2D and 3D, Poisson ratio 0.3 and 0.49,
-   eps = h and h/100, and SNESVI, each on a series of meshes (signorini.estimates.SERIES).
+   eps = h and h/100, SNESVI, and the solution's regularities 0.3 and 1 (-mms_nu), each on a series of meshes
+   (signorini.estimates.SERIES).
 2. The penalty part of the estimate against the energy-norm distance of the penalty solution to SNESVI's on the same
    mesh, eps = h to h/1000, both rules, 2D and 3D.
 3. Hertz: how far from the contact zone's edge the largest error densities lie (the four cases of make hertz, on their

@@ -102,10 +102,11 @@ def test_the_size_and_pressure_bars_take_their_penalty_parts_apart(eps0):
 def test_accuracy_on_the_manufactured_solution_ends_within_the_tolerance():
     """-accuracy 0.1 from 8 x 8 (eps = h/10): the run stops at the first cycle where the energy-norm estimate is below 10%
     of the solution's energy norm and the force's, largest pressure's and width's bars below 10% of them; there the true
-    energy-norm error is below the tolerance (the estimate's effectivity, 4 to 6, puts it 4 to 6 times below), each
-    quantity's true error is within its bar, and the cycle before did not reach the tolerance. (At 42,684 unknowns,
-    the width's bar 6.8% where the cycle before had 14%; at eps = h the width's error falls like h^(1/2) and the run
-    took 319,204 unknowns and 40 s of the suite: make accuracy-ladder's coverage series checks that case's bars.)"""
+    energy-norm error is below the tolerance (the estimate's effectivity, 2 to 3, puts it 2 to 3 times below), each
+    quantity's true error is within its bar, and the cycle before did not reach the tolerance. (At cycle 7, 8,800
+    unknowns, the largest pressure's bar 4.9% where the cycle before had 10.7%; at eps = h the width's error falls like
+    h^(1/2), and the run takes hundreds of thousands of unknowns: make accuracy-ladder's coverage series checks that
+    case's bars.)"""
     out, h5 = run(MMS + ["-dm_plex_box_faces", "8,8", "-penalty_eps0", 0.1, "-accuracy", 0.1], "accuracy_mms")
     a, _ = load(h5)
     c = cycles(h5)
@@ -114,7 +115,7 @@ def test_accuracy_on_the_manufactured_solution_ends_within_the_tolerance():
     # the default quantities in 2D: the energy, the force, the nodal maximum and the width (the recovered peak in 3D)
     assert {q for q in QUANTITIES + ("pressure_peak",) if f"accuracy_{q}_bar" in a} == set(QUANTITIES)
     norm = c["energy_value"][-1]
-    assert c["estimate"][-1] <= 0.1 * norm and c["error_energy"][-1] <= 0.1 * norm / 3, (c["estimate"][-1], c["error_energy"][-1], norm)
+    assert c["estimate"][-1] <= 0.1 * norm and c["error_energy"][-1] <= 0.1 * norm / 2, (c["estimate"][-1], c["error_energy"][-1], norm)
     # the exact quantities of the closed form (scripts/signorini/exact.py), from the run's own parameters
     exact_q = mms_quantities(mms_from_run(a), a["young_modulus"], a["poisson_ratio"])
     exact_q["contact_force"] = np.hypot(exact_q["contact_force_x"], exact_q["contact_force_y"])

@@ -117,16 +117,28 @@ def series(args, sizes, name):
 
 
 def test_effectivity_is_stable_on_the_manufactured_solution():
-    """2D mms on four meshes: effectivity = estimate / exact energy-norm error in a band about the measured 4.4 to 4.8
-    (3 to 7: above 1, a reliable estimate, and a change of the estimator by half fails it), varying by at most 1.5x,
+    """2D mms on four meshes: effectivity = estimate / exact energy-norm error in a band about the measured 2.46 to 2.51
+    (1.5 to 3.5: above 1, a reliable estimate, and a change of the estimator by half fails it), varying by at most 1.5x,
     and the estimate converging at the exact error's observed rate within 0.1."""
     r = series([], ["16,16", "32,32", "64,64", "128,128"], "estimate_mms")
     eff = r[:, 1] / r[:, 2]
-    assert np.all((eff > 3) & (eff < 7)), eff
+    assert np.all((eff > 1.5) & (eff < 3.5)), eff
     assert eff.max() / eff.min() <= 1.5, eff
     rate_est = np.polyfit(np.log(r[:, 0]), np.log(r[:, 1]), 1)[0]
     rate_err = np.polyfit(np.log(r[:, 0]), np.log(r[:, 2]), 1)[0]
     assert abs(rate_est - rate_err) <= 0.1, (rate_est, rate_err)
+
+
+@pytest.mark.parametrize("dim,sizes", [(2, ["16,16", "32,32", "64,64", "128,128"]), (3, ["8,8,8", "12,12,12", "16,16,16"])])
+def test_effectivity_is_stable_on_a_rough_manufactured_solution(dim, sizes):
+    """The manufactured solution of regularity nu = 0.3 (u in H^(1.8 - delta)), not shipped: its pointwise body force
+    |x_1 - a|^(nu - 1) is not square-integrable, so the estimate takes its load in divergence form, the oscillation of
+    G = sigma(u_exact) about its cells' means (docs/estimate.md). The effectivity varies by at most 1.5x over the meshes
+    and stays above 1 (measured 2.1 to 2.3 in 2D, 2.82 to 2.87 in 3D; with h_T ||f||_T it swung 11.1, 5.1, 8.9 in 3D)."""
+    r = series(["-dm_plex_dim", dim, "-mms_nu", 0.3], sizes, f"estimate_rough{dim}d")
+    eff = r[:, 1] / r[:, 2]
+    assert np.all(eff > 1.2), eff
+    assert eff.max() / eff.min() <= 1.5, eff
 
 
 def test_effectivity_does_not_depend_on_the_poisson_ratio():
@@ -141,10 +153,10 @@ def test_effectivity_does_not_depend_on_the_poisson_ratio():
 
 
 def test_effectivity_in_3d():
-    """The 3D mms on 4^3 and 8^3: the effectivity in a band about the measured 6.0 to 6.7 (4 to 9)."""
+    """The 3D mms on 4^3 and 8^3: the effectivity in a band about the measured 2.91 and 3.04 (2 to 4.5)."""
     r = series(["-dm_plex_dim", "3"], ["4,4,4", "8,8,8"], "estimate_mms3d")
     eff = r[:, 1] / r[:, 2]
-    assert np.all((eff > 4) & (eff < 9)), eff
+    assert np.all((eff > 2) & (eff < 4.5)), eff
 
 
 @pytest.mark.parametrize("rule", ["nodal", "gauss"])

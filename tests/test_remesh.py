@@ -334,18 +334,19 @@ MMS3 = ["-options_file", "options/mms.yaml", "-contact_monitor", "0", "-dm_plex_
 
 def test_accuracy_on_the_3d_manufactured_solution_remeshes_the_box():
     """The 3D box of the options adapts by Gmsh's meshes of the same box (its sides numbered as PETSc numbers them, so
-    that the scene's face sets are the same): -accuracy 0.8 on the energy from 4^3 stops at the first cycle whose
-    estimate is below 80% of the energy norm (measured: cycle 3, 2,331 unknowns); the true energy-norm error, computed
+    that the scene's face sets are the same): -accuracy 0.4 on the energy from 4^3 stops at the first cycle whose
+    estimate is below 40% of the energy norm (measured: cycle 2, 1,467 unknowns); the true energy-norm error, computed
     against the exact solution on each new mesh, falls at every cycle and ends within TOL by the estimate's effectivity
-    (measured 6.2 on these meshes; 6.2 to 6.7 on uniform ones, docs/estimate.md)."""
-    out, h5 = run(MMS3 + ["-accuracy", 0.8, "-accuracy_quantity", "energy"], "remesh_mms3d")
+    (measured 2.55 and 2.61 on these meshes; 2.9 to 3.2 on uniform ones, docs/estimate.md)."""
+    out, h5 = run(MMS3 + ["-accuracy", 0.4, "-accuracy_quantity", "energy"], "remesh_mms3d")
     a, _ = load(h5)
     c = cycles(h5)
     assert a["accuracy_reached"] == 1 and c["accurate"][-1] == 1 and np.all(c["accurate"][:-1] == 0), out[-2000:]
+    assert len(c["n_dofs"]) >= 3, c["n_dofs"]
     assert np.all(np.diff(c["error_energy"]) < 0) and np.all(np.diff(c["n_dofs"]) > 0), (c["error_energy"], c["n_dofs"])
     norm, est, err = c["energy_value"][-1], c["estimate"][-1], c["error_energy"][-1]
-    assert est <= 0.8 * norm and err <= 0.8 * norm, (est, err, norm)
-    assert 4.0 <= est / err <= 8.0, est / err
+    assert est <= 0.4 * norm and err <= 0.4 * norm, (est, err, norm)
+    assert np.all((c["estimate"] / c["error_energy"] >= 2.0) & (c["estimate"] / c["error_energy"] <= 4.5)), c["estimate"] / c["error_energy"]
     assert a["adapt_fraction"] == 0.5  # the energy's target keeps Doerfler's default in 3D
 
 

@@ -187,7 +187,7 @@ PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(PetscDSGetConstants(ds, &w.nconstants, &w.constants));
   w.m_normal = user->opt->material.lambda + 2.0 * user->opt->material.mu;
   w.m_shear  = 2.0 * user->opt->material.mu;
-  PetscCall(RuleCreate(w.dim, user->scene.exact_source ? 3 : 2, &w.cell_rule));
+  PetscCall(RuleCreate(w.dim, 2, &w.cell_rule));
   PetscCall(RuleCreate(w.dim - 1, 3, &w.face_rule));
   PetscCall(PetscCalloc1((w.cEnd - w.cStart) * ESTIMATE_NUM_PARTS, &w.eta2));
   PetscCall(PetscMalloc1(w.cEnd - w.cStart, &w.volume));

@@ -37,7 +37,7 @@ typedef struct {
   PetscInt           nconstants;
   PetscReal          m_normal;  /* lambda + 2 mu: the normal tractions' and the body force's squares are divided by it */
   PetscReal          m_shear;   /* 2 mu: the tangential tractions' squares are divided by it */
-  EstimateRule       cell_rule; /* for the body force */
+  EstimateRule       cell_rule; /* for the body force (a weak-data scene's G takes the load's own rule) */
   EstimateRule       face_rule; /* for the boundary terms */
   PetscReal         *eta2;      /* [ncells][ESTIMATE_NUM_PARTS] the squared indicators */
   PetscReal         *volume;    /* [ncells] */
@@ -45,6 +45,7 @@ typedef struct {
   PetscInt          *face_kind; /* [fEnd - fStart]: ESTIMATE_FACE_* or the index of the face's clamp/slip/load in the scene */
   PetscReal         *face_sum;  /* [chart][dim + 1]: sum over a face's cells of sigma n_out, and their number */
   PetscReal         *face_geom; /* [fEnd - fStart][dim + 2]: each face's measure, diameter and unit normal */
+  PetscReal         *load_mean; /* [ncells][dim * dim]: Pi_0 G, the cells' means of a weak-data scene's G = sigma(u_exact); else NULL */
 } EstimateWork;
 
 enum { ESTIMATE_FACE_FREE = -1, ESTIMATE_FACE_CONTACT = -2 };

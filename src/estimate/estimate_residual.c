@@ -7,17 +7,29 @@
                                                                and across it (tangential: frictionless, the traction has none)
    with h_T, h_F the diameters, f the body force, t the traction of the face, p_h the contact pressure of the method:
    the penalty law (1/eps)[u_h . n_o - g]_+ at each point for the Gauss rule (the traction the discrete problem applies),
-   and the nodal force over the lumped area, interpolated, for the nodal rule and SNESVI. A scene with weak data (mms)
-   loads its faces by sigma(u_exact) n and its cells by f = -div sigma(u_exact) (Scene.exact_source).
+   and the nodal force over the lumped area, interpolated, for the nodal rule and SNESVI.
+
+   A scene with weak data (mms) is loaded in divergence form, L(v) = (G, eps(v)) - (n_o . G n_o, v . n_o)_Gamma_C with
+   G = sigma(u_exact), and its pointwise f = -div G need not be square-integrable (|x_1 - a|^(nu - 1) for the
+   manufactured solution). Its residual is split with the cells' means Pi_0 G: in a P1 cell Pi_0 G - sigma(u_h) is
+   constant, so (Pi_0 G - sigma(u_h), eps(v))_T moves to T's faces, and what remains in the cell is (G - Pi_0 G, eps(v))_T,
+   bounded by the data oscillation ||G - Pi_0 G||_{C^-1,T} ||v||_a with the constant 1 (Verfurth 2013, section 1.4.5).
+   So for such a scene
+     bulk      eta_T^2 = ||G - Pi_0 G||^2_{C^-1,T} = int_T (G - Pi_0 G) : C^-1 (G - Pi_0 G),
+   and sigma(u_h) - Pi_0 G replaces sigma(u_h) in the jumps and on the free faces (whose datum G n is inside (G, eps(v))),
+   while Gamma_C keeps its pointwise datum: R = (sigma(u_h) - Pi_0 G) n + (n_o . G n_o) n_o + p_h n_o.
+   The means and the oscillation use the load's own rule (src/discretization/cell_quadrature.c: composite on the cells
+   the kink cuts), where G is Holder continuous.
    The jumps need the stress of both cells of a face, which may sit on two ranks: each cell adds sigma n_out to its
    faces, and the point SF sums them, so that an interior face holds sigma_1 n_1 + sigma_2 n_2 = [sigma n]. */
 #include <petscsf.h>
 #include "contact.h"
+#include "discretization.h"
 #include "estimate_impl.h"
 #include "obstacle.h"
 #include "physics.h"
 
-/* The body force at x: -f0_body (which includes -body_force), or the constant body force; plus the exact source. */
+/* The body force at x: -f0_body (which includes -body_force), or the constant body force. */
 static PetscErrorCode BodyForce(const EstimateWork *w, const PetscReal x[], PetscReal f[])
 {
   const Scene   *scene = &w->user->scene;
@@ -33,32 +45,64 @@ static PetscErrorCode BodyForce(const EstimateWork *w, const PetscReal x[], Pets
     for (PetscInt d = 0; d < dim; ++d) f[d] -= PetscRealPart(f0[d]);
   } else
     for (PetscInt d = 0; d < dim; ++d) f[d] += PetscRealPart(w->constants[CONST_BODY_FORCE + d]);
-  if (scene->exact_source) {
-    PetscScalar s[3];
-
-    PetscCall((*scene->exact_source)(dim, 0.0, x, dim, s, (void *)w->constants));
-    for (PetscInt d = 0; d < dim; ++d) f[d] += PetscRealPart(s[d]);
-  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* sigma(u_exact) n at x, the traction of a scene with weak data */
-static PetscErrorCode ExactTraction(const EstimateWork *w, const PetscReal x[], const PetscReal n[], PetscReal t[])
+/* G = sigma(u_exact) at x, the load of a scene with weak data */
+static PetscErrorCode ExactStress(const EstimateWork *w, const PetscReal x[], PetscReal sigma[])
 {
   const Scene   *scene = &w->user->scene;
   const PetscInt dim   = w->dim;
   PetscScalar    g[9];
-  PetscReal      grad[9], sigma[9];
+  PetscReal      grad[9];
 
   PetscFunctionBeginUser;
   PetscCall((*scene->exact_gradient)(dim, 0.0, x, dim * dim, g, (void *)scene->constants));
   for (PetscInt k = 0; k < dim * dim; ++k) grad[k] = PetscRealPart(g[k]);
   ElasticStress(dim, &w->user->opt->material, grad, sigma);
-  for (PetscInt i = 0; i < dim; ++i) {
-    t[i] = 0.0;
-    for (PetscInt j = 0; j < dim; ++j) t[i] += sigma[i * dim + j] * n[j];
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* tau : C^-1 tau, the complementary energy density of a symmetric tensor: C^-1 tau = (tau - lambda / (2 mu + d lambda)
+   tr(tau) I) / (2 mu), in plane strain (d = 2) as in 3D. */
+static PetscReal ComplianceSquare(const EstimateWork *w, const PetscReal tau[])
+{
+  const PetscReal lambda = w->user->opt->material.lambda, mu = w->user->opt->material.mu;
+  PetscReal       tr = 0.0, tt = 0.0;
+
+  for (PetscInt d = 0; d < w->dim; ++d) tr += tau[d * w->dim + d];
+  for (PetscInt k = 0; k < w->dim * w->dim; ++k) tt += tau[k] * tau[k];
+  return (tt - lambda / (2.0 * mu + w->dim * lambda) * tr * tr) / (2.0 * mu);
+}
+
+/* Pi_0 G on cell c and the oscillation ||G - Pi_0 G||^2_{C^-1,T}, by the load's rule */
+static PetscErrorCode LoadOscillation(EstimateWork *w, CellQuadrature *cq, PetscInt c, PetscReal mean[], PetscReal *osc)
+{
+  const PetscInt n   = w->dim * w->dim;
+  PetscReal      vol = 0.0, G[9], D[9];
+
+  PetscFunctionBeginUser;
+  PetscCall(CellQuadratureSetCell(cq, c));
+  for (PetscInt k = 0; k < n; ++k) mean[k] = 0.0;
+  for (PetscInt q = 0; q < cq->Nq; ++q) {
+    PetscCall(ExactStress(w, &cq->x[q * w->dim], G));
+    for (PetscInt k = 0; k < n; ++k) mean[k] += cq->w[q] * G[k];
+    vol += cq->w[q];
+  }
+  for (PetscInt k = 0; k < n; ++k) mean[k] /= vol;
+  *osc = 0.0;
+  for (PetscInt q = 0; q < cq->Nq; ++q) {
+    PetscCall(ExactStress(w, &cq->x[q * w->dim], G));
+    for (PetscInt k = 0; k < n; ++k) D[k] = G[k] - mean[k];
+    *osc += cq->w[q] * ComplianceSquare(w, D);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* sigma(u_h) of a cell, less Pi_0 G for a scene with weak data: the stress whose tractions the faces' terms measure */
+static void CellStress(const EstimateWork *w, const EstimateCell *cell, PetscInt c, PetscReal s[])
+{
+  for (PetscInt k = 0; k < w->dim * w->dim; ++k) s[k] = cell->sigma[k] - (w->load_mean ? w->load_mean[(c - w->cStart) * w->dim * w->dim + k] : 0.0);
 }
 
 /* |R . n|^2 / (lambda + 2 mu) + |R - (R . n) n|^2 / (2 mu): a traction R in energy units, by the stiffness of the body
@@ -72,20 +116,31 @@ static PetscReal WeightedSquare(const EstimateWork *w, const PetscReal R[], cons
   return rn * rn / w->m_normal + rt / w->m_shear;
 }
 
-/* Bulk terms, and each cell's sigma n_out added to its faces' sums (with a count of the cells). */
+/* Bulk terms, and each cell's sigma n_out (less Pi_0 G n_out with weak data) added to its faces' sums (with a count
+   of the cells). */
 static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
 {
   const PetscInt dim      = w->dim;
-  PetscBool      has_load = (PetscBool)(w->user->scene.f0_body || w->user->scene.exact_source);
+  PetscBool      has_load = (PetscBool)(w->user->scene.f0_body != NULL);
+  CellQuadrature cq;
 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < dim && !has_load; ++d) has_load = (PetscBool)(PetscRealPart(w->constants[CONST_BODY_FORCE + d]) != 0.0);
+  if (w->load_mean) PetscCall(CellQuadratureCreate(w->dm, &w->user->scene, &w->user->opt->verify, &cq));
   for (PetscInt c = w->cStart; c < w->cEnd; ++c) {
     EstimateCell    cell;
     const PetscInt *cone;
     PetscInt        ncone;
+    PetscReal       sigma[9];
 
     PetscCall(EstimateCellLoad(w, c, &cell));
+    if (w->load_mean) {
+      PetscReal osc = 0.0;
+
+      PetscCall(LoadOscillation(w, &cq, c, &w->load_mean[(c - w->cStart) * dim * dim], &osc));
+      w->eta2[(c - w->cStart) * ESTIMATE_NUM_PARTS + ESTIMATE_BULK] += osc;
+    }
+    CellStress(w, &cell, c, sigma);
     w->volume[c - w->cStart] = cell.volume;
     for (PetscInt i = 0; i < dim * dim; ++i) w->norm2 += cell.volume * cell.sigma[i] * cell.grad[i]; /* sigma : eps(u_h), sigma symmetric */
     if (has_load) {
@@ -102,7 +157,7 @@ static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
         PetscCall(BodyForce(w, x, f));
         for (PetscInt d = 0; d < dim; ++d) ff += w->cell_rule.w[q] * cell.volume * f[d] * f[d];
       }
-      w->eta2[(c - w->cStart) * ESTIMATE_NUM_PARTS + ESTIMATE_BULK] = PetscSqr(cell.diameter) * ff / w->m_normal;
+      w->eta2[(c - w->cStart) * ESTIMATE_NUM_PARTS + ESTIMATE_BULK] += PetscSqr(cell.diameter) * ff / w->m_normal;
     }
     PetscCall(DMPlexGetConeSize(w->dm, c, &ncone));
     PetscCall(DMPlexGetCone(w->dm, c, &cone));
@@ -114,27 +169,29 @@ static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
 
       PetscCall(EstimateFaceOfCell(w, &cell, cone[k], &face));
       for (PetscInt i = 0; i < dim; ++i)
-        for (PetscInt j = 0; j < dim; ++j) s[i] += cell.sigma[i * dim + j] * face.normal[j];
+        for (PetscInt j = 0; j < dim; ++j) s[i] += sigma[i * dim + j] * face.normal[j];
       s[dim] += 1.0;
       geom[0] = face.measure; /* the normal's sign does not matter to the jump's weighted square */
       geom[1] = face.diameter;
       for (PetscInt d = 0; d < dim; ++d) geom[2 + d] = face.normal[d];
     }
   }
+  if (w->load_mean) PetscCall(CellQuadratureDestroy(&cq));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The contact traction's misfit on a face of Gamma_C: into eta2[normal] and eta2[tangential] of its cell. */
-static PetscErrorCode ContactFace(EstimateWork *w, const EstimateCell *cell, const EstimateFace *face, PetscReal eta2[])
+/* The contact traction's misfit on a face of Gamma_C of cell c: into eta2[normal] and eta2[tangential]. */
+static PetscErrorCode ContactFace(EstimateWork *w, PetscInt c, const EstimateCell *cell, const EstimateFace *face, PetscReal eta2[])
 {
   const PetscInt dim  = w->dim;
   const PetscInt none = ContactIsNone(w->user->contact);
-  PetscReal      sn[3], eps = 0.0, rn = 0.0, rt = 0.0;
+  PetscReal      sigma[9], sn[3], eps = 0.0, rn = 0.0, rt = 0.0;
 
   PetscFunctionBeginUser;
+  CellStress(w, cell, c, sigma);
   for (PetscInt i = 0; i < dim; ++i) {
     sn[i] = 0.0;
-    for (PetscInt j = 0; j < dim; ++j) sn[i] += cell->sigma[i * dim + j] * face->normal[j];
+    for (PetscInt j = 0; j < dim; ++j) sn[i] += sigma[i * dim + j] * face->normal[j];
   }
   if (!none && !w->lp) PetscCall(ContactFaceEps(w->user->contact, cell->diameter, &eps));
   for (PetscInt q = 0; q < w->face_rule.n; ++q) {
@@ -154,12 +211,13 @@ static PetscErrorCode ContactFace(EstimateWork *w, const EstimateCell *cell, con
       p = d > 0.0 ? d / eps : 0.0;
     }
     for (PetscInt i = 0; i < dim; ++i) R[i] = sn[i] + p * n[i];
-    if (w->user->scene.weak_data) { /* the exact solution's tangential traction is the face's datum */
-      PetscReal t[3], tn = 0.0;
+    if (w->load_mean) { /* the load's normal stress on Gamma_C, n_o . G n_o (sn holds (sigma(u_h) - Pi_0 G) n) */
+      PetscReal G[9], gnn = 0.0;
 
-      PetscCall(ExactTraction(w, x, face->normal, t));
-      for (PetscInt i = 0; i < dim; ++i) tn += t[i] * n[i];
-      for (PetscInt i = 0; i < dim; ++i) R[i] -= t[i] - tn * n[i];
+      PetscCall(ExactStress(w, x, G));
+      for (PetscInt i = 0; i < dim; ++i)
+        for (PetscInt j = 0; j < dim; ++j) gnn += n[i] * G[i * dim + j] * n[j];
+      for (PetscInt i = 0; i < dim; ++i) R[i] += gnn * n[i];
     }
     for (PetscInt i = 0; i < dim; ++i) Rn += R[i] * n[i];
     for (PetscInt i = 0; i < dim; ++i) Rt += PetscSqr(R[i] - Rn * n[i]);
@@ -171,13 +229,14 @@ static PetscErrorCode ContactFace(EstimateWork *w, const EstimateCell *cell, con
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* t - sigma(u_h) n on a loaded, free or slip face (the slip's fixed components carry the support's reaction). */
-static PetscErrorCode NeumannFace(EstimateWork *w, const EstimateCell *cell, const EstimateFace *face, PetscInt kind, PetscReal eta2[])
+/* t - sigma(u_h) n on a loaded, free or slip face of cell c (the slip's fixed components carry the support's reaction);
+   with weak data t - (sigma(u_h) - Pi_0 G) n, the face's datum G n being inside (G, eps(v)). Constant on the face. */
+static PetscErrorCode NeumannFace(EstimateWork *w, PetscInt c, const EstimateCell *cell, const EstimateFace *face, PetscInt kind, PetscReal eta2[])
 {
   const PetscInt           dim      = w->dim;
   const BoundaryCondition *bc       = kind >= 0 ? &w->user->scene.bcs.bc[kind] : NULL;
   PetscBool                fixed[3] = {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE};
-  PetscReal                t0[3] = {0.0, 0.0, 0.0}, sn[3], r = 0.0;
+  PetscReal                t0[3]    = {0.0, 0.0, 0.0}, sigma[9], sn[3], R[3];
 
   PetscFunctionBeginUser;
   if (bc && bc->kind == BC_CLAMP) PetscFunctionReturn(PETSC_SUCCESS);
@@ -187,25 +246,13 @@ static PetscErrorCode NeumannFace(EstimateWork *w, const EstimateCell *cell, con
     for (PetscInt d = 0; d < dim; ++d) t0[d] = bc->value[d];
   if (bc && bc->kind == BC_PRESSURE)
     for (PetscInt d = 0; d < dim; ++d) t0[d] = -bc->value[0] * face->normal[d];
+  CellStress(w, cell, c, sigma);
   for (PetscInt i = 0; i < dim; ++i) {
     sn[i] = 0.0;
-    for (PetscInt j = 0; j < dim; ++j) sn[i] += cell->sigma[i * dim + j] * face->normal[j];
+    for (PetscInt j = 0; j < dim; ++j) sn[i] += sigma[i * dim + j] * face->normal[j];
   }
-  if (!w->user->scene.weak_data) { /* constant on the face */
-    PetscReal R[3];
-
-    for (PetscInt d = 0; d < dim; ++d) R[d] = fixed[d] ? 0.0 : t0[d] - sn[d];
-    r = face->measure * WeightedSquare(w, R, face->normal);
-  } else
-    for (PetscInt q = 0; q < w->face_rule.n; ++q) {
-      PetscReal x[3], u[3], wq, t[3], R[3];
-
-      EstimateFacePoint(w, cell, face, q, x, u, &wq);
-      PetscCall(ExactTraction(w, x, face->normal, t));
-      for (PetscInt d = 0; d < dim; ++d) R[d] = fixed[d] ? 0.0 : t0[d] + t[d] - sn[d];
-      r += wq * WeightedSquare(w, R, face->normal);
-    }
-  eta2[ESTIMATE_NEUMANN] += face->diameter * r;
+  for (PetscInt d = 0; d < dim; ++d) R[d] = fixed[d] ? 0.0 : t0[d] - sn[d];
+  eta2[ESTIMATE_NEUMANN] += face->diameter * face->measure * WeightedSquare(w, R, face->normal);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -238,9 +285,9 @@ static PetscErrorCode FaceTerms(EstimateWork *w, PetscInt pStart)
       PetscCall(EstimateCellLoad(w, support[0], &cell));
       PetscCall(EstimateFaceOfCell(w, &cell, f, &face));
       if (kind == ESTIMATE_FACE_CONTACT)
-        PetscCall(ContactFace(w, &cell, &face, eta2));
+        PetscCall(ContactFace(w, support[0], &cell, &face, eta2));
       else
-        PetscCall(NeumannFace(w, &cell, &face, kind, eta2));
+        PetscCall(NeumannFace(w, support[0], &cell, &face, kind, eta2));
     }
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -258,6 +305,7 @@ PetscErrorCode EstimateResidualTerms(EstimateWork *w)
   PetscCall(DMPlexGetChart(w->dm, &pStart, &pEnd));
   PetscCall(PetscCalloc1((pEnd - pStart) * (dim + 1), &w->face_sum));
   PetscCall(PetscMalloc1((w->fEnd - w->fStart) * (dim + 2), &w->face_geom));
+  if (w->user->scene.weak_data) PetscCall(PetscMalloc1((w->cEnd - w->cStart) * dim * dim, &w->load_mean));
   PetscCall(CellTerms(w, pStart));
   /* the faces a rank shares: their owners sum the contributions, then send the sums back */
   PetscCall(DMGetPointSF(w->dm, &sf));
@@ -274,5 +322,6 @@ PetscErrorCode EstimateResidualTerms(EstimateWork *w)
   PetscCall(FaceTerms(w, pStart));
   PetscCall(PetscFree(w->face_sum));
   PetscCall(PetscFree(w->face_geom));
+  PetscCall(PetscFree(w->load_mean));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

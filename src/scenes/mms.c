@@ -55,25 +55,6 @@ static PetscErrorCode MMSExactGradient(PetscInt dim, PetscReal t, const PetscRea
   return PETSC_SUCCESS;
 }
 
-/* The body force f = -div sigma(u_exact), for the error estimate (the solve takes the data in weak form). With
-   y = x_d and sigma = lambda tr(eps) I + 2 mu eps of the field above,
-     f_1 = (lambda + 2 mu) y phi''' - (lambda + mu) psi',   f_d = lambda phi'' - mu y psi'',
-   singular like |x_1 - a|^(nu - 1) at the kink: in L2 only for nu > 1/2. ctx: the kernels' constants[]. */
-static PetscErrorCode MMSExactSource(PetscInt dim, PetscReal t, const PetscReal x[], PetscInt Nc, PetscScalar f[], void *ctx)
-{
-  const PetscScalar *k = (const PetscScalar *)ctx, *c = &k[CONST_SCENE];
-  const PetscReal    lambda = PetscRealPart(k[CONST_LAMBDA]), mu = PetscRealPart(k[CONST_MU]);
-  const PetscReal    nu = PetscRealPart(c[MMS_NU]), s = x[0] - PetscRealPart(c[MMS_A]), y = x[dim - 1];
-  const PetscReal    A = PetscRealPart(c[MMS_AMP_A]), B = PetscRealPart(c[MMS_AMP_B]), p = 2.0 + nu, q = 1.0 + nu;
-  const PetscReal    phi2 = A * p * (p - 1.0) * PowPlus(s, p - 2.0), phi3 = A * p * (p - 1.0) * (p - 2.0) * PowPlus(s, p - 3.0);
-  const PetscReal    psi1 = B * q * PowPlus(-s, q - 1.0), psi2 = -B * q * (q - 1.0) * PowPlus(-s, q - 2.0);
-
-  for (PetscInt i = 0; i < dim; ++i) f[i] = 0.0;
-  f[0]       = (lambda + 2.0 * mu) * y * phi3 - (lambda + mu) * psi1;
-  f[dim - 1] = lambda * phi2 - mu * y * psi2;
-  return PETSC_SUCCESS;
-}
-
 PetscErrorCode SceneCreate_MMS(DM dm, const Material *mat, Scene *scene)
 {
   MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
@@ -105,7 +86,6 @@ PetscErrorCode SceneCreate_MMS(DM dm, const Material *mat, Scene *scene)
   PetscCall(SceneAddBoundary(scene, BC_CLAMP, dim == 2 ? 3 : 2, MMSExact)); /* top, x_d = 1 */
   scene->exact                = MMSExact;
   scene->exact_gradient       = MMSExactGradient;
-  scene->exact_source         = MMSExactSource;
   scene->weak_data            = PETSC_TRUE;
   scene->has_kink             = PETSC_TRUE;
   scene->kink_normal[0]       = 1.0;
