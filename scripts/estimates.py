@@ -13,14 +13,17 @@ Usage: estimates.py [--outdir DIR] [--parts estimate,bars] [--check]
 
 4. The error bars (-bars) against the known values: the manufactured solution's force, largest pressure and contact size
    in 2D and 3D, and the Hertz indenters' contact size and peak pressure at the run's force, in a block 10 times make
-   hertz's (the closed form is a half-space's); the pressure's band against the manufactured solution's pressure at the
-   nodes (--parts bars: this part alone, --parts estimate: the others).
+   hertz's (the closed form is a half-space's), and make hertz's curved bodies with their Gmsh models (-adapt_model, the
+   levels remeshed); the pressure's band against the manufactured solution's pressure at the nodes (--parts bars: this
+   part alone, --parts estimate: the others).
 
 DIR (default output/estimates) receives the runs, estimates.csv, penalty.csv, hertz.csv, bars.csv, estimates.md, bars.md,
 effectivity.png, hertz_density.png and band.png. --check: exit 1 unless, in every series, the effectivity varies by at
 most 1.5x over the four finest meshes and the estimate's rate is the error's within 0.1; the effectivity over all series varies by at most 3x;
 every penalty ratio lies in [1/3, 3]; on every Hertz case the densest cell lies within 2 cell diameters of the zone's
-edge; at least 9 in 10 error bars cover the true error, and none is over 10 times an error above 1e-4 relative; the
+edge; at least 9 in 10 error bars cover the true error, and none is over 10 times an error above its reference's accuracy
+(1e-4 relative; Hertz's closed forms on make hertz's own bodies 0.25%) but the zone's size where its bar is the one-cell band along the edge (its
+resolution); the
 pressure's band covers at least 9 in 10 of the nodes where the pressure's error is above 1e-3 of its peak.
 """
 import argparse
@@ -131,22 +134,41 @@ def coverage(outdir):
         ref = run(ref_cmd, ref_out)
         at_ref = st.hertz_truth(case, ref)  # the closed form at the reference's own force
         for q, (name, exact) in st.hertz_truth(case, a).items():
-            rows.append(coverage_row(f"hertz {case} {a['n_cells']} cells", name, *st.qoi(a, name), exact, float(ref[name]), at_ref[q][1]))
+            rows.append(coverage_row(f"hertz {case} {a['n_cells']} cells", name, *st.qoi(a, name), exact, float(ref[name]), at_ref[q][1],
+                                     floor=name == "contact_size" and st.size_bar_is_its_floor(a)))
+    for case, method, h_near in st.COVERAGE_REMESHED:
+        spec = hertz.CASES[case]
+        tag = f"{case}_remeshed_{h_near:g}_{method.replace('=', '').replace('/', '_')}"
+        mesh, model, out = (os.path.join(outdir, tag + ext) for ext in (".msh", ".geo", ".h5"))
+        spec["shape"](mesh, radius=hertz.RADIUS, h_far=spec["h_far"], h_near=h_near, width=spec["width"], near=spec["near"], model=model)
+        cmd = hertz.command(case, display_path(mesh), method, display_path(out)) + ["-bars", "-contact_grid_sequence", "2", "-adapt_model",
+                                                                                     display_path(model)]
+        if spec["dim"] == 3:
+            cmd += hertz.GAMG_3D
+        a = run(cmd, out)
+        for q, (name, exact) in st.hertz_truth(case, a).items():  # no eps -> 0 run of the same levels: the causes unmeasured
+            value = st.qoi(a, name)[0]
+            rows.append(coverage_row(f"hertz {case} remeshed h_near={h_near:g} {method}", name, *st.qoi(a, name), exact,
+                                     value if method == "vi" else float("nan"), floor=name == "contact_size" and st.size_bar_is_its_floor(a),
+                                     reference=hertz.CLOSED_FORM_ACCURACY))
     return rows, bands
 
 
-def coverage_row(case, name, value, bar, exact, limit, limit_exact=None):
+def coverage_row(case, name, value, bar, exact, limit, limit_exact=None, floor=False, reference=1e-4):
     """A quantity's bar against its true error, and against the sum of its two causes' own errors: the penalty's,
-    |value - limit|, limit the same run at eps/1000 (its eps -> 0 limit on the same mesh), and the mesh's
-    |limit - limit_exact| (limit_exact: the exact value for the limit's run, the closed form at its own force for Hertz;
-    exact by default). Where the two have opposite signs they cancel in part in the error, and the bar, which adds them,
-    is wide against it."""
+    |value - limit|, limit the same run at eps/1000 (its eps -> 0 limit on the same mesh; NaN where not run), and the
+    mesh's |limit - limit_exact| (limit_exact: the exact value for the limit's run, the closed form at its own force for
+    Hertz; exact by default). Where the two have opposite signs they cancel in part in the error, and the bar, which adds
+    them, is wide against it. floor: the bar's mesh part is the zone's one-cell band (size_bar_is_its_floor()).
+    reference: the exact value's own accuracy, relative (a closed form's is hertz.CLOSED_FORM_ACCURACY): below it the
+    error, and so the bar's ratio to it, is not known."""
     err = abs(value - exact)
     limit_exact = exact if limit_exact is None else limit_exact
     causes = abs(value - limit) + abs(limit - limit_exact)
     row = {"case": case, "quantity": name, "value": value, "exact": exact, "error": err, "bar": bar,
            "covered": int(bool(bar >= err)) if np.isfinite(bar) else "no bar", "bar_over_error": bar / err if err > 0 else float("nan"),
-           "eps_error": abs(value - limit), "mesh_error": abs(limit - limit_exact), "bar_over_causes": bar / causes if causes > 0 else float("nan")}
+           "eps_error": abs(value - limit), "mesh_error": abs(limit - limit_exact), "bar_over_causes": bar / causes if causes > 0 else float("nan"),
+           "floor": int(bool(floor)), "reference": reference}
     print(f"bars {case} {name}: {value:.6g} +- {bar:.2g} against {exact:.6g} (error {err:.2g}): "
           f"{'covered' if row['covered'] == 1 else 'NOT covered' if row['covered'] == 0 else 'no bar'}")
     return row
@@ -234,11 +256,14 @@ def bars_report(cov, bands, outdir):
              f"{st.BLOCK:g} times make hertz's (scripts/signorini/estimates.py).", "",
              "The error's two causes, each against its own reference: eps, |Q - Q(eps/1000)| on the same mesh, and the mesh, "
              "|Q(eps/1000) - exact|; bar / causes = bar / (the sum of the two).", "",
-             "| run | quantity | value | bar | exact | error | covered | bar / error | eps error | mesh error | bar / causes |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "floor: the size's mesh part is the one-cell band along the zone's edge, its resolution (no 10x check). "
+             f"Hertz's closed forms are references to about {hertz.CLOSED_FORM_ACCURACY:.2%} for make hertz's own bodies (the remeshed "
+             "rows; make hertz-curvature): a smaller error is not known, nor its bar's ratio to it (no 10x check).", "",
+             "| run | quantity | value | bar | exact | error | covered | bar / error | eps error | mesh error | bar / causes | floor |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in cov:
         lines.append(f"| {r['case']} | {r['quantity']} | {r['value']:.6g} | {r['bar']:.2g} | {r['exact']:.6g} | {r['error']:.2g} | {r['covered']} | "
-                     f"{r['bar_over_error']:.2f} | {r['eps_error']:.2g} | {r['mesh_error']:.2g} | {r['bar_over_causes']:.2f} |")
+                     f"{r['bar_over_error']:.2f} | {r['eps_error']:.2g} | {r['mesh_error']:.2g} | {r['bar_over_causes']:.2f} | {r['floor']} |")
     lines += ["", "The pressure's band (contact_pressure_bar) against the exact pressure at the nodes of Gamma_C whose error is above "
               "1e-3 of the peak:", "", "| run | nodes | covered | median band / error |", "|---|---|---|---|"]
     lines += [f"| {b['case']} | {b['nodes']} | {b['covered']} | {b['median_band_over_error']:.2f} |" for b in bands]
@@ -252,7 +277,7 @@ def check_bars(cov):
     if with_bar and sum(r["covered"] for r in with_bar) < 0.9 * len(with_bar):
         bad.append(f"bars: {sum(r['covered'] for r in with_bar)} of {len(with_bar)} cover the true error (at least 9 in 10 asked)")
     bad += [f"bars: {r['case']} {r['quantity']}: bar {r['bar']:.2g} over 10 times the error {r['error']:.2g}" for r in with_bar
-            if r["error"] > 1e-4 * abs(r["exact"]) and r["bar"] > 10 * r["error"]]
+            if r["error"] > r["reference"] * abs(r["exact"]) and r["bar"] > 10 * r["error"] and not r["floor"]]
     return bad
 
 

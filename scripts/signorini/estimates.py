@@ -97,6 +97,10 @@ def hertz_peak(case, path, top=10):
 COVERAGE_MMS = [(2, 32, []), (2, 64, []), (2, 128, []), (3, 4, ["-contact_grid_sequence", "2"] + SOLVER_3D),
                 (3, 8, ["-contact_grid_sequence", "2"] + SOLVER_3D)]
 COVERAGE_HERTZ = [("cylinder-indenter", "eps=h/10"), ("sphere-indenter", "eps=h/10")]
+# -bars with the body's Gmsh model (-adapt_model): make hertz's curved bodies from their file mesh at h_near, the levels
+# the model remeshed at halved sizes; the 3D sphere's with GAMG
+COVERAGE_REMESHED = [("cylinder", "vi", 0.006), ("cylinder", "eps=h/10", 0.006), ("cylinder", "vi", 0.003), ("cylinder", "eps=h/10", 0.003),
+                     ("cylinder", "vi", 0.024), ("cylinder", "eps=h/10", 0.024), ("sphere", "eps=h/10", 0.04)]
 MMS_QUANTITIES = ["contact_force", "pressure_max", "contact_size", "energy"]
 
 
@@ -144,6 +148,12 @@ def pressure_band_coverage(path):
 def qoi(attrs, name):
     """(value, bar) of qoi_NAME (bar NaN where there is none)."""
     return float(attrs[f"qoi_{name}"]), float(attrs.get(f"qoi_{name}_bar", float("nan")))
+
+
+def size_bar_is_its_floor(attrs):
+    """Whether the zone's size's mesh part is the final mesh's one-cell band along the edge: its resolution, which the
+    bar takes where the levels' differences are smaller (src/estimate/bars.c), not a measured convergence."""
+    return float(attrs.get("qoi_contact_size_bar_mesh", float("nan"))) == float(attrs["contact_size_band"])
 
 
 def hertz_truth(case, attrs):

@@ -84,6 +84,11 @@ CASES = {
     },
 }
 
+# How far Hertz's closed form is from the model the solver solves on make hertz's own bodies (radius 1, the unit
+# block), relative: the fitted a's and p0's offsets of make hertz-curvature at R = 1 (+0.25% and -0.23%; docs/hertz.md).
+# Errors below it are not known against the closed form (in a block 10 times larger the offset is about 0.02%).
+CLOSED_FORM_ACCURACY = 2.5e-3
+
 # The remeshed 3D cases' solver: GAMG with its aggregates on the unfiltered graph; the carried solutions' penalty rows
 # broke gamg.yaml's threshold 0.01 down on the sphere (docs/estimate.md, "Remeshing the Gmsh model")
 GAMG_3D = ["-options_file", "options/solvers/gamg.yaml", "-pc_gamg_threshold", "0"]

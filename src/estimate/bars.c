@@ -27,7 +27,11 @@
    along the edge) is its resolution, the floor of the size's mesh part:
      bar_mesh = max(grid convergence index, b1); where the levels are outside the asymptotic range but differ by no
                 more than their bands (|e21| <= b2, |e32| <= b3: the staircase), bar_mesh = max(|e21|, b1).
-   (Its penalty part is not floored: the 2h level sees the widening at eps = h only in part, 1/2 to 2/3 of the final
+   The largest nodal pressure is resolved to its step to its neighbours (PostprocessPressureStep()) in the same way: where
+   its levels are outside the asymptotic range but differ by no more than their steps, bar_mesh = max(|e21|, step1) (on
+   levels remeshed from a Gmsh model, whose nodes do not nest, the nodal maximum's differences change sign within the
+   step); in the asymptotic range its index is not floored.
+   (The size's penalty part is not floored: the 2h level sees the widening at eps = h only in part, 1/2 to 2/3 of the final
    mesh's on the manufactured solution, which the factor 2.39 of r = 1/2 and the floor of the mesh part cover; a floor
    of a 2h cell would make the bar of a Hertz zone at eps = h/10 thirty times its error. docs/estimate.md.)
    The bar is the sum of the parts, bar_mesh + bar_eps. */
@@ -65,10 +69,15 @@ PetscErrorCode BarsCheck(MPI_Comm comm, const AppCtx *user)
 
 /* The quantities of q in a fixed order, with their names and the size of their kind (the force's magnitude for its
    components and the reactions, since a component may be zero): a difference below BARS_SAME of that size is none.
-   The zone's size is at index BarsSizeIndex(dim). */
+   The zone's size is at index BarsSizeIndex(dim), the largest pressure at BarsPressureIndex(dim). */
 static PetscInt BarsSizeIndex(PetscInt dim)
 {
   return dim + 1;
+}
+
+static PetscInt BarsPressureIndex(PetscInt dim)
+{
+  return dim;
 }
 
 static PetscInt List(const AppCtx *user, PetscInt dim, const Quantities *q, char names[][64], PetscReal v[], PetscReal kind[])
@@ -141,22 +150,25 @@ static void MeshPart(const PetscReal f[3], PetscReal kind, PetscReal *bar, Petsc
   *bar = BARS_SAFETY * PetscAbsReal(e21) / (PetscPowReal(2.0, *order) - 1.0);
 }
 
-/* The zone's size, a free boundary: the mesh's part where the levels are in the asymptotic range, floored at the final
-   mesh's band; where they are not but differ by no more than their bands (a staircase within the resolution), the last
-   difference, floored the same way. f[] the sizes and b[] the bands, coarsest first. */
-static void MeshPartEdge(const PetscReal f[3], const PetscReal b[3], PetscReal *bar, PetscReal *order, char note[], size_t len)
+/* A quantity the mesh resolves only to a resolution r (the zone's size: the one-cell band along its edge; the largest
+   nodal pressure: its step to its neighbours), f[] its values and r[] the levels' resolutions, coarsest first: the
+   mesh's part where the levels are in the asymptotic range, floored at the final mesh's resolution if floored; where
+   they are not but differ by no more than their resolutions (a staircase within the resolution), the last difference,
+   floored the same way, and the note says so (what: the resolution's name). */
+static void MeshPartResolved(const PetscReal f[3], const PetscReal r[3], PetscBool floored, const char *what, PetscReal *bar, PetscReal *order,
+                             char note[], size_t len)
 {
   const PetscReal e21 = f[1] - f[2], e32 = f[0] - f[1];
 
   MeshPart(f, PetscAbsReal(f[2]), bar, order, note, len);
   if (!PetscIsNanReal(*bar)) {
-    *bar = PetscMax(*bar, b[2]);
+    if (floored) *bar = PetscMax(*bar, r[2]);
     return;
   }
-  if (PetscAbsReal(e21) <= b[1] && PetscAbsReal(e32) <= b[0]) {
-    *bar   = PetscMax(PetscAbsReal(e21), b[2]);
+  if (PetscAbsReal(e21) <= r[1] && PetscAbsReal(e32) <= r[0]) {
+    *bar   = PetscMax(PetscAbsReal(e21), r[2]);
     *order = PETSC_NAN;
-    PetscSNPrintf(note, len, "the meshes differ by less than the cells along the zone's edge: the last difference");
+    PetscSNPrintf(note, len, "the meshes differ by less than %s: the last difference", what);
   }
 }
 
@@ -194,7 +206,12 @@ PetscErrorCode BarsCompute(DM dm, AppCtx *user)
       if (k == size) {
         const PetscReal band[3] = {b->level[0].contact_size_band, b->level[1].contact_size_band, q.contact_size_band};
 
-        MeshPartEdge(f, band, &b->bar_mesh[k], &b->order[k], b->note[k], sizeof(b->note[k]));
+        MeshPartResolved(f, band, PETSC_TRUE, "the cells along the zone's edge", &b->bar_mesh[k], &b->order[k], b->note[k], sizeof(b->note[k]));
+      } else if (k == BarsPressureIndex(dim)) {
+        const PetscReal step[3] = {b->level[0].pressure_max_step, b->level[1].pressure_max_step, q.pressure_max_step};
+
+        MeshPartResolved(f, step, PETSC_FALSE, "the largest pressure's step to its neighbours", &b->bar_mesh[k], &b->order[k], b->note[k],
+                         sizeof(b->note[k]));
       } else
         MeshPart(f, kind[k], &b->bar_mesh[k], &b->order[k], b->note[k], sizeof(b->note[k]));
     }
