@@ -4,6 +4,14 @@
    (composite) quadrature that the weak data of manufactured solutions and the error norms integrate with. */
 #pragma once
 #include "signorini.h"
+#include "mesh.h" /* MeshClosure */
+
+/* element_p1.c: the P1 simplex in closed form */
+PetscErrorCode ElementP1Gradients(PetscInt dim, const PetscReal x[], PetscReal g[][3], PetscReal *volume);
+PetscErrorCode ElementP1Stiffness(PetscInt dim, PetscReal lambda, PetscReal mu, const PetscReal x[], PetscScalar Ke[]);
+PetscErrorCode ElementP1CellVertices(MeshClosure *mc, PetscSection csec, PetscSection lsec, const PetscScalar xc[], PetscInt c, PetscReal x[],
+                                     PetscInt off[], PetscInt *nv);
+PetscErrorCode ElementP1AddFixedCellsStiffness(DM dm, const Material *mat, Vec locU, Vec locF);
 
 /* section.c */
 PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user);

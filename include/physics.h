@@ -2,18 +2,13 @@
    (src/physics/); the contact treatment itself is the Contact object (include/contact.h, src/contact/). */
 #pragma once
 #include "contact.h"
-#include "mesh.h" /* MeshClosure */
+#include "mesh.h"
 
 /* elasticity.c */
 PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degree, PetscBool *section_check);
 PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user);
 PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user);
 PetscErrorCode ElasticityRigidBodyModesP1(DM dm, Vec like, MatNullSpace *nullspace);
-PetscErrorCode ElasticityP1Gradients(PetscInt dim, const PetscReal x[], PetscReal g[][3], PetscReal *volume);
-PetscErrorCode ElasticityP1ElementStiffness(PetscInt dim, PetscReal lambda, PetscReal mu, const PetscReal x[], PetscScalar Ke[]);
-PetscErrorCode ElasticityP1CellVertices(MeshClosure *mc, PetscSection csec, PetscSection lsec, const PetscScalar xc[], PetscInt c, PetscReal x[],
-                                        PetscInt off[], PetscInt *nv);
-PetscErrorCode ElasticityP1AddFixedCellsStiffness(DM dm, const Material *mat, Vec locU, Vec locF);
 
 /* weak_data.c: the load of a scene with an exact solution, L(v) = a(u_exact, v) - int_Gamma_C sigma_n(u_exact) v_n */
 PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0, PetscReal *lift);

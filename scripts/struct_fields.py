@@ -31,22 +31,54 @@ def headers(rev):
     return "\n".join(subprocess.run(["git", "show", f"{rev}:{p}"], cwd=ROOT, capture_output=True, text=True, check=True).stdout for p in paths)
 
 
+def closing(text, i):
+    """The index of the brace that closes the one at text[i]."""
+    depth = 0
+    for j in range(i, len(text)):
+        depth += {"{": 1, "}": -1}.get(text[j], 0)
+        if depth == 0:
+            return j
+    raise ValueError("unbalanced braces")
+
+
 def structures(text):
+    """{name: body} of the typedef'd structs and of struct X { ... }; at the top level, their braces matched (a nested
+    struct { ... } member; is part of its body)."""
     text = re.sub(r"/\*.*?\*/", "", text, flags=re.S)
+    text = re.sub(r"//[^\n]*", "", text)
     found = {}
-    for m in re.finditer(r"typedef\s+struct\s*\w*\s*\{(.*?)\}\s*(\w+)\s*;", text, flags=re.S):
-        found[m.group(2)] = m.group(1)
-    for m in re.finditer(r"^struct\s+(\w+)\s*\{(.*?)\}\s*;", text, flags=re.S | re.M):
-        found[m.group(1)] = m.group(2)
+    for m in re.finditer(r"^(typedef\s+)?struct\s*(\w*)\s*\{", text, flags=re.M):
+        end = closing(text, m.end() - 1)
+        body = text[m.end():end]
+        tail = re.match(r"\s*(\w*)\s*;", text[end + 1:])
+        name = tail.group(1) if m.group(1) and tail and tail.group(1) else m.group(2)
+        if name:
+            found[name] = body
     return found
 
 
+def statements(body):
+    """The members' declarations of a struct body, split at the semicolons outside nested braces."""
+    out, depth, start = [], 0, 0
+    for i, ch in enumerate(body):
+        depth += {"{": 1, "}": -1}.get(ch, 0)
+        if ch == ";" and depth == 0:
+            out.append(body[start:i])
+            start = i + 1
+    return out
+
+
 def members(body):
-    """(type, declarator) of each member; a function pointer is one member of type 'function'."""
+    """(type, declarator) of each member; a function pointer is one member of type 'function', a nested anonymous
+    struct one member whose type is its body in braces."""
     out = []
-    for stmt in body.split(";"):
+    for stmt in statements(body):
         stmt = " ".join(stmt.split())
         if not stmt:
+            continue
+        if "{" in stmt:
+            inner = stmt[stmt.index("{") + 1:stmt.rindex("}")]
+            out.extend(("{" + inner + "}", d.strip()) for d in stmt[stmt.rindex("}") + 1:].split(",") if d.strip())
             continue
         if "(*" in stmt:
             out.append(("function", stmt))
@@ -57,11 +89,18 @@ def members(body):
     return out
 
 
-def leaves(name, found):
+def leaves_of(body, found):
     total = 0
-    for typ, decl in members(found[name]):
-        total += 1 if decl.startswith("*") or typ not in found else leaves(typ, found)
+    for typ, decl in members(body):
+        if typ.startswith("{"):
+            total += leaves_of(typ[1:-1], found)
+        else:
+            total += 1 if decl.startswith("*") or typ not in found else leaves_of(found[typ], found)
     return total
+
+
+def leaves(name, found):
+    return leaves_of(found[name], found)
 
 
 def main(argv=None):

@@ -89,3 +89,84 @@ def test_no_code_tests_the_contact_type_by_name():
     by_name = [p for p, t in texts.items() if p != os.path.join("src", "contact", "contact.c")
                and re.search(r"Str(n)?cmp\([^;]*(CONTACTPENALTY|CONTACTVI|CONTACTNONE|\"penalty\"|\"vi\"|\"none\")", t)]
     assert not flag and not by_name, (flag, by_name)
+
+
+def folder(path):
+    """The folder of src/ a file is in, '' for src/main.c."""
+    parts = path.split("/")
+    return parts[1] if len(parts) > 2 else ""
+
+
+def folder_graph(calls):
+    """{folder: the other folders its files call}."""
+    graph = {}
+    for a, targets in calls.items():
+        graph.setdefault(folder(a), set()).update(folder(b) for b in targets if folder(b) != folder(a))
+    return graph
+
+
+def folder_cycle(graph):
+    """A cycle of folders that call each other (a list, its first folder repeated at its end), or None."""
+    state, stack = {}, []
+
+    def visit(f):
+        state[f] = 1
+        stack.append(f)
+        for g in sorted(graph.get(f, ())):
+            if state.get(g) == 1:
+                return stack[stack.index(g):] + [g]
+            if not state.get(g):
+                found = visit(g)
+                if found:
+                    return found
+        stack.pop()
+        state[f] = 2
+        return None
+
+    for f in sorted(graph):
+        if not state.get(f):
+            found = visit(f)
+            if found:
+                return found
+    return None
+
+
+def test_no_folder_calls_back_up():
+    """The folders of src/ are layers (docs/design.md, "Layout"): no chain of calls leads from a folder back to itself
+    (discretization/ and physics/ called each other until the P1 element moved to src/discretization/element_p1.c)."""
+    graph = folder_graph(call_graph(sources())[1])
+    assert len(graph) >= 10, sorted(graph)
+    assert folder_cycle(graph) is None, folder_cycle(graph)
+
+
+def test_the_folder_check_finds_a_cycle():
+    """The check itself: three folders in a ring are found, and a chain is not."""
+    assert folder_cycle({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == ["a", "b", "c", "a"]
+    assert folder_cycle({"a": {"b"}, "b": {"c"}, "c": set()}) is None
+
+
+def test_design_md_states_the_folders_calls():
+    """docs/design.md's list of what each folder calls ("- `X/` calls ...") is the call graph of the sources."""
+    text = open(os.path.join(ROOT, "docs", "design.md")).read()
+    block = text[text.index("<!-- folder calls -->"):text.index("<!-- end folder calls -->")]
+    stated = {}
+    for m in re.finditer(r"^- `(\w*)/?` calls (.*)$", block, flags=re.M):
+        name = "" if m.group(1) == "main.c" else m.group(1)
+        stated[name] = set(re.findall(r"`(\w+)/`", m.group(2)))
+    m = re.search(r"^- `main\.c` calls (.*)$", block, flags=re.M)
+    stated[""] = set(re.findall(r"`(\w+)/`", m.group(1)))
+    graph = folder_graph(call_graph(sources())[1])
+    assert stated == graph, {f: (sorted(stated.get(f, ())), sorted(graph.get(f, ()))) for f in set(stated) | set(graph)
+                             if stated.get(f) != graph.get(f)}
+
+
+def test_struct_fields_counts_a_nested_struct():
+    """scripts/struct_fields.py matches the braces: a nested anonymous struct is one member of its structure, its own
+    members its leaves (the Scene's full_load ended the Scene before, which the script then reported as empty)."""
+    import sys
+    sys.path.insert(0, os.path.join(ROOT, "scripts"))
+    import struct_fields as sf
+    found = sf.structures("typedef struct {\n  int a;\n  struct { /* } x; */\n    int b, c;\n    double d[3];\n  } inner;\n  PetscReal *e;\n} S;\n")
+    assert set(found) == {"S"} and len(sf.members(found["S"])) == 3 and sf.leaves("S", found) == 5, found
+    real = sf.structures(sf.headers(None))
+    assert "full_load" not in real and any(d == "full_load" for _, d in sf.members(real["Scene"])), sorted(real)

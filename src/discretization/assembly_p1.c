@@ -387,7 +387,7 @@ static PetscErrorCode AssemblyP1CreateAnyMatrix(DM dm, AppCtx *user, PetscInt nl
     PetscCall(AssemblyP1CellCoordinates(csection, xa, dim, &cverts[(c - cStart) * (dim + 1)], x));
     for (PetscInt a = 0; a <= dim; ++a)
       for (PetscInt e = 0; e < dim; ++e) idx[a * dim + e] = vidx[(cverts[(c - cStart) * (dim + 1) + a] - vStart) * dim + e];
-    PetscCall(ElasticityP1ElementStiffness(dim, user->opt->material.lambda, user->opt->material.mu, x, Ke));
+    PetscCall(ElementP1Stiffness(dim, user->opt->material.lambda, user->opt->material.mu, x, Ke));
     PetscCall(MatSetValues(*K, n, idx, n, idx, Ke, ADD_VALUES));
   }
   PetscCall(VecRestoreArrayRead(coords, &xa));
@@ -499,7 +499,7 @@ static PetscErrorCode AssemblyP1QuadratureBasis(PetscInt dim, PetscQuadrature q,
 
 /* locF = the bulk residual at locX (the Dirichlet values inserted, zero elsewhere), as DMPlexSNESComputeResidualFEM()
    gives it for P1 simplices, without PetscFE's all-cell buffers: the lifting K u_D, in closed form, on the cells with a
-   fixed component (ElasticityP1AddFixedCellsStiffness), and the body-force term int f0 . phi_a with the points and weights
+   fixed component (ElementP1AddFixedCellsStiffness), and the body-force term int f0 . phi_a with the points and weights
    of PetscFE's own rule, on every cell if the problem has a body force. The body-force kernels depend on x only (they
    get u = 0). */
 PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
@@ -520,7 +520,7 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
 
   PetscFunctionBeginUser;
   PetscCall(VecZeroEntries(locF));
-  PetscCall(ElasticityP1AddFixedCellsStiffness(dm, &user->opt->material, locX, locF));
+  PetscCall(ElementP1AddFixedCellsStiffness(dm, &user->opt->material, locX, locF));
   PetscCall(DMGetDS(dm, &ds));
   PetscCall(PetscDSGetResidual(ds, 0, &f0, &f1));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
@@ -543,7 +543,7 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
     PetscReal   X[12], vol, det;
     PetscScalar fe[12];
 
-    PetscCall(ElasticityP1CellVertices(&mc, csec, lsec, xc, c, X, off, &nv));
+    PetscCall(ElementP1CellVertices(&mc, csec, lsec, xc, c, X, off, &nv));
     for (PetscInt i = 0; i < nv * dim; ++i) fe[i] = 0.0;
     if (dim == 2)
       det = (X[2] - X[0]) * (X[5] - X[1]) - (X[3] - X[1]) * (X[4] - X[0]);

@@ -87,7 +87,7 @@ PetscErrorCode AssemblyP1CellLoop(DM dm, const Material *mat, const PetscInt cve
     PetscScalar     Ke[144];
 
     PetscCall(AssemblyP1CellCoordinates(csection, xa, dim, cv, x));
-    PetscCall(ElasticityP1ElementStiffness(dim, mat->lambda, mat->mu, x, Ke));
+    PetscCall(ElementP1Stiffness(dim, mat->lambda, mat->mu, x, Ke));
     for (PetscInt a = 0; a <= dim; ++a)
       for (PetscInt b = 0; b <= dim; ++b) add(ctx, cv[a] - vStart, cv[b] - vStart, &Ke[(a * dim) * n + b * dim], n);
   }

@@ -2,6 +2,7 @@
    (outward normal, measure, diameter) and the points of the face rule on them. */
 #include "estimate_impl.h"
 #include "physics.h"
+#include "discretization.h"
 
 /* The cell c: vertices, coordinates, displacement, the gradients of the barycentric coordinates, grad u_h and sigma(u_h). */
 PetscErrorCode EstimateCellLoad(EstimateWork *w, PetscInt c, EstimateCell *cell)
@@ -24,7 +25,7 @@ PetscErrorCode EstimateCellLoad(EstimateWork *w, PetscInt c, EstimateCell *cell)
   {
     PetscReal g[4][3];
 
-    PetscCall(ElasticityP1Gradients(dim, cell->x, g, &cell->volume));
+    PetscCall(ElementP1Gradients(dim, cell->x, g, &cell->volume));
     for (PetscInt k = 0; k < cell->nv; ++k)
       for (PetscInt d = 0; d < dim; ++d) cell->dl[k * dim + d] = g[k][d];
   }

@@ -4,6 +4,7 @@
 #include <petscbt.h>
 #include "mesh.h"
 #include "physics.h"
+#include "discretization.h"
 
 /* u = the constant vector ctx (a clamp's or slip's prescribed displacement; a slip uses its fixed components only). */
 static PetscErrorCode ConstantVector(PetscInt dim, PetscReal t, const PetscReal x[], PetscInt Nc, PetscScalar u[], void *ctx)
@@ -213,7 +214,7 @@ static PetscErrorCode AddFixedRowsP1(DM dm, AppCtx *user, Vec u, Vec locF)
   PetscCall(DMGetLocalVector(dm, &locU));
   PetscCall(VecZeroEntries(locU));
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, locU));
-  PetscCall(ElasticityP1AddFixedCellsStiffness(dm, &user->opt->material, locU, locF));
+  PetscCall(ElementP1AddFixedCellsStiffness(dm, &user->opt->material, locU, locF));
   PetscCall(DMRestoreLocalVector(dm, &locU));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -1,5 +1,6 @@
 /* Contact quantities after the solve: nodal pressure, penetration, total force, energy. */
 #include "physics.h"
+#include "discretization.h"
 
 /* The potential energy of the Dirichlet lift u_D (loc_bc: the Dirichlet values, zero on the free unknowns),
      J(u_D) = 1/2 a(u_D, u_D) - L(u_D) = u_D . r0_loc - 1/2 u_D . A u_D,
@@ -22,7 +23,7 @@ PetscErrorCode PostprocessLiftEnergy(DM dm, const AppCtx *user, PetscReal weak_l
   PetscCall(DMGetLocalVector(dm, &locA));
   PetscCall(VecZeroEntries(locA));
   if (user->prob.assembly == ASSEMBLY_P1)
-    PetscCall(ElasticityP1AddFixedCellsStiffness(dm, &user->opt->material, user->prob.loc_bc, locA));
+    PetscCall(ElementP1AddFixedCellsStiffness(dm, &user->opt->material, user->prob.loc_bc, locA));
   else {
     PetscCall(DMGetLocalVector(dm, &locZ));
     PetscCall(DMGetLocalVector(dm, &locR));
