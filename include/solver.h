@@ -34,14 +34,13 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
    -contact_coarse_mg) a coarser box costs little and is one more level of the hierarchy (a smaller coarse factorization). */
 #define GRID_SEQUENCE_MIN_FACES 64
 #define GRID_SEQUENCE_MIN_FACES_MG 16
-/* In 3D the boxes of about as many unknowns: 16^3 (14,739) against 64^2 (8,450); and 4^3 (375), whose factorization is
-   the multigrid's coarse solve, against 16^2 (578). With 16 in 3D the geometric multigrid's coarsest box was 20^3 at
-   40^3 (26,460 unknowns), and its 4 factorizations took 51 s of a 60 s run. */
+/* In 3D the boxes of about as many unknowns as 2D's: 16^3 against 64^2, and 4^3, whose factorization is the
+   multigrid's coarse solve, against 16^2 (docs/decisions.md, "The coarsest box"). */
 #define GRID_SEQUENCE_MIN_FACES_3D 16
 #define GRID_SEQUENCE_MIN_FACES_MG_3D 4
-/* ... and the multigrid's coarsest box in 3D has at most 20 cells per side (27,783 unknowns) where it nests by default: it
-   is factored by MUMPS at each build of the hierarchy (17^3, the coarsest of 68^3: 0.4 s) and solved alone by GAMG
-   (multigrid.c). With PETSc's own LU it was 8: three factorizations of 17^3 took 21 s of a 79 s run. */
+/* ... and the multigrid's coarsest box in 3D has at most 20 cells per side (27,783 unknowns) where it nests by default:
+   it is factored by MUMPS at each build of the hierarchy and solved alone by GAMG (multigrid.c; docs/decisions.md,
+   "The coarsest box"). */
 #define GRID_SEQUENCE_MAX_COARSEST_MG_3D 20
 PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt request[2], PetscInt faces[3],
                                          PetscInt *min_levels, PetscBool *coarse_mg, PetscBool *default_mg);

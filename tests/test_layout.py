@@ -170,3 +170,25 @@ def test_struct_fields_counts_a_nested_struct():
     assert set(found) == {"S"} and len(sf.members(found["S"])) == 3 and sf.leaves("S", found) == 5, found
     real = sf.structures(sf.headers(None))
     assert "full_load" not in real and any(d == "full_load" for _, d in sf.members(real["Scene"])), sorted(real)
+
+
+MEASUREMENT = re.compile(r"\d+(\.\d+)?\s*(s|ms|seconds|minutes|GB|MB|kB)\b|\d+(\.\d+)?\s*%|\d+(\.\d+)? times (faster|slower|as long)|\(perf\)", re.I)
+
+
+def c_comments():
+    """(file, line, text) of every C comment of src/ and include/."""
+    for path in sorted(glob.glob(os.path.join(ROOT, "src", "**", "*.[ch]"), recursive=True) + glob.glob(os.path.join(ROOT, "include", "*.h"))):
+        text = open(path).read()
+        for m in re.finditer(r"/\*.*?\*/", text, flags=re.S):
+            yield os.path.relpath(path, ROOT), text[:m.start()].count("\n") + 1, m.group(0)
+
+
+def test_measurements_live_in_docs_not_in_comments():
+    """Comments say what the code computes and why (issue 62): at most 5 C comments hold a measurement (seconds, memory,
+    a percentage), those stating a bound the code relies on; the others' numbers are in docs/decisions.md, whose
+    sections the comments name, each of which exists."""
+    found = [(f, line) for f, line, c in c_comments() if MEASUREMENT.search(c)]
+    assert len(found) <= 5, found
+    headings = set(re.findall(r"^## (.+)$", open(os.path.join(ROOT, "docs", "decisions.md")).read(), flags=re.M))
+    named = {(f, name) for f, _, c in c_comments() for name in re.findall(r'docs/decisions\.md,\s+"([^"]+)"', " ".join(c.split()))}
+    assert named and all(name in headings for _, name in named), sorted(n for n in named if n[1] not in headings)

@@ -64,9 +64,8 @@ PetscErrorCode ContactSetFromOptions(Contact ct)
   opts->quadrature = PENALTY_QUADRATURE_GAUSS;
   PetscCall(PetscOptionsEnum("-penalty_quadrature", "Quadrature of the penalty term: gauss (L2 product) or nodal (lumped, vertex rule)", NULL,
                              PenaltyQuadratures, (PetscEnum)opts->quadrature, (PetscEnum *)&opts->quadrature, &quadrature_set));
-  /* eps = h by default; with -accuracy, eps = h/10 on the adaptive meshes: the cheapest of 1, 0.1 and 0.01 for a
-     tolerance on the Hertz indenter (1%: 67 s, 9.0 s, 9.0 s) and on the manufactured solution (5%: 167 s, 36 s, 70 s),
-     where the penalty's error at eps = h holds the zone's width back (docs/estimate.md) */
+  /* eps = h by default; with -accuracy, eps = h/10 on the adaptive meshes, where the penalty's error at eps = h holds
+     the zone's width back (docs/decisions.md, "-accuracy's eps") */
   PetscCall(PetscOptionsHasName(NULL, NULL, "-accuracy", &accuracy));
   opts->eps0 = accuracy ? 0.1 : 1.0;
   PetscCall(PetscOptionsReal("-penalty_eps0", "eps = eps0 h^power / M (M: -penalty_eps_modulus, E by default): the factor eps0", NULL, opts->eps0,
@@ -548,8 +547,8 @@ PetscErrorCode ContactPostProcess(Contact ct, DM dm, Vec R, Vec u, PetscReal tol
    *force (NULL: not asked) is the force the penalty law would put on them, the sum of w_i d_i / eps_i (w_i the node's
    lumped area): what the solution misses there, to first order. That weighs an unseen node: on the coarse block it is
    the whole force (the rule's force is zero); at the edge of a resolved zone, where a node penetrates by a hundredth of
-   the largest penetration between two of the rule's points, it is a negligible part (the sphere indenter at R = 10
-   and 1.8 million unknowns: 15 nodes, 5.6e-7 of the force). SNESVI and no contact see every node: none. */
+   the largest penetration between two of the rule's points, it is a negligible part (docs/decisions.md, "The nodes
+   the rule does not see"). SNESVI and no contact see every node: none. */
 #define CONTACT_UNSEEN_FRACTION 1e-2
 
 PetscErrorCode ContactUnseenNodes(Contact ct, Vec u, PetscBool unseen[], PetscInt *count, PetscReal *force)

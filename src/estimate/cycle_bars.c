@@ -10,19 +10,12 @@
      r of the quantity's slowest part:
        bar_m = 3 |Q_m - Q_k| / ((h_m / h_k)^r - 1),
      and the bar is the larger of the two, so that one cycle that happens to fall near the last one does not make the
-     bar small (with j alone, the manufactured solution's force at eps = h got a bar of 0.92% at 754 unknowns against
-     an error of 3.0%); there is no bar before both exist.
+     bar small; there is no bar before both exist.
    r = 1 for the force and the largest pressure: eps follows h and the penalty's error is of order eps, as the mesh's
    is of h for the largest pressure at a kink of the profile. r = 1/2 for the zone's size, as -bars' penalty part takes
-   it (src/estimate/bars.c): its free edge moves like eps^(1/2) or faster (with r = 1 the manufactured solution's width
-   at eps = h got 12.2% against an error of 14.5%). Over the cycles of the manufactured solution (eps = h and h/10, 11
-   cycles from 8 x 8) and the Hertz indenter (16 cycles), every bar covers its error, at 1.4 to 17 times it (medians
-   3.6, 7.8 and 17: the force, a functional of the displacement whose mesh error falls like h^2, gets the widest).
-   Tried first, and left: the three-mesh index of the cycles k, j and the last one with N_j / 2^dim unknowns, with their
-   observed order (Celik et al., J. Fluids Eng. 130, 2008, for unequal ratios) and the safety factor 1.25: on the Hertz
-   indenter its bars fell below the errors (the force 0.032% against 0.052%, the largest pressure 0.004% against
-   0.33%); and the order fitted to the two differences, within [1, 2]: 21 of 24 covered on the manufactured solution.
-   The cycles' differences mix the contact zone's refinement with the far field's, and their ratios are not an order.
+   it (src/estimate/bars.c): its free edge moves like eps^(1/2) or faster.
+   The cycles' differences mix the contact zone's refinement with the far field's, and their ratios are not an order:
+   the order is the theory's, not observed.
    The penalty is part of each cycle's discretization: eps follows the smallest contact cell's size
    (MeshSetContactCellSizes()), and the penalty's error falls with it as the mesh's does; the differences between the
    cycles hold both.
@@ -30,53 +23,30 @@
    force with the penalty method, src/solver/adapt.c): the penalty's part of cycle k is bounded as -bars bounds it
    (src/estimate/bars.c), d = F(eps) - F(eps / R) and bar_eps = |d| (1 + 3 / (R - 1)) at the order 1 in eps; the
    mesh's part compares the cycles' forces extrapolated to eps = 0, F0 = (R F(eps / R) - F(eps)) / (R - 1), at the
-   order 2 of the force's mesh error (a functional of the displacement; -bars observes 2.02 on the manufactured
-   solution), with the same two cycles and safety factor 3; the bar is the sum. F(eps / R) is the tangent's prediction
-   (one linear solve; its d within 0.81 to 1.16 of a solve's at eps / R wherever d is 0.1% of F or more, over every
-   cycle of the series below and of make hertz's cylinder and spheres; below that, on the Hertz indenter's late cycles,
-   0.31 to 2.47 of d = 2e-5 F to 5e-4 F, with the bars still covering). With the order 1
-   on the sum, the penalty's order, the force's bars were at least 15.5 times its error on the Hertz indenter, where the
-   penalty's part is a tenth of the error or less; with the parts apart, at least 4.74 times (median 5.03) there, and
-   1.43 (1.92) at eps = h and 3.53 (10.3) at eps = h/10 on the manufactured solution, every cycle covered
-   (make accuracy-ladder, docs/estimate.md).
+   order 2 of the force's mesh error (a functional of the displacement), with the same two cycles and safety factor 3;
+   the bar is the sum. F(eps / R) is the tangent's prediction (one linear solve).
    The largest pressure's bar adds its penalty part on the cycle's own mesh to the index at the order 1, where the
    cycle has its pressure at eps / R: |p(eps) - p(eps / R)| (1 + 3 / (R - 1)). The nodal maximum moves between the
-   cycles with its node's place as well as with the error, and on make hertz's cylinder the two coarser cycles fell
-   within 0.05% of the last one at 12,615 unknowns, where the index alone was 0.12% against 0.14% from the closed form
-   (a closed form that itself stands 0.05% to 0.08% off the finest cycles, docs/estimate.md), and on the sphere at
-   58,233 unknowns 1.13 times the error; the penalty's part does not depend on where the nodes fall. With it, the bars
-   are at least 1.41, 1.79, 1.85 and 2.78 times the error on the cylinder, the manufactured solution at eps = h/10, the
-   Hertz indenter and the spheres (1.43, 1.80, 1.67 with the d of a Newton solve at eps / R).
+   cycles with its node's place as well as with the error, so that the index alone can fall below the error; the
+   penalty's part does not depend on where the nodes fall.
    The zone's size's two parts apart, where eps <= h / (10 M) (CYCLE_SMALL_EPS; -accuracy's default eps0 = 0.1) and the
    cycle has its size at eps / R (the same tangent's state): the penalty's part bounded as -bars bounds it, d = W(eps) -
    W(eps / R) and bar_eps = |d| (1 + 3 / (R^(1/2) - 1)) at the order 1/2 in eps; the mesh's part the index above on the
    cycles' sizes at the order 1 (the linear interpolant's zero crossing puts the free edge within a fraction of its cell);
-   the bar is the sum. With the order 1/2 on the whole size, its bars were 10.8 to 66 times the error on make hertz's
-   cylinder and decided every stop there and on the spheres; with the parts apart, 5.3 times at least, and 1.61, 2.03
-   and 1.61 at least on the manufactured solution at eps = h/10, the Hertz indenter, and again the manufactured solution
-   with d from a Newton solve at eps / R (the tangent's d is 0.36 to 1.58 times the solve's there, 0.82 to 0.98 on the
-   spheres; make accuracy-ladder, docs/estimate.md). At eps = h the parts are not apart: the manufactured solution's
-   size error falls like h^(1/2) as a whole there (12.6%, 9.3%, 8.7%, 5.8% over its cycles; the penalty's fringe at the
-   zone's edge spans cells), and a solve at eps / R on the same mesh moves it by 0.9% of 12.6% at 1,278 unknowns, where
-   the sum of the parts fell to 0.97 times the error.
+   the bar is the sum. At eps = h the parts are not apart: the penalty's fringe at the zone's edge spans cells, and the
+   size's error falls like h^(1/2) as a whole.
    The zone's size is resolved to a cell: its bar is at least the one-cell band along its edge (contact_size_band).
    The largest pressure is resolved to its node's cells: its bar is at least the change of the nodal pressure from its
-   node to its neighbours on Gamma_C (pressure_max_step, src/physics/contact_zone.c). The manufactured solution's
-   largest pressure sits at the end of Gamma_C, where the profile's slope makes the nodal value's error of order h
-   there; with the zone's edge marked too (-adapt_mark_edge) the refinement went to the edge, and at eps = h/10 its
-   cycles at 228 to 2,534 unknowns stayed within 0.5% of each other 2.4% to 3.8% from the closed form: the index fell
-   to 0.45 times the error. With the floor every cycle of the coverage series is covered (make accuracy-ladder); where
-   the maximum is smooth (the Hertz profiles' top) the step is a fraction of the tolerance (0.16% to 0.8% on the 2D
-   indenter's stops), and on tetrahedra it is the nodal tractions' scatter (3.6% at the sphere's 10% stop, 2.5% at the
-   sphere indenter's 3%), which the stops of the spheres' 10% runs do not see.
+   node to its neighbours on Gamma_C (pressure_max_step, src/physics/contact_zone.c), which bounds the nodal value's
+   error of order h where the maximum sits on a slope (the manufactured solution's, at the end of Gamma_C).
    The recovered peak (pressure_peak, src/physics/pressure_peak.c) is a least-squares fit to scattered nodal values,
-   with a standard error (its resolution) that the fit itself gives: on tetrahedra 0.3% to 1.5% of the peak on the
-   coarser cycles the index compares. The index on its whole changes triples that scatter: on the sphere's cycles from
-   148,491 to 1,780,258 unknowns its bar stayed at 0.6% to 2.3% while the peak's error was 0.02% to 0.29%. So its
-   bar counts each change only beyond twice its standard deviation (the two fits' resolutions), as a change that is
-   significant, adds its penalty part, and adds twice the last fit's resolution for the scatter of its own value
-   (PeakBar()): on the same cycles 0.25% to 1.1%, covering the error at 1.4 times at least (docs/estimate.md).
-   The energy's bar is the error estimate itself, against the solution's energy norm (src/estimate/estimate.c). */
+   with a standard error (its resolution) that the fit itself gives. The index on its whole changes would triple that
+   scatter, so its bar counts each change only beyond twice its standard deviation (the two fits' resolutions), as a
+   change that is significant, adds its penalty part, and adds twice the last fit's resolution for the scatter of its
+   own value (PeakBar()).
+   The energy's bar is the error estimate itself, against the solution's energy norm (src/estimate/estimate.c).
+   What each choice was measured against, and what was tried before it: docs/decisions.md, "The bars of -accuracy's
+   cycles". */
 #include "estimate.h"
 #include "physics.h"
 

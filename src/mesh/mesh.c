@@ -162,8 +162,7 @@ PetscErrorCode MeshCreate(MPI_Comm comm, PetscInt later_refinements, const Petsc
       /* halvings while the rows split evenly over the ranks (each rank's slabs as many rows); in 3D, where the coarsest
          box would then be too large to factor, and where -bars needs its coarser boxes (16 x 16 on 3 ranks: 8 rows do
          not split evenly, 4 uneven rows of 4 x 4 do), halvings into uneven whole rows (68^3 on 2 ranks: 17^3 in slabs of 8 and
-         9 rows, the final box's of 32 and 36, rather than 34^3 or no nesting; 40^3 stays at 10^3 in even slabs: from
-         5^3, slabs of 2 and 3 rows made the final box's 16 and 24 and the run 1.4 times slower) */
+         9 rows, the final box's of 32 and 36, rather than 34^3 or no nesting; docs/decisions.md, "Uneven slabs") */
       for (PetscInt pass = 0; pass < 2; ++pass) {
         const PetscBool even = (PetscBool)(pass == 0);
 
@@ -626,9 +625,7 @@ PetscErrorCode MeshPointGlobalIndices(PetscSection lsec, PetscSection gsec, Pets
    penalty's eps is then one value over Gamma_C, eps = eps0 h_C^power / M, as the adaptive refinement needs
    (src/solver/adapt.c). A local eps that follows each contact face's size jumps by 2 where a refined face meets an
    unrefined one; the penalty's stiffness 1/eps jumps with it, which the continuous P1 displacement cannot follow, and
-   the nodal pressure oscillates from node to node: on the Hertz cylinder indenter adapted to 22,173 unknowns at eps =
-   h/10, by up to 7.7% in the middle of the zone and +3.3% at its largest; with one eps, within 0.89% of the Hertz profile
-   there and -0.05% at its largest. */
+   the nodal pressure oscillates from node to node (docs/estimate.md, "Adaptive refinement"). */
 PetscErrorCode MeshSetContactCellSizes(DM dm, PetscInt nids, const PetscInt ids[])
 {
   PetscInt  cStart, cEnd;

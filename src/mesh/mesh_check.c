@@ -172,8 +172,8 @@ PetscErrorCode MeshCountInteriorFaces(DM dm, PetscInt n, const PetscInt faces[],
 /* A mesh file's boundary that turns by a small angle at its ridges (the vertices between two boundary edges in 2D, the
    edges between two boundary faces in 3D) approximates a curved boundary by its chords. Refinement inside the solver
    (-dm_refine, -contact_grid_sequence, -adapt_cycles) splits the chords at their midpoints and keeps that polygon, so
-   that the refined meshes converge to the answer on the file's polygon, not on the curved body: the Hertz cylinder on a
-   quarter disk meshed at h = 0.05 and refined 3 times took a contact width 25% short of the closed form. count: the
+   that the refined meshes converge to the answer on the file's polygon, not on the curved body (docs/decisions.md,
+   "Chords"). count: the
    ridges where the outward normals of the two boundary faces turn by more than MESH_FLAT_ANGLE and at most
    MESH_CURVED_ANGLE (a polygon's corners turn by more; the straight pieces by nothing), over all ranks; x, where count
    > 0: one of them. A ridge whose two faces lie on different ranks is not seen (the count is a lower bound). */

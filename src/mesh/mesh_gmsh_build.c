@@ -147,8 +147,7 @@ PetscErrorCode MeshSimplicesFromGmsh(PetscInt dim, MeshSimplices *s)
   for (size_t i = 0; i < nnodes; ++i) vertex[i] = used[i] ? s->nverts++ : -1; /* PETSc's vertexMap */
   /* the coordinates as the file Gmsh writes holds them, to 16 significant digits: Gmsh's own doubles differ by an ulp,
      and through the remeshing's sensitivity (the sizes, the marking's order, Gmsh's insertions) an ulp moves the later
-     cycles' meshes (the cylinder's 1% run from its ninth cycle on), so that -mesh_remeshed_petsc_read would no longer
-     give the same run */
+     cycles' meshes, so that -mesh_remeshed_petsc_read would no longer give the same run */
   PetscCall(PetscMalloc1(s->nverts * dim + 1, &s->coords));
   for (size_t i = 0; i < nnodes; ++i)
     if (vertex[i] >= 0)

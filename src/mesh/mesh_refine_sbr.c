@@ -3,8 +3,8 @@
    The transform keeps each point's refinement type (a vertex, a kept or halved edge, a triangle kept or split in two,
    three or four) in a label, and DMPlexTransformApply() asks for it several times per new point: through the type's
    cell transform (which new points a point makes) and its subcell orientation. DMLabelGetValue() looks for the point in
-   each of the label's up to 14 strata in turn, one binary search each; on the Hertz indenter adapted by -accuracy 0.03
-   that was 41% of the whole run (perf). The answers of both calls depend on the point only through its type:
+   each of the label's up to 14 strata in turn, one binary search each (docs/decisions.md, "Refinement lookups"). The answers of both calls depend on
+   the point only through its type:
    - the cell transform returns tables for its cell type and refinement type (in arrays that the split triangles'
      types share and rewrite at each call, so they are copied);
    - the orientation is a function of the refinement type and of the other arguments (the switch below).
@@ -16,8 +16,7 @@
    The transform also finds a point's index in its stratum (DMLabelGetStratumPointIndex()) for every new point's source
    (DMPlexTransformGetTargetPoint()), through ISGetIndices(), which expands a stratum kept as a stride index set (the
    points contiguous: the vertices, the unrefined edges) into a new array at every call: the refinement took a time
-   quadratic in the mesh's size (a profile of the Hertz indenter adapted to 73,027 unknowns: 24% of the samples in
-   ISGetIndices_Stride(), 19% in PetscFindInt(); adapted to 504,295 unknowns the run took 165 s, and 58 s without it).
+   quadratic in the mesh's size.
    Such strata are made general index sets, with the same sorted points, on any version: each lookup a binary search. */
 #include <petscdmplextransform.h>
 #include <petsc/private/dmplextransformimpl.h>

@@ -5,24 +5,13 @@
    boundary exact, with a size given at every point: here the size each cell of the current mesh asks for, as a
    list-based view on the cells, used as the background mesh (Gmsh's "PostView" field). The model's physical groups,
    which the run's boundary conditions name, are those of the new mesh.
-   The view's values (measured on the Hertz cylinder and sphere from uniform meshes at h = 0.1 and 0.2):
-   - 2D: each cell's own size, constant on it: the marked cells' halves, exactly where marked. The cylinder reached
-     -accuracy 0.03 in 9 cycles, 9,013 unknowns and 1.7 s. With the smallest size of a vertex's cells at each vertex
-     (continuous) it took 10 cycles, 115,018 unknowns and 21 s; with their mean, 14 cycles, 16,509 unknowns and 3.3 s.
-   - 3D: the smallest size of the vertex's cells at each vertex. With the cells' own sizes the sphere's first cycles
-     (one or two cells marked around a contact the mesh does not see) did not refine at all (314 to 460 unknowns in 6
-     cycles, the estimate growing), and once Gmsh met overlapping facets on the curved surface; with the mean the mesh
-     shrank. The smallest spreads a mark to the cells around it: 314 to 55,255 unknowns in 7 cycles.
-   - 2D without Gmsh's Laplace smoothing (Mesh.Smoothing 0): the smoothing was a quarter of the cylinder's -accuracy
-     0.03 run (perf), which took 1.22 s and 8,556 unknowns without it against 1.65 s and 12,615 with it (the stop moves
-     with the meshes; every bar still covered over 15 cycles), and 0.01 the same time (3.5 to 3.8 s, 39,270 unknowns
-     against 35,679). In 3D it is kept: without it the sphere's -accuracy 0.1 took 77,923 unknowns and 17.8 s against
-     58,233 and 12.2 s.
-   - 2D with Gmsh's Delaunay algorithm (Mesh.Algorithm 5) rather than its default frontal-Delaunay (6), whose point
-     insertion with the background mesh's size lookups was a third of the cylinder's 0.01 run: 3 alternated pairs,
-     0.03 in 1.18 s against 1.31 s (7,056 unknowns against 8,556), 0.01 in 2.91 s against 3.81 s (36,047 against
-     39,270); every bar still covered over 15 cycles. In 3D (the surface meshes) the default is kept: the sphere took
-     10.7 and 13.3 s against 14.2 and 14.0 s, but the sphere indenter 9.1 and 8.7 s against 7.7 and 8.1 s.
+   The view's values, and Gmsh's options:
+   - 2D: each cell's own size, constant on it: the marked cells' halves, exactly where marked;
+   - 3D: the smallest size of the vertex's cells at each vertex, which spreads a mark to the cells around it (with the
+     cells' own sizes, one or two marked cells around a contact the mesh does not see refine nothing);
+   - 2D without Gmsh's Laplace smoothing (Mesh.Smoothing 0) and with its Delaunay algorithm (Mesh.Algorithm 5), the
+     faster for the same bars; 3D keeps Gmsh's defaults.
+   What each was measured against: docs/decisions.md, "The remeshing's size view".
    Gmsh runs on rank 0 on the gathered cells, sorted by their centroids so that the view is the same on any number of
    ranks (Gmsh's search of a point's cell depends on their order where the values jump); the mesh it makes is taken
    from its API on rank 0, built as PETSc's reader builds the file Gmsh would write (mesh_gmsh_build.c), and

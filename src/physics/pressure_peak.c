@@ -2,11 +2,9 @@
 
    The nodal pressure (the node's reaction over its lumped area, ContactPostProcess()) scatters from node to node on an
    irregular triangulation of Gamma_C by more than its error at the profile's top. On tetrahedra the scatter is the
-   P1 traction's: with one eps over Gamma_C it falls with h (the quarter sphere of make hertz, one eps at h_near / 100:
-   a standard deviation about the Hertz profile of 2.8%, 1.6% and 1.0% at h_near = 0.01, 0.005 and 0.0025, within
-   r < a/2), but not with the number of unknowns that the marking puts at the zone's edge, and the largest nodal value
-   picks the scatter's upper tail (+1.1% to +2.1% over those meshes and the 10% stop of -accuracy on the sphere). A local
-   eps that follows each cell's diameter adds its own jumps (+8.3% at h_near = 0.005, MeshSetContactCellSizes()).
+   P1 traction's: with one eps over Gamma_C it falls with h, but not with the number of unknowns that the marking puts
+   at the zone's edge, and the largest nodal value picks the scatter's upper tail. A local eps that follows each cell's
+   diameter adds its own jumps (MeshSetContactCellSizes()). docs/decisions.md, "The recovered peak", has the numbers.
 
    The peak averages the scatter out as superconvergent patch recovery does for stresses (Zienkiewicz and Zhu): the
    quadratic polynomial in the tangent plane of Gamma_C at the largest nodal pressure's node (the top) that fits, by
@@ -14,26 +12,20 @@
    triangulated surface, one side of the top in 2D), and all those within PEAK_ZONE of the top's distance to the zone's
    edge (the nearest vertex of Gamma_C that carries no pressure). The peak is the fit's largest value where it has one
    within the patch, and otherwise its value at the top (the end of a steep profile, as the manufactured solution's).
-   - At its largest, not at the top: the top is where the scatter put it, on the sphere's cycles 0.06 a to 0.26 a
-     from the profile's maximum, where the Hertz profile is 0.2% to 3% lower. The fit at the top stood -0.5% to -1.2%
-     from the closed form on five of the six cycles from 148,491 to 3,148,618 unknowns; at its largest, -0.02% to
-     -0.29% from 148,491 to 1,780,258 (docs/estimate.md, "The recovered peak").
+   - At its largest, not at the top: the top is where the scatter put it, off the profile's maximum, where the profile
+     is lower.
    - A patch that grows with the zone: a fixed number of nodes covers less of the profile as h falls, and its standard
-     error stays (0.31% and 0.30% at 527,327 and 978,138 unknowns); all the nodes within a fraction of the zone average
-     more of them as the mesh refines (0.29%, 0.17% and 0.12% to 1,780,258). Its truncation, the profile's quartic
-     term, is what bounds PEAK_ZONE: the fit to the exact Hertz profile on the same nodes stands -0.02% to -0.06% from
-     p0 at 0.3, -0.05% to -0.16% at 0.4.
+     error stays; all the nodes within a fraction of the zone average more of them as the mesh refines. Its truncation,
+     the profile's quartic term, is what bounds PEAK_ZONE.
    The fit's own standard error at the point it is evaluated, phi the monomials there,
      se^2 = s^2 phi^T (D^T D)^{-1} phi,  s^2 = |p - D c|^2 / (K - m),
    (D the K x m design matrix of the monomials, c the coefficients; at the fit's largest its gradient vanishes, so
    that the point's own scatter adds nothing to first order) says how well the scatter is averaged, and the
    fit's change from the top to the top's neighbours (the nodes within PEAK_RING times the nearest one's distance) how
    well the mesh resolves the profile there, as the nodal step does (PostprocessPressureStep()): where the maximum sits
-   at a steep end of the profile (the manufactured solution's, at the end of Gamma_C: +3.4% from the closed form at
-   2,534 unknowns, where the standard error was 2.0%) the step is the larger. The step counts beyond PEAK_SIGNIFICANT
-   times its own standard deviation (that of the linear functional c . (phi_j - phi_top) of the coefficients): at a
-   smooth top the fitted slope is the scatter's, which the standard error already holds (the sphere's 1% run, one of
-   its late cycles: a step of 1.07% of p0 that was 2.3 of its deviations, where the standard error was 0.50%). The
+   at a steep end of the profile (the manufactured solution's, at the end of Gamma_C) the step is the larger. The step
+   counts beyond PEAK_SIGNIFICANT times its own standard deviation (that of the linear functional c . (phi_j - phi_top)
+   of the coefficients): at a smooth top the fitted slope is the scatter's, which the standard error already holds. The
    larger of the two is the peak's resolution, which its -accuracy bar takes as its deviation (src/estimate/cycle_bars.c).
    With fewer nodes in contact than twice the monomials the peak is the nodal maximum and its resolution the nodal step.
 

@@ -312,8 +312,8 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
    a bar below the tolerance times its value.
    Seeing its contact: the force the penalty law would put on the nodes the rule misses (ContactUnseenNodes()), which
    no bar holds, is at most ADAPT_UNSEEN_SHARE of the tolerance times the force. A mesh that misses the whole zone has
-   no force, and never passes; a resolved zone whose edge leaves a few nodes between the rule's points does (the sphere
-   indenter at R = 10 and 0.3%: 5 and 15 such nodes on its last two cycles, 3.5e-7 and 5.6e-7 of the force). */
+   no force, and never passes; a resolved zone whose edge leaves a few nodes between the rule's points does (their
+   force is a small share of the force: docs/decisions.md, "The nodes the rule does not see"). */
 #define ADAPT_UNSEEN_SHARE 0.1
 
 static PetscBool UnseenHolds(const AdaptOptions *ad, const CycleRecord *c)
@@ -437,14 +437,11 @@ static void AdaptTargets(const AdaptOptions *ad, PetscInt dim, PetscBool target[
 
 /* Doerfler's theta: -adapt_fraction where given; by default 0.5, and 0.3 in 3D where -accuracy asks for contact
    quantities only (not the energy). In 3D each remeshed vertex takes the smallest size of its cells
-   (mesh_remesh.c), so a marked cell refines its twenty-odd neighbours too and theta = 0.5 grew the Hertz sphere's
-   unknowns about 3.2 times a cycle (2,440, 6,933, 21,875, 70,644): the stop, the first cycle whose bars are within the
-   tolerance, overshot the unknowns the bars need by up to that factor. With 0.3 they grow about twice a cycle
-   (docs/estimate.md, "Doerfler's fraction in 3D"): at 10% the sphere stops at 20,441 unknowns instead of 70,644 and
-   the sphere indenter at 13,325 instead of 40,269, about 3 times sooner; at 3% the sphere takes the same time with
-   507,252 unknowns instead of 766,249. The energy's estimate is spread over the body: on the 3D manufactured solution
-   0.3 took 8 cycles instead of 3 to -accuracy 0.8, and its meshes stalled (3,153, 3,216, 3,078 unknowns); in 2D
-   (PETSc's refinement, no spreading) 0.3 was slower on the indenter at 3% and the cylinder at 1%. */
+   (mesh_remesh.c), so a marked cell refines its twenty-odd neighbours too, and theta = 0.5 grows the unknowns about
+   3 times a cycle: the stop, the first cycle whose bars are within the tolerance, overshoots the unknowns the bars
+   need by up to that factor; 0.3 grows them about twice. The energy's estimate is spread over the body, where a
+   smaller theta stalls the meshes, and in 2D (no spreading) 0.3 is slower (docs/estimate.md, "Doerfler's fraction
+   in 3D"). */
 static PetscReal AdaptFraction(const AdaptOptions *ad, const PetscBool target[], PetscInt dim)
 {
   if (ad->fraction > 0.0) return ad->fraction;

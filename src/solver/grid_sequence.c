@@ -163,8 +163,7 @@ static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
 /* The nested iteration asked for, in 2D (request[0]) and in 3D (request[1]), and the coarsest box's least cells per side
    in 2D and in 3D and its most in 3D (faces). coarse_mg: whether the coarser boxes are solved by their geometric multigrid
    (-contact_coarse_mg). default_mg: whether the 3D box, where it nests, is solved by the boxes' geometric multigrid
-   without any linear solver in the options (MultigridSetDefault()): on the 40^3 box MUMPS, the default elsewhere, took
-   106 s and 4.9 GB, the geometric multigrid 4.2 s and 0.55 GB. */
+   without any linear solver in the options (MultigridSetDefault(); docs/decisions.md, "The 3D box's default solver"). */
 PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt request[2], PetscInt faces[3],
                                          PetscInt *min_levels, PetscBool *coarse_mg, PetscBool *default_mg)
 {

@@ -138,11 +138,10 @@ PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt v
 /* The solve of the coarsest mesh. Alone (its own Newton steps, before any finer mesh) PCMG's one level would be a
    smoother: it is the coarse solver, under the prefix mg_coarse_ as on more levels. In 2D PETSc's default, LU (on
    several ranks redundant LU). In 3D, where PETSc has MUMPS, MUMPS's factorization: PETSc's own LU orders a box's
-   unknowns with far more fill than MUMPS's own orderings (on 10^3, 3,630 unknowns, 2.7e8 flops a factorization, 0.77 s
-   of the box's 0.8 s solve against 0.16 s by MUMPS). And a 3D coarsest mesh of more than MULTIGRID_COARSE_LU_ROWS_3D
-   unknowns is solved alone by GAMG, not factored at each of its Newton steps (the 17^3 box of 68^3, 16,524 unknowns:
-   0.4 s a factorization, 2.1 s for its 5 Newton steps, against 0.4 s by GAMG); below finer meshes it is factored once
-   per build of their hierarchy. Options under the prefix (-mg_coarse_pc_type, ...) decide over all of these. */
+   unknowns with far more fill than MUMPS's own orderings. And a 3D coarsest mesh of more than
+   MULTIGRID_COARSE_LU_ROWS_3D unknowns is solved alone by GAMG, not factored at each of its Newton steps; below finer
+   meshes it is factored once per build of their hierarchy (docs/decisions.md, "The coarsest mesh's solve"). Options under the prefix
+   (-mg_coarse_pc_type, ...) decide over all of these. */
 static PetscErrorCode MultigridSetCoarseSolve(SNES snes, PC pc, PetscInt nfine, const char prefix[])
 {
   KSP         coarse;

@@ -9,17 +9,15 @@
    Galerkin product of a matrix with a few hundred nonzero rows. The hierarchy then equals a rebuild's (GAMG reuses its
    prolongators on a rebuild) at the cost of a few sparse products instead of the products of the whole matrix.
    Where the coarse levels are dense those products, and the coarse smoothers' new eigenvalue estimates, cost several
-   linear iterations (make hertz-path's graded sphere mesh: 2496 coarse rows with 240 nonzeros each, 534 with 462; 62 ms
-   of a 140 ms Newton step, about 5 CG iterations' flops). There, while a Newton step changed the state of few contact
+   linear iterations (docs/decisions.md, "The finest level alone"). There, while a Newton step changed the state of few contact
    nodes since the coarse operators last followed the Jacobian (at most -contact_pc_update_changes, at the same eps, the
    last linear solve converged in at most twice the iterations of the first after that, plus 5), only the finest level
    is updated: its smoother's Jacobi diagonal and Chebyshev bound (smoother_bound.c), while its operator is the Jacobian
    itself. The coarse operators are then the Galerkin products of an earlier Jacobian, which differs from this one by a
    term of the rank of those nodes: the preconditioner stays symmetric positive definite, and CG pays a few iterations
    for the change (a load path's steps settle the rim of the contact zone a few nodes per Newton step). "There" is where
-   the last carried update cost more than PC_FINEST_ONLY_CYCLES CG iterations, in flops (deterministic, unlike times):
-   on the 2D square at 512 x 512 an update costs less than one, and the finest-only steps cost more CG iterations (50 ->
-   77 in 9 Newton steps) than they saved. */
+   the last carried update cost more than PC_FINEST_ONLY_CYCLES CG iterations, in flops (deterministic, unlike times);
+   where an update costs less, the finest-only steps cost more CG iterations than they save. */
 #include "physics.h"
 #include "solver_impl.h"
 
@@ -520,10 +518,8 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
 /* A PCMG of one level (the coarsest box's own solve) is its coarse solve, whose operator is the Jacobian itself: PETSc
    factors it again at every Newton step whose Jacobian changed, whatever the SNES's lag says of the outer PC. In 3D its
    coarse KSP is told to keep the factorization where the outer PC is kept, as a factorization is (the count of changed
-   nodes decides): the 10^3 box's MUMPS factorization takes 28 ms, a CG iteration with it 2 ms, and 40^3 on 2 ranks,
-   which nests from 10^3, factored it 4 times in its 4 Newton steps there (2 now, with 9 CG iterations instead of 4).
-   In 2D the coarsest box (16^2) factors in about a millisecond, and keeping it cost the 64^2 GAMG run one more Newton
-   step and 14 more CG iterations: 2D factors again as before. *coarse: that coarse KSP in 3D, else NULL. */
+   nodes decides); in 2D the coarsest box factors in about a millisecond, and keeping it costs more than it saves: 2D
+   factors again (docs/decisions.md, "The coarsest box's factorization"). *coarse: that coarse KSP in 3D, else NULL. */
 static PetscErrorCode OneLevelMG(KSP ksp, PetscInt dim, KSP *coarse)
 {
   PC        pc;
@@ -582,8 +578,8 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
     PetscCall(KSPGetConvergedReason(ksp, &reason));
     /* The boxes' geometric multigrid (PCMG) is not rebuilt for the count of changed nodes: its finest level is the
        Jacobian itself, whose Jacobi diagonal and Chebyshev estimate PETSc sets up again when its values change, and
-       only its Galerkin coarse operators stay those of the build, a change of the rank of those nodes (40^3 box: a
-       rebuild for 23 nodes cost 0.15 s of 4.5 s, the same 15 CG iterations without it). A factorization is exact on
+       only its Galerkin coarse operators stay those of the build, a change of the rank of those nodes (docs/decisions.md,
+       "The boxes' multigrid kept"). A factorization is exact on
        the Jacobian of its build: each changed node costs CG about dim iterations. */
     PetscCall(KSPGetPC(ksp, &pc));
     PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &geometric));

@@ -99,7 +99,7 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
 }
 
 /* The default linear solver: on the 3D box that nests (MultigridIsDefault()), CG with the boxes' geometric multigrid, whose
-   levels are given: MUMPS's fill grows as n^(4/3) there (40^3: 106 s and 4.9 GB against 4.2 s and 0.55 GB). Elsewhere
+   levels are given: MUMPS's fill grows as n^(4/3) there (docs/decisions.md, "The 3D box's default solver"). Elsewhere
    a direct solve (MUMPS), robust for the small problems of a first run; for the penalty
    method inside CG, so that a factorization can serve as the preconditioner of later Newton steps (pc_reuse.c).
    The Newton steps are as accurate as with a fresh factorization, also when it is reused. */
