@@ -70,3 +70,16 @@ def test_readme_options_table_matches_help(out_root):
     assert not missing, f"options -help prints that README's table lacks: {missing}"
     absent = sorted(r for r in rows if r not in NOT_IN_HELP and not any(pattern(r).match(o) for o in shown))
     assert not absent, f"README rows that no -help prints: {absent}"
+
+
+def test_options_md_is_a_table_of_short_entries_with_the_depth_below():
+    """docs/options.md (issue 62): each table cell at most 250 characters, and each entry that says "more below" has
+    its section "### `-option`" below the table, in the table's order."""
+    text = open(os.path.join(ROOT, "docs", "options.md")).read()
+    rows = [line for line in text.split("\n") if line.startswith("| `")]
+    assert len(rows) > 60, len(rows)
+    long = [(line[:60], len(c.strip())) for line in rows for c in line.strip().strip("|").split("|") if len(c.strip()) > 250]
+    assert not long, long
+    below = re.findall(r"\(more below, `(-[\w]+)`\)", "\n".join(rows))
+    sections = re.findall(r"^### `(-[\w]+)`$", text, flags=re.M)
+    assert below and below == sections, (below, sections)
