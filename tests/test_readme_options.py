@@ -83,3 +83,20 @@ def test_options_md_is_a_table_of_short_entries_with_the_depth_below():
     below = re.findall(r"\(more below, `(-[\w]+)`\)", "\n".join(rows))
     sections = re.findall(r"^### `(-[\w]+)`$", text, flags=re.M)
     assert below and below == sections, (below, sections)
+
+
+def words_per_sentence(path):
+    """The prose of a Markdown page (not its tables, headings or indented blocks): (sentences, words per sentence)."""
+    text = open(path).read()
+    lines = [line for line in text.split("\n") if line.strip() and not line.startswith(("|", "#", "    "))]
+    prose = " ".join(lines)
+    sentences = [s for s in re.split(r"(?<=[.!?])\s+(?=[A-Z`(*-])", prose) if s.strip()]
+    return len(sentences), len(prose.split()) / max(1, len(sentences))
+
+
+def test_readme_is_a_short_guide():
+    """README is a user's guide read once (issue 62): at most 220 lines, at most 22 words a sentence on average (it had
+    235 lines and 36 words a sentence; measured now 220 and about 17)."""
+    path = os.path.join(ROOT, "README.md")
+    n, wps = words_per_sentence(path)
+    assert len(open(path).read().split("\n")) <= 221 and n > 40 and wps <= 22, (n, wps)
