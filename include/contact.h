@@ -86,6 +86,8 @@ PetscErrorCode ContactBulkMult(Contact ct, Mat K, Vec X, Vec R);
 PetscErrorCode ContactBulkOperator(Contact ct, Mat K, Mat *Kb);
 PetscErrorCode ContactEnergy(Contact ct, DM dm, Vec u, PetscReal *energy);
 PetscErrorCode ContactSetUpSNES(Contact ct, DM dm, SNES snes);
+PetscErrorCode ContactCreateJacobian(Contact ct, DM dm, Mat K, Mat *J); /* K itself (referenced), or a copy the penalty's Jacobian is made in */
+PetscErrorCode ContactCheckSNES(Contact ct, SNES snes, Mat K);          /* after SNESSetFromOptions(): the SNES type and K suit the method */
 PetscErrorCode ContactScaleBounds(Contact ct, PetscReal s);
 PetscErrorCode ContactRoundoffTerm(Contact ct, Vec u, PetscReal *sum_sq);
 PetscErrorCode ContactSameActivity(Contact ct, DM dm, Vec X, Vec Y, PetscBool *same);

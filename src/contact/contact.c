@@ -353,6 +353,63 @@ PetscErrorCode ContactPrepareOperator(Contact ct, DM dm, Mat K)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* *J: the matrix the SNES's Jacobian is made in, for the caller to destroy. The Jacobian is K itself: for the penalty
+   method K + P in the contact rows (ContactComputeJacobian()), whose own rows the type keeps
+   (ContactPrepareOperator()); a symmetric block matrix gives no access to its rows below the diagonal, so there the
+   penalty Jacobian is a copy of K, with K's near null space. Without bounds K and K + the penalty Jacobian are
+   symmetric positive definite (semi-definite at worst; CG needs it anyway): PETSc then estimates eigenvalues by CG
+   (Lanczos) rather than GMRES, as GAMG's Chebyshev smoothers do on the finest level, without GMRES's 10 vectors of the
+   finest size. */
+PetscErrorCode ContactCreateJacobian(Contact ct, DM dm, Mat K, Mat *J)
+{
+  PetscBool sbaij, is_aij;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)K, &sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
+  if (ct->has_penalty && sbaij) {
+    MatNullSpace rigid;
+
+    PetscCall(MatDuplicate(K, MAT_COPY_VALUES, J));
+    PetscCall(MatGetNearNullSpace(K, &rigid));
+    PetscCall(MatSetNearNullSpace(*J, rigid));
+    PetscFunctionReturn(PETSC_SUCCESS);
+  }
+  *J = K;
+  PetscCall(PetscObjectReference((PetscObject)K));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)K, &is_aij, MATSEQAIJ, MATMPIAIJ, ""));
+  if (!ct->has_bounds && is_aij) { /* (BAIJ in 3.18 refuses MAT_SPD_ETERNAL) */
+    PetscCall(MatSetOption(K, MAT_SPD, PETSC_TRUE));
+    PetscCall(MatSetOption(K, MAT_SPD_ETERNAL, PETSC_TRUE));
+  }
+  PetscCall(ContactPrepareOperator(ct, dm, K)); /* the penalty keeps K's own contact rows */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* After SNESSetFromOptions(): whether the SNES type and the matrix K suit the method. SNESVI's types need the bounds
+   and the other types none; SNESVI takes the rows and columns of single components out of the Jacobian, which a block
+   matrix refuses. */
+PetscErrorCode ContactCheckSNES(Contact ct, SNES snes, Mat K)
+{
+  MPI_Comm    comm = PetscObjectComm((PetscObject)snes);
+  PetscBool   is_vi, block;
+  SNESType    type;
+  ContactType ctype;
+  MatType     mtype;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)snes, &is_vi, SNESVINEWTONRSLS, SNESVINEWTONSSLS, ""));
+  PetscCall(SNESGetType(snes, &type));
+  PetscCall(ContactGetType(ct, &ctype));
+  PetscCheck(is_vi == ct->has_bounds, comm, PETSC_ERR_USER_INPUT,
+             "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type, ctype);
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)K, &block, MATSEQBAIJ, MATMPIBAIJ, MATSEQSBAIJ, MATMPISBAIJ, ""));
+  PetscCall(MatGetType(K, &mtype));
+  PetscCheck(!(block && ct->has_bounds), comm, PETSC_ERR_USER_INPUT,
+             "-contact_method vi cannot use the block matrix %s (-dm_mat_type): SNESVI's reduced system takes single components out of it; use aij",
+             mtype);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* R = K X with K the bulk elastic operator, also while K holds the penalty Jacobian (whose rows it leaves alone). */
 PetscErrorCode ContactBulkMult(Contact ct, Mat K, Vec X, Vec R)
 {

@@ -173,41 +173,13 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   Mat       J;
   KSP       ksp;
   PC        pc;
-  PetscBool is_vi, is_multigrid;
-  SNESType  type;
+  PetscBool is_multigrid;
   PCType    pc_type;
 
   PetscFunctionBeginUser;
   PetscCall(SNESCreate(comm, snes));
   PetscCall(SNESSetDM(*snes, dm));
-  {
-    PetscBool sbaij;
-
-    /* the Jacobian is K itself: for the penalty method K + P in the contact rows (ContactComputeJacobian()); a symmetric
-       block matrix gives no access to its rows below the diagonal, so there the penalty Jacobian is a copy of K */
-    PetscCall(PetscObjectTypeCompareAny((PetscObject)user->prob.K, &sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
-    if (ContactHasPenalty(user->contact) && sbaij) {
-      MatNullSpace rigid;
-
-      PetscCall(MatDuplicate(user->prob.K, MAT_COPY_VALUES, &J));
-      PetscCall(MatGetNearNullSpace(user->prob.K, &rigid));
-      PetscCall(MatSetNearNullSpace(J, rigid));
-    } else {
-      PetscBool is_aij;
-
-      J = user->prob.K;
-      PetscCall(PetscObjectReference((PetscObject)J));
-      /* K and K + the penalty Jacobian are symmetric positive definite (semi-definite at worst; CG needs it anyway):
-         PETSc then estimates eigenvalues by CG (Lanczos) rather than GMRES, as GAMG's Chebyshev smoothers do on the
-         finest level, without GMRES's 10 vectors of the finest size */
-      PetscCall(PetscObjectTypeCompareAny((PetscObject)J, &is_aij, MATSEQAIJ, MATMPIAIJ, ""));
-      if (!ContactHasBounds(user->contact) && is_aij) { /* (BAIJ in 3.18 refuses MAT_SPD_ETERNAL) */
-        PetscCall(MatSetOption(J, MAT_SPD, PETSC_TRUE));
-        PetscCall(MatSetOption(J, MAT_SPD_ETERNAL, PETSC_TRUE));
-      }
-      PetscCall(ContactPrepareOperator(user->contact, dm, J)); /* the penalty keeps K's own contact rows */
-    }
-  }
+  PetscCall(ContactCreateJacobian(user->contact, dm, user->prob.K, &J)); /* K itself, or a copy the penalty Jacobian can be made in */
   PetscCall(SNESSetFunction(*snes, NULL, SolverFormFunction, user->prob.sctx));
   PetscCall(SNESSetJacobian(*snes, J, J, SolverFormJacobian, user->prob.sctx));
   PetscCall(MatDestroy(&J));
@@ -227,8 +199,6 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(SNESMonitorSet(*snes, ContactMonitor, user->prob.sctx, NULL));
   PetscCall(SNESSetFromOptions(*snes));
-  PetscCall(PetscObjectTypeCompareAny((PetscObject)*snes, &is_vi, SNESVINEWTONRSLS, SNESVINEWTONSSLS, ""));
-  PetscCall(SNESGetType(*snes, &type));
   PetscCall(PCGetType(pc, &pc_type));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &is_multigrid, PCGAMG, PCMG, ""));
   {
@@ -260,24 +230,7 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
         !(petsc_presolve && fine), comm, PETSC_ERR_USER_INPUT,
         "-mg_fine_ksp_type and -mg_fine_pc_type need -snes_ksp_ew_version 2 (or no Eisenstat-Walker): another version keeps PETSc's own pre-solve");
   }
-  {
-    ContactType ctype;
-
-    PetscCall(ContactGetType(user->contact, &ctype));
-    PetscCheck(is_vi == ContactHasBounds(user->contact), comm, PETSC_ERR_USER_INPUT,
-               "-snes_type %s does not fit -contact_method %s: use vinewtonrsls or vinewtonssls with vi, and a non-VI type otherwise", type, ctype);
-  }
-  { /* SNESVI takes the rows and columns of single components out of the Jacobian, which a block matrix refuses */
-    PetscBool block;
-    MatType   mtype;
-
-    PetscCall(PetscObjectTypeCompareAny((PetscObject)user->prob.K, &block, MATSEQBAIJ, MATMPIBAIJ, MATSEQSBAIJ, MATMPISBAIJ, ""));
-    PetscCall(MatGetType(user->prob.K, &mtype));
-    PetscCheck(!(block && ContactHasBounds(user->contact)), comm, PETSC_ERR_USER_INPUT,
-               "-contact_method vi cannot use the block matrix %s (-dm_mat_type): SNESVI's reduced system takes single components out of "
-               "it; use aij",
-               mtype);
-  }
+  PetscCall(ContactCheckSNES(user->contact, *snes, user->prob.K)); /* the SNES type and the matrix the method can use */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
