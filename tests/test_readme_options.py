@@ -100,3 +100,11 @@ def test_readme_is_a_short_guide():
     path = os.path.join(ROOT, "README.md")
     n, wps = words_per_sentence(path)
     assert len(open(path).read().split("\n")) <= 221 and n > 40 and wps <= 22, (n, wps)
+
+
+def test_docs_speak_of_the_software_not_of_its_sessions():
+    """docs/ in the present tense (issue 62): no page speaks of "this session", "the last stop" or an "invocation"."""
+    import glob
+    found = [(os.path.basename(p), m.group(0)) for p in glob.glob(os.path.join(ROOT, "docs", "*.md"))
+             for m in re.finditer(r"this session|last stop|stops before|this stop|invocation", open(p).read(), flags=re.I)]
+    assert not found, found
