@@ -200,3 +200,16 @@ def test_design_md_names_every_source_file():
     files = [os.path.basename(p) for p in glob.glob(os.path.join(ROOT, "src", "**", "*.[ch]"), recursive=True) + glob.glob(os.path.join(ROOT, "include", "*.h"))]
     assert len(files) > 90, len(files)
     assert not [f for f in files if f not in text], [f for f in files if f not in text]
+
+
+def test_petsc_mirrors_are_listed_in_one_table():
+    """PETSc 3.18's mirrors in one place (issue 62): docs/decisions.md's table lists at least ten files, each of which
+    exists, and each option it names (the comparisons with PETSc's own) is one the solver's sources read."""
+    text = open(os.path.join(ROOT, "docs", "decisions.md")).read()
+    table = text[text.index("## PETSc 3.18's mirrors"):]
+    listed = set(re.findall(r"^\| `(src/[\w/]+\.c)` \|", table, flags=re.M))
+    assert len(listed) >= 10, listed
+    assert all(os.path.isfile(os.path.join(ROOT, f)) for f in listed), listed
+    code = "".join(sources().values())
+    options = set(re.findall(r"`(-[a-z_]+)(?: [a-z0-9]+)?`", table))
+    assert len(options) >= 8 and all(f'"{opt}"' in code for opt in options), sorted(o for o in options if f'"{o}"' not in code)

@@ -4,7 +4,8 @@
    3.18's to round-off (-assembly_check):
    the kernel sees the point x of the face's own map, the displacement and the test functions are the support cell's
    basis at its reference face's points, as PETSc evaluates them. On a face whose orientation in its cell is not the
-   identity (3D refinement makes such faces) those are other points of the same face; PETSc's choice is kept. */
+   identity (3D refinement makes such faces) those are other points of the same face; PETSc's choice is kept.
+   One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
 #include "penalty.h"
 #include "penalty_kernels.h"
 #include "mesh.h"

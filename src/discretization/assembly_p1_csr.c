@@ -5,7 +5,8 @@
    MatSeqAIJSetPreallocationCSR() inserts a given pattern row by row through it. The arrays belong to a container
    composed with K and are freed with it. A block per vertex where every vertex is free or fully constrained; scalar
    rows where some vertex is partly fixed (a slip condition), whose MatSetValues() path was two thirds of the set-up of
-   each remeshed cycle of the Hertz sphere (its symmetry planes). */
+   each remeshed cycle of the Hertz sphere (its symmetry planes).
+   One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
 #include <petscdmplex.h>
 #include "discretization.h"
 #include "physics.h"

@@ -4,7 +4,8 @@
    sends, for each ghost vertex, its block row (the neighbours along its local edges, then the values of its local
    cells) to the owner, which adds them to its own: one exchange for the pattern, one for the values. It needs
    neither a MATPREALLOCATOR dry run nor MatSetValues(), with their stash and hash tables. Applies where every vertex
-   is free or fully constrained (a block per vertex). */
+   is free or fully constrained (a block per vertex).
+   One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
 #include <petscdmplex.h>
 #include <petscsf.h>
 #include "discretization.h"

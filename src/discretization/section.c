@@ -2,7 +2,8 @@
    as DMCreateLocalSection() builds it, in the same order of calls, but without its cell-type lookup for every mesh
    point: PETSc 3.18 makes that label's strata hash sets just before (DMPlexGetGhostCellStratum()), so each lookup is a
    hash-set query. Other discretizations (higher degrees, several fields, anchors) are left to PETSc. -section_check
-   builds both and compares them (PetscSectionCompare()). */
+   builds both and compares them (PetscSectionCompare()).
+   One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
 #include "discretization.h"
 #include "physics.h"
 

@@ -2,7 +2,8 @@
    points with dofs. PETSc 3.18 builds both with several calls per mesh point (PetscSectionCreateGlobalSection(),
    PetscSFSetGraphSection()), of which a 2D mesh has 6 per vertex (a 3D one 26). These are PETSc's results, entry for
    entry, in the same order; -section_check builds PETSc's too and compares them (PetscSectionCompare(), and the SF's
-   graph). */
+   graph).
+   One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
 #include <petscsf.h>
 #include "discretization.h"
 #include "physics.h"

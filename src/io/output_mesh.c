@@ -1,6 +1,7 @@
 /* The mesh of the HDF5 file, /geometry/vertices and /viz/topology/cells, as DMView() writes them with the format
    PETSC_VIEWER_HDF5_VIZ (PETSc 3.18's legacy coordinates and XDMF topology), without its two closures per cell.
-   Meshes whose cells are not all of one type, or that are periodic, are left to DMView(). */
+   Meshes whose cells are not all of one type, or that are periodic, are left to DMView().
+   One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
 #include <petscsf.h>
 #include <petscviewerhdf5.h>
 #include "mesh.h"

@@ -3,7 +3,8 @@
    hash-set query for every point of every closure. In a mesh whose
    points of each depth all have one type (simplices, or tensor cells, interpolated), the type follows from the depth,
    and this is PETSc's breadth-first walk with the same arrangements and orientations, so it lists the same points in
-   the same order. Any other mesh takes DMPlexGetTransitiveClosure() itself. */
+   the same order. Any other mesh takes DMPlexGetTransitiveClosure() itself.
+   One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
 #include "mesh.h"
 
 /* One cell type per depth, each of that depth's dimension, and an interpolated mesh (depth = dimension). */

@@ -16,7 +16,8 @@
    - the coordinates to the file's 16 digits (MeshSimplicesFromGmsh()).
    Checked against PETSc's reading of the file Gmsh writes (-mesh_remeshed_petsc_read, tests/test_remesh.py): every
    /cycles value the same to the last bit. Rank 0 holds the mesh and the other ranks the empty mesh, as with PETSc's
-   reader, until the distribution. */
+   reader, until the distribution.
+   One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
 #include <stdio.h>
 #include <stdlib.h>
 #include "mesh_gmsh.h"

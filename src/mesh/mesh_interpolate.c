@@ -2,7 +2,8 @@
    the points, cones and orientations that DMPlexInterpolate() gives: new faces numbered in the order the cells first
    meet them, each face's cone the first cell's raw face, edges after faces. PETSc 3.18 finds faces through a generic hash
    table and a cell-type label lookup per point; here a face is found among the few faces whose smallest vertex is the
-   same (a bucket per vertex), with no hash table and no label lookup. */
+   same (a bucket per vertex), with no hash table and no label lookup.
+   One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
 #include <stdlib.h>
 #include <petscsf.h>
 #include "mesh.h"

@@ -17,7 +17,8 @@
    (DMPlexTransformGetTargetPoint()), through ISGetIndices(), which expands a stratum kept as a stride index set (the
    points contiguous: the vertices, the unrefined edges) into a new array at every call: the refinement took a time
    quadratic in the mesh's size.
-   Such strata are made general index sets, with the same sorted points, on any version: each lookup a binary search. */
+   Such strata are made general index sets, with the same sorted points, on any version: each lookup a binary search.
+   One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
 #include <petscdmplextransform.h>
 #include <petsc/private/dmplextransformimpl.h>
 #include "mesh.h"
