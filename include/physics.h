@@ -12,6 +12,7 @@ PetscErrorCode ElasticityRigidBodyModesP1(DM dm, Vec like, MatNullSpace *nullspa
 
 /* weak_data.c: the load of a scene with an exact solution, L(v) = a(u_exact, v) - int_Gamma_C sigma_n(u_exact) v_n */
 PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0, PetscReal *lift);
+PetscErrorCode WeakDataExactStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal sigma[]);
 PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal *sn);
 
 /* postprocess.c */

@@ -45,7 +45,7 @@ typedef struct {
   PetscInt          *face_kind; /* [fEnd - fStart]: ESTIMATE_FACE_* or the index of the face's clamp/slip/load in the scene */
   PetscReal         *face_sum;  /* [chart][dim + 1]: sum over a face's cells of sigma n_out, and their number */
   PetscReal         *face_geom; /* [fEnd - fStart][dim + 2]: each face's measure, diameter and unit normal */
-  PetscReal         *load_mean; /* [ncells][dim * dim]: Pi_0 G, the cells' means of a weak-data scene's G = sigma(u_exact); else NULL */
+  PetscReal         *load_mean; /* [ncells][dim * dim]: Pi_0 G, the cells' means of a weak-data scene's G = sigma(u_exact); unused otherwise */
 } EstimateWork;
 
 enum { ESTIMATE_FACE_FREE = -1, ESTIMATE_FACE_CONTACT = -2 };

@@ -48,21 +48,6 @@ static PetscErrorCode BodyForce(const EstimateWork *w, const PetscReal x[], Pets
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* G = sigma(u_exact) at x, the load of a scene with weak data */
-static PetscErrorCode ExactStress(const EstimateWork *w, const PetscReal x[], PetscReal sigma[])
-{
-  const Scene   *scene = &w->user->scene;
-  const PetscInt dim   = w->dim;
-  PetscScalar    g[9];
-  PetscReal      grad[9];
-
-  PetscFunctionBeginUser;
-  PetscCall((*scene->exact_gradient)(dim, 0.0, x, dim * dim, g, (void *)scene->constants));
-  for (PetscInt k = 0; k < dim * dim; ++k) grad[k] = PetscRealPart(g[k]);
-  ElasticStress(dim, &w->user->opt->material, grad, sigma);
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* tau : C^-1 tau, the complementary energy density of a symmetric tensor: C^-1 tau = (tau - lambda / (2 mu + d lambda)
    tr(tau) I) / (2 mu), in plane strain (d = 2) as in 3D. */
 static PetscReal ComplianceSquare(const EstimateWork *w, const PetscReal tau[])
@@ -75,34 +60,37 @@ static PetscReal ComplianceSquare(const EstimateWork *w, const PetscReal tau[])
   return (tt - lambda / (2.0 * mu + w->dim * lambda) * tr * tr) / (2.0 * mu);
 }
 
-/* Pi_0 G on cell c and the oscillation ||G - Pi_0 G||^2_{C^-1,T}, by the load's rule */
+/* Pi_0 G on cell c and the oscillation ||G - Pi_0 G||^2_{C^-1,T}, by the load's rule (G at its points kept between
+   the two passes, in a work array of the DM) */
 static PetscErrorCode LoadOscillation(EstimateWork *w, CellQuadrature *cq, PetscInt c, PetscReal mean[], PetscReal *osc)
 {
   const PetscInt n   = w->dim * w->dim;
-  PetscReal      vol = 0.0, G[9], D[9];
+  PetscReal      vol = 0.0, D[9], *G;
 
   PetscFunctionBeginUser;
   PetscCall(CellQuadratureSetCell(cq, c));
+  PetscCall(DMGetWorkArray(w->dm, cq->Nq * n, MPIU_REAL, &G));
   for (PetscInt k = 0; k < n; ++k) mean[k] = 0.0;
   for (PetscInt q = 0; q < cq->Nq; ++q) {
-    PetscCall(ExactStress(w, &cq->x[q * w->dim], G));
-    for (PetscInt k = 0; k < n; ++k) mean[k] += cq->w[q] * G[k];
+    PetscCall(WeakDataExactStress(w->user, w->dim, &cq->x[q * w->dim], &G[q * n]));
+    for (PetscInt k = 0; k < n; ++k) mean[k] += cq->w[q] * G[q * n + k];
     vol += cq->w[q];
   }
   for (PetscInt k = 0; k < n; ++k) mean[k] /= vol;
   *osc = 0.0;
   for (PetscInt q = 0; q < cq->Nq; ++q) {
-    PetscCall(ExactStress(w, &cq->x[q * w->dim], G));
-    for (PetscInt k = 0; k < n; ++k) D[k] = G[k] - mean[k];
+    for (PetscInt k = 0; k < n; ++k) D[k] = G[q * n + k] - mean[k];
     *osc += cq->w[q] * ComplianceSquare(w, D);
   }
+  PetscCall(DMRestoreWorkArray(w->dm, cq->Nq * n, MPIU_REAL, &G));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* sigma(u_h) of a cell, less Pi_0 G for a scene with weak data: the stress whose tractions the faces' terms measure */
 static void CellStress(const EstimateWork *w, const EstimateCell *cell, PetscInt c, PetscReal s[])
 {
-  for (PetscInt k = 0; k < w->dim * w->dim; ++k) s[k] = cell->sigma[k] - (w->load_mean ? w->load_mean[(c - w->cStart) * w->dim * w->dim + k] : 0.0);
+  for (PetscInt k = 0; k < w->dim * w->dim; ++k)
+    s[k] = cell->sigma[k] - (w->user->scene.weak_data ? w->load_mean[(c - w->cStart) * w->dim * w->dim + k] : 0.0);
 }
 
 /* |R . n|^2 / (lambda + 2 mu) + |R - (R . n) n|^2 / (2 mu): a traction R in energy units, by the stiffness of the body
@@ -126,7 +114,7 @@ static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < dim && !has_load; ++d) has_load = (PetscBool)(PetscRealPart(w->constants[CONST_BODY_FORCE + d]) != 0.0);
-  if (w->load_mean) PetscCall(CellQuadratureCreate(w->dm, &w->user->scene, &w->user->opt->verify, &cq));
+  if (w->user->scene.weak_data) PetscCall(CellQuadratureCreate(w->dm, &w->user->scene, &w->user->opt->verify, &cq));
   for (PetscInt c = w->cStart; c < w->cEnd; ++c) {
     EstimateCell    cell;
     const PetscInt *cone;
@@ -134,7 +122,7 @@ static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
     PetscReal       sigma[9];
 
     PetscCall(EstimateCellLoad(w, c, &cell));
-    if (w->load_mean) {
+    if (w->user->scene.weak_data) {
       PetscReal osc = 0.0;
 
       PetscCall(LoadOscillation(w, &cq, c, &w->load_mean[(c - w->cStart) * dim * dim], &osc));
@@ -176,7 +164,7 @@ static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
       for (PetscInt d = 0; d < dim; ++d) geom[2 + d] = face.normal[d];
     }
   }
-  if (w->load_mean) PetscCall(CellQuadratureDestroy(&cq));
+  if (w->user->scene.weak_data) PetscCall(CellQuadratureDestroy(&cq));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -211,10 +199,10 @@ static PetscErrorCode ContactFace(EstimateWork *w, PetscInt c, const EstimateCel
       p = d > 0.0 ? d / eps : 0.0;
     }
     for (PetscInt i = 0; i < dim; ++i) R[i] = sn[i] + p * n[i];
-    if (w->load_mean) { /* the load's normal stress on Gamma_C, n_o . G n_o (sn holds (sigma(u_h) - Pi_0 G) n) */
+    if (w->user->scene.weak_data) { /* the load's normal stress on Gamma_C, n_o . G n_o (sn holds (sigma(u_h) - Pi_0 G) n) */
       PetscReal G[9], gnn = 0.0;
 
-      PetscCall(ExactStress(w, x, G));
+      PetscCall(WeakDataExactStress(w->user, dim, x, G));
       for (PetscInt i = 0; i < dim; ++i)
         for (PetscInt j = 0; j < dim; ++j) gnn += n[i] * G[i * dim + j] * n[j];
       for (PetscInt i = 0; i < dim; ++i) R[i] += gnn * n[i];

@@ -6,17 +6,27 @@
 #include "physics.h"
 #include "discretization.h"
 
-/* sigma_n(u_exact) = (sigma n) . n at x, with n the obstacle normal at x */
-PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal *sn)
+/* sigma(u_exact) at x, the load G of the weak form */
+PetscErrorCode WeakDataExactStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal sigma[])
 {
   PetscScalar g[9];
-  PetscReal   grad[9], sigma[9], n[3], gap;
+  PetscReal   grad[9];
 
   PetscFunctionBeginUser;
-  ObstacleGapNormalAt(&user->scene.obstacle, dim, x, n, &gap);
   PetscCall((*user->scene.exact_gradient)(dim, 0.0, x, dim * dim, g, (void *)user->scene.constants));
   for (PetscInt k = 0; k < dim * dim; ++k) grad[k] = PetscRealPart(g[k]);
   ElasticStress(dim, &user->opt->material, grad, sigma);
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* sigma_n(u_exact) = (sigma n) . n at x, with n the obstacle normal at x */
+PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal *sn)
+{
+  PetscReal sigma[9], n[3], gap;
+
+  PetscFunctionBeginUser;
+  ObstacleGapNormalAt(&user->scene.obstacle, dim, x, n, &gap);
+  PetscCall(WeakDataExactStress(user, dim, x, sigma));
   *sn = 0.0;
   for (PetscInt i = 0; i < dim; ++i)
     for (PetscInt j = 0; j < dim; ++j) *sn += n[i] * sigma[i * dim + j] * n[j];
@@ -48,12 +58,9 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0, PetscReal *lif
     PetscCall(CellQuadratureSetCell(&cq, c));
     for (PetscInt b = 0; b < cq.Nb; ++b) elem[b] = 0.0;
     for (PetscInt q = 0; q < cq.Nq; ++q) {
-      PetscScalar g[9];
-      PetscReal   grad[9], sigma[9];
+      PetscReal sigma[9];
 
-      PetscCall((*user->scene.exact_gradient)(dim, 0.0, &cq.x[q * dim], dim * dim, g, (void *)user->scene.constants));
-      for (PetscInt k = 0; k < dim * dim; ++k) grad[k] = PetscRealPart(g[k]);
-      ElasticStress(dim, &user->opt->material, grad, sigma);
+      PetscCall(WeakDataExactStress(user, dim, &cq.x[q * dim], sigma));
       for (PetscInt b = 0; b < cq.Nb; ++b) {
         PetscReal s = 0.0;
 
