@@ -630,6 +630,9 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     PetscCall(PetscTime(&t0)); /* the cycle: its mesh, its solve (the first solve for cycle 0), estimate and marking */
     c->time_cycle = (t0 - t_last) + (k == 0 ? c->time_solve : 0.0);
     t_last        = t0;
+    /* the slowest rank's time, so that every rank takes the checkpoint's decision below alike: a rank's own clock
+       would have one rank enter the collective write and the other go on to the next cycle, and the run hang */
+    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &c->time_cycle, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)*dm)));
     done = (PetscBool)(c->accurate || !user->rec.stats.converged || at_max || fixed_eps >= 0 || at_memory || unreachable >= 0 || k == ad->cycles ||
                        (!c->marked && !c->marked_edge && !c->unseen)); /* done, or a zero estimate: nothing to refine */
     ck_since += c->time_cycle;
@@ -639,7 +642,8 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
       PetscCall(PetscTime(&w0));
       PetscCall(AdaptCheckpoint(*dm, user, *u, k, write));
       PetscCall(PetscTime(&w1));
-      ck_cost  = PetscMax(w1 - w0, 1e-6);
+      ck_cost = PetscMax(w1 - w0, 1e-6);
+      PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ck_cost, 1, MPI_DOUBLE, MPI_MAX, PetscObjectComm((PetscObject)*dm))); /* alike on every rank */
       ck_since = 0.0;
     }
     PetscCall(AdaptMonitor(PetscObjectComm((PetscObject)*dm), ad, user->rec.accuracy_target, c, k)); /* once it is written */
