@@ -58,25 +58,56 @@ PetscErrorCode ContactReset(Contact ct);
 PetscErrorCode ContactSetLoad(Contact ct, DM dm, const Obstacle *obstacle);
 PetscErrorCode ContactView(Contact ct, PetscViewer viewer);
 
-/* What the type does, asked instead of its name: */
-PetscBool ContactHasPenalty(Contact ct); /* a penalty term with eps: the Jacobian differs from K in the contact rows */
-PetscBool ContactHasBounds(Contact ct);  /* SNESVI's bounds: the exact constraint */
-PetscBool ContactIsNone(Contact ct);     /* no contact term: the linear elastic problem */
-/* the contact traction is the penalty law (1/eps)[u . n - g]_+ at every point of Gamma_C (the Gauss rule); otherwise a
-   nodal force (the nodal rule, SNESVI), whose pressure is that force over the node's lumped area */
-PetscBool ContactPointwiseLaw(Contact ct);
+/* What the solver around the contact does by default for its type, stated by the type at its creation, as a PETSc KSP
+   type states the norms it supports: solver.c, newton.c, contact_monitor.c and grid_sequence.c apply it where the
+   options say nothing. */
+typedef struct {
+  PetscBool reuse_factorization; /* J = K plus terms in the contact rows only (the penalty): an earlier J's factorization
+                                    preconditions CG on the next (pc_reuse.c), which the default linear solver is */
+  PetscBool inexact_newton;      /* Eisenstat-Walker's forcing terms with an iterative preconditioner (the penalty) */
+  PetscBool linear;              /* the problem is linear (none): one Newton step, CG on the true residual's norm */
+  PetscBool nested_iteration;    /* the grid sequence's coarser boxes by default on P1: each starts Newton near the next (the penalty) */
+  PetscBool multigrid;           /* a multigrid preconditioner can follow J: not SNESVI's reduced system (vinewtonrsls) */
+  PetscBool active_set_cycles;   /* semismooth Newton's active set can cycle between steps: detected, damped (the penalty) */
+} ContactSolverDefaults;
+PetscErrorCode ContactGetSolverDefaults(Contact ct, const ContactSolverDefaults **defaults);
+
+/* How the contact pressure p on Gamma_C follows from a discrete solution, which the error estimate, the error norms and
+   the checks of the contact zone evaluate:
+     acts   a contact pressure acts at all (none: Gamma_C is a free boundary, p = 0);
+     law    p = [u . n - g]_+ / eps at every point, the penalty law, with the eps of ContactFaceEps() (the penalty, either rule);
+     nodal  the discrete force is one force per contact node, p that force over the node's lumped area (SNESVI's reaction,
+            the nodal rule's force); otherwise the law's face integrals (the Gauss rule). */
+typedef struct {
+  PetscBool acts, law, nodal;
+} ContactPressureForm;
+PetscErrorCode ContactGetPressureForm(Contact ct, ContactPressureForm *form);
+
+/* Whether the answer depends on an eps: the penalty term (1/eps)[u . n - g]_+. Asked only by a driver that solves the
+   same problem again at another eps or moves its data along a penalty's solution path (the bars' and the cycles'
+   penalty part, a load path's secant, force control), each saying why; the rest of the code asks the operations. */
+PetscBool ContactHasPenalty(Contact ct);
 
 /* eps: computed from the options on each mesh (ContactSetUp()), changed by the continuation and the sweep through
-   ContactSetEps(), which also updates the kernels' constants[CONST_PENALTY] = 1/eps; every reader of eps reads it here. */
-PetscErrorCode ContactEpsFromFactor(Contact ct, PetscReal eps0, PetscReal *eps);
-PetscErrorCode ContactSetEps(Contact ct, DM dm, PetscReal eps);
-PetscErrorCode ContactGetEps(Contact ct, PetscReal *eps);
-PetscErrorCode ContactGetEpsRange(Contact ct, PetscReal *eps_min, PetscReal *eps_max, PetscBool *local);
-PetscErrorCode ContactFaceEps(Contact ct, PetscReal cell_diameter, PetscReal *eps);
-PetscErrorCode ContactGetPenaltyScale(Contact ct, PetscReal *eps_start);
-PetscErrorCode ContactGetSet(Contact ct, const ContactSet **cs);
-PetscErrorCode ContactUnseenNodes(Contact ct, Vec u, PetscBool unseen[], PetscInt *count,
-                                  PetscReal *force); /* penetrating with no force from the rule */
+   ContactSetEps(), which also updates the kernels' constants[CONST_PENALTY] = 1/eps; every reader of eps reads it here.
+   A type without a penalty has no eps: ContactGetEps(), ContactGetEpsRange() and ContactGetPenaltyScale() give 0 and
+   ContactSetEps() keeps it 0, so that a driver that scales eps (a sweep, a continuation, a load path's reset) leaves
+   such a type as it was. How eps follows the mesh: */
+typedef enum {
+  CONTACT_EPS_NONE,  /* no eps (vi, none) */
+  CONTACT_EPS_FIXED, /* -penalty_eps, or -penalty_eps_power 0: the same eps on every mesh */
+  CONTACT_EPS_MESH   /* eps0 h^power / M, power > 0: eps falls with the cells */
+} ContactEpsScaling;
+ContactEpsScaling ContactGetEpsScaling(Contact ct);
+PetscErrorCode    ContactEpsFromFactor(Contact ct, PetscReal eps0, PetscReal *eps);
+PetscErrorCode    ContactSetEps(Contact ct, DM dm, PetscReal eps);
+PetscErrorCode    ContactGetEps(Contact ct, PetscReal *eps);
+PetscErrorCode    ContactGetEpsRange(Contact ct, PetscReal *eps_min, PetscReal *eps_max, PetscBool *local);
+PetscErrorCode    ContactFaceEps(Contact ct, PetscReal cell_diameter, PetscReal *eps);
+PetscErrorCode    ContactGetPenaltyScale(Contact ct, PetscReal *eps_start);
+PetscErrorCode    ContactGetSet(Contact ct, const ContactSet **cs);
+PetscErrorCode    ContactUnseenNodes(Contact ct, Vec u, PetscBool unseen[], PetscInt *count,
+                                     PetscReal *force); /* penetrating with no force from the rule */
 
 /* The terms of the nonlinear problem: F(u) = K u + r0 + (contact term), J = K + (contact Jacobian). */
 PetscErrorCode ContactAddResidual(Contact ct, DM dm, Vec u, Vec F);
@@ -95,7 +126,8 @@ PetscErrorCode ContactSameActivity(Contact ct, DM dm, Vec X, Vec Y, PetscBool *s
    whose normal is not an axis into (normal, tangents) so that u . n <= g bounds one unknown (src/contact/vi_frames.c).
    v <- Q^T v (to_solver) or v <- Q v; the identity for the other types and where every normal is an axis. */
 PetscErrorCode ContactSolverFrame(Contact ct, Vec v, PetscBool to_solver);
-PetscBool      ContactHasFrames(Contact ct);
+/* The displacement Q X of the SNES's iterate X: *u = X itself without frames, else work = Q X and *u = work. */
+PetscErrorCode ContactSolverDisplacement(Contact ct, Vec X, Vec work, Vec *u);
 /* The augmented Lagrangian (type al): whether the type has multipliers, and their update at u (Uzawa), made if apply;
    *change is the largest change of eps lambda it makes (a length: the penetration, or the stand-off of a node whose
    multiplier pushes). */
@@ -108,6 +140,9 @@ PetscErrorCode ContactCountActive(Contact ct, Vec X, PetscReal tol_scale, PetscB
 PetscErrorCode ContactPenetrationHash(Contact ct, Vec X, PetscInt64 *hash);
 PetscErrorCode ContactMaxNodePenetration(Contact ct, Vec u, PetscReal *dmax);
 PetscErrorCode ContactMaxPenetration(Contact ct, DM dm, Vec u, PetscReal *dmax); /* the nodes' and the rule's points' */
+/* The smallest nodal pressure that counts as acting: SNESVI's active set tolerance, 1e-10 times the largest pressure
+   over the ranks, below which its reaction is round-off; 0 for the other types, whose force is exact zero off contact. */
+PetscErrorCode ContactActivityFloor(Contact ct, PetscReal *floor);
 
 /* After the solve: the pressure and the reaction at each node (kept in the contact set), the force, the active set, the energy */
 PetscErrorCode ContactPostProcess(Contact ct, DM dm, Vec R, Vec u, PetscReal tol_scale, ContactResult *res);

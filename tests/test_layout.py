@@ -213,3 +213,24 @@ def test_petsc_mirrors_are_listed_in_one_table():
     code = "".join(sources().values())
     options = set(re.findall(r"`(-[a-z_]+)(?: [a-z0-9]+)?`", table))
     assert len(options) >= 8 and all(f'"{opt}"' in code for opt in options), sorted(o for o in options if f'"{o}"' not in code)
+
+
+CAPABILITY = re.compile(r"\bContact(HasPenalty|HasBounds|HasFrames|IsNone|PointwiseLaw|CanAugment)\s*\(")
+
+
+def test_the_method_answers_for_itself():
+    """Outside src/contact/, code asks the contact method what it is (ContactHasPenalty() and the like) at most 8 times,
+    each with a comment on that line or the three before it saying why it cannot be an operation (issue 62: there were
+    41; the solver's defaults, the pressure's form and eps are operations of the types now). ContactCanAugment() counts:
+    it is the same kind of question."""
+    calls = []
+    for path in sorted(glob.glob(os.path.join(ROOT, "src", "*", "*.c")) + glob.glob(os.path.join(ROOT, "src", "*.c"))):
+        if os.sep + "contact" + os.sep in path:
+            continue
+        lines = open(path).read().split("\n")
+        for i, line in enumerate(lines):
+            if CAPABILITY.search(line):
+                context = "\n".join(lines[max(0, i - 3):i + 1])
+                calls.append((os.path.relpath(path, ROOT), i + 1, "/*" in context))
+    assert len(calls) <= 8, calls
+    assert all(commented for _, _, commented in calls), [c for c in calls if not c[2]]

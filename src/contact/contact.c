@@ -184,19 +184,38 @@ PetscBool ContactHasPenalty(Contact ct)
   return ct->has_penalty;
 }
 
-PetscBool ContactHasBounds(Contact ct)
+PetscErrorCode ContactGetSolverDefaults(Contact ct, const ContactSolverDefaults **defaults)
 {
-  return ct->has_bounds;
+  PetscFunctionBeginUser;
+  *defaults = &ct->defaults;
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscBool ContactIsNone(Contact ct)
+/* none: no pressure; vi: its reaction, a force per node; the penalty: its law, by faces (Gauss) or nodes (nodal). */
+PetscErrorCode ContactGetPressureForm(Contact ct, ContactPressureForm *form)
 {
-  return (PetscBool)(!ct->has_penalty && !ct->has_bounds);
+  PetscFunctionBeginUser;
+  form->acts  = (PetscBool)(ct->has_penalty || ct->has_bounds);
+  form->law   = ct->has_penalty;
+  form->nodal = (PetscBool)(ct->has_bounds || (ct->has_penalty && ct->opt.quadrature != PENALTY_QUADRATURE_GAUSS));
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscBool ContactPointwiseLaw(Contact ct)
+PetscErrorCode ContactActivityFloor(Contact ct, PetscReal *floor)
 {
-  return (PetscBool)(ct->has_penalty && ct->opt.quadrature == PENALTY_QUADRATURE_GAUSS);
+  PetscFunctionBeginUser;
+  *floor = 0.0;
+  if (!ct->has_bounds) PetscFunctionReturn(PETSC_SUCCESS);
+  for (PetscInt i = 0; i < ct->set.n; ++i) *floor = PetscMax(*floor, ct->set.pressure[i]);
+  PetscCall(MPIU_Allreduce(MPI_IN_PLACE, floor, 1, MPIU_REAL, MPIU_MAX, ct->comm));
+  *floor *= 1e-10;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+ContactEpsScaling ContactGetEpsScaling(Contact ct)
+{
+  if (!ct->has_penalty) return CONTACT_EPS_NONE;
+  return ct->opt.eps_fixed > 0.0 || ct->opt.eps_power == 0.0 ? CONTACT_EPS_FIXED : CONTACT_EPS_MESH;
 }
 
 /* M of eps = eps0 h^power / M: E, or the P-wave modulus lambda + 2 mu, which grows without bound as nu -> 1/2. */
@@ -222,7 +241,7 @@ PetscErrorCode ContactEpsFromFactor(Contact ct, PetscReal eps0, PetscReal *eps)
 PetscErrorCode ContactGetPenaltyScale(Contact ct, PetscReal *eps_start)
 {
   PetscFunctionBeginUser;
-  *eps_start = ct->h / ContactModulus(ct);
+  *eps_start = ct->has_penalty ? ct->h / ContactModulus(ct) : 0.0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -236,7 +255,7 @@ PetscErrorCode ContactSetEps(Contact ct, DM dm, PetscReal eps)
   PetscInt           nc;
 
   PetscFunctionBeginUser;
-  ct->eps = eps;
+  ct->eps = ct->has_penalty ? eps : 0.0; /* no eps without a penalty (include/contact.h) */
   PetscCall(DMGetDS(dm, &ds));
   PetscCall(PetscDSGetConstants(ds, &nc, &c0));
   PetscCheck(nc > CONST_PENALTY && nc <= CONST_SCENE_MAX, ct->comm, PETSC_ERR_PLIB, "the constants of the kernels are not set");
@@ -472,9 +491,15 @@ PetscErrorCode ContactSolverFrame(Contact ct, Vec v, PetscBool to_solver)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscBool ContactHasFrames(Contact ct)
+PetscErrorCode ContactSolverDisplacement(Contact ct, Vec X, Vec work, Vec *u)
 {
-  return ct->has_frames;
+  PetscFunctionBeginUser;
+  *u = X;
+  if (!ct->has_frames) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(VecCopy(X, work));
+  PetscCall(ContactSolverFrame(ct, work, PETSC_FALSE));
+  *u = work;
+  PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscBool ContactCanAugment(Contact ct)

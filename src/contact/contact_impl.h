@@ -27,14 +27,15 @@ typedef struct {
 } ContactOps;
 
 struct _p_Contact {
-  MPI_Comm       comm;
-  char           type[64];
-  ContactOps     ops;
-  void          *data;        /* the type's own state */
-  PetscBool      has_penalty; /* set by the type's create function */
-  PetscBool      has_bounds;
-  PetscBool      has_frames; /* the SNES iterates in frames of its own at some nodes (vi on this mesh; ops.frame) */
-  ContactOptions opt;        /* read once by ContactSetFromOptions() */
+  MPI_Comm              comm;
+  char                  type[64];
+  ContactOps            ops;
+  void                 *data;        /* the type's own state */
+  PetscBool             has_penalty; /* set by the type's create function */
+  PetscBool             has_bounds;
+  PetscBool             has_frames; /* the SNES iterates in frames of its own at some nodes (vi on this mesh; ops.frame) */
+  ContactSolverDefaults defaults;   /* the type's, set by its create function */
+  ContactOptions        opt;        /* read once by ContactSetFromOptions() */
 
   /* on the mesh of ContactSetUp() */
   PetscBool    set_up;

@@ -14,6 +14,8 @@ static PetscErrorCode ContactActs_None(Contact ct, DM dm, Vec u, PetscBool acts[
 PetscErrorCode ContactCreate_None(Contact ct)
 {
   PetscFunctionBeginUser;
-  ct->ops.acts = ContactActs_None;
+  ct->ops.acts           = ContactActs_None;
+  ct->defaults.linear    = PETSC_TRUE; /* J = K: one Newton step, a linear solve */
+  ct->defaults.multigrid = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -503,20 +503,27 @@ PetscErrorCode ContactCreate_Penalty(Contact ct)
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&pen));
-  ct->data                 = pen;
-  ct->has_penalty          = PETSC_TRUE;
-  ct->ops.setup            = ContactSetUp_Penalty;
-  ct->ops.reset            = ContactReset_Penalty;
-  ct->ops.residual         = ContactResidual_Penalty;
-  ct->ops.jacobian         = ContactJacobian_Penalty;
-  ct->ops.prepare_operator = ContactPrepareOperator_Penalty;
-  ct->ops.bulk_mult        = ContactBulkMult_Penalty;
-  ct->ops.bulk_operator    = ContactBulkOperator_Penalty;
-  ct->ops.energy           = ContactEnergy_Penalty;
-  ct->ops.acts             = ContactActs_Penalty;
-  ct->ops.same_activity    = ContactSameActivity_Penalty;
-  ct->ops.check            = ContactCheck_Penalty;
-  ct->ops.view             = ContactView_Penalty;
+  ct->data        = pen;
+  ct->has_penalty = PETSC_TRUE;
+  /* J = K + the penalty's rank-one terms in the contact rows: an earlier J's factorization preconditions CG on the next,
+     and an inexact Newton is as accurate; its active set can cycle, and nested iteration starts each box near the next */
+  ct->defaults.reuse_factorization = PETSC_TRUE;
+  ct->defaults.inexact_newton      = PETSC_TRUE;
+  ct->defaults.nested_iteration    = PETSC_TRUE;
+  ct->defaults.multigrid           = PETSC_TRUE;
+  ct->defaults.active_set_cycles   = PETSC_TRUE;
+  ct->ops.setup                    = ContactSetUp_Penalty;
+  ct->ops.reset                    = ContactReset_Penalty;
+  ct->ops.residual                 = ContactResidual_Penalty;
+  ct->ops.jacobian                 = ContactJacobian_Penalty;
+  ct->ops.prepare_operator         = ContactPrepareOperator_Penalty;
+  ct->ops.bulk_mult                = ContactBulkMult_Penalty;
+  ct->ops.bulk_operator            = ContactBulkOperator_Penalty;
+  ct->ops.energy                   = ContactEnergy_Penalty;
+  ct->ops.acts                     = ContactActs_Penalty;
+  ct->ops.same_activity            = ContactSameActivity_Penalty;
+  ct->ops.check                    = ContactCheck_Penalty;
+  ct->ops.view                     = ContactView_Penalty;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

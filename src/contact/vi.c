@@ -161,8 +161,9 @@ PetscErrorCode ContactCreate_VI(Contact ct)
 
   PetscFunctionBeginUser;
   PetscCall(PetscNew(&vi));
-  ct->data             = vi;
-  ct->has_bounds       = PETSC_TRUE;
+  ct->data       = vi;
+  ct->has_bounds = PETSC_TRUE;
+  /* the defaults all PETSC_FALSE: SNESVI's reduced system changes size between steps, which no multigrid follows */
   ct->ops.setup        = ContactSetUp_VI;
   ct->ops.reset        = ContactReset_VI;
   ct->ops.setup_snes   = ContactSetUpSNES_VI;

@@ -178,7 +178,8 @@ PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(VecCopy(user->prob.loc_bc, loc_u)); /* the Dirichlet values, inserted once by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc_u));
   PetscCall(VecGetArrayRead(loc_u, &w.lu));
-  if (!ContactIsNone(user->contact) && !ContactPointwiseLaw(user->contact)) { /* the nodal force over the lumped area */
+  PetscCall(ContactGetPressureForm(user->contact, &w.pressure));
+  if (w.pressure.nodal) { /* the nodal force over the lumped area */
     PetscCall(DMGetLocalVector(dm, &loc_p));
     PetscCall(ErrorNormsPressureVector(dm, user, loc_p));
     PetscCall(VecGetArrayRead(loc_p, &w.lp));

@@ -49,11 +49,11 @@ PetscErrorCode EstimatePenaltyTerm(EstimateWork *w)
   const PetscInt     dim   = w->dim;
   const Material    *mat   = &w->user->opt->material;
   const BoundarySet *bcs   = &w->user->scene.bcs;
-  const PetscBool    nodal = (PetscBool)!ContactPointwiseLaw(w->user->contact); /* the nodal rule */
+  const PetscBool    nodal = w->pressure.nodal; /* the nodal rule */
   PetscReal         *share, sums[2] = {0.0, 0.0}, gsums[2], estar, eta2;
 
   PetscFunctionBeginUser;
-  if (!ContactHasPenalty(w->user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!w->pressure.law) PetscFunctionReturn(PETSC_SUCCESS);   /* no eps: no penalty part */
   PetscCall(PetscCalloc1(2 * (w->cEnd - w->cStart), &share)); /* per cell: ||d||^2 and ||grad_t d||^2 on its contact faces */
   for (PetscInt s = 0; s < bcs->ncontact; ++s) {
     PetscInt *faces, nf;

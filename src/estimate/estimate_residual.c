@@ -171,8 +171,7 @@ static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
 /* The contact traction's misfit on a face of Gamma_C of cell c: into eta2[normal] and eta2[tangential]. */
 static PetscErrorCode ContactFace(EstimateWork *w, PetscInt c, const EstimateCell *cell, const EstimateFace *face, PetscReal eta2[])
 {
-  const PetscInt dim  = w->dim;
-  const PetscInt none = ContactIsNone(w->user->contact);
+  const PetscInt dim = w->dim;
   PetscReal      sigma[9], sn[3], eps = 0.0, rn = 0.0, rt = 0.0;
 
   PetscFunctionBeginUser;
@@ -181,7 +180,7 @@ static PetscErrorCode ContactFace(EstimateWork *w, PetscInt c, const EstimateCel
     sn[i] = 0.0;
     for (PetscInt j = 0; j < dim; ++j) sn[i] += sigma[i * dim + j] * face->normal[j];
   }
-  if (!none && !w->lp) PetscCall(ContactFaceEps(w->user->contact, cell->diameter, &eps));
+  if (w->pressure.law && !w->pressure.nodal) PetscCall(ContactFaceEps(w->user->contact, cell->diameter, &eps));
   for (PetscInt q = 0; q < w->face_rule.n; ++q) {
     PetscReal x[3], u[3], wq, n[3], g, p = 0.0, R[3], Rn = 0.0, Rt = 0.0;
 
@@ -192,7 +191,7 @@ static PetscErrorCode ContactFace(EstimateWork *w, PetscInt c, const EstimateCel
 
       for (PetscInt k = 0; k < face->nv; ++k)
         for (PetscInt d = 0; d < dim; ++d) p += b[k] * PetscRealPart(w->lp[cell->off[face->local[k]] + d]) * n[d];
-    } else if (!none) {
+    } else if (w->pressure.law) { /* the penalty law at the point */
       PetscReal d = -g;
 
       for (PetscInt k = 0; k < dim; ++k) d += u[k] * n[k];

@@ -300,10 +300,8 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(ContactGetType(user->contact, &method));
   PetscCall(ContactGetOptions(user->contact, &copt));
   PetscCall(ContactGetSet(user->contact, &cs));
-  if (ContactHasPenalty(user->contact)) { /* 0 for the types without eps */
-    PetscCall(ContactGetEps(user->contact, &eps));
-    PetscCall(ContactGetEpsRange(user->contact, &eps_min, &eps_max, NULL));
-  }
+  PetscCall(ContactGetEps(user->contact, &eps)); /* 0 for the types without eps */
+  PetscCall(ContactGetEpsRange(user->contact, &eps_min, &eps_max, NULL));
   PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)dm), &size));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetSize(u, &ndofs));

@@ -23,10 +23,11 @@
 
 PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
 {
-  MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
-  ContactChecks *ck   = &user->rec.stats.checks;
-  PetscInt       dim, vStart, vEnd;
-  PetscReal      sums[3] = {0.0, 0.0, 0.0}, overlap[2] = {0.0, 0.0}; /* area, area facing away, area overlapping; -g/h and -g */
+  MPI_Comm            comm = PetscObjectComm((PetscObject)dm);
+  ContactChecks      *ck   = &user->rec.stats.checks;
+  PetscInt            dim, vStart, vEnd;
+  PetscReal           sums[3] = {0.0, 0.0, 0.0}, overlap[2] = {0.0, 0.0}; /* area, area facing away, area overlapping; -g/h and -g */
+  ContactPressureForm form;
 
   PetscFunctionBeginUser;
   { /* a mesh file's curved boundary refined by the solver on its chords (-adapt_cycles refuses it: AdaptCheck()) */
@@ -46,11 +47,13 @@ PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
 
       ck->locking_nu = mat->poisson_ratio;
       PetscCall(ContactGetOptions(user->contact, &copt));
-      if (ContactHasPenalty(user->contact) && copt->modulus == PENALTY_MODULUS_YOUNG)
+      PetscCall(ContactGetPressureForm(user->contact, &form));
+      if (form.law && copt->modulus == PENALTY_MODULUS_YOUNG) /* eps = eps0 h / E, whose E the P-wave modulus outgrows */
         ck->locking_eps_ratio = (mat->lambda + 2.0 * mat->mu) / mat->young_modulus;
     }
   }
-  if (ContactIsNone(user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetPressureForm(user->contact, &form));
+  if (!form.acts) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
   for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
@@ -137,24 +140,22 @@ static int ComparePoints(const void *a, const void *b)
    with only some nodes pressed is the zone's edge, which the rule smears over a cell or two whatever the zone's true
    width: counting it, a zone narrower than a cell counted 4 faces at every h (bench/zone_resolution.md).
    SNESVI's pressure is the reaction at every node, round-off (1e-16 of the largest) at the free ones: a node carries
-   force there above 1e-10 times the largest pressure, the tolerance of its active set. Without it the count changed
+   force there above ContactActivityFloor(), the tolerance of its active set. Without it the count changed
    with the round-off, 4 or 6 faces between two identical runs of the square on 2 ranks. */
 PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user, Vec u)
 {
-  MPI_Comm          comm = PetscObjectComm((PetscObject)dm);
-  ContactChecks    *ck   = &user->rec.stats.checks;
-  const ContactSet *cs;
-  PetscInt          dim, nzone = 0, pressed = 0, (*pairs)[2];
-  PetscReal         floor = 0.0, moments[10] = {0}; /* area, its first moments, its second moments xx, xy, xz, yy, yz, zz */
+  MPI_Comm            comm = PetscObjectComm((PetscObject)dm);
+  ContactChecks      *ck   = &user->rec.stats.checks;
+  const ContactSet   *cs;
+  PetscInt            dim, nzone = 0, pressed = 0, (*pairs)[2];
+  PetscReal           floor = 0.0, moments[10] = {0}; /* area, its first moments, its second moments xx, xy, xz, yy, yz, zz */
+  ContactPressureForm form;
 
   PetscFunctionBeginUser;
-  if (ContactIsNone(user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetPressureForm(user->contact, &form));
+  if (!form.acts) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactGetSet(user->contact, &cs));
-  if (ContactHasBounds(user->contact)) {
-    for (PetscInt i = 0; i < cs->n; ++i) floor = PetscMax(floor, cs->pressure[i]);
-    PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &floor, 1, MPIU_REAL, MPIU_MAX, comm));
-    floor *= 1e-10;
-  }
+  PetscCall(ContactActivityFloor(user->contact, &floor));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(PetscMalloc1(cs->n + 1, &pairs)); /* (point, node) sorted by point: a face's nodes found by bisection */
   for (PetscInt i = 0; i < cs->n; ++i) {

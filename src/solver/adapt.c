@@ -253,7 +253,7 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
   for (PetscInt q = 0; q < ACCURACY_NUM; ++q) c->value_eps[q] = PETSC_NAN;
   c->eps       = PETSC_NAN;
   c->eps_scale = PETSC_NAN;
-  if (ContactHasPenalty(user->contact)) {
+  if (ContactGetEpsScaling(user->contact) != CONTACT_EPS_NONE) { /* NaN in /cycles for the types without eps */
     PetscCall(ContactGetEps(user->contact, &c->eps));
     PetscCall(ContactGetPenaltyScale(user->contact, &c->eps_scale));
   }
@@ -283,7 +283,7 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
 
   PetscFunctionBeginUser;
   if (!(ad->accuracy > 0.0) || !(target[ACCURACY_FORCE] || target[ACCURACY_PRESSURE] || target[ACCURACY_SIZE] || target[ACCURACY_PEAK]) ||
-      !ContactHasPenalty(user->contact) || !c->converged)
+      !ContactHasPenalty(user->contact) || !c->converged) /* a driver's question: a second solve at eps / R has an eps to vary */
     PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(ContactGetEps(user->contact, &eps));
@@ -455,11 +455,9 @@ static PetscReal AdaptFraction(const AdaptOptions *ad, const PetscBool target[],
    error, which a fixed eps keeps (docs/estimate.md, "A fixed eps"). Returns the first such quantity (-1: none). */
 static PetscInt FixedEpsHolds(const AppCtx *user, const PetscBool target[], PetscInt k)
 {
-  const ContactOptions *copt = NULL;
-  const AdaptOptions   *ad   = &user->opt->adapt;
+  const AdaptOptions *ad = &user->opt->adapt;
 
-  if (!(ad->accuracy > 0.0) || k < 1 || !ContactHasPenalty(user->contact)) return -1;
-  if (ContactGetOptions(user->contact, &copt) || !copt || !(copt->eps_fixed > 0.0 || copt->eps_power == 0.0)) return -1;
+  if (!(ad->accuracy > 0.0) || k < 1 || ContactGetEpsScaling(user->contact) != CONTACT_EPS_FIXED) return -1;
   for (PetscInt q = 0; q < ACCURACY_NUM; ++q) {
     PetscBool above = target[q];
 

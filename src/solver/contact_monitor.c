@@ -44,7 +44,12 @@ PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm_scaled, vo
   sc->stats->residual_norm = fnorm;
   PetscCall(SNESGetSolution(snes, &Xs));
   PetscCall(SolverIterateDisplacement(sc, Xs, &X));
-  if (ContactHasPenalty(sc->contact)) PetscCall(DetectActiveSetCycle(snes, sc, it, fnorm, X));
+  {
+    const ContactSolverDefaults *defaults;
+
+    PetscCall(ContactGetSolverDefaults(sc->contact, &defaults));
+    if (defaults->active_set_cycles) PetscCall(DetectActiveSetCycle(snes, sc, it, fnorm, X));
+  }
   if (!sc->opt->monitor) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactCountActive(sc->contact, X, sc->displacement_scale, PETSC_TRUE, &active, &entered, &left));
   PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes),

@@ -104,7 +104,7 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
     if (n > 1 && eps != eps_last) { /* the polynomial through the last n solutions */
       PetscCall(ExtrapolationStep(n, hist, e, eps, dir));
       PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, 1.0, 0.0, PETSC_TRUE));
-    } else if (k == 1 && ContactHasPenalty(user->contact) && eps != eps_last) { /* the tangent */
+    } else if (k == 1 && eps != eps_last) { /* the tangent (a sweep is the penalty's: ContactSetFromOptions()) */
       PetscBool ok = PETSC_FALSE;
 
       PetscCall(EpsSweepTangent(snes, dm, user, u, dir, &ok));

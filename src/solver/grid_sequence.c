@@ -167,10 +167,11 @@ static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
 PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt request[2], PetscInt faces[3],
                                          PetscInt *min_levels, PetscBool *coarse_mg, PetscBool *default_mg)
 {
-  const PetscInt  k       = opt->solver.coarse_levels;
-  const char     *pc_type = opt->solver.given.pc_type;
-  const PetscBool given   = opt->solver.given.pc_type_given;
-  PetscBool       is_mg, is_factor, mg_3d;
+  const PetscInt               k       = opt->solver.coarse_levels;
+  const char                  *pc_type = opt->solver.given.pc_type;
+  const PetscBool              given   = opt->solver.given.pc_type_given;
+  PetscBool                    is_mg, is_factor, mg_3d;
+  const ContactSolverDefaults *defaults;
 
   PetscFunctionBeginUser;
   PetscCheck(k <= 0 || opt->degree == 1, comm, PETSC_ERR_USER_INPUT,
@@ -180,9 +181,10 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOpt
   /* -contact_coarse_mg: with an iterative preconditioner that is not already the boxes' multigrid (without -pc_type, the
      default is MUMPS's factorization, which a coarser box's small matrix does not make expensive); not with SNESVI, whose
      reduced system (vinewtonrsls) no PCMG can follow and whose vinewtonssls Jacobian CG cannot take */
-  *coarse_mg = (PetscBool)(opt->solver.coarse_mg && given && !is_mg && !is_factor && !ContactHasBounds(ct));
+  PetscCall(ContactGetSolverDefaults(ct, &defaults));
+  *coarse_mg = (PetscBool)(opt->solver.coarse_mg && given && !is_mg && !is_factor && defaults->multigrid);
   /* without a preconditioner in the options, the penalty method and the elastic solve on P1 */
-  *default_mg = (PetscBool)(!given && opt->degree == 1 && (ContactHasPenalty(ct) || ContactIsNone(ct)));
+  *default_mg = (PetscBool)(!given && opt->degree == 1 && defaults->multigrid);
   mg_3d       = (PetscBool)(is_mg || *coarse_mg || *default_mg);
   request[0] = request[1] = k;
   /* the coarsest box's least cells per side in 2D and in 3D, and its most in 3D (0: any) */
@@ -193,7 +195,8 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOpt
   /* by default: the penalty method, and the elastic solve with the geometric multigrid (its levels: -pc_type mg, and in
      3D the default's), on P1 */
   {
-    const PetscBool penalty = (PetscBool)(opt->degree == 1 && ContactHasPenalty(ct)), elastic = (PetscBool)(opt->degree == 1 && ContactIsNone(ct));
+    const PetscBool penalty = (PetscBool)(opt->degree == 1 && defaults->nested_iteration),
+                    elastic = (PetscBool)(opt->degree == 1 && defaults->linear);
 
     if (k < 0 && !(penalty || (elastic && is_mg))) request[0] = 0;
     if (k < 0 && !(penalty || (elastic && (is_mg || *default_mg)))) request[1] = 0;
@@ -218,10 +221,10 @@ PetscErrorCode GridSequenceBarsSizes(DM dm, const AppCtx *user)
   PetscReal            *sizes, hmax;
 
   PetscFunctionBeginUser;
-  if (!user->opt->bars || !ContactHasPenalty(user->contact) || (user->box.is_box && user->opt->degree == 1)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt->bars || ContactGetEpsScaling(user->contact) != CONTACT_EPS_MESH || (user->box.is_box && user->opt->degree == 1))
+    PetscFunctionReturn(PETSC_SUCCESS);
   if (user->prob.level >= nlevels || user->prob.level < nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactGetOptions(user->contact, &copt));
-  if (copt->eps_fixed > 0.0 || copt->eps_power <= 0.0) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexIsSimplex(dm, &simplex));
   if (dim != 3 || !simplex) PetscFunctionReturn(PETSC_SUCCESS);
@@ -240,9 +243,9 @@ static PetscErrorCode GridSequenceBarsEps(SNES snes, AppCtx *user, PetscInt nlev
   DM                    dm;
 
   PetscFunctionBeginUser;
-  if (!user->opt->bars || !ContactHasPenalty(user->contact) || user->prob.level < nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt->bars || ContactGetEpsScaling(user->contact) != CONTACT_EPS_MESH || user->prob.level < nlevels - (BARS_LEVELS - 1))
+    PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactGetOptions(user->contact, &copt));
-  if (copt->eps_fixed > 0.0) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetDM(snes, &dm));
   if (user->opt->adapt.model[0]) { /* the remeshed levels' one eps, from the first bars level's own (GridSequenceRemeshHalf()) */
     if (user->prob.level == nlevels - (BARS_LEVELS - 1)) {
@@ -276,6 +279,7 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
   PetscCall(PostprocessContact(dm, user, u));
   PostprocessGetQuantities(user, &b->level[b->nlevels]);
   b->level_h[b->nlevels++] = user->prob.h;
+  /* a driver's question: the penalty's part of the bars is a second solve at eps / R, which a type without eps has not */
   if (user->prob.level == first + BARS_EPS_LEVEL && !ContactHasPenalty(user->contact)) {
     const ContactSet *cs;
 
@@ -325,7 +329,7 @@ static PetscErrorCode GridSequenceStart(const AppCtx *user, PetscInt nlevels, So
 {
   PetscFunctionBeginUser;
   *start = SOLVER_START_COARSER_MESH;
-  if (!user->opt->bars || !ContactHasPenalty(user->contact) || user->prob.level <= nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt->bars || user->prob.level <= nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SolverStartFromCoarser(user, start));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

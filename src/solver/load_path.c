@@ -53,6 +53,8 @@ PetscErrorCode LoadPathSetUp(MPI_Comm comm, AppCtx *user)
   if (!opt->load_path.n && !SceneForceControlled(&user->scene)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactGetOptions(user->contact, &copt));
   PetscCall(SceneCheckLoadPath(comm, &user->scene, what));
+  /* a capability, not an operation: the refusal names the method to give, and force control's position secant follows
+     the penalty's force, smooth in the obstacle's position where SNESVI's reaction is not */
   PetscCheck(ContactHasPenalty(user->contact) || !(user->scene.obstacle.force > 0.0), comm, PETSC_ERR_USER_INPUT,
              "-obstacle_force works with -contact_method penalty (its positions' warm solves and force secant are the penalty's)");
   PetscCheck(!opt->bars, comm, PETSC_ERR_USER_INPUT, "-bars measures one load state: give it without %s", what);
@@ -409,6 +411,8 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
     if (force) PetscCall(SceneSetObstaclePosition(&user->scene, s)); /* the last step's position */
     PetscCall(ProblemUpdateData(dm, user));
     {
+      /* the secant through the last two solutions, measured for the penalty (docs/solvers.md, "Load paths"); SNESVI and
+         none start from the last step's solution, which their solve needs no better guess than */
       const PetscBool secant = (PetscBool)(!force && t_last != t_prev && ContactHasPenalty(user->contact));
 
       PetscCall(SolverSecantStart(snes, dm, user, u, prev, dir, secant, secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0, 1.0));

@@ -47,11 +47,10 @@ PetscErrorCode SolverBulkResidual(SolverCtx sc, Vec X, Vec R)
 PetscErrorCode SolverIterateDisplacement(SolverCtx sc, Vec X, Vec *u)
 {
   PetscFunctionBeginUser;
-  *u = X;
-  if (sc->snes_scale == 1.0 && !ContactHasFrames(sc->contact)) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(VecCopy(X, sc->work));
-  PetscCall(ContactSolverFrame(sc->contact, sc->work, PETSC_FALSE));
-  if (sc->snes_scale != 1.0) PetscCall(VecScale(sc->work, sc->snes_scale));
+  PetscCall(ContactSolverDisplacement(sc->contact, X, sc->work, u)); /* X itself, or Q X in sc->work */
+  if (sc->snes_scale == 1.0) PetscFunctionReturn(PETSC_SUCCESS);
+  if (*u == X) PetscCall(VecCopy(X, sc->work));
+  PetscCall(VecScale(sc->work, sc->snes_scale));
   *u = sc->work;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -104,11 +103,11 @@ PetscErrorCode SolverFormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
   PetscFunctionBeginUser;
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(SolverIterateDisplacement(sc, X, &u));
-  if (ContactHasPenalty(sc->contact)) {
-    PetscCall(PcReuseDecide(snes, dm, sc, u));
-    PetscCall(ContactComputeJacobian(sc->contact, dm, u, sc->K, P)); /* P is K itself, or a copy (SBAIJ: no row access) */
-    PetscCall(PcReuseAfterJacobian(snes, sc));                       /* records the build's contact rows, or updates the GAMG hierarchy */
-  }
+  /* J = K for the types without a contact Jacobian, which ContactComputeJacobian() leaves, and the factorization's reuse
+     is off for them (SolverCreateSNES()) */
+  PetscCall(PcReuseDecide(snes, dm, sc, u));
+  PetscCall(ContactComputeJacobian(sc->contact, dm, u, sc->K, P)); /* P is K itself, or a copy (SBAIJ: no row access) */
+  PetscCall(PcReuseAfterJacobian(snes, sc));                       /* records the build's contact rows, or updates the GAMG hierarchy */
   if (J != P) {
     PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));

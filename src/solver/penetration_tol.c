@@ -106,13 +106,15 @@ PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
   MPI_Comm              comm = PetscObjectComm((PetscObject)dm);
   PetscReal             d_max, eps;
   PetscInt              solves  = 1;
-  PetscBool             reached = PETSC_FALSE;
+  PetscBool             reached = PETSC_FALSE, augment;
 
   PetscFunctionBeginUser;
   PetscCall(ContactGetOptions(user->contact, &copt));
   if (!(copt->penetration_tol > 0.0) || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactMaxPenetration(user->contact, dm, u, &d_max));
-  if (ContactCanAugment(user->contact))
+  /* a driver's choice between two ways to the tolerance: Uzawa's updates of the type's multipliers, or a smaller eps */
+  augment = ContactCanAugment(user->contact);
+  if (augment)
     PetscCall(UzawaSolve(dm, user, snes, u, copt->penetration_tol, &d_max, &solves, &reached));
   else
     PetscCall(ContinuationSolve(dm, user, snes, u, copt->penetration_tol, &d_max, &solves, &reached));
@@ -122,8 +124,7 @@ PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
   if (user->rec.stats.converged && !reached) {
     PetscCall(PetscPrintf(
         comm, "  penetration tolerance: -contact_penetration_tol %g not reached after %" PetscInt_FMT " solves (the largest penetration %g%s)\n",
-        (double)copt->penetration_tol, solves, (double)d_max,
-        ContactCanAugment(user->contact) ? "; the multipliers still move by more than the tolerance" : ""));
+        (double)copt->penetration_tol, solves, (double)d_max, augment ? "; the multipliers still move by more than the tolerance" : ""));
     user->rec.stats.converged = PETSC_FALSE;
   } else if (user->rec.stats.converged)
     PetscCall(PetscPrintf(comm, "  penetration tolerance: the largest penetration %g <= %g at eps = %g, in %" PetscInt_FMT " solve(s)\n",

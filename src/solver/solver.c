@@ -105,8 +105,9 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
    The Newton steps are as accurate as with a fresh factorization, also when it is reused. */
 static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
 {
-  PC        pc;
-  PetscBool sbaij;
+  PC                           pc;
+  PetscBool                    sbaij;
+  const ContactSolverDefaults *defaults;
 
   PetscFunctionBeginUser;
   if (MultigridIsDefault(user)) { /* the 3D box that nests: CG with the boxes' geometric multigrid, as options/solvers/mg.yaml */
@@ -116,7 +117,8 @@ static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
     PetscCall(PCSetType(pc, PCMG));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCall(KSPSetType(ksp, ContactHasPenalty(user->contact) && user->opt->solver.pc_reuse ? KSPCG : KSPPREONLY));
+  PetscCall(ContactGetSolverDefaults(user->contact, &defaults));
+  PetscCall(KSPSetType(ksp, defaults->reuse_factorization && user->opt->solver.pc_reuse ? KSPCG : KSPPREONLY));
   PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
   PetscCall(KSPGetPC(ksp, &pc));
   /* K is symmetric positive definite: a symmetric block matrix (-dm_mat_type sbaij) holds its upper triangle only,
@@ -139,10 +141,11 @@ static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
      -ksp_rtol. */
 static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
 {
-  const SolverGiven *given = &user->opt->solver.given;
-  KSP                ksp;
-  PC                 pc;
-  PetscBool          is_cg, is_factor;
+  const SolverGiven           *given = &user->opt->solver.given;
+  KSP                          ksp;
+  PC                           pc;
+  PetscBool                    is_cg, is_factor;
+  const ContactSolverDefaults *defaults;
 
   PetscFunctionBeginUser;
   PetscCall(SNESGetKSP(snes, &ksp));
@@ -150,15 +153,16 @@ static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
   PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPCG, &is_cg));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &is_factor, PCLU, PCCHOLESKY, ""));
   if (is_factor) PetscFunctionReturn(PETSC_SUCCESS); /* a factorization: CG converges in one or a few iterations anyway */
+  PetscCall(ContactGetSolverDefaults(user->contact, &defaults));
   {
     const char *prefix;
     PetscInt    k;
 
     PetscCall(KSPGetOptionsPrefix(ksp, &prefix));
     PetscCall(SolverGivenIndex(prefix, &k));
-    if (is_cg && !given->ksp_norm_type[k] && ContactIsNone(user->contact)) PetscCall(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED));
+    if (is_cg && !given->ksp_norm_type[k] && defaults->linear) PetscCall(KSPSetNormType(ksp, KSP_NORM_UNPRECONDITIONED));
   }
-  if (!given->snes_ksp_ew && ContactHasPenalty(user->contact)) {
+  if (!given->snes_ksp_ew && defaults->inexact_newton) {
     PetscCall(SNESKSPSetUseEW(snes, PETSC_TRUE));
     if (!given->snes_ksp_ew_rtolmax)
       PetscCall(
@@ -211,10 +215,12 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
                pc_type);
   }
   {
-    PetscBool is_preonly;
+    PetscBool                    is_preonly;
+    const ContactSolverDefaults *defaults;
 
     PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &is_preonly));
-    user->prob.sctx->pc_reuse.enabled = (PetscBool)(ContactHasPenalty(user->contact) && user->opt->solver.pc_reuse && !is_preonly);
+    PetscCall(ContactGetSolverDefaults(user->contact, &defaults));
+    user->prob.sctx->pc_reuse.enabled = (PetscBool)(defaults->reuse_factorization && user->opt->solver.pc_reuse && !is_preonly);
   }
   PetscCall(SolverSetIterativeDefaults(*snes, user));
   {
@@ -289,8 +295,7 @@ static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal 
   PetscCall(VecGetSize(u, &r->n_dofs));
   r->level = user->prob.level;
   r->h     = user->prob.h;
-  r->eps   = 0.0;
-  if (ContactHasPenalty(user->contact)) PetscCall(ContactGetEps(user->contact, &r->eps));
+  PetscCall(ContactGetEps(user->contact, &r->eps)); /* 0 for the types without eps */
   r->newton_its         = user->rec.stats.newton_its;
   r->ksp_its            = user->rec.stats.ksp_its;
   r->pc_builds          = user->rec.stats.pc_builds;
@@ -352,11 +357,10 @@ PetscErrorCode SolverStartFromCoarser(const AppCtx *user, SolverStart *start)
 
   PetscFunctionBeginUser;
   *start = SOLVER_START_COARSER_MESH;
-  if (!ContactHasPenalty(user->contact)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactGetOptions(user->contact, &copt));
   PetscCall(ContactGetEps(user->contact, &eps));
   PetscCall(ContactGetPenaltyScale(user->contact, &eps_start));
-  if (eps >= copt->continuation_factor * eps_start) *start = SOLVER_START_NEARBY_EPS;
+  if (eps > 0.0 && eps >= copt->continuation_factor * eps_start) *start = SOLVER_START_NEARBY_EPS; /* eps 0: a type without one */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -424,7 +428,7 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
   user->prob.sctx->pc_reuse.updates        = 0;
   user->prob.sctx->pc_reuse.finest_updates = 0;
   user->rec.stats.continuation_stages      = 0;
-  if (start != SOLVER_START_NEARBY_EPS && ContactHasPenalty(user->contact) && copt->continuation && eps_target < eps_start) {
+  if (start != SOLVER_START_NEARBY_EPS && copt->continuation && eps_target < eps_start) { /* both 0 for a type without eps */
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= copt->continuation_factor) {
       PetscCall(ContactSetEps(user->contact, dm, eps));
       PetscCall(SolveRecovering(snes, user, u, &newton, &ksp));
@@ -489,13 +493,15 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
   PetscReal          normJ, est = 0.0;
   PetscInt           n, last    = -1;
   KSPConvergedReason reason;
+  PetscBool          is_vi;
 
   PetscFunctionBeginUser;
   user->rec.stats.condition_1norm = PETSC_NAN;
   if (!user->opt->solver.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
-  if (ContactHasBounds(user->contact)) {
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)snes, &is_vi, SNESVINEWTONRSLS, SNESVINEWTONSSLS, ""));
+  if (is_vi) { /* its KSP holds the reduced system of the last active set */
     J = user->prob.K;
     PetscCall(KSPCreate(PetscObjectComm((PetscObject)snes), &ksp_vi));
     PetscCall(SolverSetDefaultLinearSolver(ksp_vi, user));

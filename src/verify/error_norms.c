@@ -241,9 +241,11 @@ PetscErrorCode ErrorNormsEvaluate(DM dm, const PetscReal run_cell_h[], AppCtx *u
   e->penetration_l2  = PetscSqrtReal(gcontact[1]);
   e->penetration_max = PetscMax(gmax, 0.0);
   if (target) {
-    PetscReal weight = user->prob.h;
+    PetscReal           weight = user->prob.h;
+    ContactPressureForm form;
 
-    if (ContactHasPenalty(user->contact)) PetscCall(ContactGetEps(user->contact, &weight));
+    PetscCall(ContactGetPressureForm(user->contact, &form));
+    if (form.law) PetscCall(ContactGetEps(user->contact, &weight)); /* eps^1/2 ||R|| for the penalty, h^1/2 ||R|| otherwise */
 
     e->l2                = PetscSqrtReal(gbulk[0]);
     e->h1_semi           = PetscSqrtReal(gbulk[1]);
@@ -260,8 +262,9 @@ PetscErrorCode ErrorNormsEvaluate(DM dm, const PetscReal run_cell_h[], AppCtx *u
 /* The norms of the run: penetration always, the errors when the scene has an exact solution, and against -reference. */
 PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
 {
-  Vec         loc_uh, loc_ph = NULL;
-  ErrorTarget exact = {&user->scene, NULL, NULL};
+  Vec                 loc_uh, loc_ph = NULL;
+  ErrorTarget         exact = {&user->scene, NULL, NULL};
+  ContactPressureForm form;
 
   PetscFunctionBeginUser;
   PetscCall(MeshIndexCellTypes(dm)); /* the closures below look each point's cell type up: sorted, not hashed */
@@ -269,7 +272,8 @@ PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(DMGetLocalVector(dm, &loc_uh));
   PetscCall(VecCopy(user->prob.loc_bc, loc_uh)); /* the Dirichlet values, inserted once by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc_uh));
-  if (!ContactHasPenalty(user->contact)) {
+  PetscCall(ContactGetPressureForm(user->contact, &form));
+  if (!form.law) { /* the nodal pressure, where no law gives it at every point */
     PetscCall(DMGetLocalVector(dm, &loc_ph));
     PetscCall(ErrorNormsPressureVector(dm, user, loc_ph));
   }

@@ -450,14 +450,15 @@ static PetscErrorCode MatchReference(DM fine, const AppCtx *user, const Referenc
 
 PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
 {
-  MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
-  Reference   ref;
-  PetscInt    dim, cStart, cEnd, ncells, levels = 0, nvec;
-  DM          fine;
-  Vec         loc[2], fine_loc[2], loc_uref, loc_pref;
-  Mat         K;
-  ErrorTarget target;
-  PetscReal  *run_cell_h;
+  MPI_Comm            comm = PetscObjectComm((PetscObject)dm);
+  Reference           ref;
+  PetscInt            dim, cStart, cEnd, ncells, levels = 0, nvec;
+  ContactPressureForm form;
+  DM                  fine;
+  Vec                 loc[2], fine_loc[2], loc_uref, loc_pref;
+  Mat                 K;
+  ErrorTarget         target;
+  PetscReal          *run_cell_h;
 
   PetscFunctionBeginUser;
   PetscCall(ErrorNormsReset(&user->rec.ref_errors));
@@ -472,7 +473,8 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
              user->opt->verify.reference, ref.ncells, ncells);
 
   /* the run's displacement and, without the penalty law, its nodal pressure, on the refined mesh */
-  nvec = ContactHasPenalty(user->contact) ? 1 : 2;
+  PetscCall(ContactGetPressureForm(user->contact, &form));
+  nvec = form.law ? 1 : 2;
   PetscCall(DMCreateLocalVector(dm, &loc[0]));
   PetscCall(VecCopy(user->prob.loc_bc, loc[0])); /* the Dirichlet values, inserted by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc[0]));
