@@ -22,3 +22,10 @@ PetscErrorCode OptionsReadVector(CompatOptionItems PetscOptionsObject, MPI_Comm 
 PetscErrorCode AppErrorPushHandler(void);
 int            AppErrorExit(PetscErrorCode ierr);
 PetscErrorCode AppDiagnosticRun(const char name[], PetscErrorCode (*fn)(DM, AppCtx *, Vec), DM dm, AppCtx *user, Vec u, char failed[], size_t len);
+
+/* run_output.c: the run's results in the output file, each module's written by the module: an attribute of /run, its
+   name formatted as printf() formats, and a column of a table (/solves, /steps, /cycles) in the viewer's group */
+PetscErrorCode RunAttrReal(PetscViewer v, PetscReal value, const char format[], ...) PETSC_ATTRIBUTE_FORMAT(3, 4);
+PetscErrorCode RunAttrInt(PetscViewer v, PetscInt value, const char format[], ...) PETSC_ATTRIBUTE_FORMAT(3, 4);
+PetscErrorCode RunAttrString(PetscViewer v, const char value[], const char format[], ...) PETSC_ATTRIBUTE_FORMAT(3, 4);
+PetscErrorCode RunColumn(MPI_Comm comm, PetscViewer v, const char name[], PetscInt n, const PetscReal values[]);

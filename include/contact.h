@@ -57,6 +57,7 @@ PetscErrorCode ContactSetUp(Contact ct, DM dm, const ContactProblem *pb);
 PetscErrorCode ContactReset(Contact ct);
 PetscErrorCode ContactSetLoad(Contact ct, DM dm, const Obstacle *obstacle);
 PetscErrorCode ContactView(Contact ct, PetscViewer viewer);
+PetscErrorCode ContactWrite(Contact ct, PetscViewer v); /* the method's part of /run */
 
 /* What the solver around the contact does by default for its type, stated by the type at its creation, as a PETSc KSP
    type states the norms it supports: solver.c, newton.c, contact_monitor.c and grid_sequence.c apply it where the

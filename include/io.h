@@ -16,7 +16,9 @@ PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, cha
 
 /* output_hdf5.c */
 PetscErrorCode OutputGetOptions(MPI_Comm comm, RunOptions *opt);
-PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u);
+/* the writer of /run's part and the tables that each module owns, called by OutputWriteHDF5() once /run exists */
+typedef PetscErrorCode (*OutputResultsWriter)(DM dm, const AppCtx *user, Vec u, PetscViewer v);
+PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u, OutputResultsWriter write_results);
 #define OUTPUT_STATE_FIELDS 5 /* displacement, contact_pressure, normal_gap, contact_boundary, contact_reaction */
 PetscErrorCode OutputStateFields(DM dm, const AppCtx *user, Vec u, Vec fields[OUTPUT_STATE_FIELDS]);
 /* output_mesh.c */

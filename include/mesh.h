@@ -136,3 +136,4 @@ PetscErrorCode MeshRemeshViewCaps(PetscInt ncells, PetscInt nv, PetscInt dim, co
 /* mesh_partition.c */
 PetscErrorCode MeshPartitionDistribute(MeshPartitionerType type, DM *dm);
 PetscErrorCode MeshPartitionGetStats(DM dm, MeshPartitionStats *stats);
+PetscErrorCode MeshPartitionWrite(const MeshPartitionStats *ps, PetscViewer v); /* its part of /run */

@@ -29,3 +29,5 @@ PetscBool      SceneForceControlled(const Scene *scene);
 /* scenes/fingerprint.c: the problem as one string, for -reference */
 #define SCENE_FINGERPRINT_LEN 4096
 PetscErrorCode SceneFingerprint(const Scene *scene, const Material *mat, PetscInt dim, char buf[], size_t len);
+/* scene_write.c: the scene's part of /run */
+PetscErrorCode SceneWrite(const Scene *scene, const Material *mat, PetscInt dim, PetscViewer v);

@@ -530,5 +530,5 @@ typedef struct {
   RunRecord         rec;
 } AppCtx;
 
-/* The writer of the run's output (io/output_hdf5.c's OutputWriteHDF5()), which main() hands to the adaptive cycles */
+/* The writer of the run's output (src/main.c's, through io/output_hdf5.c's OutputWriteHDF5()), which main() hands to the adaptive cycles */
 typedef PetscErrorCode (*OutputWriter)(DM, const AppCtx *, Vec);

@@ -24,6 +24,10 @@ PetscErrorCode SolverSetStepEnergyStop(AppCtx *user, PetscReal energy);
    ||F(0)||, so that a warm start ends as tight as a start from zero */
 PetscErrorCode SolverResidualNorm(SNES snes, SolverCtx sc, Vec u, PetscReal *norm);
 PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
+/* the solve's part of /run, and the table /solves */
+PetscErrorCode SolverWrite(const RunStats *s, const Problem *prob, const SolverOptions *sopt, PetscInt coarse_levels, PetscInt nsolves,
+                           PetscViewer v);
+PetscErrorCode SolverWriteSolves(MPI_Comm comm, const SolveRecord records[], PetscInt n, PetscViewer v);
 
 /* problem.c, grid_sequence.c, eps_sweep.c */
 PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes);
@@ -58,13 +62,17 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad);
 PetscErrorCode AdaptCheck(DM dm, const AppCtx *user);
 PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter write);
 PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user);
+PetscErrorCode AdaptWrite(MPI_Comm comm, const AdaptOptions *ad, const RunRecord *rec, PetscInt dim, PetscViewer v); /* /run's and /cycles */
 PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u); /* penetration_tol.c: -contact_penetration_tol */
+PetscErrorCode PenetrationTolWrite(Contact ct, const RunStats *s, PetscViewer v);
 
 /* load_path.c: -load_steps, -load_path */
 PetscErrorCode LoadPathGetOptions(MPI_Comm comm, LoadPathOptions *lp);
 PetscErrorCode LoadPathSetUp(MPI_Comm comm, AppCtx *user);
 PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 PetscErrorCode LoadPathView(MPI_Comm comm, const AppCtx *user);
+PetscErrorCode LoadPathWrite(MPI_Comm comm, const Scene *scene, const RunStats *s, const StepRecord st[], PetscInt n, PetscInt dim,
+                             PetscViewer v); /* /steps */
 
 /* multigrid.c */
 PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt vertex_source[], AppCtx *user);
@@ -82,3 +90,4 @@ PetscErrorCode FineSmootherSetUp(KSP ksp, const SolverGiven *g);
 /* bandwidth.c */
 PetscErrorCode BandwidthGetOptions(MPI_Comm comm, PetscBool *measure);
 PetscErrorCode BandwidthMeasure(SNES snes, AppCtx *user);
+PetscErrorCode BandwidthWrite(const Bandwidth *b, PetscViewer v);

@@ -4,7 +4,7 @@ can show that it keeps every number.
 
   regression.py run DIR [--bin PATH] [--runs FILE]   runs them, writing DIR/<name>.h5
   regression.py compare A B [--rtol R] [--atol T] [--allow-added]
-                                                     /run attributes and vertex fields of A/<name>.h5 and B/<name>.h5:
+                                                     /run attributes, vertex fields and the tables /solves, /steps, /cycles of A/<name>.h5 and B/<name>.h5:
                                                      reals to R relative (default 1e-12)
                                                      or T absolute (default 1e-14: a force, a
                                                      reaction or a field zero up to round-off), integers and strings equal, the
@@ -26,6 +26,20 @@ from signorini.paths import ROOT  # noqa: E402
 from signorini.runs import read_run, vertex_fields  # noqa: E402
 
 NOT_COMPARED = ("time_", "peak_memory", "reference")
+NOT_COMPARED_COLUMNS = ("time", "memory_mb")  # the tables' timings and memory
+TABLES = ("solves", "steps", "cycles")
+
+
+def tables(path):
+    """The columns of the tables /solves, /steps and /cycles, as {"group/column": array}."""
+    import h5py
+    out = {}
+    with h5py.File(path, "r") as f:
+        for group in TABLES:
+            if group in f:
+                for name, dataset in f[group].items():
+                    out[f"{group}/{name}"] = np.asarray(dataset[()], dtype=float).ravel()
+    return out
 TIMEOUT = 600  # seconds per run
 
 
@@ -69,6 +83,17 @@ def compare_one(a, b, rtol, allow_added=False, atol=1e-14):
             same = va == vb
         if not same:
             diffs.append(f"/run {key}: {va} != {vb}")
+    ta, tb = tables(a), tables(b)
+    for key in sorted(set(ta) | set(tb)):
+        if key.split("/")[-1].startswith(NOT_COMPARED_COLUMNS) or (allow_added and key not in ta):
+            continue
+        if key not in ta or key not in tb or ta[key].shape != tb[key].shape:
+            diffs.append(f"table {key}: missing or of another length")
+            continue
+        x, y = ta[key], tb[key]
+        same = (x == y) | (np.isnan(x) & np.isnan(y)) | (np.abs(x - y) <= np.maximum(rtol * np.maximum(np.abs(x), np.abs(y)), atol))
+        if not np.all(same):
+            diffs.append(f"table {key}: rows {np.flatnonzero(~same).tolist()} differ")
     fa, fb = vertex_fields(a), vertex_fields(b)
     for key in sorted(set(fa) | set(fb)):
         if allow_added and key not in fa:

@@ -98,6 +98,35 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
    VmHWM of /proc/self/status, where Linux has it. getrusage()'s ru_maxrss is kept across execve(), so that a run
    started by a large process (a Python script holding its results) would report the resident set the starter had
    when it forked as its own peak (docs/output.md); ru_maxrss is the fallback. */
+/* The run's results in the output: each module writes its own part of /run and its tables (docs/output.md), in the
+   order of the run: the scene, the method, the solve and its drivers, the distribution. */
+static PetscErrorCode WriteResults(DM dm, const AppCtx *user, Vec u, PetscViewer v)
+{
+  MPI_Comm comm = PetscObjectComm((PetscObject)dm);
+  PetscInt dim;
+
+  PetscFunctionBeginUser;
+  PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(SceneWrite(&user->scene, &user->opt->material, dim, v));
+  PetscCall(ContactWrite(user->contact, v));
+  PetscCall(SolverWrite(&user->rec.stats, &user->prob, &user->opt->solver, user->box.coarse_levels, user->rec.nrecords, v));
+  PetscCall(SolverWriteSolves(comm, user->rec.records, user->rec.nrecords, v));
+  PetscCall(PenetrationTolWrite(user->contact, &user->rec.stats, v));
+  PetscCall(LoadPathWrite(comm, &user->scene, &user->rec.stats, user->rec.steps, user->rec.nsteps, dim, v));
+  PetscCall(AdaptWrite(comm, &user->opt->adapt, &user->rec, dim, v));
+  PetscCall(BandwidthWrite(&user->rec.stats.bandwidth, v));
+  PetscCall(MeshPartitionWrite(&user->rec.stats.partition, v));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The output file: the mesh and the fields (src/io/), and the results (WriteResults()). */
+static PetscErrorCode WriteOutput(DM dm, const AppCtx *user, Vec u)
+{
+  PetscFunctionBeginUser;
+  PetscCall(OutputWriteHDF5(dm, user, u, WriteResults));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 static PetscErrorCode RecordPeakMemory(MPI_Comm comm, RunStats *s)
 {
   struct rusage ru;
@@ -188,8 +217,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(PetscTime(&t1));
   user.rec.stats.time_setup = t1 - t0;
 
-  PetscCall(GridSequenceSolve(&dm, &user, &snes, &u));           /* one solve without nested iteration */
-  PetscCall(AdaptSolve(&dm, &user, &snes, &u, OutputWriteHDF5)); /* -adapt_cycles: refined where the estimate is largest; each cycle written */
+  PetscCall(GridSequenceSolve(&dm, &user, &snes, &u));       /* one solve without nested iteration */
+  PetscCall(AdaptSolve(&dm, &user, &snes, &u, WriteOutput)); /* -adapt_cycles: refined where the estimate is largest; each cycle written */
   PetscCall(EpsSweepSolve(dm, &user, snes, u));
   PetscCall(PenetrationTolSolve(dm, &user, snes, u)); /* -contact_penetration_tol: eps lowered until the penetration is reached */
   PetscCall(LoadPathSolve(dm, &user, snes, u));       /* the steps after the first, each from the last */
@@ -226,7 +255,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(BandwidthMeasure(snes, &user));          /* -perf_bandwidth: after the peak memory, which its vectors would raise */
   PetscCall(OptionsCheckAllUsed(comm, PETSC_FALSE)); /* the options read during the solve too */
   PetscCall(PrintSummary(dm, &user, u));
-  PetscCall(OutputWriteHDF5(dm, &user, u));
+  PetscCall(WriteOutput(dm, &user, u));
   PetscCall(PetscPrintf(comm, "  output: %s\n", opt.output));
   if (!user.rec.stats.converged && user.rec.stats.force_control_failed)
     PetscCall(PetscPrintf(comm, "ERROR: force control did not reach -obstacle_force %g (above: why); written with converged = 0\n",

@@ -658,3 +658,24 @@ PetscErrorCode ContactUnseenNodes(Contact ct, Vec u, PetscBool unseen[], PetscIn
   PetscCall(MPIU_Allreduce(&local, count, 1, MPIU_INT, MPI_SUM, ct->comm));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The method's part of /run: its type, rule and eps modulus, eps and its range over Gamma_C (0 for the types without
+   eps), the contact nodes (the free nodes of Gamma_C, each counted once), and -contact_penetration_tol where given. */
+PetscErrorCode ContactWrite(Contact ct, PetscViewer v)
+{
+  PetscReal eps_min, eps_max;
+  PetscInt  n = ct->set.n, ntotal;
+
+  PetscFunctionBeginUser;
+  PetscCall(ContactGetEpsRange(ct, &eps_min, &eps_max, NULL));
+  PetscCall(RunAttrString(v, ct->type, "method"));
+  PetscCall(RunAttrString(v, PenaltyQuadratures[ct->opt.quadrature], "penalty_quadrature"));
+  PetscCall(RunAttrString(v, PenaltyModuli[ct->opt.modulus], "penalty_eps_modulus"));
+  PetscCall(RunAttrReal(v, ct->eps, "eps"));
+  PetscCall(RunAttrReal(v, eps_min, "eps_min"));
+  PetscCall(RunAttrReal(v, eps_max, "eps_max"));
+  PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, ct->comm));
+  PetscCall(RunAttrInt(v, ntotal, "contact_nodes"));
+  if (ct->opt.penetration_tol > 0.0) PetscCall(RunAttrReal(v, ct->opt.penetration_tol, "penetration_tol"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -288,62 +288,21 @@ static PetscErrorCode WriteErrorNorms(PetscViewer v, const char prefix[], const 
 
 static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscViewer v, PetscInt ncells, PetscInt nverts)
 {
-  const RunStats       *s = &user->rec.stats;
-  PetscMPIInt           size;
-  PetscInt              dim, ndofs;
-  ContactType           method;
-  const ContactOptions *copt;
-  PetscReal             eps = 0.0, eps_min = 0.0, eps_max = 0.0;
-  const ContactSet     *cs;
+  const RunStats *s = &user->rec.stats;
+  PetscMPIInt     size;
+  PetscInt        dim, ndofs;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetType(user->contact, &method));
-  PetscCall(ContactGetOptions(user->contact, &copt));
-  PetscCall(ContactGetSet(user->contact, &cs));
-  PetscCall(ContactGetEps(user->contact, &eps)); /* 0 for the types without eps */
-  PetscCall(ContactGetEpsRange(user->contact, &eps_min, &eps_max, NULL));
   PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)dm), &size));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetSize(u, &ndofs));
   PetscCall(PetscViewerHDF5WriteGroup(v, "/run"));
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "scene", PETSC_STRING, user->scene.name));
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "method", PETSC_STRING, method));
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_quadrature", PETSC_STRING, PenaltyQuadratures[copt->quadrature]));
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "penalty_eps_modulus", PETSC_STRING, PenaltyModuli[copt->modulus]));
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "assembly", PETSC_STRING, AssemblyTypes[user->prob.assembly]));
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "snes_reason", PETSC_STRING, SNESConvergedReasons[s->reason]));
   PetscCall(WriteIntAttr(v, "dim", dim));
   PetscCall(WriteIntAttr(v, "degree", user->opt->degree));
   PetscCall(WriteIntAttr(v, "nprocs", size));
   PetscCall(WriteIntAttr(v, "n_cells", ncells));
   PetscCall(WriteIntAttr(v, "n_vertices", nverts));
   PetscCall(WriteIntAttr(v, "n_dofs", ndofs));
-  PetscCall(WriteRealAttr(v, "h", user->prob.h));
-  PetscCall(WriteRealAttr(v, "eps", eps));
-  PetscCall(WriteRealAttr(v, "eps_min", eps_min));
-  PetscCall(WriteRealAttr(v, "eps_max", eps_max));
-  PetscCall(WriteRealAttr(v, "young_modulus", user->opt->material.young_modulus));
-  PetscCall(WriteRealAttr(v, "poisson_ratio", user->opt->material.poisson_ratio));
-  PetscCall(WriteIntAttr(v, "converged", s->converged ? 1 : 0));
-  PetscCall(WriteIntAttr(v, "snes_reason_code", (PetscInt)s->reason));
-  PetscCall(WriteIntAttr(v, "newton_its", s->newton_its));
-  PetscCall(WriteIntAttr(v, "ksp_its", s->ksp_its));
-  PetscCall(WriteIntAttr(v, "newton_its_total", s->newton_its_total));
-  PetscCall(WriteIntAttr(v, "ksp_its_total", s->ksp_its_total));
-  PetscCall(WriteIntAttr(v, "grid_sequence", user->opt->solver.grid_sequence));
-  PetscCall(WriteIntAttr(v, "coarse_levels", user->box.coarse_levels));
-  PetscCall(WriteIntAttr(v, "coarse_mg", user->rec.stats.coarse_mg && user->box.coarse_levels > 0 ? 1 : 0)); /* -contact_coarse_mg applied */
-  PetscCall(WriteIntAttr(v, "default_mg", user->rec.stats.default_mg ? 1 : 0)); /* the 3D box's default: the boxes' geometric multigrid */
-  PetscCall(WriteIntAttr(v, "n_solves", user->rec.nrecords));
-  PetscCall(WriteRealAttr(v, "residual_norm", s->residual_norm));
-  PetscCall(WriteIntAttr(v, "residual_reduced", s->residual_reduced ? 1 : 0));
-  PetscCall(WriteIntAttr(v, "stopped_at_roundoff", s->roundoff_stop ? 1 : 0)); /* Newton stalled at the round-off of its terms */
-  PetscCall(WriteIntAttr(v, "pc_breakdowns", s->pc_breakdowns));               /* preconditioner breakdowns recovered from (pc_recovery.c) */
-  if (s->pc_recovery[0]) PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "pc_recovery", PETSC_STRING, s->pc_recovery));
-  PetscCall(WriteRealAttr(v, "load_norm", user->prob.load_norm));
-  PetscCall(WriteRealAttr(v, "displacement_scale", user->prob.displacement_scale));
-  PetscCall(WriteRealAttr(v, "time_setup", s->time_setup));
-  PetscCall(WriteRealAttr(v, "time_solve", s->time_solve));
   PetscCall(WriteRealAttr(v, "time_total", s->time_total));
   PetscCall(WriteIntAttr(v, "active_vertices", s->active_vertices));
   PetscCall(WriteRealAttr(v, "max_penetration", s->max_penetration));
@@ -372,39 +331,6 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
       PetscCall(WriteRealAttr(v, name, s->reaction[i][c]));
     }
   }
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "obstacle", PETSC_STRING, ObstacleTypes[user->scene.obstacle.type]));
-  for (PetscInt c = 0; c < dim; ++c) { /* where it ended: the translation of the options, a load path's last, force control's */
-    char name[32];
-
-    PetscCall(PetscSNPrintf(name, sizeof(name), "obstacle_translate_%c", "xyz"[c]));
-    PetscCall(WriteRealAttr(v, name, user->scene.obstacle.translate[c]));
-  }
-  if (SceneForceControlled(&user->scene)) {
-    PetscCall(WriteRealAttr(v, "obstacle_force", user->scene.obstacle.force)); /* the target (the last step's: 0 at the factor 0) */
-    PetscCall(WriteIntAttr(v, "force_control_its", s->force_control_its));
-  }
-  {
-    const ContactOptions *copt;
-
-    PetscCall(ContactGetOptions(user->contact, &copt));
-    if (copt->penetration_tol > 0.0) { /* -contact_penetration_tol: the tolerance and the solves that reached it (the run's eps the last) */
-      PetscCall(WriteRealAttr(v, "penetration_tol", copt->penetration_tol));
-      PetscCall(WriteIntAttr(v, "penetration_tol_solves", s->penetration_tol_solves));
-      PetscCall(WriteRealAttr(v, "penetration_tol_measured", s->penetration_tol_measured)); /* at the nodes and the rule's points */
-    }
-  }
-  {
-    char problem[SCENE_FINGERPRINT_LEN];
-
-    PetscCall(SceneFingerprint(&user->scene, &user->opt->material, dim, problem, sizeof(problem)));
-    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "problem", PETSC_STRING, problem)); /* what -reference compares */
-  }
-  {
-    PetscInt n = cs->n, ntotal;
-
-    PetscCall(MPIU_Allreduce(&n, &ntotal, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)dm)));
-    PetscCall(WriteIntAttr(v, "contact_nodes", ntotal)); /* the free nodes of Gamma_C the contact acts on, each counted once */
-  }
   { /* the checks of contact_checks.c: the number of warnings, and the values checked (not written without contact) */
     PetscInt nwarn;
 
@@ -428,23 +354,6 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
       PetscCall(WriteRealAttr(v, "contact_unseen_force", s->checks.unseen_force)); /* the law's force there: a warning above a share */
     }
   }
-  PetscCall(WriteIntAttr(v, "continuation_stages", s->continuation_stages));
-  PetscCall(WriteIntAttr(v, "active_set_cycles", s->active_set_cycles));
-  PetscCall(WriteIntAttr(v, "pc_builds", s->pc_builds));
-  PetscCall(WriteIntAttr(v, "pc_updates", s->pc_updates));               /* -contact_pc_update: coarse-operator updates of a GAMG hierarchy */
-  PetscCall(WriteIntAttr(v, "pc_finest_updates", s->pc_finest_updates)); /* -contact_pc_update_changes: updates of its finest level only */
-  PetscCall(WriteIntAttr(v, "ksp_ew", s->ksp_ew));                       /* 1: the linear tolerances of Eisenstat-Walker */
-  if (s->bandwidth.measured) {                                           /* -perf_bandwidth */
-    PetscCall(WriteRealAttr(v, "bandwidth_triad_gbs", s->bandwidth.triad_gbs));
-    PetscCall(WriteRealAttr(v, "bandwidth_matmult_gbs", s->bandwidth.matmult_gbs));
-    PetscCall(WriteRealAttr(v, "bandwidth_vcycle_gbs", s->bandwidth.vcycle_gbs));
-    PetscCall(WriteRealAttr(v, "time_matmult", s->bandwidth.matmult_s));
-    PetscCall(WriteRealAttr(v, "time_vcycle", s->bandwidth.vcycle_s));
-  }
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "partitioner", PETSC_STRING, MeshPartitionerTypes[s->partition.partitioner]));
-  PetscCall(WriteIntAttr(v, "partition_edge_cut", s->partition.edge_cut));
-  PetscCall(WriteRealAttr(v, "partition_imbalance", s->partition.imbalance));
-  if (user->opt->solver.condition_estimate) PetscCall(WriteRealAttr(v, "condition_1norm", s->condition_1norm)); /* NaN: the estimate failed */
   PetscCall(WriteRealAttr(v, "peak_memory_mb", s->peak_memory_mb));
   PetscCall(WriteRealAttr(v, "peak_memory_total_mb", s->peak_memory_total_mb));
   PetscCall(WriteRealAttr(v, "penetration_l2", user->rec.errors.penetration_l2));
@@ -462,26 +371,6 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
     PetscCall(WriteRealAttr(v, "time_estimate", user->rec.estimate.time));
   } else if (user->rec.estimate.unavailable[0])
     PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "estimate_unavailable", PETSC_STRING, user->rec.estimate.unavailable));
-  if (user->rec.ncycles) {
-    PetscCall(WriteRealAttr(v, "adapt_fraction", user->rec.adapt_fraction));
-    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "adapt_stop", PETSC_STRING, AdaptStops[user->rec.adapt_stop]));
-    if (user->opt->adapt.max_dofs) PetscCall(WriteIntAttr(v, "adapt_max_dofs", user->opt->adapt.max_dofs));
-  }
-  if (user->opt->adapt.accuracy > 0.0 && user->rec.ncycles) { /* -accuracy: asked for, reached, and the last cycle's bars */
-    const CycleRecord *c = &user->rec.cycles[user->rec.ncycles - 1];
-
-    PetscCall(WriteRealAttr(v, "accuracy", user->opt->adapt.accuracy));
-    PetscCall(WriteIntAttr(v, "accuracy_reached", c->accurate));
-    for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
-      char name[64];
-
-      if (!user->rec.accuracy_target[k]) continue;
-      PetscCall(PetscSNPrintf(name, sizeof(name), "accuracy_%s_value", AccuracyQuantities[k]));
-      PetscCall(WriteRealAttr(v, name, c->value[k]));
-      PetscCall(PetscSNPrintf(name, sizeof(name), "accuracy_%s_bar", AccuracyQuantities[k]));
-      PetscCall(WriteRealAttr(v, name, c->bar[k]));
-    }
-  }
   for (PetscInt k = 0; k < user->rec.bars.n; ++k) { /* -bars: qoi_NAME, its bar and parts and order, or why there is no bar */
     const ErrorBars *b        = &user->rec.bars;
     const char      *suffix[] = {"", "_bar", "_bar_mesh", "_bar_eps", "_order"};
@@ -503,178 +392,6 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   }
   PetscCall(WriteIntAttr(v, "verify_quadrature_points", user->opt->verify.quad_points));
   PetscCall(WriteIntAttr(v, "verify_quadrature_refine", user->opt->verify.quad_refine));
-  for (PetscInt i = 0; i < user->scene.num_constants; ++i) { /* the scene's parameters, scene_0, scene_1, ... */
-    char name[32];
-
-    PetscCall(PetscSNPrintf(name, sizeof(name), "scene_%" PetscInt_FMT, i));
-    PetscCall(WriteRealAttr(v, name, PetscRealPart(user->scene.constants[i])));
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* /solves/<column>: one row per solve of the run (grid sequence levels, eps sweep values), as datasets of length n. */
-static PetscErrorCode WriteSolves(MPI_Comm comm, const AppCtx *user, PetscViewer v)
-{
-  const char    *columns[] = {"level",     "n_dofs",    "h",          "eps",        "newton_its",     "ksp_its",
-                              "pc_builds", "converged", "time_setup", "time_solve", "max_penetration"};
-  const PetscInt ncol = (PetscInt)(sizeof(columns) / sizeof(columns[0])), n = user->rec.nrecords;
-  PetscMPIInt    rank;
-
-  PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  PetscCall(PetscViewerHDF5PushGroup(v, "/solves"));
-  for (PetscInt j = 0; j < ncol; ++j) {
-    Vec          col;
-    PetscScalar *a;
-
-    PetscCall(VecCreateMPI(comm, rank == 0 ? n : 0, n, &col));
-    PetscCall(PetscObjectSetName((PetscObject)col, columns[j]));
-    PetscCall(VecGetArray(col, &a));
-    for (PetscInt i = 0; rank == 0 && i < n; ++i) {
-      const SolveRecord *r      = &user->rec.records[i];
-      const PetscReal    vals[] = {
-             (PetscReal)r->level,     (PetscReal)r->n_dofs,     r->h,          r->eps,        (PetscReal)r->newton_its, (PetscReal)r->ksp_its,
-             (PetscReal)r->pc_builds, r->converged ? 1.0 : 0.0, r->time_setup, r->time_solve, r->max_penetration};
-      a[i] = vals[j];
-    }
-    PetscCall(VecRestoreArray(col, &a));
-    PetscCall(VecView(col, v));
-    PetscCall(VecDestroy(&col));
-  }
-  PetscCall(PetscViewerHDF5PopGroup(v));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* One column of /steps (a dataset of length nsteps, on rank 0). */
-static PetscErrorCode WriteStepColumn(MPI_Comm comm, PetscViewer v, const char name[], PetscInt n, const PetscReal values[])
-{
-  Vec          col;
-  PetscScalar *a;
-  PetscMPIInt  rank;
-
-  PetscFunctionBeginUser;
-  PetscCallMPI(MPI_Comm_rank(comm, &rank));
-  PetscCall(VecCreateMPI(comm, rank == 0 ? n : 0, n, &col));
-  PetscCall(PetscObjectSetName((PetscObject)col, name));
-  PetscCall(VecGetArray(col, &a));
-  for (PetscInt i = 0; rank == 0 && i < n; ++i) a[i] = values[i];
-  PetscCall(VecRestoreArray(col, &a));
-  PetscCall(VecView(col, v));
-  PetscCall(VecDestroy(&col));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* /steps/<column>: one row per step of a load path (load_path.c), the failed one included: the factor, the obstacle's
-   translation and force, the supports' reactions, the contact size, the largest pressure and penetration, the energy,
-   the solve's Newton steps, linear iterations, time and whether it converged. */
-static PetscErrorCode WriteSteps(MPI_Comm comm, const AppCtx *user, PetscViewer v, PetscInt dim)
-{
-  const PetscInt    n  = user->rec.nsteps;
-  const StepRecord *st = user->rec.steps;
-  PetscReal        *col;
-  char              name[128];
-
-  PetscFunctionBeginUser;
-  if (!n) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscMalloc1(n, &col));
-  PetscCall(PetscViewerHDF5PushGroup(v, "/steps"));
-#define STEP_COLUMN(label, expr)                        \
-  do {                                                  \
-    for (PetscInt i = 0; i < n; ++i) col[i] = (expr);   \
-    PetscCall(WriteStepColumn(comm, v, label, n, col)); \
-  } while (0)
-  STEP_COLUMN("factor", st[i].factor);
-  STEP_COLUMN("contact_force", st[i].contact_force);
-  for (PetscInt c = 0; c < dim; ++c) {
-    PetscCall(PetscSNPrintf(name, sizeof(name), "obstacle_translate_%c", "xyz"[c]));
-    STEP_COLUMN(name, st[i].obstacle_translate[c]);
-    PetscCall(PetscSNPrintf(name, sizeof(name), "contact_force_%c", "xyz"[c]));
-    STEP_COLUMN(name, st[i].q.force[c]);
-  }
-  for (PetscInt b = 0; b < user->scene.bcs.n; ++b) {
-    const BoundaryCondition *bc = &user->scene.bcs.bc[b];
-
-    if (bc->kind != BC_CLAMP && bc->kind != BC_SLIP) continue;
-    for (PetscInt c = 0; c < dim; ++c) {
-      PetscCall(PetscSNPrintf(name, sizeof(name), "reaction_%s_%s_%c", BoundaryKinds[bc->kind], bc->token, "xyz"[c]));
-      STEP_COLUMN(name, st[i].q.reaction[b][c]);
-    }
-  }
-  STEP_COLUMN("contact_size", st[i].q.contact_size);
-  STEP_COLUMN("pressure_max", st[i].q.pressure_max);
-  STEP_COLUMN("penetration_max", st[i].q.penetration_max);
-  STEP_COLUMN("energy", st[i].q.energy);
-  STEP_COLUMN("newton_its", (PetscReal)st[i].newton_its);
-  STEP_COLUMN("ksp_its", (PetscReal)st[i].ksp_its);
-  STEP_COLUMN("time", st[i].time);
-  STEP_COLUMN("converged", st[i].converged ? 1.0 : 0.0);
-#undef STEP_COLUMN
-  PetscCall(PetscViewerHDF5PopGroup(v));
-  PetscCall(PetscFree(col));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* /cycles/<column>: one row per mesh of the adaptive refinement (-adapt_cycles, src/solver/adapt.c). */
-static PetscErrorCode WriteCycles(MPI_Comm comm, const AppCtx *user, PetscViewer v, PetscInt dim)
-{
-  const PetscInt     n = user->rec.ncycles;
-  const CycleRecord *c = user->rec.cycles;
-  PetscReal         *col;
-
-  PetscFunctionBeginUser;
-  if (!n) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PetscMalloc1(n, &col));
-  PetscCall(PetscViewerHDF5PushGroup(v, "/cycles"));
-#define CYCLE_COLUMN(label, expr)                       \
-  do {                                                  \
-    for (PetscInt i = 0; i < n; ++i) col[i] = (expr);   \
-    PetscCall(WriteStepColumn(comm, v, label, n, col)); \
-  } while (0)
-  CYCLE_COLUMN("n_dofs", (PetscReal)c[i].n_dofs);
-  CYCLE_COLUMN("n_cells", (PetscReal)c[i].n_cells);
-  CYCLE_COLUMN("estimate", c[i].estimate);
-  CYCLE_COLUMN("estimate_penalty", c[i].estimate_penalty);
-  CYCLE_COLUMN("norm", c[i].norm);
-  for (PetscInt d = 0; d < dim; ++d) {
-    char label[32];
-
-    PetscCall(PetscSNPrintf(label, sizeof(label), "contact_force_%c", "xyz"[d]));
-    CYCLE_COLUMN(label, c[i].q.force[d]);
-  }
-  CYCLE_COLUMN("pressure_max", c[i].q.pressure_max);
-  CYCLE_COLUMN("contact_size", c[i].q.contact_size);
-  CYCLE_COLUMN("contact_size_band", c[i].q.contact_size_band);
-  CYCLE_COLUMN("pressure_max_step", c[i].q.pressure_max_step);
-  CYCLE_COLUMN("pressure_peak", c[i].q.pressure_peak);
-  CYCLE_COLUMN("pressure_peak_resolution", c[i].q.pressure_peak_resolution);
-  for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
-    char label[64];
-
-    PetscCall(PetscSNPrintf(label, sizeof(label), "%s_value", AccuracyQuantities[k]));
-    CYCLE_COLUMN(label, c[i].value[k]);
-    PetscCall(PetscSNPrintf(label, sizeof(label), "%s_bar", AccuracyQuantities[k]));
-    CYCLE_COLUMN(label, c[i].bar[k]);
-    if (k == ACCURACY_ENERGY) continue;
-    PetscCall(PetscSNPrintf(label, sizeof(label), "%s_value_eps", AccuracyQuantities[k]));
-    CYCLE_COLUMN(label, c[i].value_eps[k]);
-  }
-  CYCLE_COLUMN("eps", c[i].eps);
-  CYCLE_COLUMN("unseen_contact", (PetscReal)c[i].unseen);
-  CYCLE_COLUMN("unseen_force", c[i].unseen_force);
-  CYCLE_COLUMN("accurate", c[i].accurate ? 1.0 : 0.0);
-  CYCLE_COLUMN("error_energy", c[i].error_energy);
-  CYCLE_COLUMN("marked", (PetscReal)c[i].marked);
-  CYCLE_COLUMN("marked_edge", (PetscReal)c[i].marked_edge);
-  CYCLE_COLUMN("newton_its", (PetscReal)c[i].newton_its);
-  CYCLE_COLUMN("ksp_its", (PetscReal)c[i].ksp_its);
-  CYCLE_COLUMN("time_solve", c[i].time_solve);
-  CYCLE_COLUMN("time_mesh", c[i].time_mesh);
-  CYCLE_COLUMN("time_cycle", c[i].time_cycle);
-  CYCLE_COLUMN("memory_mb", c[i].memory_mb);
-  CYCLE_COLUMN("converged", c[i].converged ? 1.0 : 0.0);
-#undef CYCLE_COLUMN
-  PetscCall(PetscViewerHDF5PopGroup(v));
-  PetscCall(PetscFree(col));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -762,7 +479,8 @@ static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const cha
 }
 
 /* The HDF5 file, written into the temporary h5tmp, and the XDMF file into xdmftmp, both in the current directory. */
-static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, const char h5tmp[], const char xdmftmp[], const char h5name[])
+static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, OutputResultsWriter write_results, const char h5tmp[], const char xdmftmp[],
+                                 const char h5name[])
 {
   MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
   PetscViewer viewer;
@@ -790,9 +508,7 @@ static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, const char h5
   PetscCall(WriteCellFields(dm, user, viewer));
   PetscCall(PetscViewerPopFormat(viewer));
   PetscCall(WriteRunMetadata(dm, user, u, viewer, ncells, nverts));
-  PetscCall(WriteSolves(comm, user, viewer));
-  PetscCall(WriteSteps(comm, user, viewer, dim));
-  PetscCall(WriteCycles(comm, user, viewer, dim));
+  PetscCall(write_results(dm, user, u, viewer)); /* each module's own results (src/main.c) */
   PetscCall(PetscViewerDestroy(&viewer));
   if (rank == 0) PetscCall(WriteXdmf(user, xdmftmp, h5name, dim, ncells, ncorners, nverts));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -800,7 +516,7 @@ static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, const char h5
 
 /* Writes FILE.h5 and FILE.xdmf (output_file.c: temporaries renamed when complete), from inside their directory
    (OutputFileEnterDirectory()). An I/O error is reported in one sentence naming the file and the cause. */
-PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u)
+PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u, OutputResultsWriter write_results)
 {
   MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
   char           dir[PETSC_MAX_PATH_LEN], base[PETSC_MAX_PATH_LEN], xdmf[PETSC_MAX_PATH_LEN], temps[2][PETSC_MAX_PATH_LEN];
@@ -822,7 +538,7 @@ PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u)
   (void)H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* HDF5's own error stack: replaced by the sentence below */
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
   errno = 0;
-  ierr  = WriteFiles(dm, user, u, h5tmp, xdmftmp, base);
+  ierr  = WriteFiles(dm, user, u, write_results, h5tmp, xdmftmp, base);
   err   = errno;
   PetscCall(PetscPopErrorHandler());
   (void)H5Eset_auto2(H5E_DEFAULT, h5_func, h5_data);

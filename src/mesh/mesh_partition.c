@@ -4,6 +4,7 @@
 #include <metis.h>
 #include <petscsf.h>
 #include "mesh.h"
+#include "app.h"
 
 const char *const MeshPartitionerTypes[] = {"ptscotch", "metis", "simple", "box", "MeshPartitionerType", "MESH_PARTITIONER_", NULL};
 
@@ -193,5 +194,15 @@ PetscErrorCode MeshPartitionGetStats(DM dm, MeshPartitionStats *stats)
     stats->partitioner = s->partitioner;
   }
   PetscCall(MeshPartitionComputeStats(dm, stats));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The distribution's part of /run: the partitioner, the edge cut and the imbalance (MeshPartitionGetStats()). */
+PetscErrorCode MeshPartitionWrite(const MeshPartitionStats *ps, PetscViewer v)
+{
+  PetscFunctionBeginUser;
+  PetscCall(RunAttrString(v, MeshPartitionerTypes[ps->partitioner], "partitioner"));
+  PetscCall(RunAttrInt(v, ps->edge_cut, "partition_edge_cut"));
+  PetscCall(RunAttrReal(v, ps->imbalance, "partition_imbalance"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

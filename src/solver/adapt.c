@@ -20,6 +20,7 @@
    refined, so the cycles stop at the first that reaches it (its growth over N is one cycle's); where -accuracy is not
    reached there, the summary says so, and /run adapt_stop records why the cycles stopped. It decides where the cycles
    stop, never what they compute. */
+#include <petscviewerhdf5.h>
 #include <sys/resource.h>
 #include "app.h"
 #include "contact.h"
@@ -777,5 +778,83 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
                             names));
     }
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The cycles' part of /run (the fraction they marked, why they stopped, -adapt_max_dofs; with -accuracy, the tolerance,
+   whether it was reached and the last cycle's values and bars of the quantities asked for), and the table /cycles:
+   one row per mesh of the adaptive refinement. */
+PetscErrorCode AdaptWrite(MPI_Comm comm, const AdaptOptions *ad, const RunRecord *rec, PetscInt dim, PetscViewer v)
+{
+  const PetscInt     n = rec->ncycles;
+  const CycleRecord *c = rec->cycles;
+  PetscReal         *col;
+
+  PetscFunctionBeginUser;
+  if (!n) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(RunAttrReal(v, rec->adapt_fraction, "adapt_fraction"));
+  PetscCall(RunAttrString(v, AdaptStops[rec->adapt_stop], "adapt_stop"));
+  if (ad->max_dofs) PetscCall(RunAttrInt(v, ad->max_dofs, "adapt_max_dofs"));
+  if (ad->accuracy > 0.0) {
+    PetscCall(RunAttrReal(v, ad->accuracy, "accuracy"));
+    PetscCall(RunAttrInt(v, c[n - 1].accurate, "accuracy_reached"));
+    for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
+      if (!rec->accuracy_target[k]) continue;
+      PetscCall(RunAttrReal(v, c[n - 1].value[k], "accuracy_%s_value", AccuracyQuantities[k]));
+      PetscCall(RunAttrReal(v, c[n - 1].bar[k], "accuracy_%s_bar", AccuracyQuantities[k]));
+    }
+  }
+  PetscCall(PetscMalloc1(n, &col));
+  PetscCall(PetscViewerHDF5PushGroup(v, "/cycles"));
+#define CYCLE_COLUMN(label, expr)                     \
+  do {                                                \
+    for (PetscInt i = 0; i < n; ++i) col[i] = (expr); \
+    PetscCall(RunColumn(comm, v, label, n, col));     \
+  } while (0)
+  CYCLE_COLUMN("n_dofs", (PetscReal)c[i].n_dofs);
+  CYCLE_COLUMN("n_cells", (PetscReal)c[i].n_cells);
+  CYCLE_COLUMN("estimate", c[i].estimate);
+  CYCLE_COLUMN("estimate_penalty", c[i].estimate_penalty);
+  CYCLE_COLUMN("norm", c[i].norm);
+  for (PetscInt d = 0; d < dim; ++d) {
+    char label[32];
+
+    PetscCall(PetscSNPrintf(label, sizeof(label), "contact_force_%c", "xyz"[d]));
+    CYCLE_COLUMN(label, c[i].q.force[d]);
+  }
+  CYCLE_COLUMN("pressure_max", c[i].q.pressure_max);
+  CYCLE_COLUMN("contact_size", c[i].q.contact_size);
+  CYCLE_COLUMN("contact_size_band", c[i].q.contact_size_band);
+  CYCLE_COLUMN("pressure_max_step", c[i].q.pressure_max_step);
+  CYCLE_COLUMN("pressure_peak", c[i].q.pressure_peak);
+  CYCLE_COLUMN("pressure_peak_resolution", c[i].q.pressure_peak_resolution);
+  for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
+    char label[64];
+
+    PetscCall(PetscSNPrintf(label, sizeof(label), "%s_value", AccuracyQuantities[k]));
+    CYCLE_COLUMN(label, c[i].value[k]);
+    PetscCall(PetscSNPrintf(label, sizeof(label), "%s_bar", AccuracyQuantities[k]));
+    CYCLE_COLUMN(label, c[i].bar[k]);
+    if (k == ACCURACY_ENERGY) continue;
+    PetscCall(PetscSNPrintf(label, sizeof(label), "%s_value_eps", AccuracyQuantities[k]));
+    CYCLE_COLUMN(label, c[i].value_eps[k]);
+  }
+  CYCLE_COLUMN("eps", c[i].eps);
+  CYCLE_COLUMN("unseen_contact", (PetscReal)c[i].unseen);
+  CYCLE_COLUMN("unseen_force", c[i].unseen_force);
+  CYCLE_COLUMN("accurate", c[i].accurate ? 1.0 : 0.0);
+  CYCLE_COLUMN("error_energy", c[i].error_energy);
+  CYCLE_COLUMN("marked", (PetscReal)c[i].marked);
+  CYCLE_COLUMN("marked_edge", (PetscReal)c[i].marked_edge);
+  CYCLE_COLUMN("newton_its", (PetscReal)c[i].newton_its);
+  CYCLE_COLUMN("ksp_its", (PetscReal)c[i].ksp_its);
+  CYCLE_COLUMN("time_solve", c[i].time_solve);
+  CYCLE_COLUMN("time_mesh", c[i].time_mesh);
+  CYCLE_COLUMN("time_cycle", c[i].time_cycle);
+  CYCLE_COLUMN("memory_mb", c[i].memory_mb);
+  CYCLE_COLUMN("converged", c[i].converged ? 1.0 : 0.0);
+#undef CYCLE_COLUMN
+  PetscCall(PetscViewerHDF5PopGroup(v));
+  PetscCall(PetscFree(col));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

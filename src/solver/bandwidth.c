@@ -10,6 +10,7 @@
      of the interpolation P for the prolongation and one for the restriction; the coarsest level's direct solve and the
      smoother's vector operations are not counted, so the V-cycle figure is a lower bound of its traffic. */
 #include "solver.h"
+#include "app.h"
 
 #define BANDWIDTH_TRIAD_SIZE (1 << 23) /* entries per rank: 64 MB per vector */
 #define BANDWIDTH_REPEATS 10
@@ -168,5 +169,18 @@ PetscErrorCode BandwidthMeasure(SNES snes, AppCtx *user)
   }
   PetscCall(VecDestroy(&c.x));
   PetscCall(VecDestroy(&c.y));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -perf_bandwidth's part of /run: the bandwidths and the times they come from (nothing without it). */
+PetscErrorCode BandwidthWrite(const Bandwidth *b, PetscViewer v)
+{
+  PetscFunctionBeginUser;
+  if (!b->measured) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(RunAttrReal(v, b->triad_gbs, "bandwidth_triad_gbs"));
+  PetscCall(RunAttrReal(v, b->matmult_gbs, "bandwidth_matmult_gbs"));
+  PetscCall(RunAttrReal(v, b->vcycle_gbs, "bandwidth_vcycle_gbs"));
+  PetscCall(RunAttrReal(v, b->matmult_s, "time_matmult"));
+  PetscCall(RunAttrReal(v, b->vcycle_s, "time_vcycle"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

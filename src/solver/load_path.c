@@ -10,6 +10,7 @@
 #include "physics.h"
 #include "scenes.h"
 #include "solver_impl.h"
+#include <petscviewerhdf5.h>
 
 PetscErrorCode LoadPathGetOptions(MPI_Comm comm, LoadPathOptions *lp)
 {
@@ -453,5 +454,55 @@ PetscErrorCode LoadPathView(MPI_Comm comm, const AppCtx *user)
   if (user->rec.nsteps < user->opt->load_path.n || !user->rec.steps[user->rec.nsteps - 1].converged)
     PetscCall(PetscPrintf(comm, "  load path: stopped at step %" PetscInt_FMT " of %" PetscInt_FMT " (factor %g), whose solve failed\n",
                           user->rec.nsteps, user->opt->load_path.n, (double)user->rec.steps[user->rec.nsteps - 1].factor));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The load path's part of the output: force control's positions solved over the steps, and the table /steps, one row
+   per step solved, the failed one included (the factor, the obstacle's translation and force, the supports' reactions,
+   the contact size, the largest pressure and penetration, the energy, the solve's Newton steps, linear iterations,
+   time and whether it converged). */
+PetscErrorCode LoadPathWrite(MPI_Comm comm, const Scene *scene, const RunStats *s, const StepRecord st[], PetscInt n, PetscInt dim, PetscViewer v)
+{
+  PetscReal *col;
+  char       name[128];
+
+  PetscFunctionBeginUser;
+  if (SceneForceControlled(scene)) PetscCall(RunAttrInt(v, s->force_control_its, "force_control_its"));
+  if (!n) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscMalloc1(n, &col));
+  PetscCall(PetscViewerHDF5PushGroup(v, "/steps"));
+#define STEP_COLUMN(label, expr)                      \
+  do {                                                \
+    for (PetscInt i = 0; i < n; ++i) col[i] = (expr); \
+    PetscCall(RunColumn(comm, v, label, n, col));     \
+  } while (0)
+  STEP_COLUMN("factor", st[i].factor);
+  STEP_COLUMN("contact_force", st[i].contact_force);
+  for (PetscInt c = 0; c < dim; ++c) {
+    PetscCall(PetscSNPrintf(name, sizeof(name), "obstacle_translate_%c", "xyz"[c]));
+    STEP_COLUMN(name, st[i].obstacle_translate[c]);
+    PetscCall(PetscSNPrintf(name, sizeof(name), "contact_force_%c", "xyz"[c]));
+    STEP_COLUMN(name, st[i].q.force[c]);
+  }
+  for (PetscInt b = 0; b < scene->bcs.n; ++b) {
+    const BoundaryCondition *bc = &scene->bcs.bc[b];
+
+    if (bc->kind != BC_CLAMP && bc->kind != BC_SLIP) continue;
+    for (PetscInt c = 0; c < dim; ++c) {
+      PetscCall(PetscSNPrintf(name, sizeof(name), "reaction_%s_%s_%c", BoundaryKinds[bc->kind], bc->token, "xyz"[c]));
+      STEP_COLUMN(name, st[i].q.reaction[b][c]);
+    }
+  }
+  STEP_COLUMN("contact_size", st[i].q.contact_size);
+  STEP_COLUMN("pressure_max", st[i].q.pressure_max);
+  STEP_COLUMN("penetration_max", st[i].q.penetration_max);
+  STEP_COLUMN("energy", st[i].q.energy);
+  STEP_COLUMN("newton_its", (PetscReal)st[i].newton_its);
+  STEP_COLUMN("ksp_its", (PetscReal)st[i].ksp_its);
+  STEP_COLUMN("time", st[i].time);
+  STEP_COLUMN("converged", st[i].converged ? 1.0 : 0.0);
+#undef STEP_COLUMN
+  PetscCall(PetscViewerHDF5PopGroup(v));
+  PetscCall(PetscFree(col));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

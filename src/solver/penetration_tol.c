@@ -20,6 +20,7 @@
    largest penetration at the nodes. */
 #include "contact.h"
 #include "solver_impl.h"
+#include "app.h"
 
 #define PENETRATION_TOL_AIM 0.9
 #define PENETRATION_TOL_MAX_SOLVES 12
@@ -129,5 +130,19 @@ PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
   } else if (user->rec.stats.converged)
     PetscCall(PetscPrintf(comm, "  penetration tolerance: the largest penetration %g <= %g at eps = %g, in %" PetscInt_FMT " solve(s)\n",
                           (double)d_max, (double)copt->penetration_tol, (double)eps, solves));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -contact_penetration_tol's part of /run: the solves that reached it (over a load path's steps) and the largest
+   penetration it ended with, at the nodes and the rule's points; the tolerance itself is the contact's (ContactWrite()). */
+PetscErrorCode PenetrationTolWrite(Contact ct, const RunStats *s, PetscViewer v)
+{
+  const ContactOptions *copt;
+
+  PetscFunctionBeginUser;
+  PetscCall(ContactGetOptions(ct, &copt));
+  if (!(copt->penetration_tol > 0.0)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(RunAttrInt(v, s->penetration_tol_solves, "penetration_tol_solves"));
+  PetscCall(RunAttrReal(v, s->penetration_tol_measured, "penetration_tol_measured"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
