@@ -57,9 +57,10 @@ PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user)
   PetscCall(VecCopy(locF, user->prob.loc_r0));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscCall(DMRestoreLocalVector(dm, &locF));
-  PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
-  PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0, &weak_lift));
-  PetscCall(PostprocessLiftEnergy(dm, user, weak_lift, &user->prob.lift_energy)); /* a datum of the load state, not of u */
+  PetscCall(BoundaryAddLoads(dm, &user->scene.bcs, user->prob.face_sets, user->prob.loc_r0, user->prob.r0));
+  PetscCall(WeakDataAddToResidual(dm, &user->scene, &user->opt->material, &user->opt->verify, user->prob.loc_bc, user->prob.r0, &weak_lift));
+  PetscCall(
+      PostprocessLiftEnergy(dm, &user->opt->material, &user->prob, weak_lift, &user->prob.lift_energy)); /* a datum of the load state, not of u */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
