@@ -14,20 +14,26 @@ PetscErrorCode ElementP1CellVertices(MeshClosure *mc, PetscSection csec, PetscSe
 PetscErrorCode ElementP1AddFixedCellsStiffness(DM dm, const Material *mat, Vec locU, Vec locF);
 
 /* section.c */
-PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user);
+PetscErrorCode SectionSetUpP1(DM dm, PetscInt degree, PetscBool check);
 PetscErrorCode SectionSetUpGlobalP1(DM dm, PetscBool check);
 
 /* assembly_p1.c */
+/* What the P1 assembly of K reads: the material, and whether -mat_type was given (K of the options' type, which the
+   CSR paths of one rank and of many may not build) */
+typedef struct {
+  const Material *material;
+  PetscBool       mat_type_given;
+} AssemblyP1Inputs;
 PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscBool *check);
-PetscErrorCode AssemblyResolve(DM dm, AppCtx *user);
-PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K);
-PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX);
-PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF);
+PetscErrorCode AssemblyResolve(DM dm, AssemblyType requested, PetscInt degree, PetscBool check, AssemblyType *assembly);
+PetscErrorCode AssemblyP1CreateMatrix(DM dm, const AssemblyP1Inputs *in, Mat *K);
+PetscErrorCode AssemblyP1Check(DM dm, const AssemblyP1Inputs *in, Vec locX);
+PetscErrorCode AssemblyP1Residual(DM dm, const Material *mat, Vec locX, Vec locF);
 
 /* assembly_p1_csr.c */
 PetscErrorCode AssemblyP1BlockPattern(DM dm, PetscInt bs, PetscInt nb, const PetscInt vidx[], PetscInt **bptr, PetscInt **bcol);
-PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
-                                      PetscBool *done);
+PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AssemblyP1Inputs *in, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[],
+                                      Mat *K, PetscBool *done);
 PetscErrorCode AssemblyP1CSRAllocated(Mat K, PetscLogDouble *nz);
 PetscErrorCode AssemblyP1CSRApplies(DM dm, PetscInt bs, PetscBool mat_type_given, PetscBool *applies);
 PetscErrorCode AssemblyP1CellCoordinates(PetscSection csection, const PetscScalar xa[], PetscInt dim, const PetscInt verts[], PetscReal x[]);
@@ -37,8 +43,8 @@ PetscErrorCode AssemblyP1CellLoop(DM dm, const Material *mat, const PetscInt cve
 PetscErrorCode AssemblyP1CSRCompose(Mat K, PetscInt *i, PetscInt *j, PetscScalar *a, PetscInt *oi, PetscInt *oj, PetscScalar *oa);
 
 /* assembly_p1_mpiaij.c */
-PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
-                                      PetscBool *done);
+PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AssemblyP1Inputs *in, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[],
+                                      Mat *K, PetscBool *done);
 
 /* cell_quadrature.c: basis functions at the points of an accurate rule, cell by cell or on faces */
 typedef struct {

@@ -209,8 +209,17 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(AdaptCheck(dm, &user));             /* -adapt_cycles where it cannot refine */
   PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(BarsReset(&user.rec.bars));
-  PetscCall(ContactChecksGeometry(dm, &user)); /* initial overlap, an obstacle facing away: warnings */
-  PetscCall(VecDuplicate(user.prob.r0, &u));   /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
+  { /* initial overlap, an obstacle facing away, a curved boundary refined on its chords, a locking body: warnings */
+    const ContactChecksGeometryInputs in = {.contact          = user.contact,
+                                            .scene            = &user.scene,
+                                            .material         = &opt.material,
+                                            .degree           = opt.degree,
+                                            .box              = &user.box,
+                                            .grid_refinements = opt.adapt.model[0] ? 0 : opt.solver.grid_sequence}; /* a model remeshes */
+
+    PetscCall(ContactChecksGeometry(dm, &in, &user.rec.stats.checks));
+  }
+  PetscCall(VecDuplicate(user.prob.r0, &u)); /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
   PetscCall(DMSNESCheckFromOptions(snes, u));       /* -dmsnes_check: PETSc's checks against the exact solution */
   PetscCall(OptionsCheckAllUsed(comm, PETSC_TRUE)); /* a misspelled option before the solve, not after it */
@@ -223,9 +232,10 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(PenetrationTolSolve(dm, &user, snes, u)); /* -contact_penetration_tol: eps lowered until the penetration is reached */
   PetscCall(LoadPathSolve(dm, &user, snes, u));       /* the steps after the first, each from the last */
   PetscCall(SolverConditionEstimate(snes, &user, u));
-  PetscCall(PostprocessContact(dm, &user, u));
-  PetscCall(BarsCompute(dm, &user));                /* -bars: from the levels' quantities and this mesh's */
-  PetscCall(ContactChecksResolution(dm, &user, u)); /* cells across the contact zone, contact the mesh does not see: warnings */
+  PetscCall(PostprocessContact(dm, user.contact, &user.prob, &user.scene.bcs, &opt.material, u, &user.rec.stats));
+  PetscCall(BarsCompute(dm, &user)); /* -bars: from the levels' quantities and this mesh's */
+  /* cells across the contact zone, contact the mesh does not see: warnings */
+  PetscCall(ContactChecksResolution(dm, user.contact, &user.scene.bcs, user.rec.stats.contact_force_vector, u, &user.rec.stats.checks));
   { /* diagnostics: a failure there is reported and the output written without them, never the solve lost */
     char failed[512];
 
@@ -247,8 +257,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
       PetscCall(PetscStrlcat(user.rec.diagnostics_failed, failed, sizeof(user.rec.diagnostics_failed)));
     }
   }
-  PetscCall(PostprocessPenetration(&user));                        /* with the error norms' finer quadrature */
-  PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition)); /* of the final mesh */
+  PetscCall(PostprocessPenetration(&user.rec.errors, &user.rec.stats)); /* with the error norms' finer quadrature */
+  PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));      /* of the final mesh */
   PetscCall(PetscTime(&t1));
   user.rec.stats.time_total = t1 - t0;
   PetscCall(RecordPeakMemory(comm, &user.rec.stats));

@@ -11,8 +11,8 @@ const char *const AssemblyTypes[] = {"auto", "fe", "p1", "AssemblyType", "ASSEMB
 
 static PetscLogEvent ASSEMBLY_P1_Preallocate, ASSEMBLY_P1_Fill;
 
-/* Why the P1 path does not apply to dm, NULL when it does; the same answer on every rank. */
-static PetscErrorCode AssemblyP1Applies(DM dm, const AppCtx *user, const char **reason)
+/* Why the P1 path does not apply to dm with displacements of this degree, NULL when it does; the same answer on every rank. */
+static PetscErrorCode AssemblyP1Applies(DM dm, PetscInt degree, const char **reason)
 {
   static const char *const reasons[] = {NULL,
                                         "the mesh dimension is not 2 or 3",
@@ -57,7 +57,7 @@ static PetscErrorCode AssemblyP1Applies(DM dm, const AppCtx *user, const char **
     PetscCall(DMLabelGetStratumSize(ct_label, dim == 2 ? DM_POLYTOPE_TRIANGLE : DM_POLYTOPE_TETRAHEDRON, &nsimplices));
     if (nsimplices != cEnd - cStart) code = 2;
   }
-  if (!code && user->opt->degree != 1) code = 3;
+  if (!code && degree != 1) code = 3;
   if (!code && (nf != 1 || nc != dim || size != (vEnd - vStart) * dim)) code = 4;
   if (!code && (cdim != dim || localized || csize != (vEnd - vStart) * dim)) code = 5;
   if (!code && !known) code = 6;
@@ -81,20 +81,20 @@ PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscB
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The assembly of this mesh's K: -assembly, with auto resolved (p1 where it applies, fe otherwise). */
-PetscErrorCode AssemblyResolve(DM dm, AppCtx *user)
+/* The assembly of this mesh's K: the requested one (-assembly), with auto resolved (p1 where it applies to displacements
+   of this degree, fe otherwise); check (-assembly_check) needs the p1 path. */
+PetscErrorCode AssemblyResolve(DM dm, AssemblyType requested, PetscInt degree, PetscBool check, AssemblyType *assembly)
 {
   MPI_Comm    comm   = PetscObjectComm((PetscObject)dm);
   const char *reason = NULL;
 
   PetscFunctionBeginUser;
-  user->prob.assembly = user->opt->assembly;
-  PetscCall(AssemblyP1Applies(dm, user, &reason));
-  PetscCheck(user->prob.assembly != ASSEMBLY_P1 || !reason, comm, PETSC_ERR_USER_INPUT,
+  *assembly = requested;
+  PetscCall(AssemblyP1Applies(dm, degree, &reason));
+  PetscCheck(*assembly != ASSEMBLY_P1 || !reason, comm, PETSC_ERR_USER_INPUT,
              "-assembly p1 needs P1 displacements on triangles or tetrahedra, but %s: use -assembly fe or auto", reason);
-  PetscCheck(!user->opt->assembly_check || !reason, comm, PETSC_ERR_USER_INPUT,
-             "-assembly_check compares with the P1 assembly, which does not apply: %s", reason);
-  if (user->prob.assembly == ASSEMBLY_AUTO) user->prob.assembly = reason ? ASSEMBLY_FE : ASSEMBLY_P1;
+  PetscCheck(!check || !reason, comm, PETSC_ERR_USER_INPUT, "-assembly_check compares with the P1 assembly, which does not apply: %s", reason);
+  if (*assembly == ASSEMBLY_AUTO) *assembly = reason ? ASSEMBLY_FE : ASSEMBLY_P1;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -348,8 +348,8 @@ static PetscErrorCode AssemblyP1Preallocate(DM dm, PetscInt bs, PetscInt nlocal,
 
 /* K of any type on any number of ranks: preallocated (AssemblyP1Preallocate()), then filled cell by cell through
    MatSetValues(), which also sends the entries of rows owned by other ranks. Ends the preallocation's log event. */
-static PetscErrorCode AssemblyP1CreateAnyMatrix(DM dm, AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[],
-                                                ISLocalToGlobalMapping ltog, Mat *K)
+static PetscErrorCode AssemblyP1CreateAnyMatrix(DM dm, const Material *mat, PetscInt nlocal, PetscInt bs, const PetscInt vidx[],
+                                                const PetscInt cverts[], ISLocalToGlobalMapping ltog, Mat *K)
 {
   PetscSection       csection;
   Vec                coords;
@@ -387,7 +387,7 @@ static PetscErrorCode AssemblyP1CreateAnyMatrix(DM dm, AppCtx *user, PetscInt nl
     PetscCall(AssemblyP1CellCoordinates(csection, xa, dim, &cverts[(c - cStart) * (dim + 1)], x));
     for (PetscInt a = 0; a <= dim; ++a)
       for (PetscInt e = 0; e < dim; ++e) idx[a * dim + e] = vidx[(cverts[(c - cStart) * (dim + 1) + a] - vStart) * dim + e];
-    PetscCall(ElementP1Stiffness(dim, user->opt->material.lambda, user->opt->material.mu, x, Ke));
+    PetscCall(ElementP1Stiffness(dim, mat->lambda, mat->mu, x, Ke));
     PetscCall(MatSetValues(*K, n, idx, n, idx, Ke, ADD_VALUES));
   }
   PetscCall(VecRestoreArrayRead(coords, &xa));
@@ -398,7 +398,7 @@ static PetscErrorCode AssemblyP1CreateAnyMatrix(DM dm, AppCtx *user, PetscInt nl
 }
 
 /* Creates and assembles K by the P1 path; the near-null space is left to the caller. */
-PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K)
+PetscErrorCode AssemblyP1CreateMatrix(DM dm, const AssemblyP1Inputs *in, Mat *K)
 {
   PetscSection           gsection;
   ISLocalToGlobalMapping ltog;
@@ -416,14 +416,14 @@ PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K)
   PetscCall(AssemblyP1BlockSize(dm, &bs));
   PetscCall(AssemblyP1VertexIndices(dm, &vidx));
   PetscCall(AssemblyP1CellVertices(dm, &cverts));
-  PetscCall(AssemblyP1CreateSeqAIJ(dm, user, nlocal, bs, vidx, cverts, K, &done));            /* one rank, AIJ: its own CSR arrays */
-  if (!done) PetscCall(AssemblyP1CreateMPIAIJ(dm, user, nlocal, bs, vidx, cverts, K, &done)); /* several ranks, AIJ: the same */
+  PetscCall(AssemblyP1CreateSeqAIJ(dm, in, nlocal, bs, vidx, cverts, K, &done));            /* one rank, AIJ: its own CSR arrays */
+  if (!done) PetscCall(AssemblyP1CreateMPIAIJ(dm, in, nlocal, bs, vidx, cverts, K, &done)); /* several ranks, AIJ: the same */
   if (done) { /* assembled, with global indices: no local-to-global map (DMGetLocalToGlobalMapping() scans every mesh point) */
     PetscCall(MatSetOption(*K, MAT_NEW_NONZERO_ALLOCATION_ERR, PETSC_TRUE));
     PetscCall(PetscLogEventEnd(ASSEMBLY_P1_Preallocate, dm, 0, 0, 0));
   } else {
     PetscCall(DMGetLocalToGlobalMapping(dm, &ltog)); /* as DMCreateMatrix() gives it, for any other type (MATIS needs it) */
-    PetscCall(AssemblyP1CreateAnyMatrix(dm, user, nlocal, bs, vidx, cverts, ltog, K));
+    PetscCall(AssemblyP1CreateAnyMatrix(dm, in->material, nlocal, bs, vidx, cverts, ltog, K));
   }
   PetscCall(MatSetDM(*K, dm));
   PetscCall(PetscFree(vidx));
@@ -432,8 +432,9 @@ PetscErrorCode AssemblyP1CreateMatrix(DM dm, AppCtx *user, Mat *K)
 }
 
 /* -assembly_check: assembles K both ways (locX: the local solution the FE Jacobian is evaluated at) and prints
-   ||K_p1 - K_fe||_F / ||K_fe||_F with the type, block size and number of nonzeros of both. */
-PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX)
+   ||K_p1 - K_fe||_F / ||K_fe||_F with the type, block size and number of nonzeros of both. PetscFE's Jacobian needs no
+   context: its kernels read constants[] alone. */
+PetscErrorCode AssemblyP1Check(DM dm, const AssemblyP1Inputs *in, Vec locX)
 {
   MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
   Mat       Kfe, Kp1, D;
@@ -444,10 +445,10 @@ PetscErrorCode AssemblyP1Check(DM dm, AppCtx *user, Vec locX)
 
   PetscFunctionBeginUser;
   PetscCall(DMCreateMatrix(dm, &Kfe));
-  PetscCall(DMPlexSNESComputeJacobianFEM(dm, locX, Kfe, Kfe, user));
+  PetscCall(DMPlexSNESComputeJacobianFEM(dm, locX, Kfe, Kfe, NULL));
   PetscCall(MatAssemblyBegin(Kfe, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(Kfe, MAT_FINAL_ASSEMBLY));
-  PetscCall(AssemblyP1CreateMatrix(dm, user, &Kp1));
+  PetscCall(AssemblyP1CreateMatrix(dm, in, &Kp1));
   PetscCall(MatGetType(Kfe, &type_fe));
   PetscCall(MatGetType(Kp1, &type_p1));
   PetscCall(MatGetBlockSize(Kfe, &bs_fe));
@@ -502,7 +503,7 @@ static PetscErrorCode AssemblyP1QuadratureBasis(PetscInt dim, PetscQuadrature q,
    fixed component (ElementP1AddFixedCellsStiffness), and the body-force term int f0 . phi_a with the points and weights
    of PetscFE's own rule, on every cell if the problem has a body force. The body-force kernels depend on x only (they
    get u = 0). */
-PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
+PetscErrorCode AssemblyP1Residual(DM dm, const Material *mat, Vec locX, Vec locF)
 {
   PetscDS            ds;
   PetscPointFunc     f0, f1;
@@ -520,7 +521,7 @@ PetscErrorCode AssemblyP1Residual(DM dm, AppCtx *user, Vec locX, Vec locF)
 
   PetscFunctionBeginUser;
   PetscCall(VecZeroEntries(locF));
-  PetscCall(ElementP1AddFixedCellsStiffness(dm, &user->opt->material, locX, locF));
+  PetscCall(ElementP1AddFixedCellsStiffness(dm, mat, locX, locF));
   PetscCall(DMGetDS(dm, &ds));
   PetscCall(PetscDSGetResidual(ds, 0, &f0, &f1));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));

@@ -259,8 +259,8 @@ static void SeqAddScalarBlock(void *ctx, PetscInt va, PetscInt vb, const PetscSc
    vertex (AssemblyP1CreateSeqAIJ()): the pattern from the edges, the element matrices added in place in MatSetValues()'s
    order, so the values are the same to the bit. *done is false, and nothing is built, where a vertex's free components
    are not numbered consecutively. */
-static PetscErrorCode AssemblyP1CreateSeqAIJScalar(DM dm, const AppCtx *user, PetscInt nlocal, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
-                                                   PetscBool *done)
+static PetscErrorCode AssemblyP1CreateSeqAIJScalar(DM dm, const Material *mat, PetscInt nlocal, const PetscInt vidx[], const PetscInt cverts[],
+                                                   Mat *K, PetscBool *done)
 {
   PetscInt     dim, vStart, vEnd, nv, *first, *nfree, *vptr, *nbr, *key, *colofs, *ci_, *cj;
   PetscScalar *ca;
@@ -329,7 +329,7 @@ static PetscErrorCode AssemblyP1CreateSeqAIJScalar(DM dm, const AppCtx *user, Pe
   {
     SeqAddScalar add = {dim, vidx, first, vptr, nbr, colofs, ci_, ca};
 
-    PetscCall(AssemblyP1CellLoop(dm, &user->opt->material, cverts, SeqAddScalarBlock, &add));
+    PetscCall(AssemblyP1CellLoop(dm, mat, cverts, SeqAddScalarBlock, &add));
   }
   PetscCall(PetscFree2(key, colofs));
   PetscCall(PetscFree(nbr));
@@ -342,8 +342,8 @@ static PetscErrorCode AssemblyP1CreateSeqAIJScalar(DM dm, const AppCtx *user, Pe
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
-                                      PetscBool *done)
+PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AssemblyP1Inputs *in, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[],
+                                      Mat *K, PetscBool *done)
 {
   MPI_Comm     comm = PetscObjectComm((PetscObject)dm);
   PetscMPIInt  size;
@@ -358,11 +358,11 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   PetscCall(DMGetDimension(dm, &dim));
   if (size > 1) PetscFunctionReturn(PETSC_SUCCESS);
   if (bs == 1 && dim > 1) { /* some vertex partly fixed */
-    PetscCall(AssemblyP1CSRApplies(dm, dim, user->opt->solver.given.mat_type, &applies));
-    if (applies) PetscCall(AssemblyP1CreateSeqAIJScalar(dm, user, nlocal, vidx, cverts, K, done));
+    PetscCall(AssemblyP1CSRApplies(dm, dim, in->mat_type_given, &applies));
+    if (applies) PetscCall(AssemblyP1CreateSeqAIJScalar(dm, in->material, nlocal, vidx, cverts, K, done));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCall(AssemblyP1CSRApplies(dm, bs, user->opt->solver.given.mat_type, &applies));
+  PetscCall(AssemblyP1CSRApplies(dm, bs, in->mat_type_given, &applies));
   if (!applies) PetscFunctionReturn(PETSC_SUCCESS);
   nb = nlocal / bs;
   PetscCall(AssemblyP1BlockPattern(dm, bs, nb, vidx, &bptr, &bcol));
@@ -385,7 +385,7 @@ PetscErrorCode AssemblyP1CreateSeqAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   {
     SeqAdd add = {bs, vidx, bptr, bcol, ca};
 
-    PetscCall(AssemblyP1CellLoop(dm, &user->opt->material, cverts, SeqAddBlock, &add));
+    PetscCall(AssemblyP1CellLoop(dm, in->material, cverts, SeqAddBlock, &add));
   }
   PetscCall(PetscFree(bptr));
   PetscCall(PetscFree(bcol));

@@ -257,8 +257,8 @@ static PetscErrorCode Exchange(MPI_Comm comm, MPI_Datatype type, const PetscMPII
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[], Mat *K,
-                                      PetscBool *done)
+PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AssemblyP1Inputs *in, PetscInt nlocal, PetscInt bs, const PetscInt vidx[], const PetscInt cverts[],
+                                      Mat *K, PetscBool *done)
 {
   MPI_Comm     comm = PetscObjectComm((PetscObject)dm);
   PetscMPIInt  size, *icounts, *scounts, *ircounts, *irdispls, *srcounts, *srdispls;
@@ -272,7 +272,7 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   *done = PETSC_FALSE;
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(AssemblyP1CSRApplies(dm, bs, user->opt->solver.given.mat_type, &applies));
+  PetscCall(AssemblyP1CSRApplies(dm, bs, in->mat_type_given, &applies));
   if (size == 1 || !applies) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMemzero(&s, sizeof(s)));
   PetscCall(PetscMemzero(&grows, sizeof(grows)));
@@ -368,7 +368,7 @@ PetscErrorCode AssemblyP1CreateMPIAIJ(DM dm, const AppCtx *user, PetscInt nlocal
   {
     MPIAdd add = {&s, &grows, blk, ghost, gval};
 
-    PetscCall(AssemblyP1CellLoop(dm, &user->opt->material, cverts, MPIAddBlock, &add));
+    PetscCall(AssemblyP1CellLoop(dm, in->material, cverts, MPIAddBlock, &add));
   }
 
   /* the ghost rows' values to their owners, in the order of their patterns */

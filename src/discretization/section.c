@@ -151,7 +151,9 @@ static PetscErrorCode SectionBuild(DM dm, PetscInt nc, PetscInt ndof, PetscInt n
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user)
+/* The local section of dm's displacements of this degree, where P1/Q1 (the head of the file); check (-section_check):
+   compared with PETSc's. */
+PetscErrorCode SectionSetUpP1(DM dm, PetscInt degree, PetscBool check)
 {
   PetscSection section, reference = NULL;
   PetscDS      ds;
@@ -169,7 +171,7 @@ PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user)
   PetscCall(DMPlexGetDepth(dm, &depth));
   PetscCall(DMPlexGetCellTypeLabel(dm, &ct_label));
   PetscCall(DMLabelGetStratumSize(ct_label, DM_POLYTOPE_FV_GHOST, &ghosts));
-  if (nfields != 1 || user->opt->degree != 1 || depth != dim || ghosts) PetscFunctionReturn(PETSC_SUCCESS); /* PETSc's */
+  if (nfields != 1 || degree != 1 || depth != dim || ghosts) PetscFunctionReturn(PETSC_SUCCESS); /* PETSc's */
   PetscCall(DMGetField(dm, 0, NULL, &disc));
   PetscCall(PetscObjectGetClassId(disc, &id));
   if (id != PETSCFE_CLASSID) PetscFunctionReturn(PETSC_SUCCESS);
@@ -180,7 +182,7 @@ PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user)
     if (anchors) PetscFunctionReturn(PETSC_SUCCESS);
   }
   fe = (PetscFE)disc;
-  if (user->opt->section_check) {
+  if (check) {
     PetscCall(DMGetLocalSection(dm, &reference)); /* PETSc's, for the comparison below */
     PetscCall(PetscObjectReference((PetscObject)reference));
   }
@@ -229,6 +231,6 @@ PetscErrorCode SectionSetUpP1(DM dm, const AppCtx *user)
   }
   PetscCall(DMSetLocalSection(dm, section));
   PetscCall(PetscSectionDestroy(&section));
-  PetscCall(SectionSetUpGlobalP1(dm, user->opt->section_check)); /* src/discretization/section_global.c */
+  PetscCall(SectionSetUpGlobalP1(dm, check)); /* src/discretization/section_global.c */
   PetscFunctionReturn(PETSC_SUCCESS);
 }

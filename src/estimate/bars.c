@@ -192,7 +192,7 @@ PetscErrorCode BarsCompute(DM dm, AppCtx *user)
   if (!user->opt->bars) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   size = BarsSizeIndex(dim);
-  PostprocessGetQuantities(user, &q); /* the final mesh's */
+  PostprocessGetQuantities(&user->rec.stats, &q); /* the final mesh's */
   b->n = List(user, dim, &q, b->name, b->value, kind);
   for (PetscInt l = 0; l < b->nlevels; ++l) (void)List(user, dim, &b->level[l], NULL, lv[l], unused);
   if (b->eps_done) (void)List(user, dim, &b->eps_level, NULL, ev, unused);

@@ -72,7 +72,7 @@ static PetscErrorCode LoadOscillation(EstimateWork *w, CellQuadrature *cq, Petsc
   PetscCall(DMGetWorkArray(w->dm, cq->Nq * n, MPIU_REAL, &G));
   for (PetscInt k = 0; k < n; ++k) mean[k] = 0.0;
   for (PetscInt q = 0; q < cq->Nq; ++q) {
-    PetscCall(WeakDataExactStress(w->user, w->dim, &cq->x[q * w->dim], &G[q * n]));
+    PetscCall(WeakDataExactStress(&w->user->scene, &w->user->opt->material, w->dim, &cq->x[q * w->dim], &G[q * n]));
     for (PetscInt k = 0; k < n; ++k) mean[k] += cq->w[q] * G[q * n + k];
     vol += cq->w[q];
   }
@@ -201,7 +201,7 @@ static PetscErrorCode ContactFace(EstimateWork *w, PetscInt c, const EstimateCel
     if (w->user->scene.weak_data) { /* the load's normal stress on Gamma_C, n_o . G n_o (sn holds (sigma(u_h) - Pi_0 G) n) */
       PetscReal G[9], gnn = 0.0;
 
-      PetscCall(WeakDataExactStress(w->user, dim, x, G));
+      PetscCall(WeakDataExactStress(&w->user->scene, &w->user->opt->material, dim, x, G));
       for (PetscInt i = 0; i < dim; ++i)
         for (PetscInt j = 0; j < dim; ++j) gnn += n[i] * G[i * dim + j] * n[j];
       for (PetscInt i = 0; i < dim; ++i) R[i] += gnn * n[i];

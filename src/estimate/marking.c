@@ -98,7 +98,7 @@ PetscErrorCode EstimateMarkContactEdge(DM dm, AppCtx *user, Vec u, DMLabel *mark
   PetscInt *faces, n, local = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(PostprocessContactEdgeFaces(dm, user, u, &n, &faces));
+  PetscCall(PostprocessContactEdgeFaces(dm, user->contact, &user->scene.bcs, &user->opt->material, u, &n, &faces));
   for (PetscInt i = 0; i < n; ++i) {
     const PetscInt *support;
 

@@ -37,9 +37,9 @@ static void f0_bd_pressure(PetscInt dim, PetscInt Nf, PetscInt NfAux, const Pets
    winning at a node two face sets share: the slips first, then the clamps, so a clamp's value holds at its edge. */
 /* The k-th essential condition in that order (k < 2 n: the slips, then the clamps), NULL if the k-th slot holds another
    kind, with its value function and context. */
-static PetscErrorCode DirichletInOrder(const AppCtx *user, PetscInt k, const BoundaryCondition **bc, ScenePointFn *fn, void **ctx)
+static PetscErrorCode DirichletInOrder(const Scene *scene, PetscInt k, const BoundaryCondition **bc, ScenePointFn *fn, void **ctx)
 {
-  const BoundarySet *bcs = &user->scene.bcs;
+  const BoundarySet *bcs = &scene->bcs;
 
   PetscFunctionBeginUser;
   *bc = &bcs->bc[k % bcs->n];
@@ -47,24 +47,25 @@ static PetscErrorCode DirichletInOrder(const AppCtx *user, PetscInt k, const Bou
     *bc = NULL;
   else {
     *fn  = (*bc)->fn ? (*bc)->fn : ConstantVector;
-    *ctx = (*bc)->fn ? (void *)user->scene.constants : (void *)(*bc)->value;
+    *ctx = (*bc)->fn ? (void *)scene->constants : (void *)(*bc)->value;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode BoundaryAddDirichlet(DM dm, AppCtx *user)
+/* The scene's clamps and slips as essential conditions on their face sets of the label face_sets, in that order. */
+PetscErrorCode BoundaryAddDirichlet(DM dm, const Scene *scene, DMLabel face_sets)
 {
   PetscFunctionBeginUser;
-  for (PetscInt k = 0; k < 2 * user->scene.bcs.n; ++k) {
+  for (PetscInt k = 0; k < 2 * scene->bcs.n; ++k) {
     const BoundaryCondition *bc;
     ScenePointFn             fn;
     void                    *ctx;
     char                     name[96];
 
-    PetscCall(DirichletInOrder(user, k, &bc, &fn, &ctx));
+    PetscCall(DirichletInOrder(scene, k, &bc, &fn, &ctx));
     if (!bc) continue;
     PetscCall(PetscSNPrintf(name, sizeof(name), "%s %s", BoundaryKinds[bc->kind], bc->token));
-    PetscCall(DMAddBoundary(dm, DM_BC_ESSENTIAL, name, user->prob.face_sets, 1, &bc->id, 0, bc->kind == BC_SLIP ? bc->ncomp : 0,
+    PetscCall(DMAddBoundary(dm, DM_BC_ESSENTIAL, name, face_sets, 1, &bc->id, 0, bc->kind == BC_SLIP ? bc->ncomp : 0,
                             bc->kind == BC_SLIP ? bc->comps : NULL, (void (*)(void))fn, NULL, ctx, NULL));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -75,8 +76,9 @@ PetscErrorCode BoundaryAddDirichlet(DM dm, AppCtx *user)
    vertex of its faces' closures. With P1/Q1 displacements (unknowns at the vertices only) this is the value of the
    condition at the vertex, which PETSc's projection computes through each face's reference map (the same up to
    round-off in the position); it avoids that projection's three passes over the cell-type label. Higher
-   degrees take DMPlexInsertBoundaryValues(). */
-PetscErrorCode BoundaryInsertDirichlet(DM dm, const AppCtx *user, Vec loc)
+   degrees take DMPlexInsertBoundaryValues(). The scene's conditions on the face sets of face_sets, displacements of this
+   degree. */
+PetscErrorCode BoundaryInsertDirichlet(DM dm, const Scene *scene, DMLabel face_sets, PetscInt degree, Vec loc)
 {
   PetscSection       lsec, csec;
   Vec                coords;
@@ -86,7 +88,7 @@ PetscErrorCode BoundaryInsertDirichlet(DM dm, const AppCtx *user, Vec loc)
   PetscInt           dim;
 
   PetscFunctionBeginUser;
-  if (user->opt->degree != 1) {
+  if (degree != 1) {
     PetscCall(DMPlexInsertBoundaryValues(dm, PETSC_TRUE, loc, 0.0, NULL, NULL, NULL));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
@@ -97,7 +99,7 @@ PetscErrorCode BoundaryInsertDirichlet(DM dm, const AppCtx *user, Vec loc)
   PetscCall(MeshClosureCreate(dm, &mc));
   PetscCall(VecGetArrayRead(coords, &xc));
   PetscCall(VecGetArray(loc, &a));
-  for (PetscInt k = 0; k < 2 * user->scene.bcs.n; ++k) {
+  for (PetscInt k = 0; k < 2 * scene->bcs.n; ++k) {
     const PetscInt           all[3] = {0, 1, 2};
     const BoundaryCondition *bc;
     const PetscInt          *comps, *points;
@@ -106,11 +108,11 @@ PetscErrorCode BoundaryInsertDirichlet(DM dm, const AppCtx *user, Vec loc)
     IS                       is;
     PetscInt                 n, ncomp;
 
-    PetscCall(DirichletInOrder(user, k, &bc, &fn, &ctx)); /* the order of BoundaryAddDirichlet() */
-    if (!bc || !user->prob.face_sets) continue;
+    PetscCall(DirichletInOrder(scene, k, &bc, &fn, &ctx)); /* the order of BoundaryAddDirichlet() */
+    if (!bc || !face_sets) continue;
     comps = bc->kind == BC_SLIP ? bc->comps : all;
     ncomp = bc->kind == BC_SLIP ? bc->ncomp : dim;
-    PetscCall(DMLabelGetStratumIS(user->prob.face_sets, bc->id, &is));
+    PetscCall(DMLabelGetStratumIS(face_sets, bc->id, &is));
     if (!is) continue;
     PetscCall(ISGetLocalSize(is, &n));
     PetscCall(ISGetIndices(is, &points));
@@ -145,10 +147,10 @@ PetscErrorCode BoundaryInsertDirichlet(DM dm, const AppCtx *user, Vec loc)
 }
 
 /* Adds the surface loads to the local residual locF: -int t . v on each traction face set and int p n . v on each
-   pressure face set, each with its own value in constants[CONST_LOAD..] while it is integrated. */
-PetscErrorCode BoundaryAddLoadsLocal(DM dm, AppCtx *user, Vec locF)
+   pressure face set of bcs (of the label face_sets), each with its own value in constants[CONST_LOAD..] while it is
+   integrated. */
+PetscErrorCode BoundaryAddLoadsLocal(DM dm, const BoundarySet *bcs, DMLabel face_sets, Vec locF)
 {
-  BoundarySet       *bcs = &user->scene.bcs;
   PetscDS            ds;
   PetscWeakForm      wf;
   Vec                locX;
@@ -171,7 +173,7 @@ PetscErrorCode BoundaryAddLoadsLocal(DM dm, AppCtx *user, Vec locF)
     PetscFormKey             key;
 
     if (bc->kind != BC_TRACTION && bc->kind != BC_PRESSURE) continue;
-    key.label = user->prob.face_sets;
+    key.label = face_sets;
     key.value = bc->id;
     key.field = 0;
     key.part  = 0;
@@ -187,16 +189,17 @@ PetscErrorCode BoundaryAddLoadsLocal(DM dm, AppCtx *user, Vec locF)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Adds the surface loads to the residual at u = 0: the global r0 and, when it exists, its local copy loc_r0. */
-PetscErrorCode BoundaryAddLoads(DM dm, AppCtx *user, Vec r0)
+/* Adds the surface loads of bcs to the residual at u = 0: the global r0 and, when it exists (not NULL), its local copy
+   loc_r0. */
+PetscErrorCode BoundaryAddLoads(DM dm, const BoundarySet *bcs, DMLabel face_sets, Vec loc_r0, Vec r0)
 {
   Vec locF;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetLocalVector(dm, &locF));
   PetscCall(VecZeroEntries(locF));
-  PetscCall(BoundaryAddLoadsLocal(dm, user, locF));
-  if (user->prob.loc_r0) PetscCall(VecAXPY(user->prob.loc_r0, 1.0, locF));
+  PetscCall(BoundaryAddLoadsLocal(dm, bcs, face_sets, locF));
+  if (loc_r0) PetscCall(VecAXPY(loc_r0, 1.0, locF));
   PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, r0));
   PetscCall(DMRestoreLocalVector(dm, &locF));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -205,16 +208,16 @@ PetscErrorCode BoundaryAddLoads(DM dm, AppCtx *user, Vec r0)
 /* locF = loc_r0 + K (u - u_D), exact on the fixed components: the closed-form stiffness of the P1 simplices that have
    a fixed component times the free part of u (zero on the fixed components). Cheap: the cells at Gamma_D only, not
    the whole residual by PetscFE. */
-static PetscErrorCode AddFixedRowsP1(DM dm, AppCtx *user, Vec u, Vec locF)
+static PetscErrorCode AddFixedRowsP1(DM dm, const Material *mat, Vec loc_r0, Vec u, Vec locF)
 {
   Vec locU;
 
   PetscFunctionBeginUser;
-  PetscCall(VecCopy(user->prob.loc_r0, locF));
+  PetscCall(VecCopy(loc_r0, locF));
   PetscCall(DMGetLocalVector(dm, &locU));
   PetscCall(VecZeroEntries(locU));
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, locU));
-  PetscCall(ElementP1AddFixedCellsStiffness(dm, &user->opt->material, locU, locF));
+  PetscCall(ElementP1AddFixedCellsStiffness(dm, mat, locU, locF));
   PetscCall(DMRestoreLocalVector(dm, &locU));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -224,11 +227,12 @@ static PetscErrorCode AddFixedRowsP1(DM dm, AppCtx *user, Vec u, Vec locF)
    of one rank only, so the local sums add up over the ranks. A set's reaction has only the components it fixes: a point on two such face sets (the
    edge between two symmetry planes of a 3D quarter model, x = 0 fixing u_x and y = 0 fixing u_y) gives each component of its residual to the
    first listed set that fixes that component, so that whatever the order the plane x = 0 pushes along x only. A component two sets fix there (a
-   clamp and a slip) counts for the first listed. reaction[i][c]: of the i-th boundary condition (zero for the loads). */
-PetscErrorCode BoundaryComputeReactions(DM dm, AppCtx *user, Vec u, PetscReal reaction[][3])
+   clamp and a slip) counts for the first listed. reaction[i][c]: of the i-th boundary condition of bcs (zero for the
+   loads). The residual is the problem's (its assembly, loc_r0, loc_bc and face sets) in the material; PetscFE's needs no
+   context, its kernels read constants[] alone. */
+PetscErrorCode BoundaryComputeReactions(DM dm, const BoundarySet *bcs, const Material *mat, const Problem *prob, Vec u, PetscReal reaction[][3])
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
-  const BoundarySet *bcs  = &user->scene.bcs;
   PetscSection       lsec;
   Vec                locX, locF;
   const PetscScalar *f;
@@ -242,14 +246,14 @@ PetscErrorCode BoundaryComputeReactions(DM dm, AppCtx *user, Vec u, PetscReal re
   PetscCall(PetscSectionGetChart(lsec, &pStart, &pEnd));
   PetscCall(DMGetLocalVector(dm, &locX));
   PetscCall(DMGetLocalVector(dm, &locF));
-  if (user->prob.assembly == ASSEMBLY_P1) /* r0 with its fixed rows, and K (u - u_D) on the cells at a fixed component */
-    PetscCall(AddFixedRowsP1(dm, user, u, locF));
+  if (prob->assembly == ASSEMBLY_P1) /* r0 with its fixed rows, and K (u - u_D) on the cells at a fixed component */
+    PetscCall(AddFixedRowsP1(dm, mat, prob->loc_r0, u, locF));
   else { /* the whole residual, by PetscFE */
-    PetscCall(VecCopy(user->prob.loc_bc, locX));
+    PetscCall(VecCopy(prob->loc_bc, locX));
     PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, locX));
     PetscCall(VecZeroEntries(locF));
-    PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
-    PetscCall(BoundaryAddLoadsLocal(dm, user, locF));
+    PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, NULL));
+    PetscCall(BoundaryAddLoadsLocal(dm, bcs, prob->face_sets, locF));
   }
   PetscCall(PetscBTCreate(3 * (pEnd - pStart), &seen)); /* a point's component given to a set already */
   PetscCall(VecGetArrayRead(locF, &f));

@@ -21,52 +21,53 @@
 #include "obstacle.h"
 #include "physics.h"
 
-PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
+/* The checks before the solve (the head of the file) of what in describes, into ck. */
+PetscErrorCode ContactChecksGeometry(DM dm, const ContactChecksGeometryInputs *in, ContactChecks *ck)
 {
   MPI_Comm            comm = PetscObjectComm((PetscObject)dm);
-  ContactChecks      *ck   = &user->rec.stats.checks;
+  const MeshBox      *box  = in->box;
   PetscInt            dim, vStart, vEnd;
   PetscReal           sums[3] = {0.0, 0.0, 0.0}, overlap[2] = {0.0, 0.0}; /* area, area facing away, area overlapping; -g/h and -g */
   ContactPressureForm form;
 
   PetscFunctionBeginUser;
   { /* a mesh file's curved boundary refined by the solver on its chords (-adapt_cycles refuses it: AdaptCheck()) */
-    const PetscInt refinements = user->box.refine + (user->opt->adapt.model[0] ? 0 : user->opt->solver.grid_sequence); /* a model remeshes them */
+    const PetscInt refinements = box->refine + in->grid_refinements;
 
-    if (user->box.from_file && refinements > 0 && user->box.curved_ridges >= MESH_CURVED_RIDGES_MIN) {
-      ck->curved_refined     = user->box.curved_ridges;
+    if (box->from_file && refinements > 0 && box->curved_ridges >= MESH_CURVED_RIDGES_MIN) {
+      ck->curved_refined     = box->curved_ridges;
       ck->curved_refinements = refinements;
-      for (PetscInt d = 0; d < 3; ++d) ck->curved_x[d] = user->box.curved_x[d];
+      for (PetscInt d = 0; d < 3; ++d) ck->curved_x[d] = box->curved_x[d];
     }
   }
   { /* a nearly incompressible P1/Q1 body (see the head of the file) */
-    const Material *mat = &user->opt->material;
+    const Material *mat = in->material;
 
-    if (user->opt->degree == 1 && mat->poisson_ratio >= CONTACT_CHECK_LOCKING_NU) {
+    if (in->degree == 1 && mat->poisson_ratio >= CONTACT_CHECK_LOCKING_NU) {
       const ContactOptions *copt;
 
       ck->locking_nu = mat->poisson_ratio;
-      PetscCall(ContactGetOptions(user->contact, &copt));
-      PetscCall(ContactGetPressureForm(user->contact, &form));
+      PetscCall(ContactGetOptions(in->contact, &copt));
+      PetscCall(ContactGetPressureForm(in->contact, &form));
       if (form.law && copt->modulus == PENALTY_MODULUS_YOUNG) /* eps = eps0 h / E, whose E the P-wave modulus outgrows */
         ck->locking_eps_ratio = (mat->lambda + 2.0 * mat->mu) / mat->young_modulus;
     }
   }
-  PetscCall(ContactGetPressureForm(user->contact, &form));
+  PetscCall(ContactGetPressureForm(in->contact, &form));
   if (!form.acts) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
+  for (PetscInt s = 0; s < in->scene->bcs.ncontact; ++s) {
     PetscInt *faces, nf;
 
-    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces));
+    PetscCall(MeshGetBoundaryFaces(dm, in->scene->bcs.contact_ids[s], &nf, &faces));
     for (PetscInt i = 0; i < nf; ++i) {
       const PetscInt *support;
       PetscInt       *closure = NULL, ncl;
       PetscReal       n[3] = {0, 0, 0}, xc[3] = {0, 0, 0}, area, nob[3], g, dot = 0.0, diam;
 
       PetscCall(MeshFaceOutwardGeometry(dm, faces[i], dim, n, xc, &area));
-      ObstacleGapNormalAt(&user->scene.obstacle, dim, xc, nob, &g);
+      ObstacleGapNormalAt(&in->scene->obstacle, dim, xc, nob, &g);
       for (PetscInt d = 0; d < dim; ++d) dot += n[d] * nob[d];
       sums[0] += area;
       sums[1] += dot <= 0.0 ? area : 0.0;
@@ -79,7 +80,7 @@ PetscErrorCode ContactChecksGeometry(DM dm, AppCtx *user)
 
         if (closure[2 * j] < vStart || closure[2 * j] >= vEnd) continue;
         PetscCall(MeshPointPosition(dm, closure[2 * j], x));
-        ObstacleGapNormalAt(&user->scene.obstacle, dim, x, nv, &g);
+        ObstacleGapNormalAt(&in->scene->obstacle, dim, x, nv, &g);
         overlap[0] = PetscMax(overlap[0], -g / diam);
         overlap[1] = PetscMax(overlap[1], -g);
       }
@@ -141,21 +142,22 @@ static int ComparePoints(const void *a, const void *b)
    width: counting it, a zone narrower than a cell counted 4 faces at every h (bench/zone_resolution.md).
    SNESVI's pressure is the reaction at every node, round-off (1e-16 of the largest) at the free ones: a node carries
    force there above ContactActivityFloor(), the tolerance of its active set. Without it the count changed
-   with the round-off, 4 or 6 faces between two identical runs of the square on 2 ranks. */
-PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user, Vec u)
+   with the round-off, 4 or 6 faces between two identical runs of the square on 2 ranks.
+   Of the solution u with the contact on Gamma_C of bcs, force_vector the obstacle's force on the body (RunStats'
+   contact_force_vector); into ck. */
+PetscErrorCode ContactChecksResolution(DM dm, Contact contact, const BoundarySet *bcs, const PetscReal force_vector[3], Vec u, ContactChecks *ck)
 {
   MPI_Comm            comm = PetscObjectComm((PetscObject)dm);
-  ContactChecks      *ck   = &user->rec.stats.checks;
   const ContactSet   *cs;
   PetscInt            dim, nzone = 0, pressed = 0, (*pairs)[2];
   PetscReal           floor = 0.0, moments[10] = {0}; /* area, its first moments, its second moments xx, xy, xz, yy, yz, zz */
   ContactPressureForm form;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetPressureForm(user->contact, &form));
+  PetscCall(ContactGetPressureForm(contact, &form));
   if (!form.acts) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(ContactGetSet(user->contact, &cs));
-  PetscCall(ContactActivityFloor(user->contact, &floor));
+  PetscCall(ContactGetSet(contact, &cs));
+  PetscCall(ContactActivityFloor(contact, &floor));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(PetscMalloc1(cs->n + 1, &pairs)); /* (point, node) sorted by point: a face's nodes found by bisection */
   for (PetscInt i = 0; i < cs->n; ++i) {
@@ -163,10 +165,10 @@ PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user, Vec u)
     pairs[i][1] = i;
   }
   qsort(pairs, (size_t)cs->n, sizeof(pairs[0]), ComparePoints);
-  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
+  for (PetscInt s = 0; s < bcs->ncontact; ++s) {
     PetscInt *faces, nf;
 
-    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces));
+    PetscCall(MeshGetBoundaryFaces(dm, bcs->contact_ids[s], &nf, &faces));
     for (PetscInt i = 0; i < nf; ++i) {
       PetscInt *closure = NULL, ncl, nodes = 0, acting = 0;
 
@@ -236,9 +238,9 @@ PetscErrorCode ContactChecksResolution(DM dm, AppCtx *user, Vec u)
   /* a strip (a line contact) is a 2D contact in its cross-section: the 2D threshold on its width */
   ck->zone_limit         = dim == 2 || ck->zone_strip ? CONTACT_CHECK_ZONE_CELLS_2D : CONTACT_CHECK_ZONE_CELLS_3D;
   ck->resolution_checked = PETSC_TRUE;
-  PetscCall(ContactUnseenNodes(user->contact, u, NULL, &ck->unseen_nodes, &ck->unseen_force));
+  PetscCall(ContactUnseenNodes(contact, u, NULL, &ck->unseen_nodes, &ck->unseen_force));
   {
-    const PetscReal *f     = user->rec.stats.contact_force_vector;
+    const PetscReal *f     = force_vector;
     const PetscReal  force = PetscSqrtReal(f[0] * f[0] + f[1] * f[1] + f[2] * f[2]);
 
     ck->unseen_share = ck->unseen_nodes == 0 ? 0.0 : (force > 0.0 ? ck->unseen_force / force : PETSC_INFINITY);

@@ -110,17 +110,18 @@ static PetscErrorCode ShareValues(DM dm, PetscReal v[])
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Each vertex's s (the head of the file) at the chart's points, 0 off Gamma_C, the same on every rank that shares it. */
-static PetscErrorCode ZoneValues(DM dm, AppCtx *user, Vec u, PetscReal **s)
+/* Each vertex's s (the head of the file, E the material's Young modulus) at the chart's points, 0 off Gamma_C, the same
+   on every rank that shares it. */
+static PetscErrorCode ZoneValues(DM dm, Contact contact, const Material *mat, Vec u, PetscReal **s)
 {
   const ContactSet  *cs;
-  const PetscReal    E = user->opt->material.young_modulus;
+  const PetscReal    E = mat->young_modulus;
   PetscInt           dim, pStart, pEnd;
   const PetscScalar *x;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(ContactGetSet(contact, &cs));
   PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
   PetscCall(PetscCalloc1(pEnd - pStart, s)); /* 0 at a node of Gamma_C with no free component (clamped) */
   PetscCall(VecGetArrayRead(u, &x));
@@ -172,16 +173,17 @@ static PetscErrorCode FaceVertices(DM dm, PetscInt face, const PetscReal s[], Pe
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The boundary faces of Gamma_C on this rank, over its face sets in turn (*faces allocated, PetscFree()). */
-static PetscErrorCode GammaCFaces(DM dm, const AppCtx *user, PetscInt *n, PetscInt **faces)
+/* The boundary faces of Gamma_C (the contact face sets of bcs) on this rank, over its face sets in turn (*faces
+   allocated, PetscFree()). */
+static PetscErrorCode GammaCFaces(DM dm, const BoundarySet *bcs, PetscInt *n, PetscInt **faces)
 {
   PetscFunctionBeginUser;
   *n = 0;
   PetscCall(PetscMalloc1(1, faces));
-  for (PetscInt k = 0; k < user->scene.bcs.ncontact; ++k) {
+  for (PetscInt k = 0; k < bcs->ncontact; ++k) {
     PetscInt *set, nf;
 
-    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[k], &nf, &set));
+    PetscCall(MeshGetBoundaryFaces(dm, bcs->contact_ids[k], &nf, &set));
     PetscCall(PetscRealloc(sizeof(PetscInt) * (*n + nf + 1), faces));
     for (PetscInt i = 0; i < nf; ++i) {
       PetscInt ns;
@@ -194,15 +196,17 @@ static PetscErrorCode GammaCFaces(DM dm, const AppCtx *user, PetscInt *n, PetscI
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *size, PetscReal *band)
+/* The zone's size and its band (the head of the file) of the solution u with the contact on Gamma_C of bcs, in the
+   material, on every rank. */
+PetscErrorCode PostprocessContactSize(DM dm, Contact contact, const BoundarySet *bcs, const Material *mat, Vec u, PetscReal *size, PetscReal *band)
 {
   PetscInt   dim, *faces, nf;
   PetscReal *s, local[2] = {0.0, 0.0}, global[2];
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(ZoneValues(dm, user, u, &s));
-  PetscCall(GammaCFaces(dm, user, &nf, &faces));
+  PetscCall(ZoneValues(dm, contact, mat, u, &s));
+  PetscCall(GammaCFaces(dm, bcs, &nf, &faces));
   for (PetscInt i = 0; i < nf; ++i) {
     PetscInt  nv;
     PetscReal X[4][3] = {{0.0}}, sv[4];
@@ -236,15 +240,16 @@ PetscErrorCode PostprocessContactSize(DM dm, AppCtx *user, Vec u, PetscReal *siz
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The faces of Gamma_C that the zone's edge crosses, the band's (on this rank; *faces allocated, PetscFree()). */
-PetscErrorCode PostprocessContactEdgeFaces(DM dm, AppCtx *user, Vec u, PetscInt *n, PetscInt **edge)
+/* The faces of Gamma_C that the zone's edge crosses, the band's (on this rank; *faces allocated, PetscFree()), for the
+   same inputs as PostprocessContactSize(). */
+PetscErrorCode PostprocessContactEdgeFaces(DM dm, Contact contact, const BoundarySet *bcs, const Material *mat, Vec u, PetscInt *n, PetscInt **edge)
 {
   PetscReal *s;
   PetscInt   nf;
 
   PetscFunctionBeginUser;
-  PetscCall(ZoneValues(dm, user, u, &s));
-  PetscCall(GammaCFaces(dm, user, &nf, edge));
+  PetscCall(ZoneValues(dm, contact, mat, u, &s));
+  PetscCall(GammaCFaces(dm, bcs, &nf, edge));
   *n = 0;
   for (PetscInt i = 0; i < nf; ++i) { /* kept in place */
     PetscInt  nv;
@@ -262,21 +267,22 @@ PetscErrorCode PostprocessContactEdgeFaces(DM dm, AppCtx *user, Vec u, PetscInt 
    stands for the largest pressure of the cells around its node, across which the discrete pressure changes by this
    much; where the maximum sits at a kink or an end of the profile (the manufactured solution's, at the end of Gamma_C,
    changes there at the order h) the cycles' differences do not see that error while the refinement goes elsewhere,
-   and the largest pressure's bar takes the step as its floor (src/estimate/cycle_bars.c), as the size's takes its band. */
-PetscErrorCode PostprocessPressureStep(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal *step)
+   and the largest pressure's bar takes the step as its floor (src/estimate/cycle_bars.c), as the size's takes its band.
+   The nodal pressure of the contact's set, on the faces of Gamma_C of bcs. */
+PetscErrorCode PostprocessPressureStep(DM dm, Contact contact, const BoundarySet *bcs, PetscReal pressure_max, PetscReal *step)
 {
   const ContactSet *cs;
   PetscInt          pStart, pEnd, nf, *faces;
   PetscReal        *p, local = 0.0;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(ContactGetSet(contact, &cs));
   PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
   PetscCall(PetscCalloc1(pEnd - pStart, &p));
   for (PetscInt i = 0; i < cs->n; ++i)
     if (cs->is_vertex[i]) p[cs->point[i] - pStart] = cs->pressure[i];
   PetscCall(ShareValues(dm, p));
-  PetscCall(GammaCFaces(dm, user, &nf, &faces));
+  PetscCall(GammaCFaces(dm, bcs, &nf, &faces));
   for (PetscInt i = 0; i < nf && pressure_max > 0.0; ++i) {
     PetscInt  nv;
     PetscReal pv[4];

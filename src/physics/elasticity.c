@@ -161,43 +161,43 @@ PetscErrorCode ElasticityGetOptions(MPI_Comm comm, Material *mat, PetscInt *degr
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Writes the material, obstacle, body force and scene parameters into the constants[] of the kernels; the penalty's
-   1/eps is the contact's to set (ContactSetEps()), after this. */
-PetscErrorCode ElasticityUpdateConstants(DM dm, AppCtx *user)
+/* Writes the material, the scene's obstacle, body force and own parameters into the constants[] of the kernels; the
+   penalty's 1/eps is the contact's to set (ContactSetEps()), after this. */
+PetscErrorCode ElasticityUpdateConstants(DM dm, const Material *mat, const Scene *scene)
 {
   PetscDS     ds;
   PetscScalar c[CONST_SCENE_MAX];
 
   PetscFunctionBeginUser;
-  c[CONST_LAMBDA]  = user->opt->material.lambda;
-  c[CONST_MU]      = user->opt->material.mu;
+  c[CONST_LAMBDA]  = mat->lambda;
+  c[CONST_MU]      = mat->mu;
   c[CONST_PENALTY] = 0.0; /* 1/eps, set by the contact (ContactSetEps()) */
-  ObstaclePack(&user->scene.obstacle, &c[CONST_OBSTACLE]);
+  ObstaclePack(&scene->obstacle, &c[CONST_OBSTACLE]);
   for (PetscInt k = 0; k < 3; ++k) {
-    c[CONST_BODY_FORCE + k] = user->scene.bcs.body_force[k];
+    c[CONST_BODY_FORCE + k] = scene->bcs.body_force[k];
     c[CONST_LOAD + k]       = 0.0; /* set while a surface load is assembled (BoundaryAddLoads) */
   }
-  for (PetscInt i = 0; i < user->scene.num_constants; ++i) c[CONST_SCENE + i] = user->scene.constants[i];
+  for (PetscInt i = 0; i < scene->num_constants; ++i) c[CONST_SCENE + i] = scene->constants[i];
   PetscCall(DMGetDS(dm, &ds));
-  PetscCall(PetscDSSetConstants(ds, CONST_SCENE + user->scene.num_constants, c));
+  PetscCall(PetscDSSetConstants(ds, CONST_SCENE + scene->num_constants, c));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The displacement field (PetscFE, prefix displacement_) and the bulk weak form; the caller adds Gamma_D
-   (BoundaryAddDirichlet(), before anything builds the section) and then the constants (ElasticityUpdateConstants()). */
-PetscErrorCode ElasticitySetUpDiscretization(DM dm, AppCtx *user)
+/* The displacement field of this degree (PetscFE, prefix displacement_) and the bulk weak form with the scene's body
+   force and exact solution; the caller adds Gamma_D (BoundaryAddDirichlet(), before anything builds the section) and
+   then the constants (ElasticityUpdateConstants()). */
+PetscErrorCode ElasticitySetUpDiscretization(DM dm, const Scene *scene, PetscInt degree)
 {
-  MPI_Comm     comm  = PetscObjectComm((PetscObject)dm);
-  const Scene *scene = &user->scene;
-  PetscFE      fe;
-  PetscDS      ds;
-  PetscInt     dim;
-  PetscBool    simplex;
+  MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
+  PetscFE   fe;
+  PetscDS   ds;
+  PetscInt  dim;
+  PetscBool simplex;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexIsSimplex(dm, &simplex));
-  PetscCall(PetscFECreateLagrange(comm, dim, dim, simplex, user->opt->degree, PETSC_DETERMINE, &fe)); /* the degree of ElasticityGetOptions() */
+  PetscCall(PetscFECreateLagrange(comm, dim, dim, simplex, degree, PETSC_DETERMINE, &fe)); /* the degree of ElasticityGetOptions() */
   PetscCall(PetscObjectSetName((PetscObject)fe, "displacement"));
   PetscCall(DMSetField(dm, 0, NULL, (PetscObject)fe));
   PetscCall(PetscFEDestroy(&fe));

@@ -8,8 +8,9 @@
    and the surface loads of BoundaryAddLoads()); a scene's load in weak form is not in r0_loc, and WeakDataAddToResidual()
    gives its L(u_D), weak_lift. Computed once per load state, by SolverAssembleLoad(). Both vectors hold this rank's cells only, so that the local dot
    products add up over the ranks to the sums over the cells. A u_D: the closed-form stiffness of the P1 simplices at Gamma_D, or PetscFE's residual
-   at u_D less its residual at 0. Zero when the Dirichlet data are. */
-PetscErrorCode PostprocessLiftEnergy(DM dm, const AppCtx *user, PetscReal weak_lift, PetscReal *energy)
+   at u_D less its residual at 0 (which needs no context: its kernels read constants[] alone). Zero when the Dirichlet
+   data are. The problem's loc_bc, loc_r0 and assembly, in the material. */
+PetscErrorCode PostprocessLiftEnergy(DM dm, const Material *mat, const Problem *prob, PetscReal weak_lift, PetscReal *energy)
 {
   Vec         locA, locZ, locR;
   PetscReal   ud_max, local[2], global[2];
@@ -17,27 +18,27 @@ PetscErrorCode PostprocessLiftEnergy(DM dm, const AppCtx *user, PetscReal weak_l
 
   PetscFunctionBeginUser;
   *energy = 0.0;
-  PetscCall(VecNorm(user->prob.loc_bc, NORM_INFINITY, &ud_max));
+  PetscCall(VecNorm(prob->loc_bc, NORM_INFINITY, &ud_max));
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ud_max, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
   if (ud_max == 0.0) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetLocalVector(dm, &locA));
   PetscCall(VecZeroEntries(locA));
-  if (user->prob.assembly == ASSEMBLY_P1)
-    PetscCall(ElementP1AddFixedCellsStiffness(dm, &user->opt->material, user->prob.loc_bc, locA));
+  if (prob->assembly == ASSEMBLY_P1)
+    PetscCall(ElementP1AddFixedCellsStiffness(dm, mat, prob->loc_bc, locA));
   else {
     PetscCall(DMGetLocalVector(dm, &locZ));
     PetscCall(DMGetLocalVector(dm, &locR));
     PetscCall(VecZeroEntries(locZ));
     PetscCall(VecZeroEntries(locR));
-    PetscCall(DMPlexSNESComputeResidualFEM(dm, user->prob.loc_bc, locA, (void *)user));
-    PetscCall(DMPlexSNESComputeResidualFEM(dm, locZ, locR, (void *)user));
+    PetscCall(DMPlexSNESComputeResidualFEM(dm, prob->loc_bc, locA, NULL));
+    PetscCall(DMPlexSNESComputeResidualFEM(dm, locZ, locR, NULL));
     PetscCall(VecAXPY(locA, -1.0, locR));
     PetscCall(DMRestoreLocalVector(dm, &locZ));
     PetscCall(DMRestoreLocalVector(dm, &locR));
   }
-  PetscCall(VecDot(user->prob.loc_bc, user->prob.loc_r0, &dot));
+  PetscCall(VecDot(prob->loc_bc, prob->loc_r0, &dot));
   local[0] = PetscRealPart(dot);
-  PetscCall(VecDot(user->prob.loc_bc, locA, &dot));
+  PetscCall(VecDot(prob->loc_bc, locA, &dot));
   local[1] = PetscRealPart(dot);
   PetscCall(DMRestoreLocalVector(dm, &locA));
   PetscCall(MPIU_Allreduce(local, global, 2, MPIU_REAL, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
@@ -49,39 +50,39 @@ PetscErrorCode PostprocessLiftEnergy(DM dm, const AppCtx *user, PetscReal weak_l
    force the rule exerts), the supports' reactions, and the potential energy of u_h = w + u_D (w on the free unknowns),
      J(u_h) = 1/2 a(u_h, u_h) - L(u_h) + the contact term's energy,
    with 1/2 a(u_h, u_h) - L(u_h) = 1/2 w.K w + w.r0 + J(u_D): K the bulk operator on the free unknowns and r0 = A u_D - b
-   there, so that w.r0 = a(u_D, w) - L(w). */
-PetscErrorCode PostprocessContact(DM dm, AppCtx *user, Vec u)
+   there, so that w.r0 = a(u_D, w) - L(w). Of the solution u of the problem prob (K, r0, the scales) with the contact,
+   the boundary conditions bcs in the material; into the statistics st. */
+PetscErrorCode PostprocessContact(DM dm, Contact contact, const Problem *prob, const BoundarySet *bcs, const Material *mat, Vec u, RunStats *st)
 {
-  RunStats     *st = &user->rec.stats;
   ContactResult res;
   Vec           R;
   PetscScalar   uKu, r0u;
 
   PetscFunctionBeginUser;
   PetscCall(VecDuplicate(u, &R));
-  PetscCall(ContactBulkMult(user->contact, user->prob.K, u, R)); /* K u, not the penalty Jacobian times u */
+  PetscCall(ContactBulkMult(contact, prob->K, u, R)); /* K u, not the penalty Jacobian times u */
   PetscCall(VecDot(u, R, &uKu));
-  PetscCall(VecDot(u, user->prob.r0, &r0u));
-  PetscCall(VecAXPY(R, 1.0, user->prob.r0)); /* the bulk residual K u + r0, whose contact rows are the reactions */
-  PetscCall(ContactPostProcess(user->contact, dm, R, u, user->prob.displacement_scale, &res));
+  PetscCall(VecDot(u, prob->r0, &r0u));
+  PetscCall(VecAXPY(R, 1.0, prob->r0)); /* the bulk residual K u + r0, whose contact rows are the reactions */
+  PetscCall(ContactPostProcess(contact, dm, R, u, prob->displacement_scale, &res));
   PetscCall(VecDestroy(&R));
   for (PetscInt c = 0; c < 3; ++c) st->contact_force_vector[c] = res.force_vector[c];
-  PetscCall(BoundaryComputeReactions(dm, user, u, st->reaction));
+  PetscCall(BoundaryComputeReactions(dm, bcs, mat, prob, u, st->reaction));
   st->max_penetration = res.max_penetration;
   st->contact_force   = res.force;
   st->active_vertices = res.active_vertices;
-  st->energy          = 0.5 * PetscRealPart(uKu) + PetscRealPart(r0u) + user->prob.lift_energy + res.energy;
+  st->energy          = 0.5 * PetscRealPart(uKu) + PetscRealPart(r0u) + prob->lift_energy + res.energy;
   {
     const ContactSet *cs;
     PetscReal         pmax = 0.0;
 
-    PetscCall(ContactGetSet(user->contact, &cs));
+    PetscCall(ContactGetSet(contact, &cs));
     for (PetscInt i = 0; i < cs->n; ++i) pmax = PetscMax(pmax, cs->pressure[i]);
     PetscCall(MPIU_Allreduce(&pmax, &st->pressure_max, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
   }
-  PetscCall(PostprocessContactSize(dm, user, u, &st->contact_size, &st->contact_size_band));
-  PetscCall(PostprocessPressureStep(dm, user, st->pressure_max, &st->pressure_max_step));
-  PetscCall(PostprocessPressurePeak(dm, user, st->pressure_max, st->pressure_max_step, &st->pressure_peak, &st->pressure_peak_resolution));
+  PetscCall(PostprocessContactSize(dm, contact, bcs, mat, u, &st->contact_size, &st->contact_size_band));
+  PetscCall(PostprocessPressureStep(dm, contact, bcs, st->pressure_max, &st->pressure_max_step));
+  PetscCall(PostprocessPressurePeak(dm, contact, st->pressure_max, st->pressure_max_step, &st->pressure_peak, &st->pressure_peak_resolution));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -94,11 +95,9 @@ PetscReal PostprocessForceMagnitude(const Quantities *q, PetscInt dim)
   return PetscSqrtReal(f);
 }
 
-/* The quantities users read, as PostprocessContact() left them in the record. */
-void PostprocessGetQuantities(const AppCtx *user, Quantities *q)
+/* The quantities users read, as PostprocessContact() left them in the statistics st. */
+void PostprocessGetQuantities(const RunStats *st, Quantities *q)
 {
-  const RunStats *st = &user->rec.stats;
-
   for (PetscInt c = 0; c < 3; ++c) q->force[c] = st->contact_force_vector[c];
   q->pressure_max             = st->pressure_max;
   q->contact_size             = st->contact_size;
@@ -113,13 +112,14 @@ void PostprocessGetQuantities(const AppCtx *user, Quantities *q)
 }
 
 /* The largest penetration of the run: that of the nodes and the rule's points (PostprocessContact()) and that of the
-   finer quadrature of the error norms (ErrorNormsCompute()), which a curved obstacle may reach between them. */
-PetscErrorCode PostprocessPenetration(AppCtx *user)
+   finer quadrature of the error norms (ErrorNormsCompute(), errors), which a curved obstacle may reach between them;
+   into the statistics st. */
+PetscErrorCode PostprocessPenetration(const ErrorNorms *errors, RunStats *st)
 {
   PetscFunctionBeginUser;
-  if (!PetscIsNanReal(user->rec.errors.penetration_max) && user->rec.errors.penetration_max > user->rec.stats.max_penetration) {
-    user->rec.stats.max_penetration     = user->rec.errors.penetration_max;
-    user->rec.stats.penetration_between = PETSC_TRUE;
+  if (!PetscIsNanReal(errors->penetration_max) && errors->penetration_max > st->max_penetration) {
+    st->max_penetration     = errors->penetration_max;
+    st->penetration_between = PETSC_TRUE;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

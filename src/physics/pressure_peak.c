@@ -307,8 +307,8 @@ static PetscBool LeastSquares(PetscInt k, PetscInt m, PetscReal A[], const Petsc
 }
 
 /* The peak and its resolution (the head of the file), on every rank; pressure_max and step, the nodal maximum and its
-   step (PostprocessPressureStep()), where there is too little contact to fit. */
-PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_max, PetscReal step, PetscReal *peak, PetscReal *resolution)
+   step (PostprocessPressureStep()), where there is too little contact to fit. The nodal pressure of the contact's set. */
+PetscErrorCode PostprocessPressurePeak(DM dm, Contact contact, PetscReal pressure_max, PetscReal step, PetscReal *peak, PetscReal *resolution)
 {
   MPI_Comm          comm = PetscObjectComm((PetscObject)dm);
   const ContactSet *cs;
@@ -320,7 +320,7 @@ PetscErrorCode PostprocessPressurePeak(DM dm, AppCtx *user, PetscReal pressure_m
   *peak       = pressure_max;
   *resolution = step;
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(ContactGetSet(contact, &cs));
   /* the largest vertex pressure over all ranks (pressure_max counts every point of the set); the nodes below PEAK_TIE
      of it carry none (a node at the zone's edge whose pressure is a round-off, of either sign, is out on every run and
      partition: the default square's 8 x 8 SNESVI run on 2 ranks gave 0.7124 and 0.7069 in two runs, its count of nodes

@@ -6,37 +6,38 @@
 #include "physics.h"
 #include "discretization.h"
 
-/* sigma(u_exact) at x, the load G of the weak form */
-PetscErrorCode WeakDataExactStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal sigma[])
+/* sigma(u_exact) at x, the load G of the weak form: the scene's exact gradient in the material */
+PetscErrorCode WeakDataExactStress(const Scene *scene, const Material *mat, PetscInt dim, const PetscReal x[], PetscReal sigma[])
 {
   PetscScalar g[9];
   PetscReal   grad[9];
 
   PetscFunctionBeginUser;
-  PetscCall((*user->scene.exact_gradient)(dim, 0.0, x, dim * dim, g, (void *)user->scene.constants));
+  PetscCall((*scene->exact_gradient)(dim, 0.0, x, dim * dim, g, (void *)scene->constants));
   for (PetscInt k = 0; k < dim * dim; ++k) grad[k] = PetscRealPart(g[k]);
-  ElasticStress(dim, &user->opt->material, grad, sigma);
+  ElasticStress(dim, mat, grad, sigma);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* sigma_n(u_exact) = (sigma n) . n at x, with n the obstacle normal at x */
-PetscErrorCode WeakDataExactNormalStress(const AppCtx *user, PetscInt dim, const PetscReal x[], PetscReal *sn)
+/* sigma_n(u_exact) = (sigma n) . n at x, with n the normal of the scene's obstacle at x */
+PetscErrorCode WeakDataExactNormalStress(const Scene *scene, const Material *mat, PetscInt dim, const PetscReal x[], PetscReal *sn)
 {
   PetscReal sigma[9], n[3], gap;
 
   PetscFunctionBeginUser;
-  ObstacleGapNormalAt(&user->scene.obstacle, dim, x, n, &gap);
-  PetscCall(WeakDataExactStress(user, dim, x, sigma));
+  ObstacleGapNormalAt(&scene->obstacle, dim, x, n, &gap);
+  PetscCall(WeakDataExactStress(scene, mat, dim, x, sigma));
   *sn = 0.0;
   for (PetscInt i = 0; i < dim; ++i)
     for (PetscInt j = 0; j < dim; ++j) *sn += n[i] * sigma[i * dim + j] * n[j];
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* r0 -= L: r0 holds the bulk residual at u = 0 (the Dirichlet lifting) on entry. *lift = L(u_D) of the Dirichlet lift,
+/* r0 -= L for the scene's exact solution in the material, integrated with the accurate rule of quad: r0 holds the bulk
+   residual at u = 0 (the Dirichlet lifting) on entry. *lift = L(u_D) of the Dirichlet lift (loc_bc: its values),
    for the energy (PostprocessLiftEnergy()), 0 without weak data; loc_r0 does not take L: the supports' reactions stay the
    stress a(u_h, phi) on Gamma_D that holds the body, which L on the fixed rows (a(u_exact, phi) there) would cancel. */
-PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0, PetscReal *lift)
+PetscErrorCode WeakDataAddToResidual(DM dm, const Scene *scene, const Material *mat, const VerifyOptions *quad, Vec loc_bc, Vec r0, PetscReal *lift)
 {
   CellQuadrature cq;
   Vec            locL;
@@ -45,11 +46,11 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0, PetscReal *lif
 
   PetscFunctionBeginUser;
   *lift = 0.0;
-  if (!user->scene.weak_data) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCheck(user->scene.exact && user->scene.exact_gradient, PetscObjectComm((PetscObject)dm), PETSC_ERR_PLIB,
-             "Scene %s asks for weak data but has no exact solution and gradient", user->scene.name);
+  if (!scene->weak_data) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCheck(scene->exact && scene->exact_gradient, PetscObjectComm((PetscObject)dm), PETSC_ERR_PLIB,
+             "Scene %s asks for weak data but has no exact solution and gradient", scene->name);
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(CellQuadratureCreate(dm, &user->scene, &user->opt->verify, &cq));
+  PetscCall(CellQuadratureCreate(dm, scene, quad, &cq));
   PetscCall(PetscMalloc1(PetscMax(cq.Nb, 1), &elem));
   PetscCall(DMGetLocalVector(dm, &locL));
   PetscCall(VecZeroEntries(locL));
@@ -60,7 +61,7 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0, PetscReal *lif
     for (PetscInt q = 0; q < cq.Nq; ++q) {
       PetscReal sigma[9];
 
-      PetscCall(WeakDataExactStress(user, dim, &cq.x[q * dim], sigma));
+      PetscCall(WeakDataExactStress(scene, mat, dim, &cq.x[q * dim], sigma));
       for (PetscInt b = 0; b < cq.Nb; ++b) {
         PetscReal s = 0.0;
 
@@ -72,16 +73,16 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0, PetscReal *lif
     }
     PetscCall(DMPlexVecSetClosure(dm, NULL, locL, c, elem, ADD_ALL_VALUES));
   }
-  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
-    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces));
+  for (PetscInt s = 0; s < scene->bcs.ncontact; ++s) {
+    PetscCall(MeshGetBoundaryFaces(dm, scene->bcs.contact_ids[s], &nf, &faces));
     for (PetscInt i = 0; i < nf; ++i) {
       PetscCall(CellQuadratureSetFace(&cq, faces[i]));
       for (PetscInt b = 0; b < cq.Nb; ++b) elem[b] = 0.0;
       for (PetscInt q = 0; q < cq.Nq; ++q) {
         PetscReal sn, n[3], gap;
 
-        PetscCall(WeakDataExactNormalStress(user, dim, &cq.x[q * dim], &sn));
-        ObstacleGapNormalAt(&user->scene.obstacle, dim, &cq.x[q * dim], n, &gap);
+        PetscCall(WeakDataExactNormalStress(scene, mat, dim, &cq.x[q * dim], &sn));
+        ObstacleGapNormalAt(&scene->obstacle, dim, &cq.x[q * dim], n, &gap);
         for (PetscInt b = 0; b < cq.Nb; ++b) {
           PetscReal vn = 0.0;
 
@@ -96,7 +97,7 @@ PetscErrorCode WeakDataAddToResidual(DM dm, AppCtx *user, Vec r0, PetscReal *lif
   {
     PetscScalar dot;
 
-    PetscCall(VecDot(locL, user->prob.loc_bc, &dot)); /* this rank's cells only: the sum over the ranks is L(u_D) */
+    PetscCall(VecDot(locL, loc_bc, &dot)); /* this rank's cells only: the sum over the ranks is L(u_D) */
     PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &dot, 1, MPIU_SCALAR, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
     *lift = PetscRealPart(dot);
   }

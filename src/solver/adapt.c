@@ -248,8 +248,8 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
   c->estimate         = user->rec.estimate.total;
   c->estimate_penalty = user->rec.estimate.part[ESTIMATE_PENALTY];
   c->norm             = user->rec.estimate.norm;
-  PetscCall(PostprocessContact(dm, user, u));
-  PostprocessGetQuantities(user, &c->q);
+  PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
+  PostprocessGetQuantities(&user->rec.stats, &c->q);
   c->marked = 0;
   for (PetscInt q = 0; q < ACCURACY_NUM; ++q) c->value_eps[q] = PETSC_NAN;
   c->eps       = PETSC_NAN;
@@ -295,8 +295,8 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
   if (ok) { /* u(eps_new) = u + (eps_new - eps) du/deps, du/deps = dir eps_new / eps^2 */
     PetscCall(VecDuplicate(u, &u_new));
     PetscCall(VecWAXPY(u_new, (eps_new - eps) * eps_new / (eps * eps), dir, u));
-    PetscCall(PostprocessContact(dm, user, u_new));
-    PostprocessGetQuantities(user, &q);
+    PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u_new, &user->rec.stats));
+    PostprocessGetQuantities(&user->rec.stats, &q);
     c->value_eps[ACCURACY_FORCE]    = PostprocessForceMagnitude(&q, dim);
     c->value_eps[ACCURACY_PRESSURE] = q.pressure_max;
     c->value_eps[ACCURACY_SIZE]     = q.contact_size;
@@ -305,7 +305,8 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
   }
   PetscCall(VecDestroy(&dir));
   PetscCall(ContactSetEps(user->contact, dm, eps));
-  PetscCall(PostprocessContact(dm, user, u)); /* the contact state of the cycle's solution again */
+  /* the contact state of the cycle's solution again */
+  PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

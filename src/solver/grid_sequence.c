@@ -276,8 +276,8 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
   PetscFunctionBeginUser;
   if (!user->opt->bars || user->prob.level < first || user->prob.level >= nlevels || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(PostprocessContact(dm, user, u));
-  PostprocessGetQuantities(user, &b->level[b->nlevels]);
+  PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
+  PostprocessGetQuantities(&user->rec.stats, &b->level[b->nlevels]);
   b->level_h[b->nlevels++] = user->prob.h;
   /* a driver's question: the penalty's part of the bars is a second solve at eps / R, which a type without eps has not */
   if (user->prob.level == first + BARS_EPS_LEVEL && !ContactHasPenalty(user->contact)) {
@@ -302,8 +302,8 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
     PetscCall(ContactSetEps(user->contact, dm, b->eps_second));
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
     if (user->rec.stats.converged) {
-      PetscCall(PostprocessContact(dm, user, u));
-      PostprocessGetQuantities(user, &b->eps_level);
+      PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
+      PostprocessGetQuantities(&user->rec.stats, &b->eps_level);
       b->eps_done = PETSC_TRUE;
     }
     PetscCall(BarsRecordPressure(dm, user, p_eps, b->eps_done ? cs->pressure : NULL));

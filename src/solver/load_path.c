@@ -75,8 +75,9 @@ static PetscErrorCode ProblemUpdateData(DM dm, AppCtx *user)
 
   PetscFunctionBeginUser;
   PetscCall(VecZeroEntries(user->prob.loc_bc));
-  PetscCall(BoundaryInsertDirichlet(dm, user, user->prob.loc_bc));
-  PetscCall(ElasticityUpdateConstants(dm, user)); /* the obstacle, the body force, the scene's loads; 1/eps is reset below */
+  PetscCall(BoundaryInsertDirichlet(dm, &user->scene, user->prob.face_sets, user->opt->degree, user->prob.loc_bc));
+  PetscCall(
+      ElasticityUpdateConstants(dm, &user->opt->material, &user->scene)); /* the obstacle, the body force, the scene's loads; 1/eps is reset below */
   PetscCall(ContactGetEps(user->contact, &eps));
   PetscCall(ContactSetEps(user->contact, dm, eps));
   PetscCall(ContactSetLoad(user->contact, dm, &user->scene.obstacle));
@@ -200,7 +201,7 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
     PetscCall(SNESSetTolerances(snes, atol, PetscMin(rtol, FORCE_CONTROL_SOLVE_TOL * FORCE_CONTROL_RTOL * target / user->prob.load_norm), stol, maxit,
                                 maxf));
   PetscCall(BodyDepth(dm, user, &depth));
-  PetscCall(PostprocessContact(dm, user, u));
+  PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
   ForceAlong(user, &f, &s);
   for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && user->rec.stats.converged; ++it) {
     PetscReal s_next;
@@ -259,7 +260,7 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
     PetscCall(SolverSecantStart(snes, dm, user, u, u_prev, dir, (PetscBool)(s != s_prev), s != s_prev ? (s_next - s) / (s - s_prev) : 0.0, 1.0));
     s_prev = s, f_prev = f;
     PetscCall(SolverSolveWarm(snes, user, u, "force control")); /* from zero where Newton stalls at a kink of the penalty */
-    PetscCall(PostprocessContact(dm, user, u));
+    PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
     ForceAlong(user, &f, &s);
     ++*its;
   }
@@ -289,7 +290,7 @@ static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u,
   PetscFunctionBeginUser;
   *ok  = PETSC_FALSE;
   *its = 0;
-  PetscCall(PostprocessContact(dm, user, u));
+  PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
   ForceAlong(user, &f, &s);
   for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && user->rec.stats.converged; ++it) {
     PetscReal s_next, move, d;
@@ -313,7 +314,7 @@ static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u,
     PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
     PetscCall(ProblemUpdateData(dm, user));
     PetscCall(SolverSolveWarm(snes, user, u, "force control"));
-    PetscCall(PostprocessContact(dm, user, u));
+    PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
     ForceAlong(user, &f, &s);
     ++*its;
   }
@@ -333,10 +334,10 @@ static PetscErrorCode LoadPathRecordStep(DM dm, AppCtx *user, Vec u, PetscReal t
     PetscCall(PetscCalloc1(user->opt->load_path.n * OUTPUT_STATE_FIELDS, &user->rec.step_fields));
   }
   s = &user->rec.steps[user->rec.nsteps];
-  PetscCall(PostprocessContact(dm, user, u));
+  PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
   PetscCall(OutputStateFields(dm, user, u, &user->rec.step_fields[user->rec.nsteps * OUTPUT_STATE_FIELDS]));
   user->rec.nsteps++;
-  PostprocessGetQuantities(user, &s->q);
+  PostprocessGetQuantities(&user->rec.stats, &s->q);
   s->factor        = t;
   s->contact_force = user->rec.stats.contact_force;
   for (PetscInt c = 0; c < 3; ++c) s->obstacle_translate[c] = user->scene.obstacle.translate[c];

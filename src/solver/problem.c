@@ -16,16 +16,17 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(BoundaryCheckFaceSets(dm, &user->scene));
   PetscCall(DMGetLabel(dm, "Face Sets", &user->prob.face_sets));
   PetscCall(MeshGetMaxCellDiameter(dm, &user->prob.h));
-  PetscCall(ElasticitySetUpDiscretization(dm, user));
-  PetscCall(BoundaryAddDirichlet(dm, user)); /* Gamma_D, before anything builds the section */
-  PetscCall(ElasticityUpdateConstants(dm, user));
-  PetscCall(SectionSetUpP1(dm, user)); /* P1/Q1: the local section without PETSc's cell-type lookups */
+  PetscCall(ElasticitySetUpDiscretization(dm, &user->scene, user->opt->degree));
+  PetscCall(BoundaryAddDirichlet(dm, &user->scene, user->prob.face_sets)); /* Gamma_D, before anything builds the section */
+  PetscCall(ElasticityUpdateConstants(dm, &user->opt->material, &user->scene));
+  PetscCall(SectionSetUpP1(dm, user->opt->degree, user->opt->section_check)); /* P1/Q1: the local section without PETSc's cell-type lookups */
   PetscCall(BoundaryCheckRigidMotions(dm, &user->scene));
   PetscCall(DMCreateLocalVector(dm, &user->prob.loc_bc)); /* the Dirichlet values, zero elsewhere */
   PetscCall(DMCreateGlobalVector(dm, &user->prob.r0));    /* F(0), assembled below; the set-up's global vectors duplicate it */
   PetscCall(VecZeroEntries(user->prob.loc_bc));
-  PetscCall(BoundaryInsertDirichlet(dm, user, user->prob.loc_bc));
-  PetscCall(AssemblyResolve(dm, user));                                      /* -assembly auto: fe or p1 for this mesh */
+  PetscCall(BoundaryInsertDirichlet(dm, &user->scene, user->prob.face_sets, user->opt->degree, user->prob.loc_bc));
+  /* -assembly auto: fe or p1 for this mesh */
+  PetscCall(AssemblyResolve(dm, user->opt->assembly, user->opt->degree, user->opt->assembly_check, &user->prob.assembly));
   if (user->prob.assembly == ASSEMBLY_FE) PetscCall(MeshIndexCellTypes(dm)); /* before PetscFE's closure per cell */
   {
     ContactProblem cp;

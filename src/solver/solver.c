@@ -10,18 +10,19 @@
 
 PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
 {
-  Vec          locX;
-  MatNullSpace rigid;
+  const AssemblyP1Inputs p1 = {&user->opt->material, user->opt->solver.given.mat_type};
+  Vec                    locX;
+  MatNullSpace           rigid;
 
   PetscFunctionBeginUser;
   if (user->prob.assembly == ASSEMBLY_P1)
-    PetscCall(AssemblyP1CreateMatrix(dm, user, &user->prob.K));
+    PetscCall(AssemblyP1CreateMatrix(dm, &p1, &user->prob.K));
   else
     PetscCall(DMCreateMatrix(dm, &user->prob.K));
   PetscCall(DMGetLocalVector(dm, &locX));
   PetscCall(VecCopy(user->prob.loc_bc, locX)); /* u = 0 with the Dirichlet values, inserted once by ProblemSetUp() */
   if (user->prob.assembly == ASSEMBLY_FE) PetscCall(DMPlexSNESComputeJacobianFEM(dm, locX, user->prob.K, user->prob.K, user));
-  if (user->opt->assembly_check) PetscCall(AssemblyP1Check(dm, user, locX));
+  if (user->opt->assembly_check) PetscCall(AssemblyP1Check(dm, &p1, locX));
   PetscCall(MatAssemblyBegin(user->prob.K, MAT_FINAL_ASSEMBLY));
   PetscCall(MatAssemblyEnd(user->prob.K, MAT_FINAL_ASSEMBLY));
   PetscCall(DMRestoreLocalVector(dm, &locX));
@@ -49,7 +50,7 @@ PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user)
   PetscCall(VecCopy(user->prob.loc_bc, locX));
   PetscCall(VecZeroEntries(locF));
   if (user->prob.assembly == ASSEMBLY_P1)
-    PetscCall(AssemblyP1Residual(dm, user, locX, locF)); /* the same residual without PetscFE's generic cell loop */
+    PetscCall(AssemblyP1Residual(dm, &user->opt->material, locX, locF)); /* the same residual without PetscFE's generic cell loop */
   else
     PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
   PetscCall(VecZeroEntries(user->prob.r0));
@@ -58,9 +59,10 @@ PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user)
   PetscCall(VecCopy(locF, user->prob.loc_r0));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscCall(DMRestoreLocalVector(dm, &locF));
-  PetscCall(BoundaryAddLoads(dm, user, user->prob.r0));
-  PetscCall(WeakDataAddToResidual(dm, user, user->prob.r0, &weak_lift));
-  PetscCall(PostprocessLiftEnergy(dm, user, weak_lift, &user->prob.lift_energy)); /* a datum of the load state, not of u */
+  PetscCall(BoundaryAddLoads(dm, &user->scene.bcs, user->prob.face_sets, user->prob.loc_r0, user->prob.r0));
+  PetscCall(WeakDataAddToResidual(dm, &user->scene, &user->opt->material, &user->opt->verify, user->prob.loc_bc, user->prob.r0, &weak_lift));
+  PetscCall(
+      PostprocessLiftEnergy(dm, &user->opt->material, &user->prob, weak_lift, &user->prob.lift_energy)); /* a datum of the load state, not of u */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -144,7 +144,7 @@ static PetscErrorCode IntegrateContact(DM dm, const PetscReal run_cell_h[], AppC
         if (t->scene) {
           PetscReal sn;
 
-          PetscCall(WeakDataExactNormalStress(user, dim, x, &sn));
+          PetscCall(WeakDataExactNormalStress(&user->scene, &user->opt->material, dim, x, &sn));
           p_target = -sn;
         } else {
           PetscCall(CellQuadratureInterpolate(cq, pr, q, v, NULL));
