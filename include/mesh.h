@@ -15,6 +15,7 @@ PetscErrorCode MeshCreateSimplexBox(MPI_Comm comm, PetscInt dim, const PetscInt 
 PetscErrorCode MeshLabelBoxFaces(DM dm, const PetscReal lower[], const PetscReal upper[]);
 PetscInt       MeshBoxFaceId(PetscInt dim, PetscInt d, PetscInt s);
 PetscErrorCode MeshCreateBoxLevel(DM coarse, const MeshBox *box, PetscInt level, DM *fine, PetscInt **vertex_source);
+PetscErrorCode MeshBoxWrite(const MeshBox *box, PetscViewer v); /* its part of /run */
 PetscErrorCode MeshGetMaxCellDiameter(DM dm, PetscReal *h);
 PetscErrorCode MeshCellDiameter(DM dm, PetscInt c, PetscReal *diam);
 PetscErrorCode MeshCellMeanEdge(DM dm, PetscInt c, PetscReal *mean);

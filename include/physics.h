@@ -20,6 +20,7 @@ PetscErrorCode PostprocessContact(DM dm, Contact contact, const Problem *prob, c
 PetscErrorCode PostprocessLiftEnergy(DM dm, const Material *mat, const Problem *prob, PetscReal weak_lift, PetscReal *energy);
 PetscErrorCode PostprocessPenetration(const ErrorNorms *errors, RunStats *st);
 void           PostprocessGetQuantities(const RunStats *st, Quantities *q);
+PetscErrorCode PostprocessWrite(const RunStats *s, const BoundarySet *bcs, PetscInt dim, PetscViewer v); /* the quantities in /run */
 PetscReal      PostprocessForceMagnitude(const Quantities *q, PetscInt dim);
 /* contact_zone.c */
 PetscErrorCode PostprocessContactSize(DM dm, Contact contact, const BoundarySet *bcs, const Material *mat, Vec u, PetscReal *size, PetscReal *band);
@@ -41,6 +42,7 @@ typedef struct {
 PetscErrorCode ContactChecksGeometry(DM dm, const ContactChecksGeometryInputs *in, ContactChecks *ck);
 PetscErrorCode ContactChecksResolution(DM dm, Contact contact, const BoundarySet *bcs, const PetscReal force_vector[3], Vec u, ContactChecks *ck);
 PetscErrorCode ContactChecksWarnings(MPI_Comm comm, const ContactChecks *ck, PetscBool print, PetscInt *nwarnings);
+PetscErrorCode ContactChecksWrite(MPI_Comm comm, const ContactChecks *ck, PetscViewer v); /* their part of /run */
 
 /* elasticity.c: sigma(grad u) = lambda tr(eps) I + 2 mu eps, grad[i*dim+j] = du_i/dx_j */
 void ElasticStress(PetscInt dim, const Material *mat, const PetscReal grad[], PetscReal sigma[]);

@@ -107,8 +107,15 @@ static PetscErrorCode WriteResults(DM dm, const AppCtx *user, Vec u, PetscViewer
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
+  PetscCall(RunAttrReal(v, user->rec.stats.time_total, "time_total"));
+  PetscCall(RunAttrReal(v, user->rec.stats.peak_memory_mb, "peak_memory_mb"));
+  PetscCall(RunAttrReal(v, user->rec.stats.peak_memory_total_mb, "peak_memory_total_mb"));
+  if (user->rec.diagnostics_failed[0]) PetscCall(RunAttrString(v, user->rec.diagnostics_failed, "diagnostics_failed"));
+  PetscCall(MeshBoxWrite(&user->box, v));
   PetscCall(SceneWrite(&user->scene, &user->opt->material, dim, v));
   PetscCall(ContactWrite(user->contact, v));
+  PetscCall(PostprocessWrite(&user->rec.stats, &user->scene.bcs, dim, v));
+  PetscCall(ContactChecksWrite(comm, &user->rec.stats.checks, v));
   PetscCall(SolverWrite(&user->rec.stats, &user->prob, &user->opt->solver, user->box.coarse_levels, user->rec.nrecords, v));
   PetscCall(SolverWriteSolves(comm, user->rec.records, user->rec.nrecords, v));
   PetscCall(PenetrationTolWrite(user->contact, &user->rec.stats, v));

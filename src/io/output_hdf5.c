@@ -288,9 +288,8 @@ static PetscErrorCode WriteErrorNorms(PetscViewer v, const char prefix[], const 
 
 static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscViewer v, PetscInt ncells, PetscInt nverts)
 {
-  const RunStats *s = &user->rec.stats;
-  PetscMPIInt     size;
-  PetscInt        dim, ndofs;
+  PetscMPIInt size;
+  PetscInt    dim, ndofs;
 
   PetscFunctionBeginUser;
   PetscCallMPI(MPI_Comm_size(PetscObjectComm((PetscObject)dm), &size));
@@ -303,59 +302,6 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(WriteIntAttr(v, "n_cells", ncells));
   PetscCall(WriteIntAttr(v, "n_vertices", nverts));
   PetscCall(WriteIntAttr(v, "n_dofs", ndofs));
-  PetscCall(WriteRealAttr(v, "time_total", s->time_total));
-  PetscCall(WriteIntAttr(v, "active_vertices", s->active_vertices));
-  PetscCall(WriteRealAttr(v, "max_penetration", s->max_penetration));
-  PetscCall(WriteRealAttr(v, "contact_force", s->contact_force));
-  PetscCall(WriteRealAttr(v, "energy", s->energy));
-  PetscCall(WriteRealAttr(v, "pressure_max", s->pressure_max));                         /* the largest nodal contact pressure */
-  PetscCall(WriteRealAttr(v, "contact_size", s->contact_size));                         /* the contact zone's width (2D) or area (3D) */
-  PetscCall(WriteRealAttr(v, "contact_size_band", s->contact_size_band));               /* the one-cell strip along its edge */
-  PetscCall(WriteRealAttr(v, "pressure_max_step", s->pressure_max_step));               /* the largest pressure's change to its neighbours */
-  PetscCall(WriteRealAttr(v, "pressure_peak", s->pressure_peak));                       /* the largest pressure recovered by a local fit */
-  PetscCall(WriteRealAttr(v, "pressure_peak_resolution", s->pressure_peak_resolution)); /*   and its resolution */
-  for (PetscInt c = 0; c < dim; ++c) {                                                  /* the total force of the obstacle, contact_force_x, _y, _z */
-    char name[32];
-
-    PetscCall(PetscSNPrintf(name, sizeof(name), "contact_force_%c", "xyz"[c]));
-    PetscCall(WriteRealAttr(v, name, s->contact_force_vector[c]));
-  }
-  for (PetscInt i = 0; i < user->scene.bcs.n; ++i) { /* reaction_clamp_3_x, ...: the force of each support on the body */
-    const BoundaryCondition *bc = &user->scene.bcs.bc[i];
-
-    if (bc->kind != BC_CLAMP && bc->kind != BC_SLIP) continue;
-    for (PetscInt c = 0; c < dim; ++c) {
-      char name[128];
-
-      PetscCall(PetscSNPrintf(name, sizeof(name), "reaction_%s_%s_%c", BoundaryKinds[bc->kind], bc->token, "xyz"[c]));
-      PetscCall(WriteRealAttr(v, name, s->reaction[i][c]));
-    }
-  }
-  { /* the checks of contact_checks.c: the number of warnings, and the values checked (not written without contact) */
-    PetscInt nwarn;
-
-    PetscCall(ContactChecksWarnings(PetscObjectComm((PetscObject)dm), &s->checks, PETSC_FALSE, &nwarn));
-    PetscCall(WriteIntAttr(v, "warnings", nwarn));
-    if (user->rec.diagnostics_failed[0])
-      PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "diagnostics_failed", PETSC_STRING, user->rec.diagnostics_failed));
-    if (s->checks.geometry_checked) {
-      PetscCall(WriteRealAttr(v, "initial_overlap_cells", s->checks.overlap_cells));
-      PetscCall(WriteRealAttr(v, "initial_overlap_fraction", s->checks.overlap_fraction));
-      PetscCall(WriteRealAttr(v, "initial_overlap_ratio", s->checks.overlap_ratio));
-      PetscCall(WriteRealAttr(v, "obstacle_away_fraction", s->checks.away_fraction));
-    }
-    if (user->box.from_file) PetscCall(WriteIntAttr(v, "curved_boundary_ridges", user->box.curved_ridges)); /* MeshCountCurvedRidges() */
-    PetscCall(WriteIntAttr(v, "curved_boundary_refined", s->checks.curved_refined ? 1 : 0)); /* and the solver refined them: a warning */
-    if (s->checks.resolution_checked) {
-      PetscCall(WriteIntAttr(v, "contact_zone_faces", s->checks.zone_faces));
-      PetscCall(WriteRealAttr(v, "contact_zone_cells", s->checks.zone_cells));
-      if (s->checks.zone_strip) PetscCall(WriteRealAttr(v, "contact_zone_width_cells", s->checks.zone_width_cells)); /* a line contact's */
-      PetscCall(WriteIntAttr(v, "contact_unseen_nodes", s->checks.unseen_nodes));  /* penetrating with no force from the rule, */
-      PetscCall(WriteRealAttr(v, "contact_unseen_force", s->checks.unseen_force)); /* the law's force there: a warning above a share */
-    }
-  }
-  PetscCall(WriteRealAttr(v, "peak_memory_mb", s->peak_memory_mb));
-  PetscCall(WriteRealAttr(v, "peak_memory_total_mb", s->peak_memory_total_mb));
   PetscCall(WriteRealAttr(v, "penetration_l2", user->rec.errors.penetration_l2));
   PetscCall(WriteRealAttr(v, "penetration_max", user->rec.errors.penetration_max));
   PetscCall(WriteErrorNorms(v, "error", &user->rec.errors));

@@ -660,3 +660,11 @@ PetscErrorCode MeshSetContactCellSizes(DM dm, PetscInt nids, const PetscInt ids[
   PetscCall(MeshSetCellSizes(dm, h, sizes));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The mesh file's part of /run: the ridges of its curved boundary that MeshCountCurvedRidges() found (nothing for a box). */
+PetscErrorCode MeshBoxWrite(const MeshBox *box, PetscViewer v)
+{
+  PetscFunctionBeginUser;
+  if (box->from_file) PetscCall(RunAttrInt(v, box->curved_ridges, "curved_boundary_ridges"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

@@ -20,6 +20,7 @@
 #include "mesh.h"
 #include "obstacle.h"
 #include "physics.h"
+#include "app.h"
 
 /* The checks before the solve (the head of the file) of what in describes, into ck. */
 PetscErrorCode ContactChecksGeometry(DM dm, const ContactChecksGeometryInputs *in, ContactChecks *ck)
@@ -324,5 +325,32 @@ PetscErrorCode ContactChecksWarnings(MPI_Comm comm, const ContactChecks *ck, Pet
                       (double)ck->locking_nu, eps));
   }
   if (nwarnings) *nwarnings = n;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The checks in /run: the number of warnings, and the values checked (ContactChecksGeometry(), ContactChecksResolution();
+   nothing of a check not made, as without contact): the initial overlap, an obstacle facing away, a curved boundary
+   the solver refined, the contact zone's cells (and a strip's width), the contact the mesh does not see. */
+PetscErrorCode ContactChecksWrite(MPI_Comm comm, const ContactChecks *ck, PetscViewer v)
+{
+  PetscInt nwarn;
+
+  PetscFunctionBeginUser;
+  PetscCall(ContactChecksWarnings(comm, ck, PETSC_FALSE, &nwarn));
+  PetscCall(RunAttrInt(v, nwarn, "warnings"));
+  if (ck->geometry_checked) {
+    PetscCall(RunAttrReal(v, ck->overlap_cells, "initial_overlap_cells"));
+    PetscCall(RunAttrReal(v, ck->overlap_fraction, "initial_overlap_fraction"));
+    PetscCall(RunAttrReal(v, ck->overlap_ratio, "initial_overlap_ratio"));
+    PetscCall(RunAttrReal(v, ck->away_fraction, "obstacle_away_fraction"));
+  }
+  PetscCall(RunAttrInt(v, ck->curved_refined ? 1 : 0, "curved_boundary_refined")); /* a mesh file's curved boundary refined on its chords */
+  if (ck->resolution_checked) {
+    PetscCall(RunAttrInt(v, ck->zone_faces, "contact_zone_faces"));
+    PetscCall(RunAttrReal(v, ck->zone_cells, "contact_zone_cells"));
+    if (ck->zone_strip) PetscCall(RunAttrReal(v, ck->zone_width_cells, "contact_zone_width_cells")); /* a line contact's */
+    PetscCall(RunAttrInt(v, ck->unseen_nodes, "contact_unseen_nodes"));                              /* penetrating with no force from the rule, */
+    PetscCall(RunAttrReal(v, ck->unseen_force, "contact_unseen_force")); /* the law's force there: a warning above a share */
+  }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -1,6 +1,7 @@
 /* Contact quantities after the solve: nodal pressure, penetration, total force, energy. */
 #include "physics.h"
 #include "discretization.h"
+#include "app.h"
 
 /* The potential energy of the Dirichlet lift u_D (loc_bc: the Dirichlet values, zero on the free unknowns),
      J(u_D) = 1/2 a(u_D, u_D) - L(u_D) = u_D . r0_loc - 1/2 u_D . A u_D,
@@ -120,6 +121,33 @@ PetscErrorCode PostprocessPenetration(const ErrorNorms *errors, RunStats *st)
   if (!PetscIsNanReal(errors->penetration_max) && errors->penetration_max > st->max_penetration) {
     st->max_penetration     = errors->penetration_max;
     st->penetration_between = PETSC_TRUE;
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The solution's quantities in /run (PostprocessContact()): where the rule acts, the largest penetration, the contact
+   force and its vector, the energy, the largest pressure with its step and its recovered peak, the contact zone's size
+   with its band, and the force of each clamp's and slip's support on the body (reaction_clamp_3_x, ...). */
+PetscErrorCode PostprocessWrite(const RunStats *s, const BoundarySet *bcs, PetscInt dim, PetscViewer v)
+{
+  PetscFunctionBeginUser;
+  PetscCall(RunAttrInt(v, s->active_vertices, "active_vertices"));
+  PetscCall(RunAttrReal(v, s->max_penetration, "max_penetration"));
+  PetscCall(RunAttrReal(v, s->contact_force, "contact_force"));
+  PetscCall(RunAttrReal(v, s->energy, "energy"));
+  PetscCall(RunAttrReal(v, s->pressure_max, "pressure_max"));                         /* the largest nodal contact pressure */
+  PetscCall(RunAttrReal(v, s->contact_size, "contact_size"));                         /* the contact zone's width (2D) or area (3D) */
+  PetscCall(RunAttrReal(v, s->contact_size_band, "contact_size_band"));               /* the one-cell strip along its edge */
+  PetscCall(RunAttrReal(v, s->pressure_max_step, "pressure_max_step"));               /* the largest pressure's change to its neighbours */
+  PetscCall(RunAttrReal(v, s->pressure_peak, "pressure_peak"));                       /* the largest pressure recovered by a local fit */
+  PetscCall(RunAttrReal(v, s->pressure_peak_resolution, "pressure_peak_resolution")); /*   and its resolution */
+  for (PetscInt c = 0; c < dim; ++c) PetscCall(RunAttrReal(v, s->contact_force_vector[c], "contact_force_%c", "xyz"[c]));
+  for (PetscInt i = 0; i < bcs->n; ++i) {
+    const BoundaryCondition *bc = &bcs->bc[i];
+
+    if (bc->kind != BC_CLAMP && bc->kind != BC_SLIP) continue;
+    for (PetscInt c = 0; c < dim; ++c)
+      PetscCall(RunAttrReal(v, s->reaction[i][c], "reaction_%s_%s_%c", BoundaryKinds[bc->kind], bc->token, "xyz"[c]));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
