@@ -16,18 +16,25 @@ PetscErrorCode EstimateView(MPI_Comm comm, const ErrorEstimate *est, const Error
 PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DMLabel *marked, PetscInt *nmarked);
 /* cycle_bars.c: the bars of -accuracy's quantities on the adaptive cycles */
 #define CYCLE_EPS_RATIO 10.0 /* the quantities' penalty parts on a cycle: their values at eps / CYCLE_EPS_RATIO (src/solver/adapt.c) */
-PetscErrorCode CycleBarsCompute(AppCtx *user, PetscInt dim, PetscInt last);
+/* the values and bars of cycles[last], from the cycles before it */
+PetscErrorCode CycleBarsCompute(CycleRecord cycles[], PetscInt dim, PetscInt last);
 PetscReal      CycleBarsPenaltyPart(const CycleRecord *c, PetscInt k);
-PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nunseen, PetscReal *force);
-PetscErrorCode EstimateMarkContactEdge(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nmarked);
+/* the cells around the contact set's nodes the rule does not see */
+PetscErrorCode EstimateMarkUnseenContact(DM dm, Contact contact, Vec u, DMLabel *marked, PetscInt *nunseen, PetscReal *force);
+/* the cells of the faces faces[0..n) of Gamma_C that the contact zone's edge crosses (PostprocessContactEdgeFaces()) */
+PetscErrorCode EstimateMarkContactEdge(DM dm, PetscInt n, const PetscInt faces[], DMLabel *marked, PetscInt *nmarked);
 
 /* bars.c: -bars, the error bars of the quantities users read */
-PetscErrorCode BarsCheck(MPI_Comm comm, const AppCtx *user);
+/* -bars (bars) with fewer than two nested meshes below the final one (nlevels) or several eps: refused */
+PetscErrorCode BarsCheck(MPI_Comm comm, PetscBool bars, PetscInt nlevels, Contact contact);
 PetscErrorCode BarsReset(ErrorBars *b);
-PetscErrorCode BarsRecordPressure(DM dm, AppCtx *user, const PetscReal p_eps[], const PetscReal p_second[]);
+/* the 2h level's nodal pressure p_eps[] and that at the second eps p_second[] (NULL: none), kept in *b at the vertices */
+PetscErrorCode BarsRecordPressure(DM dm, Contact contact, const PetscReal p_eps[], const PetscReal p_second[], ErrorBars *b);
 /* the recorded 2h pressure carried to a remeshed level (-bars with -adapt_model): made on dm, with a local vector
    of its displacement's layout, then applied on the new mesh fine, with a local vector of its layout */
-PetscErrorCode BarsPressureTransferCreate(DM dm, AppCtx *user, Vec loc, MeshTransfer *tr);
-PetscErrorCode BarsPressureTransferApply(DM fine, AppCtx *user, Vec fine_loc, MeshTransfer *tr);
-PetscErrorCode BarsCompute(DM dm, AppCtx *user);
+PetscErrorCode BarsPressureTransferCreate(DM dm, const ErrorBars *b, Vec loc, MeshTransfer *tr);
+PetscErrorCode BarsPressureTransferApply(DM fine, ErrorBars *b, Vec fine_loc, MeshTransfer *tr);
+/* the bars of the final mesh's quantities q (bcs: its supports' reactions; converged: the run's solves) and the
+   pressure's band at the contact set's nodes, into *b, from the levels b recorded */
+PetscErrorCode BarsCompute(DM dm, const BoundarySet *bcs, Contact contact, const Quantities *q, PetscBool converged, ErrorBars *b);
 PetscErrorCode BarsView(MPI_Comm comm, const ErrorBars *b);

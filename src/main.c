@@ -176,8 +176,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(ProblemSetUp(dm, &user, &snes));
   PetscCall(ReferenceCheckFile(dm, &user));     /* before the solve, not after it */
   PetscCall(EstimateCheckSupported(dm, &user)); /* -estimate on a discretization it does not cover */
-  PetscCall(BarsCheck(comm, &user));            /* -bars without three nested meshes */
-  PetscCall(AdaptCheck(dm, &user));             /* -adapt_cycles where it cannot refine */
+  PetscCall(BarsCheck(comm, opt.bars, user.box.coarse_levels + opt.solver.grid_sequence, user.contact)); /* -bars without three nested meshes */
+  PetscCall(AdaptCheck(dm, &user));                                                                      /* -adapt_cycles where it cannot refine */
   PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(BarsReset(&user.rec.bars));
   PetscCall(ContactChecksGeometry(dm, &user)); /* initial overlap, an obstacle facing away: warnings */
@@ -195,7 +195,12 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(LoadPathSolve(dm, &user, snes, u));       /* the steps after the first, each from the last */
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, &user, u));
-  PetscCall(BarsCompute(dm, &user));                /* -bars: from the levels' quantities and this mesh's */
+  if (opt.bars) { /* -bars: from the levels' quantities and this mesh's */
+    Quantities q;
+
+    PostprocessGetQuantities(&user, &q);
+    PetscCall(BarsCompute(dm, &user.scene.bcs, user.contact, &q, user.rec.stats.converged, &user.rec.bars));
+  }
   PetscCall(ContactChecksResolution(dm, &user, u)); /* cells across the contact zone, contact the mesh does not see: warnings */
   { /* diagnostics: a failure there is reported and the output written without them, never the solve lost */
     char failed[512];
