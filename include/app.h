@@ -21,4 +21,4 @@ PetscErrorCode OptionsReadVector(CompatOptionItems PetscOptionsObject, MPI_Comm 
 /* errors.c: a refusal of the user's input as one paragraph, PETSc's error block for internal errors */
 PetscErrorCode AppErrorPushHandler(void);
 int            AppErrorExit(PetscErrorCode ierr);
-PetscErrorCode AppDiagnosticRun(const char name[], PetscErrorCode (*fn)(DM, AppCtx *, Vec), DM dm, AppCtx *user, Vec u, char failed[], size_t len);
+PetscErrorCode AppDiagnosticRun(const char name[], PetscErrorCode (*fn)(void *ctx), void *ctx, char failed[], size_t len);

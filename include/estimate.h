@@ -1,15 +1,27 @@
 /* The a posteriori estimate of the error of a run (src/estimate/): a residual-type estimator of the energy-norm error
    ||u - u_h||_a, with one indicator per cell, split into the parts of EstimatePart (include/signorini.h). Read only:
-   it reads the solution and the contact after the solve and writes RunRecord.estimate. */
+   it reads the solution and the contact after the solve and writes the ErrorEstimate its caller gives. */
 #pragma once
 #include "signorini.h"
 #include "mesh.h"
 
+/* What the estimate reads of the run, read only: its data and the solution's discretization (the caller's pieces of it). */
+typedef struct {
+  const Scene         *scene;   /* the loads, the boundary conditions and Gamma_C, the obstacle, a weak-data scene's G */
+  const Material      *mat;     /* the stress of u_h, and the moduli the tractions' squares are divided by */
+  const VerifyOptions *verify;  /* the accurate rule of a weak-data scene's load */
+  Contact              contact; /* how the pressure follows from u_h, the penalty's eps, the contact set */
+  PetscInt             degree;  /* of the displacement: the estimator is P1's */
+  Vec                  loc_bc;  /* the Dirichlet values, a local vector of the mesh */
+} EstimateRun;
+
 /* estimate.c */
 PetscErrorCode EstimateGetOptions(MPI_Comm comm, RunOptions *opt);
-PetscErrorCode EstimateCheckSupported(DM dm, const AppCtx *user);
+/* -estimate given (estimate and estimate_given) on a discretization the estimator does not cover: refused */
+PetscErrorCode EstimateCheckSupported(DM dm, PetscBool estimate, PetscBool estimate_given, PetscInt degree);
 PetscErrorCode EstimateReset(ErrorEstimate *est);
-PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u);
+/* the estimate of the solution u on dm into *est (reset first; why not, if the discretization is not P1 simplices) */
+PetscErrorCode EstimateCompute(DM dm, const EstimateRun *run, Vec u, ErrorEstimate *est);
 PetscErrorCode EstimateView(MPI_Comm comm, const ErrorEstimate *est, const ErrorNorms *exact);
 
 /* marking.c: the cells an adaptive refinement refines (Doerfler's bulk criterion) */

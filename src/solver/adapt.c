@@ -235,7 +235,16 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
 
   PetscFunctionBeginUser;
   PetscCall(EstimateReset(&user->rec.estimate));
-  PetscCall(EstimateCompute(dm, user, u));
+  if (user->opt->estimate) { /* always: -adapt_cycles refuses -estimate false (AdaptCheck()) */
+    const EstimateRun run = {.scene   = &user->scene,
+                             .mat     = &user->opt->material,
+                             .verify  = &user->opt->verify,
+                             .contact = user->contact,
+                             .degree  = user->opt->degree,
+                             .loc_bc  = user->prob.loc_bc};
+
+    PetscCall(EstimateCompute(dm, &run, u, &user->rec.estimate));
+  }
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   local = cEnd - cStart;
   PetscCall(MPIU_Allreduce(&local, &c->n_cells, 1, MPIU_INT, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
@@ -259,7 +268,16 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
   }
   c->error_energy = PETSC_NAN;
   if (user->scene.exact) {
-    PetscCall(ErrorNormsCompute(dm, user, u));
+    const VerifyRun run = {.opt     = &user->opt->verify,
+                           .scene   = &user->scene,
+                           .mat     = &user->opt->material,
+                           .degree  = user->opt->degree,
+                           .contact = user->contact,
+                           .h       = user->prob.h,
+                           .loc_bc  = user->prob.loc_bc,
+                           .K       = user->prob.K};
+
+    PetscCall(ErrorNormsCompute(dm, &run, u, &user->rec.errors));
     c->error_energy = user->rec.errors.energy;
   }
   user->rec.ncycles = k + 1;
