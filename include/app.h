@@ -21,7 +21,7 @@ PetscErrorCode OptionsReadVector(CompatOptionItems PetscOptionsObject, MPI_Comm 
 /* errors.c: a refusal of the user's input as one paragraph, PETSc's error block for internal errors */
 PetscErrorCode AppErrorPushHandler(void);
 int            AppErrorExit(PetscErrorCode ierr);
-PetscErrorCode AppDiagnosticRun(const char name[], PetscErrorCode (*fn)(DM, AppCtx *, Vec), DM dm, AppCtx *user, Vec u, char failed[], size_t len);
+PetscErrorCode AppDiagnosticRun(const char name[], PetscErrorCode (*fn)(void *ctx), void *ctx, char failed[], size_t len);
 
 /* run_output.c: the run's results in the output file, each module's written by the module: an attribute of /run, its
    name formatted as printf() formats, and a column of a table (/solves, /steps, /cycles) in the viewer's group */

@@ -157,6 +157,48 @@ static PetscErrorCode RecordPeakMemory(MPI_Comm comm, RunStats *s)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The diagnostics after the solve (AppDiagnosticRun()), each with what it reads of the run and the record it fills. */
+typedef struct {
+  DM             dm;
+  Vec            u;
+  VerifyRun      verify;         /* the error norms' and the -reference comparison's view of the run */
+  EstimateRun    estimate;       /* the estimate's */
+  PetscBool      estimate_asked; /* -estimate */
+  ErrorNorms    *errors, *ref_errors;
+  ErrorEstimate *est;
+} Diagnostic;
+
+static PetscErrorCode DiagnosticErrorNorms(void *ctx)
+{
+  const Diagnostic *d = (const Diagnostic *)ctx;
+
+  PetscFunctionBeginUser;
+  PetscCall(ErrorNormsCompute(d->dm, &d->verify, d->u, d->errors));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode DiagnosticReference(void *ctx)
+{
+  const Diagnostic *d = (const Diagnostic *)ctx;
+
+  PetscFunctionBeginUser;
+  PetscCall(ReferenceCompute(d->dm, &d->verify, d->u, d->ref_errors));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The estimate where -estimate asks for it; without it the record is reset (no estimate, and no reason for none). */
+static PetscErrorCode DiagnosticEstimate(void *ctx)
+{
+  const Diagnostic *d = (const Diagnostic *)ctx;
+
+  PetscFunctionBeginUser;
+  if (d->estimate_asked)
+    PetscCall(EstimateCompute(d->dm, &d->estimate, d->u, d->est));
+  else
+    PetscCall(EstimateReset(d->est));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The run, from the options to the output; *converged says whether the nonlinear solve converged. An error returns here
    and then to main(), which ends the run as the error asks (AppErrorExit()). */
 static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
@@ -210,10 +252,14 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   if (opt.adapt.cycles || (opt.bars && opt.adapt.model[0]))               /* one eps on Gamma_C: the remeshed meshes do not nest */
     PetscCall(MeshSetContactCellSizes(dm, user.scene.bcs.ncontact, user.scene.bcs.contact_ids));
   PetscCall(ProblemSetUp(dm, &user, &snes));
-  PetscCall(ReferenceCheckFile(dm, &user));     /* before the solve, not after it */
-  PetscCall(EstimateCheckSupported(dm, &user)); /* -estimate on a discretization it does not cover */
-  PetscCall(BarsCheck(comm, &user));            /* -bars without three nested meshes */
-  PetscCall(AdaptCheck(dm, &user));             /* -adapt_cycles where it cannot refine */
+  { /* before the solve, not after it */
+    const VerifyRun verify = {.opt = &opt.verify, .scene = &user.scene, .mat = &opt.material, .degree = opt.degree};
+
+    PetscCall(ReferenceCheckFile(dm, &verify));
+  }
+  PetscCall(EstimateCheckSupported(dm, opt.estimate, opt.estimate_given, opt.degree)); /* -estimate on a discretization it does not cover */
+  PetscCall(BarsCheck(comm, opt.bars, user.box.coarse_levels + opt.solver.grid_sequence, user.contact)); /* -bars without three nested meshes */
+  PetscCall(AdaptCheck(dm, &user));                                                                      /* -adapt_cycles where it cannot refine */
   PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(BarsReset(&user.rec.bars));
   { /* initial overlap, an obstacle facing away, a curved boundary refined on its chords, a locking body: warnings */
@@ -240,24 +286,51 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(LoadPathSolve(dm, &user, snes, u));       /* the steps after the first, each from the last */
   PetscCall(SolverConditionEstimate(snes, &user, u));
   PetscCall(PostprocessContact(dm, user.contact, &user.prob, &user.scene.bcs, &opt.material, u, &user.rec.stats));
-  PetscCall(BarsCompute(dm, &user)); /* -bars: from the levels' quantities and this mesh's */
+  if (opt.bars) { /* -bars: from the levels' quantities and this mesh's */
+    Quantities q;
+
+    PostprocessGetQuantities(&user.rec.stats, &q);
+    PetscCall(BarsCompute(dm, &user.scene.bcs, user.contact, &q, user.rec.stats.converged, &user.rec.bars));
+  }
   /* cells across the contact zone, contact the mesh does not see: warnings */
   PetscCall(ContactChecksResolution(dm, user.contact, &user.scene.bcs, user.rec.stats.contact_force_vector, u, &user.rec.stats.checks));
   { /* diagnostics: a failure there is reported and the output written without them, never the solve lost */
-    char failed[512];
+    char       failed[512];
+    Diagnostic d = {
+        .dm             = dm,
+        .u              = u,
+        .verify         = {.opt     = &opt.verify,
+                           .scene   = &user.scene,
+                           .mat     = &opt.material,
+                           .degree  = opt.degree,
+                           .contact = user.contact,
+                           .h       = user.prob.h,
+                           .loc_bc  = user.prob.loc_bc,
+                           .K       = user.prob.K},
+        .estimate       = {.scene   = &user.scene,
+                           .mat     = &opt.material,
+                           .verify  = &opt.verify,
+                           .contact = user.contact,
+                           .degree  = opt.degree,
+                           .loc_bc  = user.prob.loc_bc},
+        .estimate_asked = opt.estimate,
+        .errors         = &user.rec.errors,
+        .ref_errors     = &user.rec.ref_errors,
+        .est            = &user.rec.estimate,
+    };
 
-    PetscCall(AppDiagnosticRun("error norms", ErrorNormsCompute, dm, &user, u, failed, sizeof(failed)));
+    PetscCall(AppDiagnosticRun("error norms", DiagnosticErrorNorms, &d, failed, sizeof(failed)));
     if (failed[0]) {
       PetscCall(ErrorNormsReset(&user.rec.errors));
       PetscCall(PetscStrlcat(user.rec.diagnostics_failed, failed, sizeof(user.rec.diagnostics_failed)));
     }
-    PetscCall(AppDiagnosticRun("-reference comparison", ReferenceCompute, dm, &user, u, failed, sizeof(failed)));
+    PetscCall(AppDiagnosticRun("-reference comparison", DiagnosticReference, &d, failed, sizeof(failed)));
     if (failed[0]) {
       PetscCall(ErrorNormsReset(&user.rec.ref_errors));
       if (user.rec.diagnostics_failed[0]) PetscCall(PetscStrlcat(user.rec.diagnostics_failed, "; ", sizeof(user.rec.diagnostics_failed)));
       PetscCall(PetscStrlcat(user.rec.diagnostics_failed, failed, sizeof(user.rec.diagnostics_failed)));
     }
-    PetscCall(AppDiagnosticRun("error estimate", EstimateCompute, dm, &user, u, failed, sizeof(failed)));
+    PetscCall(AppDiagnosticRun("error estimate", DiagnosticEstimate, &d, failed, sizeof(failed)));
     if (failed[0]) {
       PetscCall(EstimateReset(&user.rec.estimate));
       if (user.rec.diagnostics_failed[0]) PetscCall(PetscStrlcat(user.rec.diagnostics_failed, "; ", sizeof(user.rec.diagnostics_failed)));

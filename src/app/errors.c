@@ -175,9 +175,9 @@ int AppErrorExit(PetscErrorCode ierr)
 
 /* A diagnostic after the solve (the error norms, the -reference comparison) must not lose the solve: an error in it is
    caught (PETSc's return handler, not the run's), its message kept in failed[] ("" if none), and the run goes on to
-   write its output without it. Every rank learns whether any rank failed; a rank that fails while the others wait for
-   it inside the diagnostic would leave them there, so the agreement waits a minute at most and then aborts. */
-PetscErrorCode AppDiagnosticRun(const char name[], PetscErrorCode (*fn)(DM, AppCtx *, Vec), DM dm, AppCtx *user, Vec u, char failed[], size_t len)
+   write its output without it (fn(ctx): the diagnostic with what it reads and writes). Every rank learns whether any rank failed; a rank that fails
+   while the others wait for it inside the diagnostic would leave them there, so the agreement waits a minute at most and then aborts. */
+PetscErrorCode AppDiagnosticRun(const char name[], PetscErrorCode (*fn)(void *ctx), void *ctx, char failed[], size_t len)
 {
   PetscErrorCode ierr;
   int            mine, any = 0, done = 0;
@@ -186,7 +186,7 @@ PetscErrorCode AppDiagnosticRun(const char name[], PetscErrorCode (*fn)(DM, AppC
   PetscFunctionBeginUser;
   failed[0] = 0;
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
-  ierr = fn(dm, user, u);
+  ierr = fn(ctx);
   PetscCall(PetscPopErrorHandler());
   mine = ierr ? 1 : 0;
   PetscCallMPI(MPI_Iallreduce(&mine, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD, &req));

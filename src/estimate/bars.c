@@ -50,15 +50,15 @@
 #define BARS_EPS_ORDER 1.0      /* the penalty's order in eps of a functional of the displacement */
 #define BARS_EPS_ORDER_EDGE 0.5 /*   and of the zone's size */
 
-/* -bars needs three nested meshes and one eps; refused before the solve otherwise. */
-PetscErrorCode BarsCheck(MPI_Comm comm, const AppCtx *user)
+/* -bars needs three nested meshes and one eps; refused before the solve otherwise. nlevels: the meshes the run solves
+   below the final one (the coarser boxes and the grid sequence's levels). */
+PetscErrorCode BarsCheck(MPI_Comm comm, PetscBool bars, PetscInt nlevels, Contact contact)
 {
-  const PetscInt        nlevels = user->box.coarse_levels + user->opt->solver.grid_sequence;
   const ContactOptions *copt;
 
   PetscFunctionBeginUser;
-  if (!user->opt->bars) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(ContactGetOptions(user->contact, &copt));
+  if (!bars) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetOptions(contact, &copt));
   PetscCheck(nlevels >= BARS_LEVELS - 1, comm, PETSC_ERR_USER_INPUT,
              "-bars needs the solutions on three nested meshes, and this run solves %" PetscInt_FMT
              ": give -contact_grid_sequence 2 (the mesh of the options and two uniform refinements of it), or on a box -contact_coarse_levels 2",
@@ -80,12 +80,12 @@ static PetscInt BarsPressureIndex(PetscInt dim)
   return dim;
 }
 
-static PetscInt List(const AppCtx *user, PetscInt dim, const Quantities *q, char names[][64], PetscReal v[], PetscReal kind[])
+static PetscInt List(const BoundarySet *bcs, PetscInt dim, const Quantities *q, char names[][64], PetscReal v[], PetscReal kind[])
 {
   PetscInt  n     = 0;
   PetscReal force = PostprocessForceMagnitude(q, dim), reactions = 0.0;
 
-  for (PetscInt i = 0; i < user->scene.bcs.n; ++i)
+  for (PetscInt i = 0; i < bcs->n; ++i)
     for (PetscInt c = 0; c < dim; ++c) reactions += PetscSqr(q->reaction[i][c]);
   reactions = PetscMax(PetscSqrtReal(reactions), force);
   for (PetscInt c = 0; c < dim; ++c) {
@@ -105,8 +105,8 @@ static PetscInt List(const AppCtx *user, PetscInt dim, const Quantities *q, char
   if (names) PetscSNPrintf(names[n], 64, "energy");
   kind[n] = PetscAbsReal(q->energy);
   v[n++]  = q->energy;
-  for (PetscInt i = 0; i < user->scene.bcs.n; ++i) {
-    const BoundaryCondition *bc = &user->scene.bcs.bc[i];
+  for (PetscInt i = 0; i < bcs->n; ++i) {
+    const BoundaryCondition *bc = &bcs->bc[i];
 
     if (bc->kind != BC_CLAMP && bc->kind != BC_SLIP) continue;
     for (PetscInt c = 0; c < dim; ++c) {
@@ -178,37 +178,33 @@ static PetscReal EpsPart(PetscReal d, PetscReal r)
   return PetscAbsReal(d) * (1.0 + BARS_SAFETY_TWO_LEVELS / (PetscPowReal(BARS_EPS_RATIO, r) - 1.0));
 }
 
-static PetscErrorCode BarsPressureBand(DM dm, AppCtx *user);
+static PetscErrorCode BarsPressureBand(DM dm, const BoundarySet *bcs, Contact contact, PetscBool converged, ErrorBars *b);
 
-PetscErrorCode BarsCompute(DM dm, AppCtx *user)
+/* The bars of the final mesh's quantities q, from those of the levels below it that b holds; -bars is the caller's question. */
+PetscErrorCode BarsCompute(DM dm, const BoundarySet *bcs, Contact contact, const Quantities *q, PetscBool converged, ErrorBars *b)
 {
-  ErrorBars *b = &user->rec.bars;
-  Quantities q;
-  PetscInt   dim, size;
-  PetscReal  lv[BARS_LEVELS - 1][BARS_MAX], ev[BARS_MAX], kind[BARS_MAX], unused[BARS_MAX];
+  PetscInt  dim, size;
+  PetscReal lv[BARS_LEVELS - 1][BARS_MAX], ev[BARS_MAX], kind[BARS_MAX], unused[BARS_MAX];
 
   PetscFunctionBeginUser;
-  b->n = 0;
-  if (!user->opt->bars) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   size = BarsSizeIndex(dim);
-  PostprocessGetQuantities(&user->rec.stats, &q); /* the final mesh's */
-  b->n = List(user, dim, &q, b->name, b->value, kind);
-  for (PetscInt l = 0; l < b->nlevels; ++l) (void)List(user, dim, &b->level[l], NULL, lv[l], unused);
-  if (b->eps_done) (void)List(user, dim, &b->eps_level, NULL, ev, unused);
+  b->n = List(bcs, dim, q, b->name, b->value, kind);
+  for (PetscInt l = 0; l < b->nlevels; ++l) (void)List(bcs, dim, &b->level[l], NULL, lv[l], unused);
+  if (b->eps_done) (void)List(bcs, dim, &b->eps_level, NULL, ev, unused);
   for (PetscInt k = 0; k < b->n; ++k) {
-    if (b->nlevels < BARS_LEVELS - 1 || !user->rec.stats.converged) {
+    if (b->nlevels < BARS_LEVELS - 1 || !converged) {
       b->bar_mesh[k] = b->order[k] = PETSC_NAN;
       PetscCall(PetscSNPrintf(b->note[k], sizeof(b->note[k]), "a solve of the three meshes failed"));
     } else {
       const PetscReal f[3] = {lv[0][k], lv[1][k], b->value[k]};
 
       if (k == size) {
-        const PetscReal band[3] = {b->level[0].contact_size_band, b->level[1].contact_size_band, q.contact_size_band};
+        const PetscReal band[3] = {b->level[0].contact_size_band, b->level[1].contact_size_band, q->contact_size_band};
 
         MeshPartResolved(f, band, PETSC_TRUE, "the cells along the zone's edge", &b->bar_mesh[k], &b->order[k], b->note[k], sizeof(b->note[k]));
       } else if (k == BarsPressureIndex(dim)) {
-        const PetscReal step[3] = {b->level[0].pressure_max_step, b->level[1].pressure_max_step, q.pressure_max_step};
+        const PetscReal step[3] = {b->level[0].pressure_max_step, b->level[1].pressure_max_step, q->pressure_max_step};
 
         MeshPartResolved(f, step, PETSC_FALSE, "the largest pressure's step to its neighbours", &b->bar_mesh[k], &b->order[k], b->note[k],
                          sizeof(b->note[k]));
@@ -224,7 +220,7 @@ PetscErrorCode BarsCompute(DM dm, AppCtx *user)
     }
     b->bar[k] = b->bar_mesh[k] + b->bar_eps[k]; /* NaN with the mesh's part */
   }
-  PetscCall(BarsPressureBand(dm, user));
+  PetscCall(BarsPressureBand(dm, bcs, contact, converged, b));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -248,9 +244,8 @@ PetscErrorCode BarsReset(ErrorBars *b)
    the two-level index of the mesh's part with the safety factor 3 and the order 1 (a pointwise order of a profile is
    not observed: Celik et al., J. Fluids Eng. 130, 2008, report profiles with one order), and the penalty's part as for
    the quantities. Ghost vertices get their owners' values (the point SF), so every rank interpolates what it holds. */
-PetscErrorCode BarsRecordPressure(DM dm, AppCtx *user, const PetscReal p_eps[], const PetscReal p_second[])
+PetscErrorCode BarsRecordPressure(DM dm, Contact contact, const PetscReal p_eps[], const PetscReal p_second[], ErrorBars *b)
 {
-  ErrorBars        *b = &user->rec.bars;
   const ContactSet *cs;
   PetscInt          pStart, pEnd, vStart, vEnd, nroots;
   PetscReal        *chart[2];
@@ -258,7 +253,7 @@ PetscErrorCode BarsRecordPressure(DM dm, AppCtx *user, const PetscReal p_eps[], 
 
   PetscFunctionBeginUser;
   PetscCall(BarsReset(b));
-  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(ContactGetSet(contact, &cs));
   PetscCall(DMPlexGetChart(dm, &pStart, &pEnd));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
   PetscCall(PetscCalloc2(pEnd - pStart, &chart[0], pEnd - pStart, &chart[1]));
@@ -288,9 +283,8 @@ PetscErrorCode BarsRecordPressure(DM dm, AppCtx *user, const PetscReal p_eps[], 
    The two values ride in the first two components of a vector of the displacement's layout. The fields are zero off
    Gamma_C, so that a new vertex of the curved boundary, a sagitta h^2 / 8R off the old chords, takes a share of the
    interior's zero of the order of h / 8R. */
-PetscErrorCode BarsPressureTransferCreate(DM dm, AppCtx *user, Vec loc, MeshTransfer *tr)
+PetscErrorCode BarsPressureTransferCreate(DM dm, const ErrorBars *b, Vec loc, MeshTransfer *tr)
 {
-  ErrorBars   *b = &user->rec.bars;
   PetscSection sec;
   PetscInt     vStart, vEnd;
   PetscScalar *a;
@@ -315,9 +309,8 @@ PetscErrorCode BarsPressureTransferCreate(DM dm, AppCtx *user, Vec loc, MeshTran
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode BarsPressureTransferApply(DM fine, AppCtx *user, Vec fine_loc, MeshTransfer *tr)
+PetscErrorCode BarsPressureTransferApply(DM fine, ErrorBars *b, Vec fine_loc, MeshTransfer *tr)
 {
-  ErrorBars         *b = &user->rec.bars;
   PetscSection       sec;
   PetscInt           vStart, vEnd;
   const PetscScalar *a;
@@ -352,7 +345,7 @@ PetscErrorCode BarsPressureTransferApply(DM fine, AppCtx *user, Vec fine_loc, Me
    do near the zone's edge, while its error does not; the neighbours' largest covers it (docs/estimate.md, "The
    pressure's band", measures both against a fine SNESVI profile). chart[] holds the band at every point
    of the chart (-1 where none), the owners' values at the ghosts; the result is the same on every rank. */
-static PetscErrorCode BandOverNeighbours(DM dm, const AppCtx *user, PetscReal chart[])
+static PetscErrorCode BandOverNeighbours(DM dm, const BoundarySet *bcs, PetscReal chart[])
 {
   DMLabel    sets;
   PetscSF    sf;
@@ -371,12 +364,12 @@ static PetscErrorCode BandOverNeighbours(DM dm, const AppCtx *user, PetscReal ch
   }
   PetscCall(PetscMalloc1(pEnd - pStart, &wide));
   PetscCall(PetscArraycpy(wide, chart, pEnd - pStart));
-  for (PetscInt k = 0; k < user->scene.bcs.ncontact && sets; ++k) {
+  for (PetscInt k = 0; k < bcs->ncontact && sets; ++k) {
     IS              is;
     const PetscInt *faces;
     PetscInt        nf;
 
-    PetscCall(DMLabelGetStratumIS(sets, user->scene.bcs.contact_ids[k], &is));
+    PetscCall(DMLabelGetStratumIS(sets, bcs->contact_ids[k], &is));
     if (!is) continue;
     PetscCall(ISGetLocalSize(is, &nf));
     PetscCall(ISGetIndices(is, &faces));
@@ -406,17 +399,17 @@ static PetscErrorCode BandOverNeighbours(DM dm, const AppCtx *user, PetscReal ch
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The band at the final mesh's contact nodes, from the values the grid sequence carried there. */
-static PetscErrorCode BarsPressureBand(DM dm, AppCtx *user)
+/* The band at the final mesh's contact nodes, from the values the grid sequence carried there (none unless the three
+   meshes converged). */
+static PetscErrorCode BarsPressureBand(DM dm, const BoundarySet *bcs, Contact contact, PetscBool converged, ErrorBars *b)
 {
-  ErrorBars        *b = &user->rec.bars;
   const ContactSet *cs;
   PetscInt          vStart, vEnd;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(ContactGetSet(contact, &cs));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
-  b->pressure_band = (PetscBool)(b->pressure_recorded && user->rec.stats.converged && b->nlevels == BARS_LEVELS - 1);
+  b->pressure_band = (PetscBool)(b->pressure_recorded && converged && b->nlevels == BARS_LEVELS - 1);
   if (b->pressure_band) {
     PetscInt   pStart, pEnd;
     PetscReal *chart;
@@ -433,7 +426,7 @@ static PetscErrorCode BarsPressureBand(DM dm, AppCtx *user)
         chart[cs->point[i] - pStart] =
             BARS_SAFETY_TWO_LEVELS * PetscAbsReal(cs->pressure[i] - b->pressure_levels[0][v]) + EpsPart(b->pressure_levels[1][v], BARS_EPS_ORDER);
     }
-    PetscCall(BandOverNeighbours(dm, user, chart));
+    PetscCall(BandOverNeighbours(dm, bcs, chart));
     for (PetscInt i = 0; i < cs->n; ++i)
       b->pressure_bar[i] = cs->is_vertex[i] ? chart[cs->point[i] - pStart] : PETSC_NAN; /* NaN: not a vertex (P2) */
     PetscCall(PetscFree(chart));

@@ -161,9 +161,9 @@ PetscReal CycleBarsPenaltyPart(const CycleRecord *c, PetscInt k)
 }
 
 /* The last cycle's values and bars; the earlier cycles' values are those of the earlier calls, one per cycle. */
-PetscErrorCode CycleBarsCompute(AppCtx *user, PetscInt dim, PetscInt last)
+PetscErrorCode CycleBarsCompute(CycleRecord cycles[], PetscInt dim, PetscInt last)
 {
-  CycleRecord *c = &user->rec.cycles[last];
+  CycleRecord *c = &cycles[last];
 
   PetscFunctionBeginUser;
   c->value[ACCURACY_ENERGY]   = c->norm;
@@ -172,11 +172,10 @@ PetscErrorCode CycleBarsCompute(AppCtx *user, PetscInt dim, PetscInt last)
   c->value[ACCURACY_SIZE]     = c->q.contact_size;
   c->value[ACCURACY_PEAK]     = c->q.pressure_peak;
   c->bar[ACCURACY_ENERGY]     = c->estimate;
-  for (PetscInt k = ACCURACY_FORCE; k < ACCURACY_NUM; ++k)
-    c->bar[k] = Bar(user->rec.cycles, k, last, dim, k == ACCURACY_SIZE ? CYCLE_ORDER_SIZE : CYCLE_ORDER);
+  for (PetscInt k = ACCURACY_FORCE; k < ACCURACY_NUM; ++k) c->bar[k] = Bar(cycles, k, last, dim, k == ACCURACY_SIZE ? CYCLE_ORDER_SIZE : CYCLE_ORDER);
   {
-    const PetscReal force = ForceBar(user->rec.cycles, last, dim), pressure = PressureBar(user->rec.cycles, last, dim),
-                    size = SizeBar(user->rec.cycles, last, dim), peak = PeakBar(user->rec.cycles, last, dim);
+    const PetscReal force = ForceBar(cycles, last, dim), pressure = PressureBar(cycles, last, dim), size = SizeBar(cycles, last, dim),
+                    peak = PeakBar(cycles, last, dim);
 
     if (!PetscIsNanReal(force)) c->bar[ACCURACY_FORCE] = force;
     if (!PetscIsNanReal(pressure)) c->bar[ACCURACY_PRESSURE] = pressure;

@@ -32,7 +32,7 @@ PetscErrorCode EstimateGetOptions(MPI_Comm comm, RunOptions *opt)
 }
 
 /* Whether the estimator applies: P1 on simplices; *why says what else the discretization is. */
-static PetscErrorCode Supported(DM dm, const AppCtx *user, PetscBool *ok, char why[], size_t len)
+static PetscErrorCode Supported(DM dm, PetscInt degree, PetscBool *ok, char why[], size_t len)
 {
   PetscInt       dim, cStart, cEnd, simplex = 1, all;
   DMPolytopeType ct;
@@ -45,9 +45,9 @@ static PetscErrorCode Supported(DM dm, const AppCtx *user, PetscBool *ok, char w
     simplex = DMPolytopeTypeGetNumVertices(ct) == dim + 1;
   }
   PetscCall(MPIU_Allreduce(&simplex, &all, 1, MPIU_INT, MPI_MIN, PetscObjectComm((PetscObject)dm)));
-  *ok = (PetscBool)(all && user->opt->degree == 1);
-  if (user->opt->degree != 1)
-    PetscCall(PetscSNPrintf(why, len, "implemented for P1, not P%" PetscInt_FMT, user->opt->degree));
+  *ok = (PetscBool)(all && degree == 1);
+  if (degree != 1)
+    PetscCall(PetscSNPrintf(why, len, "implemented for P1, not P%" PetscInt_FMT, degree));
   else if (!all)
     PetscCall(PetscSNPrintf(why, len, "implemented for simplices (triangles, tetrahedra), not %s", dim == 2 ? "quadrilaterals" : "hexahedra"));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -55,14 +55,14 @@ static PetscErrorCode Supported(DM dm, const AppCtx *user, PetscBool *ok, char w
 
 /* -estimate given on a discretization the estimator does not cover is refused before the solve; by default such a run
    goes without the estimate, and the summary says why. */
-PetscErrorCode EstimateCheckSupported(DM dm, const AppCtx *user)
+PetscErrorCode EstimateCheckSupported(DM dm, PetscBool estimate, PetscBool estimate_given, PetscInt degree)
 {
   PetscBool ok;
   char      why[128] = "";
 
   PetscFunctionBeginUser;
-  if (!user->opt->estimate || !user->opt->estimate_given) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(Supported(dm, user, &ok, why, sizeof(why)));
+  if (!estimate || !estimate_given) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(Supported(dm, degree, &ok, why, sizeof(why)));
   PetscCheck(ok, PetscObjectComm((PetscObject)dm), PETSC_ERR_USER_INPUT,
              "-estimate: the error estimate is %s; run without -estimate (or with -estimate false)", why);
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -116,7 +116,7 @@ static PetscErrorCode RuleCreate(PetscInt sdim, PetscInt npts, EstimateRule *rul
    condition, or ESTIMATE_FACE_FREE (traction-free, or loaded by the exact solution of a scene with weak data). */
 static PetscErrorCode ClassifyFaces(EstimateWork *w)
 {
-  const BoundarySet *bcs = &w->user->scene.bcs;
+  const BoundarySet *bcs = &w->scene->bcs;
   DMLabel            label;
 
   PetscFunctionBeginUser;
@@ -143,9 +143,9 @@ static PetscErrorCode ClassifyFaces(EstimateWork *w)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
+/* The estimate of u on dm into *est; -estimate is the caller's question (its callers call it where it is asked for). */
+PetscErrorCode EstimateCompute(DM dm, const EstimateRun *run, Vec u, ErrorEstimate *est)
 {
-  ErrorEstimate *est  = &user->rec.estimate;
   MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
   EstimateWork   w;
   PetscBool      ok;
@@ -158,13 +158,15 @@ PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
   PetscFunctionBeginUser;
   PetscCall(PetscTime(&t0));
   PetscCall(EstimateReset(est));
-  if (!user->opt->estimate) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(Supported(dm, user, &ok, est->unavailable, sizeof(est->unavailable)));
+  PetscCall(Supported(dm, run->degree, &ok, est->unavailable, sizeof(est->unavailable)));
   if (!ok) PetscFunctionReturn(PETSC_SUCCESS);
 
   PetscCall(PetscMemzero(&w, sizeof(w)));
-  w.dm   = dm;
-  w.user = user;
+  w.dm      = dm;
+  w.scene   = run->scene;
+  w.mat     = run->mat;
+  w.verify  = run->verify;
+  w.contact = run->contact;
   PetscCall(DMGetDimension(dm, &w.dim));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &w.cStart, &w.cEnd));
   PetscCall(DMPlexGetHeightStratum(dm, 1, &w.fStart, &w.fEnd));
@@ -175,19 +177,19 @@ PetscErrorCode EstimateCompute(DM dm, AppCtx *user, Vec u)
   PetscCall(DMGetCoordinatesLocal(dm, &coords));
   PetscCall(VecGetArrayRead(coords, &w.xc));
   PetscCall(DMGetLocalVector(dm, &loc_u));
-  PetscCall(VecCopy(user->prob.loc_bc, loc_u)); /* the Dirichlet values, inserted once by ProblemSetUp() */
+  PetscCall(VecCopy(run->loc_bc, loc_u)); /* the Dirichlet values, inserted once by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc_u));
   PetscCall(VecGetArrayRead(loc_u, &w.lu));
-  PetscCall(ContactGetPressureForm(user->contact, &w.pressure));
+  PetscCall(ContactGetPressureForm(run->contact, &w.pressure));
   if (w.pressure.nodal) { /* the nodal force over the lumped area */
     PetscCall(DMGetLocalVector(dm, &loc_p));
-    PetscCall(ErrorNormsPressureVector(dm, user, loc_p));
+    PetscCall(ErrorNormsPressureVector(dm, run->contact, loc_p));
     PetscCall(VecGetArrayRead(loc_p, &w.lp));
   }
   PetscCall(DMGetDS(dm, &ds));
   PetscCall(PetscDSGetConstants(ds, &w.nconstants, &w.constants));
-  w.m_normal = user->opt->material.lambda + 2.0 * user->opt->material.mu;
-  w.m_shear  = 2.0 * user->opt->material.mu;
+  w.m_normal = run->mat->lambda + 2.0 * run->mat->mu;
+  w.m_shear  = 2.0 * run->mat->mu;
   PetscCall(RuleCreate(w.dim, 2, &w.cell_rule));
   PetscCall(RuleCreate(w.dim - 1, 3, &w.face_rule));
   PetscCall(PetscCalloc1((w.cEnd - w.cStart) * ESTIMATE_NUM_PARTS, &w.eta2));

@@ -42,7 +42,7 @@ PetscErrorCode EstimateCellLoad(EstimateWork *w, PetscInt c, EstimateCell *cell)
       cell->grad[i * dim + j] = 0.0;
       for (PetscInt k = 0; k < cell->nv; ++k) cell->grad[i * dim + j] += cell->u[k * dim + i] * cell->dl[k * dim + j];
     }
-  ElasticStress(dim, &w->user->opt->material, cell->grad, cell->sigma);
+  ElasticStress(dim, w->mat, cell->grad, cell->sigma);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

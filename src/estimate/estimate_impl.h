@@ -27,27 +27,30 @@ typedef struct {
 } EstimateRule;
 
 typedef struct {
-  DM                  dm;
-  AppCtx             *user;
-  PetscInt            dim, cStart, cEnd, fStart, fEnd;
-  MeshClosure         mc;
-  PetscSection        lsec, csec;
-  const PetscScalar  *xc, *lu;   /* local coordinates, local displacement with the Dirichlet values */
-  const PetscScalar  *lp;        /* the nodal contact pressure as p n (the nodal rule and SNESVI), NULL for the pointwise law */
-  ContactPressureForm pressure;  /* how the contact pressure follows from u_h (ContactGetPressureForm()) */
-  const PetscScalar  *constants; /* the kernels' constants[] */
-  PetscInt            nconstants;
-  PetscReal           m_normal;  /* lambda + 2 mu: the normal tractions' and the body force's squares are divided by it */
-  PetscReal           m_shear;   /* 2 mu: the tangential tractions' squares are divided by it */
-  EstimateRule        cell_rule; /* for the body force (a weak-data scene's G takes the load's own rule) */
-  EstimateRule        face_rule; /* for the boundary terms */
-  PetscReal          *eta2;      /* [ncells][ESTIMATE_NUM_PARTS] the squared indicators */
-  PetscReal          *volume;    /* [ncells] */
-  PetscReal           norm2;     /* the local cells' sum of sigma(u_h) : grad u_h |T|, the square of u_h's energy norm */
-  PetscInt           *face_kind; /* [fEnd - fStart]: ESTIMATE_FACE_* or the index of the face's clamp/slip/load in the scene */
-  PetscReal          *face_sum;  /* [chart][dim + 1]: sum over a face's cells of sigma n_out, and their number */
-  PetscReal          *face_geom; /* [fEnd - fStart][dim + 2]: each face's measure, diameter and unit normal */
-  PetscReal          *load_mean; /* [ncells][dim * dim]: Pi_0 G, the cells' means of a weak-data scene's G = sigma(u_exact); unused otherwise */
+  DM                   dm;
+  const Scene         *scene; /* the loads, the boundary conditions and Gamma_C, the obstacle */
+  const Material      *mat;
+  const VerifyOptions *verify; /* the accurate rule of a weak-data scene's load */
+  Contact              contact;
+  PetscInt             dim, cStart, cEnd, fStart, fEnd;
+  MeshClosure          mc;
+  PetscSection         lsec, csec;
+  const PetscScalar   *xc, *lu;   /* local coordinates, local displacement with the Dirichlet values */
+  const PetscScalar   *lp;        /* the nodal contact pressure as p n (the nodal rule and SNESVI), NULL for the pointwise law */
+  ContactPressureForm  pressure;  /* how the contact pressure follows from u_h (ContactGetPressureForm()) */
+  const PetscScalar   *constants; /* the kernels' constants[] */
+  PetscInt             nconstants;
+  PetscReal            m_normal;  /* lambda + 2 mu: the normal tractions' and the body force's squares are divided by it */
+  PetscReal            m_shear;   /* 2 mu: the tangential tractions' squares are divided by it */
+  EstimateRule         cell_rule; /* for the body force (a weak-data scene's G takes the load's own rule) */
+  EstimateRule         face_rule; /* for the boundary terms */
+  PetscReal           *eta2;      /* [ncells][ESTIMATE_NUM_PARTS] the squared indicators */
+  PetscReal           *volume;    /* [ncells] */
+  PetscReal            norm2;     /* the local cells' sum of sigma(u_h) : grad u_h |T|, the square of u_h's energy norm */
+  PetscInt            *face_kind; /* [fEnd - fStart]: ESTIMATE_FACE_* or the index of the face's clamp/slip/load in the scene */
+  PetscReal           *face_sum;  /* [chart][dim + 1]: sum over a face's cells of sigma n_out, and their number */
+  PetscReal           *face_geom; /* [fEnd - fStart][dim + 2]: each face's measure, diameter and unit normal */
+  PetscReal           *load_mean; /* [ncells][dim * dim]: Pi_0 G, the cells' means of a weak-data scene's G = sigma(u_exact); unused otherwise */
 } EstimateWork;
 
 enum { ESTIMATE_FACE_FREE = -1, ESTIMATE_FACE_CONTACT = -2 };

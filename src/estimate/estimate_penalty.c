@@ -47,8 +47,8 @@ static PetscReal TangentialGradientSquared(PetscInt dim, const EstimateCell *cel
 PetscErrorCode EstimatePenaltyTerm(EstimateWork *w)
 {
   const PetscInt     dim   = w->dim;
-  const Material    *mat   = &w->user->opt->material;
-  const BoundarySet *bcs   = &w->user->scene.bcs;
+  const Material    *mat   = w->mat;
+  const BoundarySet *bcs   = &w->scene->bcs;
   const PetscBool    nodal = w->pressure.nodal; /* the nodal rule */
   PetscReal         *share, sums[2] = {0.0, 0.0}, gsums[2], estar, eta2;
 
@@ -75,7 +75,7 @@ PetscErrorCode EstimatePenaltyTerm(EstimateWork *w)
         const PetscInt a = face.local[k];
         PetscReal      n[3], g;
 
-        ObstacleGapNormalAt(&w->user->scene.obstacle, dim, &cell.x[a * dim], n, &g);
+        ObstacleGapNormalAt(&w->scene->obstacle, dim, &cell.x[a * dim], n, &g);
         v[k] = -g;
         for (PetscInt d = 0; d < dim; ++d) v[k] += cell.u[a * dim + d] * n[d];
         vp[k] = PetscMax(v[k], 0.0);
@@ -93,7 +93,7 @@ PetscErrorCode EstimatePenaltyTerm(EstimateWork *w)
         } else {
           PetscReal n[3], g;
 
-          ObstacleGapNormalAt(&w->user->scene.obstacle, dim, x, n, &g);
+          ObstacleGapNormalAt(&w->scene->obstacle, dim, x, n, &g);
           d = -g;
           for (PetscInt k = 0; k < dim; ++k) d += u[k] * n[k];
           d = PetscMax(d, 0.0);

@@ -32,7 +32,7 @@
 /* The body force at x: -f0_body (which includes -body_force), or the constant body force. */
 static PetscErrorCode BodyForce(const EstimateWork *w, const PetscReal x[], PetscReal f[])
 {
-  const Scene   *scene = &w->user->scene;
+  const Scene   *scene = w->scene;
   const PetscInt dim   = w->dim;
 
   PetscFunctionBeginUser;
@@ -52,7 +52,7 @@ static PetscErrorCode BodyForce(const EstimateWork *w, const PetscReal x[], Pets
    tr(tau) I) / (2 mu), in plane strain (d = 2) as in 3D. */
 static PetscReal ComplianceSquare(const EstimateWork *w, const PetscReal tau[])
 {
-  const PetscReal lambda = w->user->opt->material.lambda, mu = w->user->opt->material.mu;
+  const PetscReal lambda = w->mat->lambda, mu = w->mat->mu;
   PetscReal       tr = 0.0, tt = 0.0;
 
   for (PetscInt d = 0; d < w->dim; ++d) tr += tau[d * w->dim + d];
@@ -72,7 +72,7 @@ static PetscErrorCode LoadOscillation(EstimateWork *w, CellQuadrature *cq, Petsc
   PetscCall(DMGetWorkArray(w->dm, cq->Nq * n, MPIU_REAL, &G));
   for (PetscInt k = 0; k < n; ++k) mean[k] = 0.0;
   for (PetscInt q = 0; q < cq->Nq; ++q) {
-    PetscCall(WeakDataExactStress(&w->user->scene, &w->user->opt->material, w->dim, &cq->x[q * w->dim], &G[q * n]));
+    PetscCall(WeakDataExactStress(w->scene, w->mat, w->dim, &cq->x[q * w->dim], &G[q * n]));
     for (PetscInt k = 0; k < n; ++k) mean[k] += cq->w[q] * G[q * n + k];
     vol += cq->w[q];
   }
@@ -90,7 +90,7 @@ static PetscErrorCode LoadOscillation(EstimateWork *w, CellQuadrature *cq, Petsc
 static void CellStress(const EstimateWork *w, const EstimateCell *cell, PetscInt c, PetscReal s[])
 {
   for (PetscInt k = 0; k < w->dim * w->dim; ++k)
-    s[k] = cell->sigma[k] - (w->user->scene.weak_data ? w->load_mean[(c - w->cStart) * w->dim * w->dim + k] : 0.0);
+    s[k] = cell->sigma[k] - (w->scene->weak_data ? w->load_mean[(c - w->cStart) * w->dim * w->dim + k] : 0.0);
 }
 
 /* |R . n|^2 / (lambda + 2 mu) + |R - (R . n) n|^2 / (2 mu): a traction R in energy units, by the stiffness of the body
@@ -109,12 +109,12 @@ static PetscReal WeightedSquare(const EstimateWork *w, const PetscReal R[], cons
 static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
 {
   const PetscInt dim      = w->dim;
-  PetscBool      has_load = (PetscBool)(w->user->scene.f0_body != NULL);
+  PetscBool      has_load = (PetscBool)(w->scene->f0_body != NULL);
   CellQuadrature cq;
 
   PetscFunctionBeginUser;
   for (PetscInt d = 0; d < dim && !has_load; ++d) has_load = (PetscBool)(PetscRealPart(w->constants[CONST_BODY_FORCE + d]) != 0.0);
-  if (w->user->scene.weak_data) PetscCall(CellQuadratureCreate(w->dm, &w->user->scene, &w->user->opt->verify, &cq));
+  if (w->scene->weak_data) PetscCall(CellQuadratureCreate(w->dm, w->scene, w->verify, &cq));
   for (PetscInt c = w->cStart; c < w->cEnd; ++c) {
     EstimateCell    cell;
     const PetscInt *cone;
@@ -122,7 +122,7 @@ static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
     PetscReal       sigma[9];
 
     PetscCall(EstimateCellLoad(w, c, &cell));
-    if (w->user->scene.weak_data) {
+    if (w->scene->weak_data) {
       PetscReal osc = 0.0;
 
       PetscCall(LoadOscillation(w, &cq, c, &w->load_mean[(c - w->cStart) * dim * dim], &osc));
@@ -164,7 +164,7 @@ static PetscErrorCode CellTerms(EstimateWork *w, PetscInt pStart)
       for (PetscInt d = 0; d < dim; ++d) geom[2 + d] = face.normal[d];
     }
   }
-  if (w->user->scene.weak_data) PetscCall(CellQuadratureDestroy(&cq));
+  if (w->scene->weak_data) PetscCall(CellQuadratureDestroy(&cq));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -180,12 +180,12 @@ static PetscErrorCode ContactFace(EstimateWork *w, PetscInt c, const EstimateCel
     sn[i] = 0.0;
     for (PetscInt j = 0; j < dim; ++j) sn[i] += sigma[i * dim + j] * face->normal[j];
   }
-  if (w->pressure.law && !w->pressure.nodal) PetscCall(ContactFaceEps(w->user->contact, cell->diameter, &eps));
+  if (w->pressure.law && !w->pressure.nodal) PetscCall(ContactFaceEps(w->contact, cell->diameter, &eps));
   for (PetscInt q = 0; q < w->face_rule.n; ++q) {
     PetscReal x[3], u[3], wq, n[3], g, p = 0.0, R[3], Rn = 0.0, Rt = 0.0;
 
     EstimateFacePoint(w, cell, face, q, x, u, &wq);
-    ObstacleGapNormalAt(&w->user->scene.obstacle, dim, x, n, &g);
+    ObstacleGapNormalAt(&w->scene->obstacle, dim, x, n, &g);
     if (w->lp) { /* the nodal pressure, stored as p n at the nodes */
       const PetscReal *b = &w->face_rule.bary[q * w->face_rule.nb];
 
@@ -198,10 +198,10 @@ static PetscErrorCode ContactFace(EstimateWork *w, PetscInt c, const EstimateCel
       p = d > 0.0 ? d / eps : 0.0;
     }
     for (PetscInt i = 0; i < dim; ++i) R[i] = sn[i] + p * n[i];
-    if (w->user->scene.weak_data) { /* the load's normal stress on Gamma_C, n_o . G n_o (sn holds (sigma(u_h) - Pi_0 G) n) */
+    if (w->scene->weak_data) { /* the load's normal stress on Gamma_C, n_o . G n_o (sn holds (sigma(u_h) - Pi_0 G) n) */
       PetscReal G[9], gnn = 0.0;
 
-      PetscCall(WeakDataExactStress(&w->user->scene, &w->user->opt->material, dim, x, G));
+      PetscCall(WeakDataExactStress(w->scene, w->mat, dim, x, G));
       for (PetscInt i = 0; i < dim; ++i)
         for (PetscInt j = 0; j < dim; ++j) gnn += n[i] * G[i * dim + j] * n[j];
       for (PetscInt i = 0; i < dim; ++i) R[i] += gnn * n[i];
@@ -221,7 +221,7 @@ static PetscErrorCode ContactFace(EstimateWork *w, PetscInt c, const EstimateCel
 static PetscErrorCode NeumannFace(EstimateWork *w, PetscInt c, const EstimateCell *cell, const EstimateFace *face, PetscInt kind, PetscReal eta2[])
 {
   const PetscInt           dim      = w->dim;
-  const BoundaryCondition *bc       = kind >= 0 ? &w->user->scene.bcs.bc[kind] : NULL;
+  const BoundaryCondition *bc       = kind >= 0 ? &w->scene->bcs.bc[kind] : NULL;
   PetscBool                fixed[3] = {PETSC_FALSE, PETSC_FALSE, PETSC_FALSE};
   PetscReal                t0[3]    = {0.0, 0.0, 0.0}, sigma[9], sn[3], R[3];
 
@@ -264,7 +264,7 @@ static PetscErrorCode FaceTerms(EstimateWork *w, PetscInt pStart)
       const PetscReal eta2 = 0.5 * geom[1] * geom[0] * WeightedSquare(w, s, &geom[2]);
 
       for (PetscInt k = 0; k < ns; ++k) w->eta2[(support[k] - w->cStart) * ESTIMATE_NUM_PARTS + ESTIMATE_JUMP] += eta2;
-    } else if (kind == ESTIMATE_FACE_CONTACT || kind == ESTIMATE_FACE_FREE || w->user->scene.bcs.bc[kind].kind != BC_CLAMP) {
+    } else if (kind == ESTIMATE_FACE_CONTACT || kind == ESTIMATE_FACE_FREE || w->scene->bcs.bc[kind].kind != BC_CLAMP) {
       PetscReal   *eta2 = &w->eta2[(support[0] - w->cStart) * ESTIMATE_NUM_PARTS];
       EstimateCell cell;
       EstimateFace face;
@@ -292,7 +292,7 @@ PetscErrorCode EstimateResidualTerms(EstimateWork *w)
   PetscCall(DMPlexGetChart(w->dm, &pStart, &pEnd));
   PetscCall(PetscCalloc1((pEnd - pStart) * (dim + 1), &w->face_sum));
   PetscCall(PetscMalloc1((w->fEnd - w->fStart) * (dim + 2), &w->face_geom));
-  if (w->user->scene.weak_data) PetscCall(PetscMalloc1((w->cEnd - w->cStart) * dim * dim, &w->load_mean));
+  if (w->scene->weak_data) PetscCall(PetscMalloc1((w->cEnd - w->cStart) * dim * dim, &w->load_mean));
   PetscCall(CellTerms(w, pStart));
   /* the faces a rank shares: their owners sum the contributions, then send the sums back */
   PetscCall(DMGetPointSF(w->dm, &sf));

@@ -5,7 +5,6 @@
    to *marked, created if NULL; *nmarked counts them over all ranks. */
 #include "contact.h"
 #include "estimate.h"
-#include "physics.h"
 
 #define MARK_BISECTIONS 60 /* halvings of [0, max eta_T]: t to 1e-18 of the largest indicator */
 
@@ -63,16 +62,16 @@ PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DM
    estimate are zero) are marked too (added to *marked, created if NULL and there is one), so that the cycles refine
    until the rule sees the contact; *nunseen counts the nodes over all ranks, *force is the force the penalty law
    would put on them. */
-PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nunseen, PetscReal *force)
+PetscErrorCode EstimateMarkUnseenContact(DM dm, Contact contact, Vec u, DMLabel *marked, PetscInt *nunseen, PetscReal *force)
 {
   const ContactSet *cs;
   PetscBool        *unseen;
   PetscInt          cStart, cEnd;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(ContactGetSet(contact, &cs));
   PetscCall(PetscMalloc1(cs->n + 1, &unseen));
-  PetscCall(ContactUnseenNodes(user->contact, u, unseen, nunseen, force));
+  PetscCall(ContactUnseenNodes(contact, u, unseen, nunseen, force));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   for (PetscInt i = 0; i < cs->n; ++i) {
     PetscInt *star = NULL, nstar;
@@ -89,16 +88,16 @@ PetscErrorCode EstimateMarkUnseenContact(DM dm, AppCtx *user, Vec u, DMLabel *ma
 }
 
 /* The cells along the contact zone's edge: the cells of the faces of Gamma_C that the edge crosses, the one-cell band
-   that floors the zone's size's bar (src/estimate/cycle_bars.c, src/physics/contact_zone.c). Doerfler's marking on the
+   that floors the zone's size's bar (src/estimate/cycle_bars.c, src/physics/contact_zone.c), the faces faces[0..n) that
+   PostprocessContactEdgeFaces() finds. Doerfler's marking on the
    energy-norm indicators refines them only where the energy's error is, while the size's bar cannot fall below the
    band: marking them too halves the band at each cycle (-adapt_mark_edge). Added to *marked, created if NULL and there
    is one; *nmarked counts the cells over all ranks. */
-PetscErrorCode EstimateMarkContactEdge(DM dm, AppCtx *user, Vec u, DMLabel *marked, PetscInt *nmarked)
+PetscErrorCode EstimateMarkContactEdge(DM dm, PetscInt n, const PetscInt faces[], DMLabel *marked, PetscInt *nmarked)
 {
-  PetscInt *faces, n, local = 0;
+  PetscInt local = 0;
 
   PetscFunctionBeginUser;
-  PetscCall(PostprocessContactEdgeFaces(dm, user->contact, &user->scene.bcs, &user->opt->material, u, &n, &faces));
   for (PetscInt i = 0; i < n; ++i) {
     const PetscInt *support;
 
@@ -107,7 +106,6 @@ PetscErrorCode EstimateMarkContactEdge(DM dm, AppCtx *user, Vec u, DMLabel *mark
     PetscCall(DMLabelSetValue(*marked, support[0], DM_ADAPT_REFINE));
     ++local;
   }
-  PetscCall(PetscFree(faces));
   PetscCall(MPIU_Allreduce(&local, nmarked, 1, MPIU_INT, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

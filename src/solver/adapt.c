@@ -236,7 +236,16 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
 
   PetscFunctionBeginUser;
   PetscCall(EstimateReset(&user->rec.estimate));
-  PetscCall(EstimateCompute(dm, user, u));
+  if (user->opt->estimate) { /* always: -adapt_cycles refuses -estimate false (AdaptCheck()) */
+    const EstimateRun run = {.scene   = &user->scene,
+                             .mat     = &user->opt->material,
+                             .verify  = &user->opt->verify,
+                             .contact = user->contact,
+                             .degree  = user->opt->degree,
+                             .loc_bc  = user->prob.loc_bc};
+
+    PetscCall(EstimateCompute(dm, &run, u, &user->rec.estimate));
+  }
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   local = cEnd - cStart;
   PetscCall(MPIU_Allreduce(&local, &c->n_cells, 1, MPIU_INT, MPIU_SUM, PetscObjectComm((PetscObject)dm)));
@@ -260,7 +269,16 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
   }
   c->error_energy = PETSC_NAN;
   if (user->scene.exact) {
-    PetscCall(ErrorNormsCompute(dm, user, u));
+    const VerifyRun run = {.opt     = &user->opt->verify,
+                           .scene   = &user->scene,
+                           .mat     = &user->opt->material,
+                           .degree  = user->opt->degree,
+                           .contact = user->contact,
+                           .h       = user->prob.h,
+                           .loc_bc  = user->prob.loc_bc,
+                           .K       = user->prob.K};
+
+    PetscCall(ErrorNormsCompute(dm, &run, u, &user->rec.errors));
     c->error_energy = user->rec.errors.energy;
   }
   user->rec.ncycles = k + 1;
@@ -608,8 +626,9 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     PetscCall(AdaptRecord(*dm, user, *u, k));
     PetscCall(AdaptQuantitiesAtSmallerEps(*dm, user, *snes, *u, c));
     c->time_mesh = time_mesh;
-    PetscCall(CycleBarsCompute(user, dim, k));
-    PetscCall(EstimateMarkUnseenContact(*dm, user, *u, &marked, &c->unseen, &c->unseen_force)); /* the cells around the contact the mesh misses */
+    PetscCall(CycleBarsCompute(user->rec.cycles, dim, k));
+    /* the cells around the contact the mesh misses */
+    PetscCall(EstimateMarkUnseenContact(*dm, user->contact, *u, &marked, &c->unseen, &c->unseen_force));
     c->accurate    = Accurate(ad, user->rec.accuracy_target, c);
     c->marked_edge = 0;
     at_max         = (PetscBool)(ad->max_dofs > 0 && c->n_dofs >= ad->max_dofs);
@@ -624,8 +643,13 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     if (!c->accurate && k < ad->cycles && user->rec.stats.converged && !at_max && fixed_eps < 0 && !at_memory && unreachable < 0) {
       PetscCall(EstimateMark(*dm, &user->rec.estimate, user->rec.adapt_fraction, &marked, &c->marked));
       if (ad->mark_edge && ad->accuracy > 0.0 && user->rec.accuracy_target[ACCURACY_SIZE] &&
-          c->q.contact_size_band > ad->accuracy * PetscAbsReal(c->q.contact_size))
-        PetscCall(EstimateMarkContactEdge(*dm, user, *u, &marked, &c->marked_edge));
+          c->q.contact_size_band > ad->accuracy * PetscAbsReal(c->q.contact_size)) {
+        PetscInt *faces, nfaces;
+
+        PetscCall(PostprocessContactEdgeFaces(*dm, user->contact, &user->scene.bcs, &user->opt->material, *u, &nfaces, &faces));
+        PetscCall(EstimateMarkContactEdge(*dm, nfaces, faces, &marked, &c->marked_edge));
+        PetscCall(PetscFree(faces));
+      }
     }
     PetscCall(PetscTime(&t0)); /* the cycle: its mesh, its solve (the first solve for cycle 0), estimate and marking */
     c->time_cycle = (t0 - t_last) + (k == 0 ? c->time_solve : 0.0);

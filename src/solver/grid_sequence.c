@@ -105,7 +105,7 @@ static PetscErrorCode Remesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel m
   }
   PetscCall(LocalSolution(*dm, user, *u, &loc));
   PetscCall(MeshTransferCreateFromField(*dm, loc, &tr));
-  if (user->rec.bars.pressure_recorded) PetscCall(BarsPressureTransferCreate(*dm, user, loc, &tr_p)); /* -bars's 2h pressure */
+  if (user->rec.bars.pressure_recorded) PetscCall(BarsPressureTransferCreate(*dm, &user->rec.bars, loc, &tr_p)); /* -bars's 2h pressure */
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
   PetscCall(MeshRemesh(*dm, user->opt->adapt.model, &user->box, size, &fine));
@@ -117,7 +117,7 @@ static PetscErrorCode Remesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel m
   PetscCall(DMCreateLocalVector(fine, &loc));
   PetscCall(MeshTransferApply(tr, fine, loc));
   PetscCall(MeshTransferDestroy(&tr));
-  if (tr_p) PetscCall(BarsPressureTransferApply(fine, user, loc, &tr_p));
+  if (tr_p) PetscCall(BarsPressureTransferApply(fine, &user->rec.bars, loc, &tr_p));
   PetscCall(TakeMesh(dm, fine, &loc, u));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -284,7 +284,7 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
     const ContactSet *cs;
 
     PetscCall(ContactGetSet(user->contact, &cs));
-    PetscCall(BarsRecordPressure(dm, user, cs->pressure, NULL)); /* the pressure's band: no penalty part */
+    PetscCall(BarsRecordPressure(dm, user->contact, cs->pressure, NULL, b)); /* the pressure's band: no penalty part */
   } else if (user->prob.level == first + BARS_EPS_LEVEL) {
     const RunStats    saved = user->rec.stats;
     const ContactSet *cs;
@@ -306,7 +306,7 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
       PostprocessGetQuantities(&user->rec.stats, &b->eps_level);
       b->eps_done = PETSC_TRUE;
     }
-    PetscCall(BarsRecordPressure(dm, user, p_eps, b->eps_done ? cs->pressure : NULL));
+    PetscCall(BarsRecordPressure(dm, user->contact, p_eps, b->eps_done ? cs->pressure : NULL, b));
     PetscCall(PetscFree(p_eps));
     PetscCall(ContactSetEps(user->contact, dm, b->eps));
     PetscCall(VecCopy(u0, u));

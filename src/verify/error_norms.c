@@ -18,7 +18,7 @@ PetscErrorCode ErrorNormsReset(ErrorNorms *e)
 }
 
 /* loc_p = p n at the nodes of Gamma_C, from the nodal pressures of the contact set (zero elsewhere). */
-PetscErrorCode ErrorNormsPressureVector(DM dm, AppCtx *user, Vec loc_p)
+PetscErrorCode ErrorNormsPressureVector(DM dm, Contact contact, Vec loc_p)
 {
   Vec               P;
   PetscScalar      *p;
@@ -30,7 +30,7 @@ PetscErrorCode ErrorNormsPressureVector(DM dm, AppCtx *user, Vec loc_p)
   PetscCall(DMGetGlobalVector(dm, &P));
   PetscCall(VecZeroEntries(P));
   PetscCall(VecGetArray(P, &p));
-  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(ContactGetSet(contact, &cs));
   for (PetscInt i = 0; i < cs->n; ++i) /* fixed components stay 0 */
     for (PetscInt c = 0; c < dim; ++c)
       if (cs->dof[i * dim + c] >= 0) p[cs->dof[i * dim + c]] = cs->pressure[i] * cs->normal[i * dim + c];
@@ -42,7 +42,7 @@ PetscErrorCode ErrorNormsPressureVector(DM dm, AppCtx *user, Vec loc_p)
 }
 
 /* Integrals over Omega: |e|^2, |grad e|^2 and sigma(e) : grad e with e = u_target - u_h. */
-static PetscErrorCode IntegrateBulk(DM dm, AppCtx *user, CellQuadrature *cq, Vec loc_uh, const ErrorTarget *t, PetscReal sums[3])
+static PetscErrorCode IntegrateBulk(DM dm, const Material *mat, CellQuadrature *cq, Vec loc_uh, const ErrorTarget *t, PetscReal sums[3])
 {
   const PetscInt dim = cq->dim;
   PetscInt       cStart, cEnd;
@@ -80,7 +80,7 @@ static PetscErrorCode IntegrateBulk(DM dm, AppCtx *user, CellQuadrature *cq, Vec
         g[k] = gt[k] - g[k];
         s1 += PetscSqr(g[k]);
       }
-      ElasticStress(dim, &user->opt->material, g, sigma);
+      ElasticStress(dim, mat, g, sigma);
       for (PetscInt k = 0; k < dim * dim; ++k) s2 += sigma[k] * g[k];
       sums[0] += cq->w[q] * s0;
       sums[1] += cq->w[q] * s1;
@@ -94,7 +94,7 @@ static PetscErrorCode IntegrateBulk(DM dm, AppCtx *user, CellQuadrature *cq, Vec
 
 /* Integrals over Gamma_C: R^2 and [d]_+^2, the max of [d]_+, and the load b_i = int R phi_i . n of the dual problem.
    Without a target (t == NULL) only the penetration is integrated. */
-static PetscErrorCode IntegrateContact(DM dm, const PetscReal run_cell_h[], AppCtx *user, CellQuadrature *cq, Vec loc_uh, Vec loc_ph,
+static PetscErrorCode IntegrateContact(DM dm, const PetscReal run_cell_h[], const VerifyRun *run, CellQuadrature *cq, Vec loc_uh, Vec loc_ph,
                                        const ErrorTarget *t, Vec loc_b, PetscReal sums[2], PetscReal *dmax)
 {
   const PetscInt dim = cq->dim;
@@ -106,8 +106,8 @@ static PetscErrorCode IntegrateContact(DM dm, const PetscReal run_cell_h[], AppC
   PetscFunctionBeginUser;
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, NULL));
   PetscCall(PetscMalloc1(PetscMax(cq->Nb, 1), &elem));
-  for (PetscInt s = 0; s < user->scene.bcs.ncontact; ++s) {
-    PetscCall(MeshGetBoundaryFaces(dm, user->scene.bcs.contact_ids[s], &nf, &faces)); /* of this mesh, maybe a refinement of the run's */
+  for (PetscInt s = 0; s < run->scene->bcs.ncontact; ++s) {
+    PetscCall(MeshGetBoundaryFaces(dm, run->scene->bcs.contact_ids[s], &nf, &faces)); /* of this mesh, maybe a refinement of the run's */
     for (PetscInt i = 0; i < nf; ++i) {
       PetscScalar *uh = NULL, *ph = NULL, *pr = NULL;
 
@@ -119,7 +119,7 @@ static PetscErrorCode IntegrateContact(DM dm, const PetscReal run_cell_h[], AppC
           diam = run_cell_h[cq->cell - cStart];
         else
           PetscCall(MeshCellDiameter(dm, cq->cell, &diam));
-        PetscCall(ContactFaceEps(user->contact, diam, &eps));
+        PetscCall(ContactFaceEps(run->contact, diam, &eps));
       }
       PetscCall(DMPlexVecGetClosure(dm, NULL, loc_uh, cq->cell, NULL, &uh));
       if (loc_ph) PetscCall(DMPlexVecGetClosure(dm, NULL, loc_ph, cq->cell, NULL, &ph));
@@ -130,7 +130,7 @@ static PetscErrorCode IntegrateContact(DM dm, const PetscReal run_cell_h[], AppC
         PetscReal        u[3], v[3], n[3], d, p_h = 0.0, p_target = 0.0, R;
 
         PetscCall(CellQuadratureInterpolate(cq, uh, q, u, NULL));
-        ObstacleGapNormalAt(&user->scene.obstacle, dim, x, n, &d);
+        ObstacleGapNormalAt(&run->scene->obstacle, dim, x, n, &d);
         d = -d;
         for (PetscInt k = 0; k < dim; ++k) d += u[k] * n[k];
         sums[1] += cq->w[q] * PetscSqr(PetscMax(d, 0.0));
@@ -144,7 +144,7 @@ static PetscErrorCode IntegrateContact(DM dm, const PetscReal run_cell_h[], AppC
         if (t->scene) {
           PetscReal sn;
 
-          PetscCall(WeakDataExactNormalStress(&user->scene, &user->opt->material, dim, x, &sn));
+          PetscCall(WeakDataExactNormalStress(run->scene, run->mat, dim, x, &sn));
           p_target = -sn;
         } else {
           PetscCall(CellQuadratureInterpolate(cq, pr, q, v, NULL));
@@ -217,7 +217,7 @@ static PetscErrorCode DualNorm(DM dm, Mat K, Vec loc_b, PetscReal *norm)
    K is the elastic operator of dm for the dual norm. Without a target (NULL) only the penetration norms. run_cell_h:
    for each cell of dm, the diameter of the run's cell that holds it, whose local eps the penalty law takes (NULL: dm
    is the run's mesh). */
-PetscErrorCode ErrorNormsEvaluate(DM dm, const PetscReal run_cell_h[], AppCtx *user, Mat K, Vec loc_uh, Vec loc_ph, const ErrorTarget *target,
+PetscErrorCode ErrorNormsEvaluate(DM dm, const PetscReal run_cell_h[], const VerifyRun *run, Mat K, Vec loc_uh, Vec loc_ph, const ErrorTarget *target,
                                   ErrorNorms *e)
 {
   MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
@@ -227,13 +227,13 @@ PetscErrorCode ErrorNormsEvaluate(DM dm, const PetscReal run_cell_h[], AppCtx *u
 
   PetscFunctionBeginUser;
   PetscCall(ErrorNormsReset(e));
-  PetscCall(CellQuadratureCreate(dm, &user->scene, &user->opt->verify, &cq));
+  PetscCall(CellQuadratureCreate(dm, run->scene, run->opt, &cq));
   if (target) {
     PetscCall(DMGetLocalVector(dm, &loc_b));
     PetscCall(VecZeroEntries(loc_b));
-    PetscCall(IntegrateBulk(dm, user, &cq, loc_uh, target, bulk));
+    PetscCall(IntegrateBulk(dm, run->mat, &cq, loc_uh, target, bulk));
   }
-  PetscCall(IntegrateContact(dm, run_cell_h, user, &cq, loc_uh, loc_ph, target, loc_b, contact, &dmax));
+  PetscCall(IntegrateContact(dm, run_cell_h, run, &cq, loc_uh, loc_ph, target, loc_b, contact, &dmax));
   PetscCall(CellQuadratureDestroy(&cq));
   PetscCall(MPIU_Allreduce(bulk, gbulk, 3, MPIU_REAL, MPIU_SUM, comm));
   PetscCall(MPIU_Allreduce(contact, gcontact, 2, MPIU_REAL, MPIU_SUM, comm));
@@ -241,11 +241,11 @@ PetscErrorCode ErrorNormsEvaluate(DM dm, const PetscReal run_cell_h[], AppCtx *u
   e->penetration_l2  = PetscSqrtReal(gcontact[1]);
   e->penetration_max = PetscMax(gmax, 0.0);
   if (target) {
-    PetscReal           weight = user->prob.h;
+    PetscReal           weight = run->h;
     ContactPressureForm form;
 
-    PetscCall(ContactGetPressureForm(user->contact, &form));
-    if (form.law) PetscCall(ContactGetEps(user->contact, &weight)); /* eps^1/2 ||R|| for the penalty, h^1/2 ||R|| otherwise */
+    PetscCall(ContactGetPressureForm(run->contact, &form));
+    if (form.law) PetscCall(ContactGetEps(run->contact, &weight)); /* eps^1/2 ||R|| for the penalty, h^1/2 ||R|| otherwise */
 
     e->l2                = PetscSqrtReal(gbulk[0]);
     e->h1_semi           = PetscSqrtReal(gbulk[1]);
@@ -259,32 +259,32 @@ PetscErrorCode ErrorNormsEvaluate(DM dm, const PetscReal run_cell_h[], AppCtx *u
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The norms of the run: penetration always, the errors when the scene has an exact solution, and against -reference. */
-PetscErrorCode ErrorNormsCompute(DM dm, AppCtx *user, Vec u)
+/* The norms of the run into *e: penetration always, the errors when the scene has an exact solution. */
+PetscErrorCode ErrorNormsCompute(DM dm, const VerifyRun *run, Vec u, ErrorNorms *e)
 {
   Vec                 loc_uh, loc_ph = NULL;
-  ErrorTarget         exact = {&user->scene, NULL, NULL};
+  ErrorTarget         exact = {run->scene, NULL, NULL};
   ContactPressureForm form;
 
   PetscFunctionBeginUser;
   PetscCall(MeshIndexCellTypes(dm)); /* the closures below look each point's cell type up: sorted, not hashed */
-  PetscCall(ErrorNormsReset(&user->rec.errors));
+  PetscCall(ErrorNormsReset(e));
   PetscCall(DMGetLocalVector(dm, &loc_uh));
-  PetscCall(VecCopy(user->prob.loc_bc, loc_uh)); /* the Dirichlet values, inserted once by ProblemSetUp() */
+  PetscCall(VecCopy(run->loc_bc, loc_uh)); /* the Dirichlet values, inserted once by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc_uh));
-  PetscCall(ContactGetPressureForm(user->contact, &form));
+  PetscCall(ContactGetPressureForm(run->contact, &form));
   if (!form.law) { /* the nodal pressure, where no law gives it at every point */
     PetscCall(DMGetLocalVector(dm, &loc_ph));
-    PetscCall(ErrorNormsPressureVector(dm, user, loc_ph));
+    PetscCall(ErrorNormsPressureVector(dm, run->contact, loc_ph));
   }
-  if (user->scene.exact && user->scene.exact_gradient) {
+  if (run->scene->exact && run->scene->exact_gradient) {
     Mat K;
 
-    PetscCall(ContactBulkOperator(user->contact, user->prob.K, &K)); /* K, or a copy without the penalty Jacobian: K is read only */
-    PetscCall(ErrorNormsEvaluate(dm, NULL, user, K, loc_uh, loc_ph, &exact, &user->rec.errors));
+    PetscCall(ContactBulkOperator(run->contact, run->K, &K)); /* K, or a copy without the penalty Jacobian: K is read only */
+    PetscCall(ErrorNormsEvaluate(dm, NULL, run, K, loc_uh, loc_ph, &exact, e));
     PetscCall(MatDestroy(&K));
   } else
-    PetscCall(ErrorNormsEvaluate(dm, NULL, user, NULL, loc_uh, loc_ph, NULL, &user->rec.errors));
+    PetscCall(ErrorNormsEvaluate(dm, NULL, run, NULL, loc_uh, loc_ph, NULL, e));
   if (loc_ph) PetscCall(DMRestoreLocalVector(dm, &loc_ph));
   PetscCall(DMRestoreLocalVector(dm, &loc_uh));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -194,9 +194,9 @@ static PetscBool ReferenceHasCell(const Reference *ref, const PetscInt v[])
 /* The checks of the reference's /run against this run: same scene and dimension, converged, degree 1. */
 /* The reference solved this run's problem: its /run attribute "problem" (scenes/fingerprint.c) equals this run's; the
    message names the first item that differs. */
-static PetscErrorCode ReferenceCheckProblem(MPI_Comm comm, const AppCtx *user, PetscInt dim, PetscViewer v)
+static PetscErrorCode ReferenceCheckProblem(MPI_Comm comm, const VerifyRun *run, PetscInt dim, PetscViewer v)
 {
-  const char *file = user->opt->verify.reference;
+  const char *file = run->opt->reference;
   char        mine[SCENE_FINGERPRINT_LEN], *theirs = NULL;
   PetscBool   has, same;
 
@@ -206,7 +206,7 @@ static PetscErrorCode ReferenceCheckProblem(MPI_Comm comm, const AppCtx *user, P
              "Reference file %s has no /run attribute problem (written by an older version of the solver): the problem it solved cannot be "
              "compared with this run's; run the reference again",
              file);
-  PetscCall(SceneFingerprint(&user->scene, &user->opt->material, dim, mine, sizeof(mine)));
+  PetscCall(SceneFingerprint(run->scene, run->mat, dim, mine, sizeof(mine)));
   PetscCall(PetscViewerHDF5ReadAttribute(v, "/run", "problem", PETSC_STRING, NULL, &theirs));
   PetscCall(PetscStrcmp(mine, theirs, &same));
   if (!same) {
@@ -232,9 +232,9 @@ static PetscErrorCode ReferenceCheckProblem(MPI_Comm comm, const AppCtx *user, P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, PetscInt dim, PetscViewer v, PetscInt *ref_dim, PetscInt *ncells)
+static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const VerifyRun *run, PetscInt dim, PetscViewer v, PetscInt *ref_dim, PetscInt *ncells)
 {
-  const char *file       = user->opt->verify.reference;
+  const char *file       = run->opt->reference;
   const char *datasets[] = {"/geometry/vertices", "/vertex_fields/displacement", "/vertex_fields/contact_pressure", "/viz/topology/cells"};
   PetscInt    converged, degree;
   char       *scene = NULL;
@@ -250,16 +250,16 @@ static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, Pe
   PetscCall(PetscViewerHDF5HasAttribute(v, "/run", "scene", &has));
   PetscCheck(has, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "Reference file %s has no /run attribute scene: not an output of this solver", file);
   PetscCall(PetscViewerHDF5ReadAttribute(v, "/run", "scene", PETSC_STRING, NULL, &scene));
-  PetscCall(PetscStrcmp(scene, user->scene.name, &same));
-  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "Reference %s is a run of scene %s, this is scene %s", file, scene, user->scene.name);
+  PetscCall(PetscStrcmp(scene, run->scene->name, &same));
+  PetscCheck(same, comm, PETSC_ERR_USER_INPUT, "Reference %s is a run of scene %s, this is scene %s", file, scene, run->scene->name);
   PetscCall(PetscFree(scene));
-  PetscCall(ReferenceCheckProblem(comm, user, dim, v));
+  PetscCall(ReferenceCheckProblem(comm, run, dim, v));
   PetscCheck(*ref_dim == dim, comm, PETSC_ERR_USER_INPUT, "Reference %s is %" PetscInt_FMT "D, this run is %" PetscInt_FMT "D", file, *ref_dim, dim);
   PetscCheck(converged == 1, comm, PETSC_ERR_USER_INPUT, "Reference %s did not converge (/run converged = 0)", file);
-  PetscCheck(degree == 1 && user->opt->degree == 1, comm, PETSC_ERR_USER_INPUT,
+  PetscCheck(degree == 1 && run->degree == 1, comm, PETSC_ERR_USER_INPUT,
              "-reference needs degree 1 in the run and the reference (they are compared through vertex values); got %" PetscInt_FMT
              " and %" PetscInt_FMT,
-             user->opt->degree, degree);
+             run->degree, degree);
   for (size_t i = 0; i < sizeof(datasets) / sizeof(datasets[0]); ++i) {
     PetscCall(PetscViewerHDF5HasDataset(v, datasets[i], &has));
     PetscCheck(has, PETSC_COMM_SELF, PETSC_ERR_USER_INPUT, "Reference file %s has no dataset %s: not an output of this solver", file, datasets[i]);
@@ -268,9 +268,9 @@ static PetscErrorCode ReferenceCheckHeader(MPI_Comm comm, const AppCtx *user, Pe
 }
 
 /* Before the solve: the -reference file (if any) opens as HDF5 and fits this run (ReferenceCheckHeader()). */
-PetscErrorCode ReferenceCheckFile(DM dm, const AppCtx *user)
+PetscErrorCode ReferenceCheckFile(DM dm, const VerifyRun *run)
 {
-  const char    *file = user->opt->verify.reference;
+  const char    *file = run->opt->reference;
   PetscViewer    v;
   PetscInt       dim, ref_dim, ncells;
   PetscErrorCode ierr;
@@ -286,7 +286,7 @@ PetscErrorCode ReferenceCheckFile(DM dm, const AppCtx *user)
   PetscCall(PetscPopErrorHandler());
   if (ierr) PetscCall(OutputFileLeaveDirectory(cwd));
   PetscCheck(!ierr, PETSC_COMM_SELF, PETSC_ERR_FILE_OPEN, "Reference file '%s' (-reference) cannot be opened as an HDF5 file", file);
-  PetscCall(ReferenceCheckHeader(PetscObjectComm((PetscObject)dm), user, dim, v, &ref_dim, &ncells));
+  PetscCall(ReferenceCheckHeader(PetscObjectComm((PetscObject)dm), run, dim, v, &ref_dim, &ncells));
   PetscCall(PetscViewerDestroy(&v));
   PetscCall(OutputFileLeaveDirectory(cwd));
   { /* the reference's mesh is this one refined uniformly (the final mesh of nested iteration too: this one refined) */
@@ -301,9 +301,9 @@ PetscErrorCode ReferenceCheckFile(DM dm, const AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode ReferenceRead(MPI_Comm comm, const AppCtx *user, PetscInt dim, Reference *ref)
+static PetscErrorCode ReferenceRead(MPI_Comm comm, const VerifyRun *run, PetscInt dim, Reference *ref)
 {
-  const char *file = user->opt->verify.reference;
+  const char *file = run->opt->reference;
   PetscViewer v;
   PetscInt    n;
   PetscReal  *cells;
@@ -314,7 +314,7 @@ static PetscErrorCode ReferenceRead(MPI_Comm comm, const AppCtx *user, PetscInt 
   PetscCall(PetscMemzero(ref, sizeof(*ref)));
   PetscCall(OutputFileEnterDirectory(file, &cwd, base, sizeof(base))); /* read by its short name */
   PetscCall(PetscViewerHDF5Open(PETSC_COMM_SELF, base, FILE_MODE_READ, &v));
-  PetscCall(ReferenceCheckHeader(comm, user, dim, v, &ref->dim, &ref->ncells));
+  PetscCall(ReferenceCheckHeader(comm, run, dim, v, &ref->dim, &ref->ncells));
   PetscCall(ReadArray(v, file, "/geometry", "vertices", &n, &ref->x));
   ref->nv = n / dim;
   PetscCall(ReadArray(v, file, "/vertex_fields", "displacement", &n, &ref->u));
@@ -376,7 +376,7 @@ static PetscErrorCode RefineAndInterpolate(DM dm, PetscInt levels, PetscInt nvec
 
 /* Fills the reference displacement and pressure (as p n) into local vectors of fine, vertex by vertex, after checking
    that every vertex and cell of fine is one of the reference. */
-static PetscErrorCode MatchReference(DM fine, const AppCtx *user, const Reference *ref, Vec loc_u, Vec loc_p)
+static PetscErrorCode MatchReference(DM fine, const VerifyRun *run, const Reference *ref, Vec loc_u, Vec loc_p)
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)fine);
   const PetscInt     dim  = ref->dim;
@@ -406,7 +406,7 @@ static PetscErrorCode MatchReference(DM fine, const AppCtx *user, const Referenc
 
     PetscCall(PetscSectionGetOffset(csec, v, &coff));
     for (PetscInt d = 0; d < dim; ++d) x[d] = PetscRealPart(xc[coff + d]);
-    ObstacleGapNormalAt(&user->scene.obstacle, dim, x, n, &gap);
+    ObstacleGapNormalAt(&run->scene->obstacle, dim, x, n, &gap);
     i                = ReferenceFindVertex(ref, x);
     vmap[v - vStart] = i;
     if (i < 0) {
@@ -440,15 +440,16 @@ static PetscErrorCode MatchReference(DM fine, const AppCtx *user, const Referenc
   PetscCheck(!nbad[0], comm, PETSC_ERR_USER_INPUT,
              "Reference %s does not match: a vertex of this mesh refined is not one of its vertices. Run the reference on the same coarse mesh "
              "with a larger -dm_refine",
-             user->opt->verify.reference);
+             run->opt->reference);
   PetscCheck(!nbad[1], comm, PETSC_ERR_USER_INPUT,
              "Reference %s does not match: its vertices are those of this mesh refined, but not its cells. Run the reference on the same coarse "
              "mesh with a larger -dm_refine",
-             user->opt->verify.reference);
+             run->opt->reference);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
+/* The norms of the run against the -reference solution into *e (NaN without -reference). */
+PetscErrorCode ReferenceCompute(DM dm, const VerifyRun *run, Vec u, ErrorNorms *e)
 {
   MPI_Comm            comm = PetscObjectComm((PetscObject)dm);
   Reference           ref;
@@ -461,44 +462,44 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   PetscReal          *run_cell_h;
 
   PetscFunctionBeginUser;
-  PetscCall(ErrorNormsReset(&user->rec.ref_errors));
-  if (!user->opt->verify.reference[0]) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ErrorNormsReset(e));
+  if (!run->opt->reference[0]) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(ReferenceRead(comm, user, dim, &ref));
+  PetscCall(ReferenceRead(comm, run, dim, &ref));
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   PetscCall(MeshCountOwned(dm, cStart, cEnd, &ncells));
   while ((PetscInt64)ncells << (dim * levels) < (PetscInt64)ref.ncells && levels < 8) ++levels;
   PetscCheck((PetscInt64)ncells << (dim * levels) == (PetscInt64)ref.ncells, comm, PETSC_ERR_USER_INPUT,
-             "Reference %s has %" PetscInt_FMT " cells, which is not this mesh (%" PetscInt_FMT " cells) uniformly refined",
-             user->opt->verify.reference, ref.ncells, ncells);
+             "Reference %s has %" PetscInt_FMT " cells, which is not this mesh (%" PetscInt_FMT " cells) uniformly refined", run->opt->reference,
+             ref.ncells, ncells);
 
   /* the run's displacement and, without the penalty law, its nodal pressure, on the refined mesh */
-  PetscCall(ContactGetPressureForm(user->contact, &form));
+  PetscCall(ContactGetPressureForm(run->contact, &form));
   nvec = form.law ? 1 : 2;
   PetscCall(DMCreateLocalVector(dm, &loc[0]));
-  PetscCall(VecCopy(user->prob.loc_bc, loc[0])); /* the Dirichlet values, inserted by ProblemSetUp() */
+  PetscCall(VecCopy(run->loc_bc, loc[0])); /* the Dirichlet values, inserted by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, loc[0]));
   if (nvec == 2) {
     PetscCall(DMCreateLocalVector(dm, &loc[1]));
-    PetscCall(ErrorNormsPressureVector(dm, user, loc[1]));
+    PetscCall(ErrorNormsPressureVector(dm, run->contact, loc[1]));
   }
   PetscCall(RefineAndInterpolate(dm, levels, nvec, loc, &fine, fine_loc, &run_cell_h));
   for (PetscInt k = 0; k < nvec; ++k) PetscCall(VecDestroy(&loc[k]));
 
   PetscCall(DMCreateLocalVector(fine, &loc_uref));
   PetscCall(DMCreateLocalVector(fine, &loc_pref));
-  PetscCall(MatchReference(fine, user, &ref, loc_uref, loc_pref));
+  PetscCall(MatchReference(fine, run, &ref, loc_uref, loc_pref));
   PetscCall(ReferenceDestroy(&ref));
 
   if (levels == 0)
-    PetscCall(ContactBulkOperator(user->contact, user->prob.K, &K)); /* the run's bulk operator, K read only */
+    PetscCall(ContactBulkOperator(run->contact, run->K, &K)); /* the run's bulk operator, K read only */
   else {
     Vec locX;
 
     PetscCall(DMCreateMatrix(fine, &K));
     PetscCall(DMGetLocalVector(fine, &locX));
     PetscCall(VecZeroEntries(locX));
-    PetscCall(DMPlexSNESComputeJacobianFEM(fine, locX, K, K, user));
+    PetscCall(DMPlexSNESComputeJacobianFEM(fine, locX, K, K, NULL)); /* the weak form's kernels read the constants of the DS, no context */
     PetscCall(DMRestoreLocalVector(fine, &locX));
     PetscCall(MatAssemblyBegin(K, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(K, MAT_FINAL_ASSEMBLY));
@@ -506,9 +507,9 @@ PetscErrorCode ReferenceCompute(DM dm, AppCtx *user, Vec u)
   target.scene        = NULL;
   target.loc_u        = loc_uref;
   target.loc_pressure = loc_pref;
-  PetscCall(ErrorNormsEvaluate(fine, run_cell_h, user, K, fine_loc[0], nvec == 2 ? fine_loc[1] : NULL, &target, &user->rec.ref_errors));
+  PetscCall(ErrorNormsEvaluate(fine, run_cell_h, run, K, fine_loc[0], nvec == 2 ? fine_loc[1] : NULL, &target, e));
   PetscCall(PetscFree(run_cell_h));
-  PetscCall(PetscInfo(dm, "Reference %s: %" PetscInt_FMT " refinement(s)\n", user->opt->verify.reference, levels));
+  PetscCall(PetscInfo(dm, "Reference %s: %" PetscInt_FMT " refinement(s)\n", run->opt->reference, levels));
 
   PetscCall(MatDestroy(&K));
   for (PetscInt k = 0; k < nvec; ++k) PetscCall(VecDestroy(&fine_loc[k]));
