@@ -50,3 +50,5 @@ PetscErrorCode BarsPressureTransferApply(DM fine, ErrorBars *b, Vec fine_loc, Me
    pressure's band at the contact set's nodes, into *b, from the levels b recorded */
 PetscErrorCode BarsCompute(DM dm, const BoundarySet *bcs, Contact contact, const Quantities *q, PetscBool converged, ErrorBars *b);
 PetscErrorCode BarsView(MPI_Comm comm, const ErrorBars *b);
+PetscErrorCode EstimateWrite(const ErrorEstimate *est, PetscViewer v); /* its part of /run */
+PetscErrorCode BarsWrite(const ErrorBars *b, PetscViewer v);           /* -bars' part of /run */

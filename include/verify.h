@@ -34,3 +34,4 @@ PetscErrorCode ErrorNormsCompute(DM dm, const VerifyRun *run, Vec u, ErrorNorms 
 PetscErrorCode ReferenceCompute(DM dm, const VerifyRun *run, Vec u, ErrorNorms *e);
 /* before the solve: the -reference file fits the run (reads run's opt, scene, mat and degree only) */
 PetscErrorCode ReferenceCheckFile(DM dm, const VerifyRun *run);
+PetscErrorCode VerifyWrite(const VerifyOptions *opt, const ErrorNorms *errors, const ErrorNorms *ref_errors, PetscViewer v); /* their part of /run */

@@ -116,6 +116,9 @@ static PetscErrorCode WriteResults(DM dm, const AppCtx *user, Vec u, PetscViewer
   PetscCall(ContactWrite(user->contact, v));
   PetscCall(PostprocessWrite(&user->rec.stats, &user->scene.bcs, dim, v));
   PetscCall(ContactChecksWrite(comm, &user->rec.stats.checks, v));
+  PetscCall(VerifyWrite(&user->opt->verify, &user->rec.errors, &user->rec.ref_errors, v));
+  PetscCall(EstimateWrite(&user->rec.estimate, v));
+  PetscCall(BarsWrite(&user->rec.bars, v));
   PetscCall(SolverWrite(&user->rec.stats, &user->prob, &user->opt->solver, user->box.coarse_levels, user->rec.nrecords, v));
   PetscCall(SolverWriteSolves(comm, user->rec.records, user->rec.nrecords, v));
   PetscCall(PenetrationTolWrite(user->contact, &user->rec.stats, v));

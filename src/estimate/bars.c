@@ -39,6 +39,7 @@
 #include "contact.h"
 #include "estimate.h"
 #include "physics.h"
+#include "app.h"
 
 #define BARS_SAFETY 1.25           /* Roache's safety factor of a three-mesh study with its observed order */
 #define BARS_SAFETY_TWO_LEVELS 3.0 /*   and of a two-level one whose order comes from theory */
@@ -456,6 +457,23 @@ PetscErrorCode BarsView(MPI_Comm comm, const ErrorBars *b)
     else
       PetscCall(PetscPrintf(comm, "    %-24s %.6g +- %.2g (mesh %.2g, eps %.2g; observed order %.2f)\n", b->name[k], (double)b->value[k],
                             (double)b->bar[k], (double)b->bar_mesh[k], (double)b->bar_eps[k], (double)b->order[k]));
+  }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* -bars in /run: for each quantity NAME, qoi_NAME, its bar, the bar's two parts and the observed order (where each is
+   known), or qoi_NAME_note saying why there is no bar. */
+PetscErrorCode BarsWrite(const ErrorBars *b, PetscViewer v)
+{
+  const char *suffix[] = {"", "_bar", "_bar_mesh", "_bar_eps", "_order"};
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < b->n; ++k) {
+    const PetscReal values[] = {b->value[k], b->bar[k], b->bar_mesh[k], b->bar_eps[k], b->order[k]};
+
+    for (PetscInt j = 0; j < 5; ++j)
+      if (!PetscIsNanReal(values[j])) PetscCall(RunAttrReal(v, values[j], "qoi_%s%s", b->name[k], suffix[j]));
+    if (b->note[k][0]) PetscCall(RunAttrString(v, b->note[k], "qoi_%s_note", b->name[k]));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }

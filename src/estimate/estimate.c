@@ -255,3 +255,17 @@ PetscErrorCode EstimateView(MPI_Comm comm, const ErrorEstimate *est, const Error
   PetscCall(PetscPrintf(comm, "\n"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
+
+/* The estimate's part of /run: its total and its parts (estimate_PART, the parts of include/signorini.h) and its time,
+   or why the run has none (estimate_unavailable). */
+PetscErrorCode EstimateWrite(const ErrorEstimate *est, PetscViewer v)
+{
+  PetscFunctionBeginUser;
+  if (est->computed) {
+    PetscCall(RunAttrReal(v, est->total, "estimate_total"));
+    for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k) PetscCall(RunAttrReal(v, est->part[k], "estimate_%s", EstimateParts[k]));
+    PetscCall(RunAttrReal(v, est->time, "time_estimate"));
+  } else if (est->unavailable[0])
+    PetscCall(RunAttrString(v, est->unavailable, "estimate_unavailable"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}

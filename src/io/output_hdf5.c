@@ -6,10 +6,10 @@
 #include <sys/statvfs.h>
 #include <petscsf.h>
 #include <petscviewerhdf5.h>
+#include "app.h"
+#include "contact.h"
 #include "mesh.h"
-#include "physics.h"
 #include "io.h"
-#include "scenes.h"
 
 PetscErrorCode OutputGetOptions(MPI_Comm comm, RunOptions *opt)
 {
@@ -256,37 +256,9 @@ static PetscErrorCode WriteCellFields(DM dm, const AppCtx *user, PetscViewer vie
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-static PetscErrorCode WriteRealAttr(PetscViewer v, const char name[], PetscReal value)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", name, PETSC_REAL, &value));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode WriteIntAttr(PetscViewer v, const char name[], PetscInt value)
-{
-  PetscFunctionBeginUser;
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", name, PETSC_INT, &value));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-/* prefix_l2, prefix_h1, ... for the norms that were computed (NaN: not computed, not written). */
-static PetscErrorCode WriteErrorNorms(PetscViewer v, const char prefix[], const ErrorNorms *e)
-{
-  const char *names[]  = {"l2", "h1_semi", "h1", "energy", "pressure_l2", "pressure_weighted", "pressure_dual"};
-  PetscReal   values[] = {e->l2, e->h1_semi, e->h1, e->energy, e->pressure_l2, e->pressure_weighted, e->pressure_dual};
-  char        name[64];
-
-  PetscFunctionBeginUser;
-  for (size_t i = 0; i < sizeof(values) / sizeof(values[0]); ++i) {
-    if (PetscIsNanReal(values[i])) continue;
-    PetscCall(PetscSNPrintf(name, sizeof(name), "%s_%s", prefix, names[i]));
-    PetscCall(WriteRealAttr(v, name, values[i]));
-  }
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
-static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscViewer v, PetscInt ncells, PetscInt nverts)
+/* The group /run with the mesh's size: the dimension, the displacement's degree, the ranks, the owned cells, vertices
+   and unknowns; the run's results follow, each written by its module (OutputResultsWriter). */
+static PetscErrorCode WriteMeshSize(DM dm, PetscInt degree, Vec u, PetscViewer v, PetscInt ncells, PetscInt nverts)
 {
   PetscMPIInt size;
   PetscInt    dim, ndofs;
@@ -296,53 +268,15 @@ static PetscErrorCode WriteRunMetadata(DM dm, const AppCtx *user, Vec u, PetscVi
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetSize(u, &ndofs));
   PetscCall(PetscViewerHDF5WriteGroup(v, "/run"));
-  PetscCall(WriteIntAttr(v, "dim", dim));
-  PetscCall(WriteIntAttr(v, "degree", user->opt->degree));
-  PetscCall(WriteIntAttr(v, "nprocs", size));
-  PetscCall(WriteIntAttr(v, "n_cells", ncells));
-  PetscCall(WriteIntAttr(v, "n_vertices", nverts));
-  PetscCall(WriteIntAttr(v, "n_dofs", ndofs));
-  PetscCall(WriteRealAttr(v, "penetration_l2", user->rec.errors.penetration_l2));
-  PetscCall(WriteRealAttr(v, "penetration_max", user->rec.errors.penetration_max));
-  PetscCall(WriteErrorNorms(v, "error", &user->rec.errors));
-  PetscCall(WriteErrorNorms(v, "reference_error", &user->rec.ref_errors));
-  if (user->rec.estimate.computed) { /* estimate_total and estimate_PART (the parts of include/signorini.h) */
-    PetscCall(WriteRealAttr(v, "estimate_total", user->rec.estimate.total));
-    for (PetscInt k = 0; k < ESTIMATE_NUM_PARTS; ++k) {
-      char name[64];
-
-      PetscCall(PetscSNPrintf(name, sizeof(name), "estimate_%s", EstimateParts[k]));
-      PetscCall(WriteRealAttr(v, name, user->rec.estimate.part[k]));
-    }
-    PetscCall(WriteRealAttr(v, "time_estimate", user->rec.estimate.time));
-  } else if (user->rec.estimate.unavailable[0])
-    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "estimate_unavailable", PETSC_STRING, user->rec.estimate.unavailable));
-  for (PetscInt k = 0; k < user->rec.bars.n; ++k) { /* -bars: qoi_NAME, its bar and parts and order, or why there is no bar */
-    const ErrorBars *b        = &user->rec.bars;
-    const char      *suffix[] = {"", "_bar", "_bar_mesh", "_bar_eps", "_order"};
-    const PetscReal  values[] = {b->value[k], b->bar[k], b->bar_mesh[k], b->bar_eps[k], b->order[k]};
-    char             name[128];
-
-    for (PetscInt j = 0; j < 5; ++j) {
-      if (PetscIsNanReal(values[j])) continue;
-      PetscCall(PetscSNPrintf(name, sizeof(name), "qoi_%s%s", b->name[k], suffix[j]));
-      PetscCall(WriteRealAttr(v, name, values[j]));
-    }
-    if (b->note[k][0]) {
-      PetscCall(PetscSNPrintf(name, sizeof(name), "qoi_%s_note", b->name[k]));
-      PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", name, PETSC_STRING, b->note[k]));
-    }
-  }
-  if (user->opt->verify.reference[0]) {
-    PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", "reference", PETSC_STRING, user->opt->verify.reference));
-  }
-  PetscCall(WriteIntAttr(v, "verify_quadrature_points", user->opt->verify.quad_points));
-  PetscCall(WriteIntAttr(v, "verify_quadrature_refine", user->opt->verify.quad_refine));
+  PetscCall(RunAttrInt(v, dim, "dim"));
+  PetscCall(RunAttrInt(v, degree, "degree"));
+  PetscCall(RunAttrInt(v, size, "nprocs"));
+  PetscCall(RunAttrInt(v, ncells, "n_cells"));
+  PetscCall(RunAttrInt(v, nverts, "n_vertices"));
+  PetscCall(RunAttrInt(v, ndofs, "n_dofs"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* XDMF for ParaView into the file xdmf, pointing into h5name, the final .h5 beside it (rank 0 only). The reals are
-   declared 8-byte (XDMF's default precision is 4: ParaView would read them as floats). */
 /* One node or cell attribute of an XDMF grid: the whole dataset /group/name (n values of nc components), or with
    step >= 0 the step's slab of a load path's time series (nsteps x n [x nc], the step the first dimension). */
 static void XdmfAttribute(FILE *fp, const char h5name[], const char group[], const char name[], const char center[], PetscInt n, PetscInt nc,
@@ -453,7 +387,7 @@ static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, OutputResults
   PetscCall(WriteVertexFields(dm, user, u, viewer));
   PetscCall(WriteCellFields(dm, user, viewer));
   PetscCall(PetscViewerPopFormat(viewer));
-  PetscCall(WriteRunMetadata(dm, user, u, viewer, ncells, nverts));
+  PetscCall(WriteMeshSize(dm, user->opt->degree, u, viewer, ncells, nverts));
   PetscCall(write_results(dm, user, u, viewer)); /* each module's own results (src/main.c) */
   PetscCall(PetscViewerDestroy(&viewer));
   if (rank == 0) PetscCall(WriteXdmf(user, xdmftmp, h5name, dim, ncells, ncorners, nverts));

@@ -7,6 +7,7 @@
 #include "discretization.h"
 #include "physics.h"
 #include "verify.h"
+#include "app.h"
 
 PetscErrorCode ErrorNormsReset(ErrorNorms *e)
 {
@@ -287,5 +288,32 @@ PetscErrorCode ErrorNormsCompute(DM dm, const VerifyRun *run, Vec u, ErrorNorms 
     PetscCall(ErrorNormsEvaluate(dm, NULL, run, NULL, loc_uh, loc_ph, NULL, e));
   if (loc_ph) PetscCall(DMRestoreLocalVector(dm, &loc_ph));
   PetscCall(DMRestoreLocalVector(dm, &loc_uh));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* prefix_l2, prefix_h1, ... for the norms that were computed (NaN: not computed, not written). */
+static PetscErrorCode ErrorNormsWrite(const char prefix[], const ErrorNorms *e, PetscViewer v)
+{
+  const char *names[]  = {"l2", "h1_semi", "h1", "energy", "pressure_l2", "pressure_weighted", "pressure_dual"};
+  PetscReal   values[] = {e->l2, e->h1_semi, e->h1, e->energy, e->pressure_l2, e->pressure_weighted, e->pressure_dual};
+
+  PetscFunctionBeginUser;
+  for (size_t i = 0; i < sizeof(values) / sizeof(values[0]); ++i)
+    if (!PetscIsNanReal(values[i])) PetscCall(RunAttrReal(v, values[i], "%s_%s", prefix, names[i]));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The verification's part of /run: the penetration's norms, the errors against the scene's exact solution (error_*)
+   and against -reference (reference_error_*, with the reference's file), and the finer quadrature they took. */
+PetscErrorCode VerifyWrite(const VerifyOptions *opt, const ErrorNorms *errors, const ErrorNorms *ref_errors, PetscViewer v)
+{
+  PetscFunctionBeginUser;
+  PetscCall(RunAttrReal(v, errors->penetration_l2, "penetration_l2"));
+  PetscCall(RunAttrReal(v, errors->penetration_max, "penetration_max"));
+  PetscCall(ErrorNormsWrite("error", errors, v));
+  PetscCall(ErrorNormsWrite("reference_error", ref_errors, v));
+  if (opt->reference[0]) PetscCall(RunAttrString(v, opt->reference, "reference"));
+  PetscCall(RunAttrInt(v, opt->quad_points, "verify_quadrature_points"));
+  PetscCall(RunAttrInt(v, opt->quad_refine, "verify_quadrature_refine"));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
