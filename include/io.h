@@ -16,10 +16,24 @@ PetscErrorCode OutputFileCommit(MPI_Comm comm, const char dir[], PetscInt n, cha
 
 /* output_hdf5.c */
 PetscErrorCode OutputGetOptions(MPI_Comm comm, RunOptions *opt);
-/* the writer of /run's part and the tables that each module owns, called by OutputWriteHDF5() once /run exists */
-typedef PetscErrorCode (*OutputResultsWriter)(DM dm, const AppCtx *user, Vec u, PetscViewer v);
-PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u, OutputResultsWriter write_results);
 #define OUTPUT_STATE_FIELDS 5 /* displacement, contact_pressure, normal_gap, contact_boundary, contact_reaction */
-PetscErrorCode OutputStateFields(DM dm, const AppCtx *user, Vec u, Vec fields[OUTPUT_STATE_FIELDS]);
+/* What the output file holds besides the mesh, as the run gives it (src/main.c): where it goes, the sources of the
+   fields, and the writer of the results, which each module writes into /run and its tables once /run exists. */
+typedef struct {
+  const char          *path;        /* -output */
+  PetscBool            dmview;      /* -output_dmview: the mesh by DMView() */
+  Contact              contact;     /* the contact set: the nodal pressure, gap, reaction and area */
+  Vec                  loc_bc;      /* the Dirichlet values, inserted into the displacement */
+  const Scene         *scene;       /* its exact solution, where it has one: exact_displacement and error */
+  PetscInt             degree;      /* of the displacement */
+  PetscInt             nsteps;      /* a load path's steps, whose state fields are a time series, */
+  Vec const           *step_fields; /*   OUTPUT_STATE_FIELDS per step (OutputStateFields()) */
+  const ErrorBars     *bars;        /* the pressure's band (-bars) */
+  const ErrorEstimate *estimate;    /* the cells' indicators */
+  PetscErrorCode (*write_results)(DM dm, Vec u, PetscViewer v, void *ctx);
+  void *ctx;
+} OutputContent;
+PetscErrorCode OutputWriteHDF5(DM dm, Vec u, const OutputContent *out);
+PetscErrorCode OutputStateFields(DM dm, Contact contact, Vec loc_bc, Vec u, Vec fields[OUTPUT_STATE_FIELDS]);
 /* output_mesh.c */
 PetscErrorCode OutputViewMesh(DM dm, PetscViewer viewer);

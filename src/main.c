@@ -100,10 +100,11 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
    when it forked as its own peak (docs/output.md); ru_maxrss is the fallback. */
 /* The run's results in the output: each module writes its own part of /run and its tables (docs/output.md), in the
    order of the run: the scene, the method, the solve and its drivers, the distribution. */
-static PetscErrorCode WriteResults(DM dm, const AppCtx *user, Vec u, PetscViewer v)
+static PetscErrorCode WriteResults(DM dm, Vec u, PetscViewer v, void *ctx)
 {
-  MPI_Comm comm = PetscObjectComm((PetscObject)dm);
-  PetscInt dim;
+  const AppCtx *user = (const AppCtx *)ctx;
+  MPI_Comm      comm = PetscObjectComm((PetscObject)dm);
+  PetscInt      dim;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
@@ -132,8 +133,21 @@ static PetscErrorCode WriteResults(DM dm, const AppCtx *user, Vec u, PetscViewer
 /* The output file: the mesh and the fields (src/io/), and the results (WriteResults()). */
 static PetscErrorCode WriteOutput(DM dm, const AppCtx *user, Vec u)
 {
+  const OutputContent out = {.path          = user->opt->output,
+                             .dmview        = user->opt->output_dmview,
+                             .contact       = user->contact,
+                             .loc_bc        = user->prob.loc_bc,
+                             .scene         = &user->scene,
+                             .degree        = user->opt->degree,
+                             .nsteps        = user->rec.nsteps,
+                             .step_fields   = user->rec.step_fields,
+                             .bars          = &user->rec.bars,
+                             .estimate      = &user->rec.estimate,
+                             .write_results = WriteResults,
+                             .ctx           = (void *)user};
+
   PetscFunctionBeginUser;
-  PetscCall(OutputWriteHDF5(dm, user, u, WriteResults));
+  PetscCall(OutputWriteHDF5(dm, u, &out));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

@@ -53,7 +53,7 @@ static PetscErrorCode ViewVertexField(Vec v, PetscInt nc, PetscViewer viewer)
 /* The state of a solution at the owned vertices (plain vectors, in the order of /geometry/vertices), the fields a load
    path keeps at every step: the displacement (with the Dirichlet values), the nodal contact pressure, the normal gap
    g - u_n and the Gamma_C indicator, from u and the contact set as PostprocessContact() left it. */
-PetscErrorCode OutputStateFields(DM dm, const AppCtx *user, Vec u, Vec fields[OUTPUT_STATE_FIELDS])
+PetscErrorCode OutputStateFields(DM dm, Contact contact, Vec loc_bc, Vec u, Vec fields[OUTPUT_STATE_FIELDS])
 {
   const char *const  names[OUTPUT_STATE_FIELDS] = {"displacement", "contact_pressure", "normal_gap", "contact_boundary", "contact_reaction"};
   const ContactSet  *cs;
@@ -65,7 +65,7 @@ PetscErrorCode OutputStateFields(DM dm, const AppCtx *user, Vec u, Vec fields[OU
   PetscScalar       *d, *p, *g, *m, *fr;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(ContactGetSet(contact, &cs));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
   PetscCall(MeshOwnedIndex(dm, vStart, vEnd, &index, &nowned)); /* plain vectors over the owned vertices, no DM clone */
@@ -80,7 +80,7 @@ PetscErrorCode OutputStateFields(DM dm, const AppCtx *user, Vec u, Vec fields[OU
     PetscCall(VecZeroEntries(fields[f]));
   }
   PetscCall(DMGetLocalVector(dm, &locU));
-  PetscCall(VecCopy(user->prob.loc_bc, locU)); /* the Dirichlet values, inserted once by ProblemSetUp() */
+  PetscCall(VecCopy(loc_bc, locU)); /* the Dirichlet values, inserted once by ProblemSetUp() */
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, locU));
   PetscCall(VecGetArrayRead(locU, &lu));
   PetscCall(VecGetArray(fields[0], &d));
@@ -123,7 +123,7 @@ PetscErrorCode OutputStateFields(DM dm, const AppCtx *user, Vec u, Vec fields[OU
    indicator), of the last solution or, with a load path, of every step as a time series (the step the first dimension,
    PETSc's timestepping); the nodal reaction and lumped area; the exact solution and error when the scene has one; the
    pressure's band with -bars. */
-static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscViewer viewer)
+static PetscErrorCode WriteVertexFields(DM dm, const OutputContent *out, Vec u, PetscViewer viewer)
 {
   const ContactSet  *cs;
   DM                 cdm;
@@ -134,17 +134,17 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   PetscScalar       *ar, *ex = NULL, *er = NULL;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetSet(user->contact, &cs));
+  PetscCall(ContactGetSet(out->contact, &cs));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexGetDepthStratum(dm, 0, &vStart, &vEnd));
   PetscCall(MeshOwnedIndex(dm, vStart, vEnd, &index, &nowned));
-  PetscCall(OutputStateFields(dm, user, u, state));
-  if (user->rec.nsteps) {
+  PetscCall(OutputStateFields(dm, out->contact, out->loc_bc, u, state));
+  if (out->nsteps) {
     for (PetscInt f = 0; f < OUTPUT_STATE_FIELDS; ++f) {
       PetscCall(PetscViewerHDF5PushTimestepping(viewer));
-      for (PetscInt k = 0; k < user->rec.nsteps; ++k) {
+      for (PetscInt k = 0; k < out->nsteps; ++k) {
         PetscCall(PetscViewerHDF5SetTimestep(viewer, k));
-        PetscCall(ViewVertexField(user->rec.step_fields[k * OUTPUT_STATE_FIELDS + f], f ? 1 : dim, viewer));
+        PetscCall(ViewVertexField(out->step_fields[k * OUTPUT_STATE_FIELDS + f], f ? 1 : dim, viewer));
       }
       PetscCall(PetscViewerHDF5PopTimestepping(viewer));
     }
@@ -161,7 +161,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
   }
   PetscCall(VecRestoreArray(area, &ar));
   PetscCall(ViewVertexField(area, 1, viewer));
-  if (user->scene.exact) {
+  if (out->scene->exact) {
     PetscCall(DMGetCoordinateDM(dm, &cdm));
     PetscCall(DMGetLocalSection(cdm, &csec));
     PetscCall(DMGetCoordinatesLocal(dm, &coords));
@@ -181,7 +181,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
       goff = index[v - vStart] * dim;
       PetscCall(PetscSectionGetOffset(csec, v, &coff));
       for (PetscInt c = 0; c < dim; ++c) xv[c] = PetscRealPart(xc[coff + c]);
-      PetscCall((*user->scene.exact)(dim, 0.0, xv, dim, &ex[goff], (void *)user->scene.constants));
+      PetscCall((*out->scene->exact)(dim, 0.0, xv, dim, &ex[goff], (void *)out->scene->constants));
       for (PetscInt c = 0; c < dim; ++c) er[goff + c] = d[goff + c] - ex[goff + c];
     }
     PetscCall(VecRestoreArrayRead(coords, &xc));
@@ -191,7 +191,7 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
     PetscCall(ViewVertexField(exact, dim, viewer));
     PetscCall(ViewVertexField(error, dim, viewer));
   }
-  if (user->rec.bars.pressure_band) { /* -bars: the band of the nodal pressure (src/estimate/bars.c), 0 off Gamma_C */
+  if (out->bars->pressure_band) { /* -bars: the band of the nodal pressure (src/estimate/bars.c), 0 off Gamma_C */
     Vec          band;
     PetscScalar *bv;
 
@@ -199,10 +199,10 @@ static PetscErrorCode WriteVertexFields(DM dm, const AppCtx *user, Vec u, PetscV
     PetscCall(PetscObjectSetName((PetscObject)band, "contact_pressure_bar"));
     PetscCall(VecZeroEntries(band));
     PetscCall(VecGetArray(band, &bv));
-    for (PetscInt i = 0; i < user->rec.bars.npressure; ++i) {
+    for (PetscInt i = 0; i < out->bars->npressure; ++i) {
       const PetscInt goff = cs->is_vertex[i] ? index[cs->point[i] - vStart] : -1;
 
-      if (goff >= 0) bv[goff] = user->rec.bars.pressure_bar[i];
+      if (goff >= 0) bv[goff] = out->bars->pressure_bar[i];
     }
     PetscCall(VecRestoreArray(band, &bv));
     PetscCall(ViewVertexField(band, 1, viewer));
@@ -242,9 +242,9 @@ static PetscErrorCode ViewCellField(DM dm, const char name[], const PetscReal va
 }
 
 /* The estimate's cell fields: error_indicator (eta_T) and error_density (eta_T / |T|^1/2). */
-static PetscErrorCode WriteCellFields(DM dm, const AppCtx *user, PetscViewer viewer)
+static PetscErrorCode WriteCellFields(DM dm, const OutputContent *out, PetscViewer viewer)
 {
-  const ErrorEstimate *est = &user->rec.estimate;
+  const ErrorEstimate *est = out->estimate;
   PetscInt             cStart, cEnd;
 
   PetscFunctionBeginUser;
@@ -310,13 +310,13 @@ static void XdmfAttribute(FILE *fp, const char h5name[], const char group[], con
    collection of one grid per step (time = the step's number, 1, 2, ...: a path may go back to a factor, which a time
    cannot), each with the step's state fields; the fields of the last solution only (reaction, area, exact solution,
    band, estimate) are in the last step's grid. */
-static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const char h5name[], PetscInt dim, PetscInt ncells, PetscInt ncorners,
+static PetscErrorCode WriteXdmf(const OutputContent *out, const char xdmf[], const char h5name[], PetscInt dim, PetscInt ncells, PetscInt ncorners,
                                 PetscInt nverts)
 {
   const char    *fields[] = {"displacement",     "contact_pressure", "normal_gap",         "contact_boundary",
                              "contact_reaction", "contact_area",     "exact_displacement", "error"};
   const PetscInt ncomp[]  = {dim, 1, 1, 1, 1, 1, dim, dim};
-  const PetscInt nfields = user->scene.exact ? 8 : 6, nsteps = user->rec.nsteps;
+  const PetscInt nfields = out->scene->exact ? 8 : 6, nsteps = out->nsteps;
   const char    *topo = dim == 2 ? (ncorners == 3 ? "Triangle" : "Quadrilateral") : (ncorners == 4 ? "Tetrahedron" : "Hexahedron");
   FILE          *fp;
   int            bad;
@@ -345,8 +345,8 @@ static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const cha
       if (f >= OUTPUT_STATE_FIELDS && !last) continue; /* the last solution's only */
       XdmfAttribute(fp, h5name, "vertex_fields", fields[f], "Node", nverts, ncomp[f], f < OUTPUT_STATE_FIELDS ? k : -1, nsteps);
     }
-    if (user->rec.bars.pressure_band && last) XdmfAttribute(fp, h5name, "vertex_fields", "contact_pressure_bar", "Node", nverts, 1, -1, 0);
-    for (PetscInt f = 0; f < 2 && user->rec.estimate.computed && last; ++f)
+    if (out->bars->pressure_band && last) XdmfAttribute(fp, h5name, "vertex_fields", "contact_pressure_bar", "Node", nverts, 1, -1, 0);
+    for (PetscInt f = 0; f < 2 && out->estimate->computed && last; ++f)
       XdmfAttribute(fp, h5name, "cell_fields", f ? "error_density" : "error_indicator", "Cell", ncells, 1, -1, 0);
     fprintf(fp, "  </Grid>\n");
   }
@@ -359,8 +359,7 @@ static PetscErrorCode WriteXdmf(const AppCtx *user, const char xdmf[], const cha
 }
 
 /* The HDF5 file, written into the temporary h5tmp, and the XDMF file into xdmftmp, both in the current directory. */
-static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, OutputResultsWriter write_results, const char h5tmp[], const char xdmftmp[],
-                                 const char h5name[])
+static PetscErrorCode WriteFiles(DM dm, const OutputContent *out, Vec u, const char h5tmp[], const char xdmftmp[], const char h5name[])
 {
   MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
   PetscViewer viewer;
@@ -380,36 +379,36 @@ static PetscErrorCode WriteFiles(DM dm, const AppCtx *user, Vec u, OutputResults
 
   PetscCall(PetscViewerHDF5Open(comm, h5tmp, FILE_MODE_WRITE, &viewer));
   PetscCall(PetscViewerPushFormat(viewer, PETSC_VIEWER_HDF5_VIZ));
-  if (user->opt->output_dmview)
+  if (out->dmview)
     PetscCall(DMView(dm, viewer));
   else
     PetscCall(OutputViewMesh(dm, viewer)); /* DMView() without its closures per cell */
-  PetscCall(WriteVertexFields(dm, user, u, viewer));
-  PetscCall(WriteCellFields(dm, user, viewer));
+  PetscCall(WriteVertexFields(dm, out, u, viewer));
+  PetscCall(WriteCellFields(dm, out, viewer));
   PetscCall(PetscViewerPopFormat(viewer));
-  PetscCall(WriteMeshSize(dm, user->opt->degree, u, viewer, ncells, nverts));
-  PetscCall(write_results(dm, user, u, viewer)); /* each module's own results (src/main.c) */
+  PetscCall(WriteMeshSize(dm, out->degree, u, viewer, ncells, nverts));
+  PetscCall(out->write_results(dm, u, viewer, out->ctx)); /* each module's own results (src/main.c) */
   PetscCall(PetscViewerDestroy(&viewer));
-  if (rank == 0) PetscCall(WriteXdmf(user, xdmftmp, h5name, dim, ncells, ncorners, nverts));
+  if (rank == 0) PetscCall(WriteXdmf(out, xdmftmp, h5name, dim, ncells, ncorners, nverts));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Writes FILE.h5 and FILE.xdmf (output_file.c: temporaries renamed when complete), from inside their directory
    (OutputFileEnterDirectory()). An I/O error is reported in one sentence naming the file and the cause. */
-PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u, OutputResultsWriter write_results)
+PetscErrorCode OutputWriteHDF5(DM dm, Vec u, const OutputContent *out)
 {
   MPI_Comm       comm = PetscObjectComm((PetscObject)dm);
   char           dir[PETSC_MAX_PATH_LEN], base[PETSC_MAX_PATH_LEN], xdmf[PETSC_MAX_PATH_LEN], temps[2][PETSC_MAX_PATH_LEN];
   char           tdir[PETSC_MAX_PATH_LEN], h5tmp[PETSC_MAX_PATH_LEN], xdmftmp[PETSC_MAX_PATH_LEN];
-  const char    *targets[2] = {xdmf, user->opt->output};
+  const char    *targets[2] = {xdmf, out->path};
   PetscErrorCode ierr;
   int            cwd, err = 0, local_failed, failed;
   H5E_auto2_t    h5_func;
   void          *h5_data;
 
   PetscFunctionBeginUser;
-  PetscCall(OutputFileSplitPath(user->opt->output, dir, sizeof(dir), base, sizeof(base)));
-  PetscCall(OutputFileXdmfName(user->opt->output, xdmf, sizeof(xdmf)));
+  PetscCall(OutputFileSplitPath(out->path, dir, sizeof(dir), base, sizeof(base)));
+  PetscCall(OutputFileXdmfName(out->path, xdmf, sizeof(xdmf)));
   PetscCall(OutputFileCreateTemps(comm, dir, 2, temps));                                  /* [0] the XDMF file, [1] the HDF5 file */
   PetscCall(OutputFileSplitPath(temps[0], tdir, sizeof(tdir), xdmftmp, sizeof(xdmftmp))); /* names inside dir */
   PetscCall(OutputFileSplitPath(temps[1], tdir, sizeof(tdir), h5tmp, sizeof(h5tmp)));
@@ -418,7 +417,7 @@ PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u, OutputResultsWr
   (void)H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* HDF5's own error stack: replaced by the sentence below */
   PetscCall(PetscPushErrorHandler(PetscReturnErrorHandler, NULL));
   errno = 0;
-  ierr  = WriteFiles(dm, user, u, write_results, h5tmp, xdmftmp, base);
+  ierr  = WriteFiles(dm, out, u, h5tmp, xdmftmp, base);
   err   = errno;
   PetscCall(PetscPopErrorHandler());
   (void)H5Eset_auto2(H5E_DEFAULT, h5_func, h5_data);
@@ -438,7 +437,7 @@ PetscErrorCode OutputWriteHDF5(DM dm, const AppCtx *user, Vec u, OutputResultsWr
       PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", strerror(err)));
     else if (ierr)
       PetscCall(PetscSNPrintf(cause, sizeof(cause), "%s", specific && specific[0] ? specific : text));
-    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot write the output file %s: %s", user->opt->output, cause);
+    SETERRQ(PETSC_COMM_SELF, PETSC_ERR_FILE_WRITE, "Cannot write the output file %s: %s", out->path, cause);
   }
   PetscCall(OutputFileCommit(comm, dir, 2, temps, targets));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -335,7 +335,7 @@ static PetscErrorCode LoadPathRecordStep(DM dm, AppCtx *user, Vec u, PetscReal t
   }
   s = &user->rec.steps[user->rec.nsteps];
   PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-  PetscCall(OutputStateFields(dm, user, u, &user->rec.step_fields[user->rec.nsteps * OUTPUT_STATE_FIELDS]));
+  PetscCall(OutputStateFields(dm, user->contact, user->prob.loc_bc, u, &user->rec.step_fields[user->rec.nsteps * OUTPUT_STATE_FIELDS]));
   user->rec.nsteps++;
   PostprocessGetQuantities(&user->rec.stats, &s->q);
   s->factor        = t;
