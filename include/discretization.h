@@ -17,13 +17,17 @@ PetscErrorCode ElementP1AddFixedCellsStiffness(DM dm, const Material *mat, Vec l
 PetscErrorCode SectionSetUpP1(DM dm, PetscInt degree, PetscBool check);
 PetscErrorCode SectionSetUpGlobalP1(DM dm, PetscBool check);
 
-/* assembly_p1.c */
-/* What the P1 assembly of K reads: the material, and whether -mat_type was given (K of the options' type, which the
-   CSR paths of one rank and of many may not build) */
+/* assembly.c: the bulk terms by the mesh's assembly (fe or p1): K, F_bulk, K u_D. What the P1 assembly of K reads:
+   the material, and whether -mat_type was given (K of the options' type, which the CSR paths may not build) */
 typedef struct {
   const Material *material;
   PetscBool       mat_type_given;
 } AssemblyP1Inputs;
+PetscErrorCode AssemblyCreateOperator(DM dm, AssemblyType assembly, const AssemblyP1Inputs *p1, PetscBool check, Vec locX, Mat *K);
+PetscErrorCode AssemblyResidual(DM dm, AssemblyType assembly, const Material *mat, Vec locX, Vec locF);
+PetscErrorCode AssemblyLiftStiffness(DM dm, AssemblyType assembly, const Material *mat, Vec loc_bc, Vec locA);
+
+/* assembly_p1.c */
 PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscBool *check);
 PetscErrorCode AssemblyResolve(DM dm, AssemblyType requested, PetscInt degree, PetscBool check, AssemblyType *assembly);
 PetscErrorCode AssemblyP1CreateMatrix(DM dm, const AssemblyP1Inputs *in, Mat *K);

@@ -82,7 +82,8 @@ PetscErrorCode AssemblyGetOptions(MPI_Comm comm, AssemblyType *requested, PetscB
 }
 
 /* The assembly of this mesh's K: the requested one (-assembly), with auto resolved (p1 where it applies to displacements
-   of this degree, fe otherwise); check (-assembly_check) needs the p1 path. */
+   of this degree, fe otherwise); check (-assembly_check) needs the p1 path. PetscFE's closures then look each point's
+   cell type up in an index made once (MeshIndexCellTypes()). */
 PetscErrorCode AssemblyResolve(DM dm, AssemblyType requested, PetscInt degree, PetscBool check, AssemblyType *assembly)
 {
   MPI_Comm    comm   = PetscObjectComm((PetscObject)dm);
@@ -95,6 +96,7 @@ PetscErrorCode AssemblyResolve(DM dm, AssemblyType requested, PetscInt degree, P
              "-assembly p1 needs P1 displacements on triangles or tetrahedra, but %s: use -assembly fe or auto", reason);
   PetscCheck(!check || !reason, comm, PETSC_ERR_USER_INPUT, "-assembly_check compares with the P1 assembly, which does not apply: %s", reason);
   if (*assembly == ASSEMBLY_AUTO) *assembly = reason ? ASSEMBLY_FE : ASSEMBLY_P1;
+  if (*assembly == ASSEMBLY_FE) PetscCall(MeshIndexCellTypes(dm)); /* before PetscFE's closure per cell */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

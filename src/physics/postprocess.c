@@ -8,12 +8,11 @@
    since r0_loc = A u_D - b holds every row (the fixed ones too) of the residual at u_D (SolverAssembleLoad(): the bulk
    and the surface loads of BoundaryAddLoads()); a scene's load in weak form is not in r0_loc, and WeakDataAddToResidual()
    gives its L(u_D), weak_lift. Computed once per load state, by SolverAssembleLoad(). Both vectors hold this rank's cells only, so that the local dot
-   products add up over the ranks to the sums over the cells. A u_D: the closed-form stiffness of the P1 simplices at Gamma_D, or PetscFE's residual
-   at u_D less its residual at 0 (which needs no context: its kernels read constants[] alone). Zero when the Dirichlet
+   products add up over the ranks to the sums over the cells. A u_D by the mesh's assembly (AssemblyLiftStiffness()). Zero when the Dirichlet
    data are. The problem's loc_bc, loc_r0 and assembly, in the material. */
 PetscErrorCode PostprocessLiftEnergy(DM dm, const Material *mat, const Problem *prob, PetscReal weak_lift, PetscReal *energy)
 {
-  Vec         locA, locZ, locR;
+  Vec         locA;
   PetscReal   ud_max, local[2], global[2];
   PetscScalar dot;
 
@@ -23,20 +22,7 @@ PetscErrorCode PostprocessLiftEnergy(DM dm, const Material *mat, const Problem *
   PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ud_max, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
   if (ud_max == 0.0) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetLocalVector(dm, &locA));
-  PetscCall(VecZeroEntries(locA));
-  if (prob->assembly == ASSEMBLY_P1)
-    PetscCall(ElementP1AddFixedCellsStiffness(dm, mat, prob->loc_bc, locA));
-  else {
-    PetscCall(DMGetLocalVector(dm, &locZ));
-    PetscCall(DMGetLocalVector(dm, &locR));
-    PetscCall(VecZeroEntries(locZ));
-    PetscCall(VecZeroEntries(locR));
-    PetscCall(DMPlexSNESComputeResidualFEM(dm, prob->loc_bc, locA, NULL));
-    PetscCall(DMPlexSNESComputeResidualFEM(dm, locZ, locR, NULL));
-    PetscCall(VecAXPY(locA, -1.0, locR));
-    PetscCall(DMRestoreLocalVector(dm, &locZ));
-    PetscCall(DMRestoreLocalVector(dm, &locR));
-  }
+  PetscCall(AssemblyLiftStiffness(dm, prob->assembly, mat, prob->loc_bc, locA)); /* A u_D */
   PetscCall(VecDot(prob->loc_bc, prob->loc_r0, &dot));
   local[0] = PetscRealPart(dot);
   PetscCall(VecDot(prob->loc_bc, locA, &dot));

@@ -27,7 +27,6 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
   PetscCall(BoundaryInsertDirichlet(dm, &user->scene, user->prob.face_sets, user->opt->degree, user->prob.loc_bc));
   /* -assembly auto: fe or p1 for this mesh */
   PetscCall(AssemblyResolve(dm, user->opt->assembly, user->opt->degree, user->opt->assembly_check, &user->prob.assembly));
-  if (user->prob.assembly == ASSEMBLY_FE) PetscCall(MeshIndexCellTypes(dm)); /* before PetscFE's closure per cell */
   {
     ContactProblem cp;
 

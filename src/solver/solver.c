@@ -15,16 +15,9 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
   MatNullSpace           rigid;
 
   PetscFunctionBeginUser;
-  if (user->prob.assembly == ASSEMBLY_P1)
-    PetscCall(AssemblyP1CreateMatrix(dm, &p1, &user->prob.K));
-  else
-    PetscCall(DMCreateMatrix(dm, &user->prob.K));
   PetscCall(DMGetLocalVector(dm, &locX));
   PetscCall(VecCopy(user->prob.loc_bc, locX)); /* u = 0 with the Dirichlet values, inserted once by ProblemSetUp() */
-  if (user->prob.assembly == ASSEMBLY_FE) PetscCall(DMPlexSNESComputeJacobianFEM(dm, locX, user->prob.K, user->prob.K, user));
-  if (user->opt->assembly_check) PetscCall(AssemblyP1Check(dm, &p1, locX));
-  PetscCall(MatAssemblyBegin(user->prob.K, MAT_FINAL_ASSEMBLY));
-  PetscCall(MatAssemblyEnd(user->prob.K, MAT_FINAL_ASSEMBLY));
+  PetscCall(AssemblyCreateOperator(dm, user->prob.assembly, &p1, user->opt->assembly_check, locX, &user->prob.K));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   if (user->opt->degree == 1)
     PetscCall(ElasticityRigidBodyModesP1(dm, user->prob.r0, &rigid)); /* unknowns at the vertices only */
@@ -49,10 +42,7 @@ PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user)
   PetscCall(DMGetLocalVector(dm, &locF));
   PetscCall(VecCopy(user->prob.loc_bc, locX));
   PetscCall(VecZeroEntries(locF));
-  if (user->prob.assembly == ASSEMBLY_P1)
-    PetscCall(AssemblyP1Residual(dm, &user->opt->material, locX, locF)); /* the same residual without PetscFE's generic cell loop */
-  else
-    PetscCall(DMPlexSNESComputeResidualFEM(dm, locX, locF, user));
+  PetscCall(AssemblyResidual(dm, user->prob.assembly, &user->opt->material, locX, locF));
   PetscCall(VecZeroEntries(user->prob.r0));
   PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, user->prob.r0));
   if (!user->prob.loc_r0) PetscCall(VecDuplicate(locF, &user->prob.loc_r0)); /* with the fixed rows, which the global vector drops */
