@@ -75,13 +75,13 @@ PetscErrorCode LoadPathWrite(MPI_Comm comm, const Scene *scene, const RunStats *
                              PetscViewer v); /* /steps */
 
 /* multigrid.c */
-PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt vertex_source[], AppCtx *user);
-PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user);
-PetscErrorCode MultigridSetCoarseBoxSolver(KSP ksp, const AppCtx *user);
+PetscErrorCode MultigridAddLevel(Multigrid mg, SNES snes, DM coarse, DM fine, const PetscInt vertex_source[], PetscInt degree);
+PetscErrorCode MultigridSetUpPC(Multigrid mg, SNES snes, PetscInt level, const MeshBox *box, const SolverOptions *opt);
+PetscErrorCode MultigridSetCoarseBoxSolver(Multigrid mg, KSP ksp, PetscInt level, const MeshBox *box);
 PetscErrorCode MultigridCreate(PetscBool coarse_mg, Multigrid *mg);
 PetscErrorCode MultigridDestroy(Multigrid *mg);
 PetscErrorCode MultigridSetDefault(Multigrid mg, PetscBool is_default);
-PetscBool      MultigridIsDefault(const AppCtx *user);
+PetscBool      MultigridIsDefault(Multigrid mg);
 
 /* fine_smoother.c: -mg_fine_ksp_*, -mg_fine_pc_* */
 PetscErrorCode FineSmootherGiven(KSP ksp, const SolverGiven *g, PetscBool *given);

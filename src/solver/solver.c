@@ -114,7 +114,7 @@ static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
   const ContactSolverDefaults *defaults;
 
   PetscFunctionBeginUser;
-  if (MultigridIsDefault(user)) { /* the 3D box that nests: CG with the boxes' geometric multigrid, as options/solvers/mg.yaml */
+  if (MultigridIsDefault(user->mg)) { /* the 3D box that nests: CG with the boxes' geometric multigrid, as options/solvers/mg.yaml */
     PetscCall(KSPSetType(ksp, KSPCG));
     PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
     PetscCall(KSPGetPC(ksp, &pc));
@@ -203,7 +203,7 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscCall(SNESSetConvergenceTest(*snes, SolverConverged, user->prob.sctx, NULL));
   PetscCall(SNESGetKSP(*snes, &ksp));
   PetscCall(SolverSetDefaultLinearSolver(ksp, user));
-  PetscCall(MultigridSetCoarseBoxSolver(ksp, user)); /* -contact_coarse_mg on a coarser box */
+  PetscCall(MultigridSetCoarseBoxSolver(user->mg, ksp, user->prob.level, &user->box)); /* -contact_coarse_mg on a coarser box */
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(SNESMonitorSet(*snes, ContactMonitor, user->prob.sctx, NULL));
   PetscCall(SNESSetFromOptions(*snes));
@@ -425,7 +425,8 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
       PetscCall(ContactForgetMultipliers(user->contact));
     }
   }
-  PetscCall(MultigridSetUpPC(snes, user)); /* -pc_type mg: the levels of the meshes solved so far */
+  /* -pc_type mg: the levels of the meshes solved so far */
+  PetscCall(MultigridSetUpPC(user->mg, snes, user->prob.level, &user->box, &user->opt->solver));
   user->prob.sctx->warm = warm;
   PetscCall(PetscTime(&t0));
   user->prob.sctx->pc_reuse.builds         = 0; /* counted per solve */
