@@ -230,8 +230,9 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   {
     PetscBool petsc_presolve, fine;
 
-    PetscCall(SolverForcingSetUp(*snes, user->prob.sctx, &petsc_presolve)); /* Eisenstat-Walker's terms with the oversolving guard */
-    PetscCall(SolverStepGuessSetUp(ksp, user->prob.sctx));
+    /* Eisenstat-Walker's terms with the oversolving guard */
+    PetscCall(SolverForcingSetUp(&user->prob.sctx->forcing, *snes, user->opt->solver.ew_guard, &petsc_presolve));
+    PetscCall(SolverStepGuessSetUp(&user->prob.sctx->step_guess, ksp, &user->opt->solver.given));
     if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, user->prob.sctx));
     PetscCall(FineSmootherGiven(ksp, &user->opt->solver.given, &fine));
     PetscCheck(!fine || is_multigrid, comm, PETSC_ERR_USER_INPUT,
@@ -322,7 +323,7 @@ static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
   PetscCall(ContactSolverFrame(user->contact, u, PETSC_TRUE)); /* the SNES's unknowns: Q^T u/U */
   PetscCall(ContactScaleBounds(user->contact, 1.0 / U));
   PetscCall(SNESSolve(snes, NULL, u));
-  PetscCall(SolverStepGuessDrop(user->prob.sctx)); /* unused if no linear solve came */
+  PetscCall(SolverStepGuessDrop(&user->prob.sctx->step_guess)); /* unused if no linear solve came */
   PetscCall(ContactSolverFrame(user->contact, u, PETSC_FALSE));
   PetscCall(VecScale(u, U));
   PetscCall(ContactScaleBounds(user->contact, U));
@@ -334,13 +335,14 @@ static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
    preconditioner (pc_recovery.c) while one is left; the Newton steps and linear iterations of every attempt count. */
 static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *newton, PetscInt *ksp)
 {
-  PetscBool retry = PETSC_TRUE;
+  const SolverCtx sc    = user->prob.sctx;
+  PetscBool       retry = PETSC_TRUE;
 
   PetscFunctionBeginUser;
   PetscCall(SolverSNESSolve(snes, user, u));
   PetscCall(RecordSolve(snes, user, newton, ksp));
   while (!user->rec.stats.converged && retry) {
-    PetscCall(PcRecoveryTry(snes, user->prob.sctx, &retry));
+    PetscCall(PcRecoveryTry(&sc->pc_recovery, snes, sc->opt, &sc->pc_reuse, sc->stats, &retry));
     if (!retry) break;
     PetscCall(SolverSNESSolve(snes, user, u));
     PetscCall(RecordSolve(snes, user, newton, ksp));

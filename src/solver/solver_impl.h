@@ -13,6 +13,11 @@
 
 /* State of the preconditioner reuse (pc_reuse.c). */
 typedef struct {
+  /* what it reads (PcReuseSetUp()) */
+  Mat                  K;       /* the bulk operator, in which the Jacobian is made */
+  Contact              contact; /* the contact term, its rows of K (ContactBulkRowsOf()) */
+  const SolverOptions *opt;
+  /* the reuse */
   PetscBool enabled;         /* penalty method with a Krylov method around the preconditioner */
   PetscBool built;           /* a build exists */
   PetscReal eps;             /* eps of the build */
@@ -144,23 +149,30 @@ PetscErrorCode SolverResidual(SolverCtx sc, DM dm, Vec u, Vec F);
 PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx);
 
 /* ew_forcing.c */
-PetscErrorCode SolverForcingSetUp(SNES snes, SolverCtx sc, PetscBool *petsc_presolve);
-PetscErrorCode SolverForcingPreSolve(KSP ksp, SolverCtx sc);
+PetscErrorCode SolverForcingSetUp(SolverForcing *fc, SNES snes, PetscReal guard, PetscBool *petsc_presolve);
+PetscErrorCode SolverForcingPreSolve(SolverForcing *fc, KSP ksp, PetscReal ref, PetscReal snes_scale);
 
 /* step_guess.c */
-PetscErrorCode SolverStepGuessSetUp(KSP ksp, SolverCtx sc);
+PetscErrorCode SolverStepGuessSetUp(SolverStepGuess *sg, KSP ksp, const SolverGiven *given);
+PetscErrorCode SolverStepGuessSet(SolverStepGuess *sg, Vec du);
+PetscErrorCode SolverStepGuessPreSolve(SolverStepGuess *sg, KSP ksp, Vec x, PetscReal snes_scale);
+PetscErrorCode SolverStepGuessDrop(SolverStepGuess *sg);
+/* newton.c: the next solve's first linear solve starts from the Newton step du predicts (SolverStepGuessSet()) */
 PetscErrorCode SolverSetStepGuess(SolverCtx sc, Vec du);
-PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, SolverCtx sc);
-PetscErrorCode SolverStepGuessDrop(SolverCtx sc);
+
+/* extrapolated_start.c */
 PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscReal factor, PetscReal relaxed, PetscBool step_guess);
 PetscErrorCode SolverSecantStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor, PetscReal relaxed);
 
 /* pc_reuse.c */
-PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X);
-PetscErrorCode PcReuseAfterJacobian(SNES snes, SolverCtx sc);
-PetscErrorCode PcReuseDestroy(SolverCtx sc);
-PetscErrorCode PcReuseReset(SolverCtx sc);
+PetscErrorCode PcReuseSetUp(PcReuse *r, Mat K, Contact contact, const SolverOptions *opt);
+PetscErrorCode PcReuseDecide(PcReuse *r, SNES snes, DM dm, Vec X);
+PetscErrorCode PcReuseAfterJacobian(PcReuse *r, SNES snes);
+PetscErrorCode PcReuseDestroy(PcReuse *r);
+PetscErrorCode PcReuseReset(PcReuse *r);
 
 /* pc_recovery.c */
-PetscErrorCode PcRecoveryTry(SNES snes, SolverCtx sc, PetscBool *retry);
-PetscErrorCode SmootherBoundFinest(PC pc, PetscInt nlevels, SolverCtx sc, const PetscScalar jvals[], PetscBool check);
+PetscErrorCode PcRecoveryTry(PcRecovery *rec, SNES snes, const SolverOptions *opt, PcReuse *reuse, RunStats *stats, PetscBool *retry);
+
+/* smoother_bound.c */
+PetscErrorCode SmootherBoundFinest(PcReuse *r, PC pc, PetscInt nlevels, const PetscScalar jvals[], PetscBool check);
