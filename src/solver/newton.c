@@ -32,7 +32,7 @@ PetscErrorCode SolverCtxDestroy(SolverCtx *sc)
 }
 
 /* The next solve's first linear solve starts from the Newton step that the change du of the solution (the user's
-   units) predicts (step_guess.c). */
+   units) predicts (src/linear/step_guess.c). */
 PetscErrorCode SolverSetStepGuess(SolverCtx sc, Vec du)
 {
   PetscFunctionBeginUser;
@@ -132,7 +132,7 @@ PetscErrorCode SolverFormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
    error is of the order of h) is not stopped by a reduction of that residual alone; one far below it (an extrapolated
    start of the eps sweep) is not held to a reduction that round-off cannot reach.
    Every norm here is relative, so the test is the same in any units. The reference of -snes_rtol is
-   SolverStopReference() (include/solver.h), which the forcing terms (ew_forcing.c) share. */
+   SolverStopReference() (solver_impl.h), which the core passes to the forcing terms (src/linear/ew_forcing.c). */
 
 /* The size of the round-off in the residual at u: F = K u + r0 + (1/eps)[u_n - g]_+ n w sums terms much larger than F
    itself near the solution, and double precision knows each to about PETSC_MACHINE_EPSILON of its size. The terms:
@@ -246,7 +246,7 @@ PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscRea
 }
 
 /* Before each linear solve: the finest multigrid smoother's -mg_fine_ options (fine_smoother.c), the initial guess
-   (step_guess.c), then the linear tolerance of the inexact Newton (ew_forcing.c). */
+   (step_guess.c), then the linear tolerance of the inexact Newton (ew_forcing.c), all in src/linear/. */
 PetscErrorCode SolverPreSolve(KSP ksp, Vec b, Vec x, void *ctx)
 {
   SolverCtx sc = (SolverCtx)ctx;

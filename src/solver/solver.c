@@ -105,7 +105,7 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
 /* The default linear solver: on the 3D box that nests (MultigridIsDefault()), CG with the boxes' geometric multigrid, whose
    levels are given: MUMPS's fill grows as n^(4/3) there (docs/decisions.md, "The 3D box's default solver"). Elsewhere
    a direct solve (MUMPS), robust for the small problems of a first run; for the penalty
-   method inside CG, so that a factorization can serve as the preconditioner of later Newton steps (pc_reuse.c).
+   method inside CG, so that a factorization can serve as the preconditioner of later Newton steps (src/linear/pc_reuse.c).
    The Newton steps are as accurate as with a fresh factorization, also when it is reused. */
 static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
 {
@@ -332,7 +332,7 @@ static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
 }
 
 /* SolverSNESSolve() and RecordSolve(), then again from the last iterate after each recovery from a breakdown of the
-   preconditioner (pc_recovery.c) while one is left; the Newton steps and linear iterations of every attempt count. */
+   preconditioner (src/linear/pc_recovery.c) while one is left; the Newton steps and linear iterations of every attempt count. */
 static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *newton, PetscInt *ksp)
 {
   const SolverCtx sc    = user->prob.sctx;

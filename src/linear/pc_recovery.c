@@ -21,7 +21,7 @@
    Each step is taken once per run, counted in /run pc_breakdowns and described in pc_recovery; -contact_pc_recovery 0
    leaves the breakdown a failed solve. A breakdown is never turned into a converged result without the Newton
    convergence test it would have had to pass anyway. */
-#include "solver_impl.h"
+#include "linear_impl.h"
 
 #define SAFER_EMAX 1.5
 

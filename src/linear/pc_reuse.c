@@ -18,8 +18,8 @@
    for the change (a load path's steps settle the rim of the contact zone a few nodes per Newton step). "There" is where
    the last carried update cost more than PC_FINEST_ONLY_CYCLES CG iterations, in flops (deterministic, unlike times);
    where an update costs less, the finest-only steps cost more CG iterations than they save. */
-#include "physics.h"
-#include "solver_impl.h"
+#include "contact.h"
+#include "linear_impl.h"
 
 #define PC_FINEST_ONLY_CYCLES 2.0 /* the coarse operators may stay where a carried update costs more CG iterations than this */
 

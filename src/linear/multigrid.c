@@ -7,7 +7,7 @@
    -contact_coarse_mg: with another iterative preconditioner, the coarser boxes of nested iteration are solved by this
    geometric multigrid under the options prefix contact_coarse_, and the final mesh by the options' preconditioner. */
 #include "mesh.h"
-#include "solver_impl.h"
+#include "linear_impl.h"
 
 /* a 3D coarsest mesh of more unknowns is solved alone by GAMG, not by a factorization at each Newton step */
 #define MULTIGRID_COARSE_LU_ROWS_3D 10000

@@ -9,7 +9,7 @@
    not. An estimate costs ten products with the finest matrix at each update; the bound, a pass
    over the contact rows. The coarse levels still estimate again: their estimates cost little. */
 #include "contact.h"
-#include "solver_impl.h"
+#include "linear_impl.h"
 
 /* The finest level's smoother if it is Chebyshev with point Jacobi (the case the bound covers), else NULL. */
 static PetscErrorCode FinestChebyshevJacobi(PC pc, PetscInt nlevels, KSP *smoother)

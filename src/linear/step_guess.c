@@ -8,7 +8,7 @@
    a close guess meets the forcing term almost at once, and Newton, left with the guess as its step, needs more steps.
    The test stays so set for later solves, where it changes nothing unless the options ask for a nonzero initial guess,
    which it then measures the same way. */
-#include "solver_impl.h"
+#include "linear.h"
 
 /* At the SNES's set-up: what the options asked of its KSP (given: the solver's options given, SolverGiven). */
 PetscErrorCode SolverStepGuessSetUp(SolverStepGuess *sg, KSP ksp, const SolverGiven *given)

@@ -7,7 +7,7 @@
    This pre-solve (part of SolverPreSolve() in newton.c) replaces PETSc's (KSPPreSolve_SNESEW(), installed with the
    SNES's KSP); without the guard its terms are PETSc's exactly. Other versions (-snes_ksp_ew_version) keep PETSc's.
    One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
-#include "solver_impl.h"
+#include "linear.h"
 
 #define EW_ENDGAME 10.0 /* a step expected to land within this factor of Newton's target ... */
 #define EW_FINISH 0.3   /* ... is solved to this fraction of it */
