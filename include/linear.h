@@ -70,7 +70,7 @@ typedef struct {
 
 /* State of the recovery from preconditioner breakdowns (pc_recovery.c). */
 typedef struct {
-  PetscInt stage; /* recovery steps taken: 0 none, 1 rebuilt, 2 GMRES, 3 direct */
+  PetscInt stage; /* recovery steps taken: 0 none, 1 rebuilt, 2 safer smoother bounds (a multigrid), 3 direct */
 } PcRecovery;
 
 /* The forcing terms of the inexact Newton (ew_forcing.c): Eisenstat-Walker's, with the guard against oversolving. */
