@@ -64,7 +64,7 @@ PetscErrorCode ContactWrite(Contact ct, PetscViewer v); /* the method's part of 
    options say nothing. */
 typedef struct {
   PetscBool reuse_factorization; /* J = K plus terms in the contact rows only (the penalty): an earlier J's factorization
-                                    preconditions CG on the next (pc_reuse.c), which the default linear solver is */
+                                    preconditions CG on the next (src/linear/pc_reuse.c), which the default linear solver is */
   PetscBool inexact_newton;      /* Eisenstat-Walker's forcing terms with an iterative preconditioner (the penalty) */
   PetscBool linear;              /* the problem is linear (none): one Newton step, CG on the true residual's norm */
   PetscBool nested_iteration;    /* the grid sequence's coarser boxes by default on P1: each starts Newton near the next (the penalty) */
@@ -148,7 +148,7 @@ PetscErrorCode ContactActivityFloor(Contact ct, PetscReal *floor);
 /* After the solve: the pressure and the reaction at each node (kept in the contact set), the force, the active set, the energy */
 PetscErrorCode ContactPostProcess(Contact ct, DM dm, Vec R, Vec u, PetscReal tol_scale, ContactResult *res);
 
-/* The rows of K that the penalty Jacobian changes (penalty.c, bulk_rows.c): read by the GAMG updates (src/solver/pc_reuse.c) */
+/* The rows of K that the penalty Jacobian changes (penalty.c, bulk_rows.c): read by the GAMG updates (src/linear/pc_reuse.c) */
 typedef struct {
   PetscInt     n;                 /* owned rows of the contact dofs */
   PetscInt    *rows, *ptr, *cols; /* their global numbers, and their columns in CSR form */

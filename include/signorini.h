@@ -120,7 +120,7 @@ typedef struct {
 
 /* PETSc's own options whose presence changes the project's defaults ("where the options say nothing"), read with the
    rest in the options phase (SolverGetOptions()), for each options prefix the solver's objects can have: the solve's
-   KSP (no prefix) and the coarser boxes' KSP ("contact_coarse_", src/solver/multigrid.c). */
+   KSP (no prefix) and the coarser boxes' KSP ("contact_coarse_", src/linear/multigrid.c). */
 #define SOLVER_KSP_PREFIXES 2
 #define MULTIGRID_MAX_LEVELS 16 /* levels of a multigrid preconditioner the solver follows */
 typedef struct {
@@ -141,7 +141,7 @@ typedef struct {
   PetscReal esteig[SOLVER_KSP_PREFIXES * (MULTIGRID_MAX_LEVELS + 1)][4];
 } SolverGiven;
 
-/* Options of the nonlinear solve around the contact (SolverGetOptions(), src/solver/solver_options.c). */
+/* Options of the nonlinear solve around the contact (SolverGetOptions(), src/linear/solver_options.c). */
 typedef struct {
   SolverGiven given;
   PetscBool   monitor;
@@ -519,7 +519,7 @@ typedef struct {
 /* The state of a run, by concern: its options, its scene, the problem on the current mesh, the hierarchy of the meshes
    solved before it, and its record. */
 typedef struct _p_Contact   *Contact;   /* include/contact.h */
-typedef struct _n_Multigrid *Multigrid; /* the nested meshes' interpolations, private to src/solver/ (solver_impl.h) */
+typedef struct _n_Multigrid *Multigrid; /* the nested meshes' interpolations, private to src/linear/ (linear_impl.h) */
 typedef struct {
   const RunOptions *opt;     /* read once before any set-up, then read only */
   Contact           contact; /* created and read from the options once, set up on the mesh of each problem */

@@ -1,7 +1,9 @@
 /* Solver: assembly of the bulk operator, the SNES (residual, Jacobian, scaling, convergence), the problem on one mesh, grid sequencing, eps sweep,
- * preconditioner reuse, the Newton monitor (src/solver/). */
+ * the Newton monitor (src/solver/). Its linear acceleration (preconditioner reuse and recovery, forcing terms, step
+ * guess, the nested meshes' multigrid, the solver's options) is the layer below, include/linear.h. */
 #pragma once
 #include "signorini.h"
+#include "linear.h"
 
 /* solver.c */
 /* the bound of Eisenstat-Walker's linear tolerances, the penalty method's default with an iterative preconditioner */
@@ -43,14 +45,11 @@ PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
 #define GRID_SEQUENCE_MIN_FACES_3D 16
 #define GRID_SEQUENCE_MIN_FACES_MG_3D 4
 /* ... and the multigrid's coarsest box in 3D has at most 20 cells per side (27,783 unknowns) where it nests by default:
-   it is factored by MUMPS at each build of the hierarchy and solved alone by GAMG (multigrid.c; docs/decisions.md,
+   it is factored by MUMPS at each build of the hierarchy and solved alone by GAMG (src/linear/multigrid.c; docs/decisions.md,
    "The coarsest box"). */
 #define GRID_SEQUENCE_MAX_COARSEST_MG_3D 20
 PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOptions *opt, PetscInt request[2], PetscInt faces[3],
                                          PetscInt *min_levels, PetscBool *coarse_mg, PetscBool *default_mg);
-PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts);
-PetscErrorCode SolverGivenIndex(const char prefix[], PetscInt *k);
-PetscErrorCode SolverGivenEsteig(const SolverGiven *g, const char prefix[], PetscInt *n, PetscReal t[]);
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
 PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked);
 PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked);
@@ -73,19 +72,6 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 PetscErrorCode LoadPathView(MPI_Comm comm, const AppCtx *user);
 PetscErrorCode LoadPathWrite(MPI_Comm comm, const Scene *scene, const RunStats *s, const StepRecord st[], PetscInt n, PetscInt dim,
                              PetscViewer v); /* /steps */
-
-/* multigrid.c */
-PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt vertex_source[], AppCtx *user);
-PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user);
-PetscErrorCode MultigridSetCoarseBoxSolver(KSP ksp, const AppCtx *user);
-PetscErrorCode MultigridCreate(PetscBool coarse_mg, Multigrid *mg);
-PetscErrorCode MultigridDestroy(Multigrid *mg);
-PetscErrorCode MultigridSetDefault(Multigrid mg, PetscBool is_default);
-PetscBool      MultigridIsDefault(const AppCtx *user);
-
-/* fine_smoother.c: -mg_fine_ksp_*, -mg_fine_pc_* */
-PetscErrorCode FineSmootherGiven(KSP ksp, const SolverGiven *g, PetscBool *given);
-PetscErrorCode FineSmootherSetUp(KSP ksp, const SolverGiven *g);
 
 /* bandwidth.c */
 PetscErrorCode BandwidthGetOptions(MPI_Comm comm, PetscBool *measure);

@@ -7,6 +7,7 @@ static const char help[] =
 #include "contact.h"
 #include "discretization.h"
 #include "estimate.h"
+#include "linear.h"
 #include "scenes.h"
 #include "mesh.h"
 #include "physics.h"

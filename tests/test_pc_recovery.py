@@ -1,4 +1,4 @@
-"""Recovery from a breakdown of the preconditioner (make test; src/solver/pc_recovery.c): a Krylov solve that stops on
+"""Recovery from a breakdown of the preconditioner (make test; src/linear/pc_recovery.c): a Krylov solve that stops on
 its preconditioner (DIVERGED_INDEFINITE_PC) no longer ends the run; Newton goes on from its last iterate after a fresh
 build, then safer smoother bounds, then a direct solve, each counted in /run pc_breakdowns and named in pc_recovery,
 and the answer is the direct solver's. With -contact_pc_recovery 0 the breakdown stays a failed solve

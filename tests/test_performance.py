@@ -103,7 +103,7 @@ def test_3d_box_default_solver_is_the_boxes_multigrid(np_):
 
 def test_3d_coarsest_box_keeps_its_factorization_between_newton_steps():
     """The coarsest box's own solve is a PCMG of one level, whose coarse solve factors the Jacobian itself: PETSc
-    factored it again at every Newton step (src/solver/pc_reuse.c). In 3D it now keeps the factorization as a
+    factored it again at every Newton step (src/linear/pc_reuse.c). In 3D it now keeps the factorization as a
     factorization is kept (the count of changed nodes decides): on the 20^3 box nested from 10^3 (3,630 unknowns, 28 ms
     a MUMPS factorization) the run made 5 numeric factorizations, 4 of them in the 10^3 box's 4 Newton steps; at most
     3 now (-log_view's MatLUFactorNum), with the answer of MUMPS on the final box to 1e-8."""
@@ -179,7 +179,7 @@ def test_sweep_starts_the_linear_solve_from_a_refused_extrapolation(ranks):
     """From the third value on, a sweep extrapolates the last two solutions in eps. Where that guess lifts Gauss points
     that the last solution has in contact, it is not Newton's first iterate (the line search cut its steps at those
     kinks); Newton starts from the last solution, and its first linear solve from the step the guess predicts
-    (src/solver/step_guess.c). On the 256 x 256 square with GAMG the guesses for 1e-2 h and 1e-3 h lift 3 and 1 Gauss
+    (src/linear/step_guess.c). On the 256 x 256 square with GAMG the guesses for 1e-2 h and 1e-3 h lift 3 and 1 Gauss
     points (a temporary count, not asserted here) that the answers keep in contact; from the last solution alone those
     values took 3 Newton steps and 22 CG iterations each on one rank (2 and 20, 3 and 23 on two), from the guessed step
     2 and 15, 2 and 14 (2 and 16, 2 and 15 on two). Each must take at most 2 steps and 17 iterations, and the sweep
@@ -299,7 +299,7 @@ def test_truncated_prolongator_keeps_gamg_iterations_flat_in_eps(np_):
                                          (2, ["-dm_plex_box_faces", "96,96", "-penalty_eps0", "1e-6"])])
 def test_finest_smoother_options_give_the_gamg_answer(np_, extra):
     """options/solvers/ssor_fine.yaml: -mg_fine_ksp_type richardson -mg_fine_pc_type sor -mg_fine_ksp_max_it 1 give the
-    finest level of the GAMG hierarchy one SSOR sweep (src/solver/fine_smoother.c); -ksp_view shows that smoother under
+    finest level of the GAMG hierarchy one SSOR sweep (src/linear/fine_smoother.c); -ksp_view shows that smoother under
     the prefix mg_fine_ and every other level with Chebyshev. The answer is gamg.yaml's to 1e-8; the elastic solve at
     128 x 128 takes fewer CG iterations (20 against 25); the penalty run at 1e-6 h on 2 ranks converges."""
     args = SQUARE + extra + ["-options_file", "options/solvers/gamg.yaml"]
@@ -326,7 +326,7 @@ def test_finest_smoother_options_give_the_gamg_answer(np_, extra):
 )
 def test_finest_smoother_interval_is_bounded_not_estimated(np_, extra):
     """With the updates, the finest level's Chebyshev interval comes from the build's estimate on K and a Gershgorin
-    bound of the penalty term (src/solver/smoother_bound.c), not from a new estimate. -contact_pc_update_check
+    bound of the penalty term (src/linear/smoother_bound.c), not from a new estimate. -contact_pc_update_check
     estimates afresh on every updated Jacobian: the interval's top stays above 1.1 times that estimate (what PETSc's
     own re-estimate would give, to 1%), and the answer is the one of the re-estimates (-contact_pc_update_esteig).
     Without nesting: from a zero guess Newton takes enough steps to update several times. The updates of the finest

@@ -281,7 +281,7 @@ def test_the_3d_peak_is_the_fits_largest_off_the_top_node(tmp_path, np_):
 def test_a_gamg_breakdown_on_a_carried_solution_is_recovered_without_a_direct_solve(sphere):
     """The sphere's sixth remeshed cycle (18,632 unknowns): the carried solution's first Jacobian holds the penalty rows
     of its contact, GAMG's aggregates of contact nodes alone (the threshold drops their links into the body) make CG
-    break down, and GAMG rebuilt on the unfiltered graph (src/solver/pc_recovery.c, step 2) solves it, without the
+    break down, and GAMG rebuilt on the unfiltered graph (src/linear/pc_recovery.c, step 2) solves it, without the
     direct solve of step 3: the same cycles and answer as the direct solver's. Whether the breakdown comes at a given
     threshold is a matter of round-off and of the meshes (it came at the fifth cycle and the threshold 0.01 or 0.1
     before the remeshed boundary kept its sizes, mesh_remesh_caps.c; now at the sixth and 0.01, where 0.1 takes a

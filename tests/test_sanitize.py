@@ -34,7 +34,7 @@ CASES = {
     # the recovered peak's fit on tetrahedra (30 nodes in contact: its 20 nearest, gathered from both ranks)
     "sphere_3d_peak_fit_np2": (2, ["-scene", "general", "-dm_plex_dim", 3, "-dm_plex_box_faces", "12,12,3", "-contact_faces", 1, "-bc_clamp", 2,
                                    "-bc_clamp_2_translate", "0,0,-0.01", "-obstacle", "sphere", "-obstacle_center", "0.5,0.5,-2", "-obstacle_radius", 2], 0),
-    # a preconditioner breakdown at every multigrid build, recovered by a direct solve (src/solver/pc_recovery.c)
+    # a preconditioner breakdown at every multigrid build, recovered by a direct solve (src/linear/pc_recovery.c)
     "pc_recovery": (1, ["-dm_plex_box_faces", "16,16", "-options_file", "options/solvers/gamg.yaml", "-mg_levels_ksp_chebyshev_esteig", "0,0.05,0,0.3"], 0),
     # a Gmsh file read on rank 0 (the other rank checks a mesh without cells), a local eps on PETSc's boundary integration,
     # the closed form checked against it, the SBAIJ copy of K for the penalty Jacobian with its Cholesky factorization

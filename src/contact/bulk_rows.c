@@ -6,7 +6,7 @@
 
 /* A's values in the rows rows[0 .. n-1] (global numbers, owned), in CSR arrays allocated together (PetscFree3(*ptr,
    *cols, *vals)): row i's columns and values at ptr[i] .. ptr[i + 1] - 1. The contact rows of K here, and those of the
-   finest GAMG prolongator (src/solver/pc_reuse.c). */
+   finest GAMG prolongator (src/linear/pc_reuse.c). */
 PetscErrorCode ContactCopyRows(Mat A, PetscInt n, const PetscInt rows[], PetscInt **ptr, PetscInt **cols, PetscScalar **vals)
 {
   PetscInt nnz = 0;

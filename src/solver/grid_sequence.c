@@ -59,7 +59,7 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   PetscCall(GridSequenceBarsSizes(fine, user)); /* -bars on tetrahedra: the final mesh's eps on this level */
   if (marked) PetscCall(MeshSetContactCellSizes(fine, user->scene.bcs.ncontact, user->scene.bcs.contact_ids)); /* one eps on Gamma_C */
   PetscCall(ProblemSetUp(fine, user, snes));
-  PetscCall(MultigridAddLevel(*snes, *dm, fine, vertex_source, user)); /* with -pc_type mg */
+  PetscCall(MultigridAddLevel(user->mg, *snes, *dm, fine, vertex_source, user->opt->degree)); /* with -pc_type mg */
   if (user->opt->degree == 1)
     PetscCall(MeshInterpolateVertexSources(*dm, fine, vertex_source, loc, &fine_loc)); /* exact and fast */
   else

@@ -15,6 +15,7 @@ PetscErrorCode SolverCtxCreate(Mat K, Vec r0, Contact contact, const SolverOptio
   (*sc)->opt        = opt;
   (*sc)->stats      = stats;
   (*sc)->snes_scale = 1.0;
+  PetscCall(PcReuseSetUp(&(*sc)->pc_reuse, K, contact, opt));
   PetscCall(VecDuplicate(r0, &(*sc)->work)); /* DMCreateGlobalVector() would scan every mesh point again */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -23,10 +24,19 @@ PetscErrorCode SolverCtxDestroy(SolverCtx *sc)
 {
   PetscFunctionBeginUser;
   if (!*sc) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PcReuseDestroy(*sc));
-  PetscCall(SolverStepGuessDrop(*sc));
+  PetscCall(PcReuseDestroy(&(*sc)->pc_reuse));
+  PetscCall(SolverStepGuessDrop(&(*sc)->step_guess));
   PetscCall(VecDestroy(&(*sc)->work));
   PetscCall(PetscFree(*sc));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The next solve's first linear solve starts from the Newton step that the change du of the solution (the user's
+   units) predicts (src/linear/step_guess.c). */
+PetscErrorCode SolverSetStepGuess(SolverCtx sc, Vec du)
+{
+  PetscFunctionBeginUser;
+  PetscCall(SolverStepGuessSet(&sc->step_guess, du));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -105,9 +115,9 @@ PetscErrorCode SolverFormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
   PetscCall(SolverIterateDisplacement(sc, X, &u));
   /* J = K for the types without a contact Jacobian, which ContactComputeJacobian() leaves, and the factorization's reuse
      is off for them (SolverCreateSNES()) */
-  PetscCall(PcReuseDecide(snes, dm, sc, u));
+  PetscCall(PcReuseDecide(&sc->pc_reuse, snes, dm, u));
   PetscCall(ContactComputeJacobian(sc->contact, dm, u, sc->K, P)); /* P is K itself, or a copy (SBAIJ: no row access) */
-  PetscCall(PcReuseAfterJacobian(snes, sc));                       /* records the build's contact rows, or updates the GAMG hierarchy */
+  PetscCall(PcReuseAfterJacobian(&sc->pc_reuse, snes));            /* records the build's contact rows, or updates the GAMG hierarchy */
   if (J != P) {
     PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
@@ -122,7 +132,7 @@ PetscErrorCode SolverFormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
    error is of the order of h) is not stopped by a reduction of that residual alone; one far below it (an extrapolated
    start of the eps sweep) is not held to a reduction that round-off cannot reach.
    Every norm here is relative, so the test is the same in any units. The reference of -snes_rtol is
-   SolverStopReference() (include/solver.h), which the forcing terms (ew_forcing.c) share. */
+   SolverStopReference() (solver_impl.h), which the core passes to the forcing terms (src/linear/ew_forcing.c). */
 
 /* The size of the round-off in the residual at u: F = K u + r0 + (1/eps)[u_n - g]_+ n w sums terms much larger than F
    itself near the solution, and double precision knows each to about PETSC_MACHINE_EPSILON of its size. The terms:
@@ -236,14 +246,14 @@ PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscRea
 }
 
 /* Before each linear solve: the finest multigrid smoother's -mg_fine_ options (fine_smoother.c), the initial guess
-   (step_guess.c), then the linear tolerance of the inexact Newton (ew_forcing.c). */
+   (step_guess.c), then the linear tolerance of the inexact Newton (ew_forcing.c), all in src/linear/. */
 PetscErrorCode SolverPreSolve(KSP ksp, Vec b, Vec x, void *ctx)
 {
   SolverCtx sc = (SolverCtx)ctx;
 
   PetscFunctionBeginUser;
   PetscCall(FineSmootherSetUp(ksp, &sc->opt->given));
-  PetscCall(SolverStepGuessPreSolve(ksp, x, sc));
-  PetscCall(SolverForcingPreSolve(ksp, sc));
+  PetscCall(SolverStepGuessPreSolve(&sc->step_guess, ksp, x, sc->snes_scale));
+  PetscCall(SolverForcingPreSolve(&sc->forcing, ksp, SolverStopReference(sc), sc->snes_scale));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -95,7 +95,7 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
 /* The default linear solver: on the 3D box that nests (MultigridIsDefault()), CG with the boxes' geometric multigrid, whose
    levels are given: MUMPS's fill grows as n^(4/3) there (docs/decisions.md, "The 3D box's default solver"). Elsewhere
    a direct solve (MUMPS), robust for the small problems of a first run; for the penalty
-   method inside CG, so that a factorization can serve as the preconditioner of later Newton steps (pc_reuse.c).
+   method inside CG, so that a factorization can serve as the preconditioner of later Newton steps (src/linear/pc_reuse.c).
    The Newton steps are as accurate as with a fresh factorization, also when it is reused. */
 static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
 {
@@ -104,7 +104,7 @@ static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
   const ContactSolverDefaults *defaults;
 
   PetscFunctionBeginUser;
-  if (MultigridIsDefault(user)) { /* the 3D box that nests: CG with the boxes' geometric multigrid, as options/solvers/mg.yaml */
+  if (MultigridIsDefault(user->mg)) { /* the 3D box that nests: CG with the boxes' geometric multigrid, as options/solvers/mg.yaml */
     PetscCall(KSPSetType(ksp, KSPCG));
     PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
     PetscCall(KSPGetPC(ksp, &pc));
@@ -193,7 +193,7 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscCall(SNESSetConvergenceTest(*snes, SolverConverged, user->prob.sctx, NULL));
   PetscCall(SNESGetKSP(*snes, &ksp));
   PetscCall(SolverSetDefaultLinearSolver(ksp, user));
-  PetscCall(MultigridSetCoarseBoxSolver(ksp, user)); /* -contact_coarse_mg on a coarser box */
+  PetscCall(MultigridSetCoarseBoxSolver(user->mg, ksp, user->prob.level, &user->box)); /* -contact_coarse_mg on a coarser box */
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(SNESMonitorSet(*snes, ContactMonitor, user->prob.sctx, NULL));
   PetscCall(SNESSetFromOptions(*snes));
@@ -220,8 +220,9 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   {
     PetscBool petsc_presolve, fine;
 
-    PetscCall(SolverForcingSetUp(*snes, user->prob.sctx, &petsc_presolve)); /* Eisenstat-Walker's terms with the oversolving guard */
-    PetscCall(SolverStepGuessSetUp(ksp, user->prob.sctx));
+    /* Eisenstat-Walker's terms with the oversolving guard */
+    PetscCall(SolverForcingSetUp(&user->prob.sctx->forcing, *snes, user->opt->solver.ew_guard, &petsc_presolve));
+    PetscCall(SolverStepGuessSetUp(&user->prob.sctx->step_guess, ksp, &user->opt->solver.given));
     if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, user->prob.sctx));
     PetscCall(FineSmootherGiven(ksp, &user->opt->solver.given, &fine));
     PetscCheck(!fine || is_multigrid, comm, PETSC_ERR_USER_INPUT,
@@ -312,7 +313,7 @@ static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
   PetscCall(ContactSolverFrame(user->contact, u, PETSC_TRUE)); /* the SNES's unknowns: Q^T u/U */
   PetscCall(ContactScaleBounds(user->contact, 1.0 / U));
   PetscCall(SNESSolve(snes, NULL, u));
-  PetscCall(SolverStepGuessDrop(user->prob.sctx)); /* unused if no linear solve came */
+  PetscCall(SolverStepGuessDrop(&user->prob.sctx->step_guess)); /* unused if no linear solve came */
   PetscCall(ContactSolverFrame(user->contact, u, PETSC_FALSE));
   PetscCall(VecScale(u, U));
   PetscCall(ContactScaleBounds(user->contact, U));
@@ -321,16 +322,17 @@ static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
 }
 
 /* SolverSNESSolve() and RecordSolve(), then again from the last iterate after each recovery from a breakdown of the
-   preconditioner (pc_recovery.c) while one is left; the Newton steps and linear iterations of every attempt count. */
+   preconditioner (src/linear/pc_recovery.c) while one is left; the Newton steps and linear iterations of every attempt count. */
 static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *newton, PetscInt *ksp)
 {
-  PetscBool retry = PETSC_TRUE;
+  const SolverCtx sc    = user->prob.sctx;
+  PetscBool       retry = PETSC_TRUE;
 
   PetscFunctionBeginUser;
   PetscCall(SolverSNESSolve(snes, user, u));
   PetscCall(RecordSolve(snes, user, newton, ksp));
   while (!user->rec.stats.converged && retry) {
-    PetscCall(PcRecoveryTry(snes, user->prob.sctx, &retry));
+    PetscCall(PcRecoveryTry(&sc->pc_recovery, snes, sc->opt, &sc->pc_reuse, sc->stats, &retry));
     if (!retry) break;
     PetscCall(SolverSNESSolve(snes, user, u));
     PetscCall(RecordSolve(snes, user, newton, ksp));
@@ -415,7 +417,8 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
       PetscCall(ContactForgetMultipliers(user->contact));
     }
   }
-  PetscCall(MultigridSetUpPC(snes, user)); /* -pc_type mg: the levels of the meshes solved so far */
+  /* -pc_type mg: the levels of the meshes solved so far */
+  PetscCall(MultigridSetUpPC(user->mg, snes, user->prob.level, &user->box, &user->opt->solver));
   user->prob.sctx->warm = warm;
   PetscCall(PetscTime(&t0));
   user->prob.sctx->pc_reuse.builds         = 0; /* counted per solve */

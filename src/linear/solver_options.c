@@ -1,7 +1,7 @@
 /* Options of the nonlinear solve around the contact: the monitor, the preconditioner's reuse, updates and recovery,
    nested iteration, the inexact Newton's guard and the round-off stop. Read once, before any set-up. */
 #include "app.h"
-#include "solver.h"
+#include "linear.h"
 
 static const char *const solver_ksp_prefixes[SOLVER_KSP_PREFIXES] = {"", "contact_coarse_"};
 

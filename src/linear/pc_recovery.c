@@ -21,7 +21,7 @@
    Each step is taken once per run, counted in /run pc_breakdowns and described in pc_recovery; -contact_pc_recovery 0
    leaves the breakdown a failed solve. A breakdown is never turned into a converged result without the Newton
    convergence test it would have had to pass anyway. */
-#include "solver_impl.h"
+#include "linear_impl.h"
 
 #define SAFER_EMAX 1.5
 
@@ -74,10 +74,9 @@ static PetscErrorCode IsBreakdown(SNES snes, KSPConvergedReason *kreason, PetscB
 }
 
 /* Appends one action to the run's record (/run pc_recovery, "; "-separated). */
-static PetscErrorCode Record(SolverCtx sc, const char action[], KSPConvergedReason kreason)
+static PetscErrorCode Record(RunStats *s, const char action[], KSPConvergedReason kreason)
 {
-  RunStats *s = sc->stats;
-  char      item[160];
+  char item[160];
 
   PetscFunctionBeginUser;
   PetscCall(PetscSNPrintf(item, sizeof(item), "%s%s after %s", s->pc_recovery[0] ? "; " : "", action, KSPConvergedReasons[kreason]));
@@ -101,11 +100,11 @@ static PetscErrorCode UseDirectSolve(SNES snes, PC pc)
 }
 
 /* After a failed SNESSolve: if it ended on a breakdown and a recovery step is left, takes the next one and sets
- *retry (solve again from the last iterate); else leaves the failure as it is. */
-PetscErrorCode PcRecoveryTry(SNES snes, SolverCtx sc, PetscBool *retry)
+ *retry (solve again from the last iterate); else leaves the failure as it is. reuse: the preconditioner's reuse, whose
+   build is forgotten; stats: where the steps are recorded (/run pc_breakdowns and pc_recovery). */
+PetscErrorCode PcRecoveryTry(PcRecovery *rec, SNES snes, const SolverOptions *opt, PcReuse *reuse, RunStats *stats, PetscBool *retry)
 {
   MPI_Comm           comm = PetscObjectComm((PetscObject)snes);
-  PcRecovery        *rec  = &sc->pc_recovery;
   KSPConvergedReason kreason;
   PetscBool          breakdown, is_gamg, is_mg;
   KSP                ksp;
@@ -113,18 +112,18 @@ PetscErrorCode PcRecoveryTry(SNES snes, SolverCtx sc, PetscBool *retry)
 
   PetscFunctionBeginUser;
   *retry = PETSC_FALSE;
-  if (!sc->opt->pc_recovery || rec->stage >= 3) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!opt->pc_recovery || rec->stage >= 3) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(IsBreakdown(snes, &kreason, &breakdown));
   if (!breakdown) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCGAMG, &is_gamg));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
-  PetscCall(PcReuseReset(sc));                  /* the next Newton step builds afresh, and builds only from then on */
+  PetscCall(PcReuseReset(reuse));               /* the next Newton step builds afresh, and builds only from then on */
   PetscCall(SNESSetLagPreconditioner(snes, 1)); /* (PcReuseDecide() sets the lag again where it takes over) */
   if (rec->stage == 0) {                        /* 1. a fresh build */
     rec->stage = 1;
-    PetscCall(Record(sc, "preconditioner rebuilt", kreason));
+    PetscCall(Record(stats, "preconditioner rebuilt", kreason));
     PetscCall(PetscPrintf(comm, "  preconditioner breakdown (%s): rebuilt on the current Jacobian, Newton goes on from its last iterate\n",
                           KSPConvergedReasons[kreason]));
   } else if (rec->stage == 1 && (is_gamg || is_mg)) { /* 2. safer smoother bounds */
@@ -139,8 +138,8 @@ PetscErrorCode PcRecoveryTry(SNES snes, SolverCtx sc, PetscBool *retry)
       PetscCall(PCGAMGSetThreshold(pc, &unfiltered, 1)); /* every level's graph whole: aggregates reach into the body */
     } else
       PetscCall(SaferChebyshev(pc)); /* the levels of the nested meshes stay */
-    PetscCall(
-        Record(sc, is_gamg ? "GAMG rebuilt with each level's own eigenvalue estimate and unfiltered graph" : "Chebyshev intervals widened", kreason));
+    PetscCall(Record(stats, is_gamg ? "GAMG rebuilt with each level's own eigenvalue estimate and unfiltered graph" : "Chebyshev intervals widened",
+                     kreason));
     PetscCall(PetscPrintf(comm, "  preconditioner breakdown (%s) again: %s, from the last iterate\n", KSPConvergedReasons[kreason],
                           is_gamg
                               ? "GAMG rebuilt, each level's smoother bounded by its own eigenvalue estimate, its aggregates on the unfiltered graph"
@@ -148,7 +147,7 @@ PetscErrorCode PcRecoveryTry(SNES snes, SolverCtx sc, PetscBool *retry)
   } else { /* 3. a direct solve */
     rec->stage = 3;
     PetscCall(UseDirectSolve(snes, pc));
-    PetscCall(Record(sc, "direct solve (MUMPS)", kreason));
+    PetscCall(Record(stats, "direct solve (MUMPS)", kreason));
     PetscCall(
         PetscPrintf(comm, "  preconditioner breakdown (%s) again: a direct solve (MUMPS) from the last iterate\n", KSPConvergedReasons[kreason]));
   }

@@ -3,7 +3,7 @@
    by its number (-mg_levels_N_), which depends on the mesh and on GAMG's coarsening; here the finest smoother gets the
    prefix mg_fine_ once the hierarchy exists, and its options are read again under it (those not given keep the values
    -mg_levels_ gave). Without -mg_fine_ksp_type and -mg_fine_pc_type nothing is changed. */
-#include "solver.h"
+#include "linear.h"
 
 /* The PC's prefix followed by mg_fine_. */
 static PetscErrorCode FinePrefix(PC pc, char fine[], size_t len)

@@ -18,19 +18,19 @@
    for the change (a load path's steps settle the rim of the contact zone a few nodes per Newton step). "There" is where
    the last carried update cost more than PC_FINEST_ONLY_CYCLES CG iterations, in flops (deterministic, unlike times);
    where an update costs less, the finest-only steps cost more CG iterations than they save. */
-#include "physics.h"
-#include "solver_impl.h"
+#include "contact.h"
+#include "linear_impl.h"
 
 #define PC_FINEST_ONLY_CYCLES 2.0 /* the coarse operators may stay where a carried update costs more CG iterations than this */
 
 /* Number of contact nodes (over all ranks) whose state differs from the state at the last build. */
-static PetscErrorCode CountChangesSince(SolverCtx sc, PetscInt dim, const PetscScalar x[], PetscBool **state, PetscBool record, PetscInt *changes)
+static PetscErrorCode CountChangesSince(PcReuse *r, PetscInt dim, const PetscScalar x[], PetscBool **state, PetscBool record, PetscInt *changes)
 {
   PetscInt          local = 0;
   const ContactSet *cs;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetSet(sc->contact, &cs));
+  PetscCall(ContactGetSet(r->contact, &cs));
   if (!*state) PetscCall(PetscCalloc1(cs->n + 1, state)); /* no node penetrated before the first record */
   for (PetscInt i = 0; i < cs->n; ++i) {
     const PetscBool on = (PetscBool)(ContactNodePenetration(cs, dim, i, x) > 0.0);
@@ -38,7 +38,7 @@ static PetscErrorCode CountChangesSince(SolverCtx sc, PetscInt dim, const PetscS
     local += on != (*state)[i];
     if (record) (*state)[i] = on;
   }
-  PetscCall(MPIU_Allreduce(&local, changes, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)sc->K)));
+  PetscCall(MPIU_Allreduce(&local, changes, 1, MPIU_INT, MPI_SUM, PetscObjectComm((PetscObject)r->K)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -50,18 +50,17 @@ static inline PetscBool LinearSolveGrew(PetscInt its, PetscInt its_first)
   return (PetscBool)(its_first >= 0 && its > 2 * its_first + 5);
 }
 
-static PetscErrorCode CountChanges(SolverCtx sc, PetscInt dim, const PetscScalar x[], PetscBool record, PetscInt *changes)
+static PetscErrorCode CountChanges(PcReuse *r, PetscInt dim, const PetscScalar x[], PetscBool record, PetscInt *changes)
 {
   PetscFunctionBeginUser;
-  PetscCall(CountChangesSince(sc, dim, x, &sc->pc_reuse.built_active, record, changes));
+  PetscCall(CountChangesSince(r, dim, x, &r->built_active, record, changes));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Whether this Newton step updates the finest level only (the header's comment), and if not, the current states become
    those the coarse operators follow. Collective. */
-static PetscErrorCode DecideFinestOnly(KSP ksp, DM dm, SolverCtx sc, Vec X)
+static PetscErrorCode DecideFinestOnly(KSP ksp, DM dm, PcReuse *r, Vec X)
 {
-  PcReuse           *r       = &sc->pc_reuse;
   PetscInt           changes = 0, its, dim;
   PetscReal          eps;
   KSPConvergedReason reason;
@@ -69,21 +68,21 @@ static PetscErrorCode DecideFinestOnly(KSP ksp, DM dm, SolverCtx sc, Vec X)
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(ContactGetEps(sc->contact, &eps));
+  PetscCall(ContactGetEps(r->contact, &eps));
   PetscCall(VecGetArrayRead(X, &x));
   r->finest_only = PETSC_FALSE;
   /* only where the coarse operators have followed the Jacobian since the build, at this eps (a new eps changes the
      penalty at every contact node, not at a few), and the last linear solve converged */
-  if (r->dcoarse && sc->opt->pc_update_changes > 0 && eps == r->carried_eps && r->cycle_cost > 0.0 &&
+  if (r->dcoarse && r->opt->pc_update_changes > 0 && eps == r->carried_eps && r->cycle_cost > 0.0 &&
       r->carry_cost > PC_FINEST_ONLY_CYCLES * r->cycle_cost) {
     PetscCall(KSPGetIterationNumber(ksp, &its));
     PetscCall(KSPGetConvergedReason(ksp, &reason));
     if (r->its_after_carry < 0) r->its_after_carry = its;
-    PetscCall(CountChangesSince(sc, dim, x, &r->carried_active, PETSC_FALSE, &changes));
-    r->finest_only = (PetscBool)(changes <= sc->opt->pc_update_changes && reason >= 0 && !LinearSolveGrew(its, r->its_after_carry));
+    PetscCall(CountChangesSince(r, dim, x, &r->carried_active, PETSC_FALSE, &changes));
+    r->finest_only = (PetscBool)(changes <= r->opt->pc_update_changes && reason >= 0 && !LinearSolveGrew(its, r->its_after_carry));
   }
   if (!r->finest_only) {
-    PetscCall(CountChangesSince(sc, dim, x, &r->carried_active, PETSC_TRUE, &changes));
+    PetscCall(CountChangesSince(r, dim, x, &r->carried_active, PETSC_TRUE, &changes));
     r->its_after_carry = -1; /* set by the next call */
     r->carried_eps     = eps;
   }
@@ -93,7 +92,7 @@ static PetscErrorCode DecideFinestOnly(KSP ksp, DM dm, SolverCtx sc, Vec X)
 
 /* The levels of a GAMG hierarchy whose coarse operators can follow the Jacobian (0 if there is none yet, or if the
    Jacobian is not K itself with its kept contact rows). */
-static PetscErrorCode HierarchyLevels(SNES snes, SolverCtx sc, PC *pc, PetscInt *nlevels)
+static PetscErrorCode HierarchyLevels(SNES snes, PcReuse *r, PC *pc, PetscInt *nlevels)
 {
   KSP       ksp;
   PetscBool is_gamg;
@@ -103,7 +102,7 @@ static PetscErrorCode HierarchyLevels(SNES snes, SolverCtx sc, PC *pc, PetscInt 
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(KSPGetPC(ksp, pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)*pc, PCGAMG, &is_gamg));
-  if (!is_gamg || !sc->opt->pc_update || sc->pc_reuse.no_update || !ContactBulkRowsOf(sc->contact) || !ContactBulkRowsOf(sc->contact)->ptr)
+  if (!is_gamg || !r->opt->pc_update || r->no_update || !ContactBulkRowsOf(r->contact) || !ContactBulkRowsOf(r->contact)->ptr)
     PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PCMGGetLevels(*pc, nlevels));
   for (PetscInt l = 0; l < *nlevels; ++l) {
@@ -118,20 +117,20 @@ static PetscErrorCode HierarchyLevels(SNES snes, SolverCtx sc, PC *pc, PetscInt 
 }
 
 /* The Jacobian's values in the contact rows into vals (collective only through the caller). */
-static PetscErrorCode ContactRowValues(SolverCtx sc, PetscScalar vals[])
+static PetscErrorCode ContactRowValues(PcReuse *r, PetscScalar vals[])
 {
-  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
+  const ContactBulkRows *br = ContactBulkRowsOf(r->contact);
 
   PetscFunctionBeginUser;
-  for (PetscInt r = 0; r < br->n; ++r) {
+  for (PetscInt row = 0; row < br->n; ++row) {
     const PetscScalar *v;
     PetscInt           ncols;
 
-    PetscCall(MatGetRow(sc->K, br->rows[r], &ncols, NULL, &v));
-    PetscCheck(ncols == br->ptr[r + 1] - br->ptr[r], PETSC_COMM_SELF, PETSC_ERR_PLIB, "the Jacobian's row %" PetscInt_FMT " left K's pattern",
-               br->rows[r]);
-    PetscCall(PetscArraycpy(&vals[br->ptr[r]], v, ncols));
-    PetscCall(MatRestoreRow(sc->K, br->rows[r], &ncols, NULL, &v));
+    PetscCall(MatGetRow(r->K, br->rows[row], &ncols, NULL, &v));
+    PetscCheck(ncols == br->ptr[row + 1] - br->ptr[row], PETSC_COMM_SELF, PETSC_ERR_PLIB, "the Jacobian's row %" PetscInt_FMT " left K's pattern",
+               br->rows[row]);
+    PetscCall(PetscArraycpy(&vals[br->ptr[row]], v, ncols));
+    PetscCall(MatRestoreRow(r->K, br->rows[row], &ncols, NULL, &v));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -160,10 +159,8 @@ static PetscErrorCode DestroyProducts(PcReuse *r)
 }
 
 /* The marks of the contact rows (1, or 2 in Z) at their columns, from any rank. */
-static PetscErrorCode ScatterMarks(SolverCtx sc, const ContactBulkRows *br)
+static PetscErrorCode ScatterMarks(PcReuse *r, const ContactBulkRows *br)
 {
-  PcReuse *r = &sc->pc_reuse;
-
   PetscFunctionBeginUser;
   PetscCall(VecScatterBegin(br->scatter, r->zmark, r->zcols, INSERT_VALUES, SCATTER_FORWARD));
   PetscCall(VecScatterEnd(br->scatter, r->zmark, r->zcols, INSERT_VALUES, SCATTER_FORWARD));
@@ -172,20 +169,19 @@ static PetscErrorCode ScatterMarks(SolverCtx sc, const ContactBulkRows *br)
 
 /* The mirrors: the entries (s, c) of J whose column c is a contact row of this rank and whose row s is no contact row
    of any rank, J(s, c) = K(c, s) by symmetry. */
-static PetscErrorCode MirrorsSetUp(SolverCtx sc)
+static PetscErrorCode MirrorsSetUp(PcReuse *r)
 {
-  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
-  PcReuse               *r  = &sc->pc_reuse;
+  const ContactBulkRows *br = ContactBulkRowsOf(r->contact);
   PetscInt               n  = 0;
   const PetscScalar     *mark;
 
   PetscFunctionBeginUser;
-  PetscCall(MatCreateVecs(sc->K, &r->zmark, NULL));
+  PetscCall(MatCreateVecs(r->K, &r->zmark, NULL));
   PetscCall(VecDuplicate(br->x, &r->zcols));
   for (PetscInt row = 0; row < br->n; ++row) PetscCall(VecSetValue(r->zmark, br->rows[row], 1.0, INSERT_VALUES));
   PetscCall(VecAssemblyBegin(r->zmark));
   PetscCall(VecAssemblyEnd(r->zmark));
-  PetscCall(ScatterMarks(sc, br));
+  PetscCall(ScatterMarks(r, br));
   PetscCall(VecGetArrayRead(r->zcols, &mark));
   for (PetscInt k = 0; k < br->ptr[br->n]; ++k) n += PetscRealPart(mark[br->lcols[k]]) == 0.0;
   PetscCall(PetscMalloc2(n, &r->mirror_k, n, &r->mirror_at));
@@ -209,12 +205,11 @@ static PetscErrorCode MirrorsSetUp(SolverCtx sc)
    diagonal. Such a row is nearly diagonal, so the finest level's smoother (Jacobi, SOR) solves it alone, while in the coarse
    operators its 1/eps would pin every coarse function touching it (GAMG's aggregates mix the contact dofs with the
    bulk); a rebuild at that eps would leave the same dofs out of its aggregates. Also sets zrows. */
-static PetscErrorCode EffectiveValues(SolverCtx sc, const PetscScalar jvals[], PetscScalar eff[])
+static PetscErrorCode EffectiveValues(PcReuse *r, const PetscScalar jvals[], PetscScalar eff[])
 {
-  const ContactBulkRows *br    = ContactBulkRowsOf(sc->contact);
-  PcReuse               *r     = &sc->pc_reuse;
+  const ContactBulkRows *br    = ContactBulkRowsOf(r->contact);
   const PetscInt         nnz   = br->ptr[br->n];
-  const PetscReal        ratio = sc->opt->pc_update_truncate;
+  const PetscReal        ratio = r->opt->pc_update_truncate;
   const PetscScalar     *mark;
 
   PetscFunctionBeginUser;
@@ -231,7 +226,7 @@ static PetscErrorCode EffectiveValues(SolverCtx sc, const PetscScalar jvals[], P
   }
   PetscCall(VecAssemblyBegin(r->zmark));
   PetscCall(VecAssemblyEnd(r->zmark));
-  PetscCall(ScatterMarks(sc, br));
+  PetscCall(ScatterMarks(r, br));
   PetscCall(VecGetArrayRead(r->zcols, &mark));
   for (PetscInt row = 0; row < br->n; ++row) {
     const PetscInt kd = br->diag[row];
@@ -245,10 +240,9 @@ static PetscErrorCode EffectiveValues(SolverCtx sc, const PetscScalar jvals[], P
 }
 
 /* The finest prolongator's rows at the owned contact rows, as GAMG made them. */
-static PetscErrorCode ProlongatorRowsSave(PC pc, SolverCtx sc)
+static PetscErrorCode ProlongatorRowsSave(PC pc, PcReuse *r)
 {
-  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
-  PcReuse               *r  = &sc->pc_reuse;
+  const ContactBulkRows *br = ContactBulkRowsOf(r->contact);
 
   PetscFunctionBeginUser;
   PetscCall(PCMGGetInterpolation(pc, r->nlevels - 1, &r->rfine));
@@ -258,10 +252,9 @@ static PetscErrorCode ProlongatorRowsSave(PC pc, SolverCtx sc)
 }
 
 /* The finest prolongator's contact rows: zero in Z (all = PETSC_FALSE), GAMG's values elsewhere (all rows with all). */
-static PetscErrorCode ProlongatorRowsSet(SolverCtx sc, PetscBool all)
+static PetscErrorCode ProlongatorRowsSet(PcReuse *r, PetscBool all)
 {
-  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
-  PcReuse               *r  = &sc->pc_reuse;
+  const ContactBulkRows *br = ContactBulkRowsOf(r->contact);
   PetscScalar           *zero;
   PetscInt               iz = 0, nmax = 0;
 
@@ -286,10 +279,9 @@ static PetscErrorCode ProlongatorRowsSet(SolverCtx sc, PetscBool all)
 /* The product on the finest level without matrices of its size: D is nonzero in the contact rows only, at the columns
    S of those rows, so R^T D R = R_S^T D_S R_S with R_S the rows S of the prolongator (fetched from any rank) and D_S
    the change restricted to S x S. Each rank computes its own part, and a COO matrix sums the parts. */
-static PetscErrorCode FinestProductSetUp(PC pc, SolverCtx sc)
+static PetscErrorCode FinestProductSetUp(PC pc, PcReuse *r)
 {
-  PcReuse               *r   = &sc->pc_reuse;
-  const ContactBulkRows *br  = ContactBulkRowsOf(sc->contact);
+  const ContactBulkRows *br  = ContactBulkRowsOf(r->contact);
   const PetscInt         nnz = br->ptr[br->n];
   PetscInt               nS  = nnz, N1, n1, *S, *coo_i, *coo_j, nrows;
   const PetscInt        *ia, *ja;
@@ -311,9 +303,9 @@ static PetscErrorCode FinestProductSetUp(PC pc, SolverCtx sc)
   r->rlocal = sub[0];
   PetscCall(PetscFree(sub));
   /* with the truncation, the columns S that are no contact row (on any rank) get the mirrors of their entries */
-  if (sc->opt->pc_update_truncate > 0.0) {
-    PetscCall(MirrorsSetUp(sc));
-    PetscCall(ProlongatorRowsSave(pc, sc));
+  if (r->opt->pc_update_truncate > 0.0) {
+    PetscCall(MirrorsSetUp(r));
+    PetscCall(ProlongatorRowsSave(pc, r));
   }
   /* D_S in COO form: the contact rows' places in S, their columns' places (bulk_lcols); then the mirrors */
   PetscCall(PetscMalloc2(nnz + r->nmirror, &coo_i, nnz + r->nmirror, &coo_j));
@@ -433,10 +425,9 @@ static PetscErrorCode CarryCost(PC pc, PetscLogDouble products, PcReuse *r)
 
 /* The change of the Jacobian since the last build or update, carried down the hierarchy: each coarse operator gets
    R^T D R, D the change on the level above (the first product makes the patterns, the later ones reuse them). */
-static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
+static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, PcReuse *r)
 {
-  PcReuse               *r    = &sc->pc_reuse;
-  const ContactBulkRows *br   = ContactBulkRowsOf(sc->contact);
+  const ContactBulkRows *br   = ContactBulkRowsOf(r->contact);
   PetscInt               nnz  = br->ptr[br->n];
   PetscReal              dmax = 0.0;
   PetscLogDouble         flops0, flops1;
@@ -445,11 +436,11 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
   if (!r->dcoarse) {
     r->nlevels = nlevels;
     PetscCall(PetscCalloc1(nlevels, &r->dcoarse));
-    PetscCall(FinestProductSetUp(pc, sc));
+    PetscCall(FinestProductSetUp(pc, r));
     PetscCall(HierarchyNonzeros(pc, nlevels, r));
   }
   PetscCheck(r->nlevels == nlevels, PetscObjectComm((PetscObject)pc), PETSC_ERR_PLIB, "the multigrid hierarchy changed its levels");
-  PetscCall(ContactRowValues(sc, r->dvals));
+  PetscCall(ContactRowValues(r, r->dvals));
   PetscCall(PetscArraycpy(r->built_vals, r->dvals, nnz)); /* J now, for the finest smoother's bound */
   if (r->finest_only) { /* the coarse operators, R's rows Z and eff_vals stay as they are, consistent with each other */
     KSP smoother;
@@ -458,12 +449,12 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
     PetscCall(PCMGGetSmoother(pc, nlevels - 1, &smoother));
     PetscCall(KSPGetOperators(smoother, &A, NULL));
     PetscCall(KSPSetOperators(smoother, A, A)); /* its Jacobi diagonal again */
-    if (!sc->opt->pc_update_esteig) PetscCall(SmootherBoundFinest(pc, nlevels, sc, r->built_vals, sc->opt->pc_update_check));
+    if (!r->opt->pc_update_esteig) PetscCall(SmootherBoundFinest(r, pc, nlevels, r->built_vals, r->opt->pc_update_check));
     r->finest_updates++;
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCall(EffectiveValues(sc, r->dvals, r->eff_dvals));
-  PetscCall(ProlongatorRowsSet(sc, PETSC_FALSE));
+  PetscCall(EffectiveValues(r, r->dvals, r->eff_dvals));
+  PetscCall(ProlongatorRowsSet(r, PETSC_FALSE));
   for (PetscInt k = 0; k < nnz + r->nmirror; ++k) {
     const PetscScalar now = r->eff_dvals[k];
 
@@ -498,7 +489,7 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
   }
   PetscCall(PetscGetFlops(&flops1));
   PetscCall(CarryCost(pc, flops1 - flops0, r));
-  if (sc->opt->pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r));
+  if (r->opt->pc_update_check) PetscCall(CheckHierarchy(pc, nlevels, r));
   /* every level's operator is new: its Chebyshev smoother estimates its eigenvalues again, its Jacobi or LU sets up
      again (KSPSetOperators() marks the new matrix, as a rebuild would) */
   for (PetscInt l = 0; l < nlevels; ++l) {
@@ -510,7 +501,7 @@ static PetscErrorCode UpdateHierarchy(PC pc, PetscInt nlevels, SolverCtx sc)
     PetscCall(KSPSetOperators(smoother, A, A));
   }
   /* except the finest level's Chebyshev interval, which a bound keeps (smoother_bound.c) */
-  if (!sc->opt->pc_update_esteig) PetscCall(SmootherBoundFinest(pc, nlevels, sc, r->built_vals, sc->opt->pc_update_check));
+  if (!r->opt->pc_update_esteig) PetscCall(SmootherBoundFinest(r, pc, nlevels, r->built_vals, r->opt->pc_update_check));
   r->updates++;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -538,9 +529,8 @@ static PetscErrorCode OneLevelMG(KSP ksp, PetscInt dim, KSP *coarse)
 
 /* Called by the Jacobian evaluation at X, before SNES sets up the preconditioner: sets the SNES preconditioner lag to
    rebuild (-2) or reuse (-1), and records the state of the build. */
-PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
+PetscErrorCode PcReuseDecide(PcReuse *r, SNES snes, DM dm, Vec X)
 {
-  PcReuse           *r = &sc->pc_reuse;
   KSP                ksp, one_level;
   PetscInt           dim, changes = 0, its = 0;
   KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
@@ -558,22 +548,22 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
     PC       pc;
     PetscInt nlevels;
 
-    PetscCall(HierarchyLevels(snes, sc, &pc, &nlevels));
+    PetscCall(HierarchyLevels(snes, r, &pc, &nlevels));
     if (nlevels > 1 && r->recorded) { /* the hierarchy follows the Jacobian (PcReuseAfterJacobian()): no rebuild */
       r->update = PETSC_TRUE;
-      PetscCall(DecideFinestOnly(ksp, dm, sc, X));
+      PetscCall(DecideFinestOnly(ksp, dm, r, X));
       PetscCall(SNESSetLagPreconditioner(snes, -1));
       PetscFunctionReturn(PETSC_SUCCESS);
     }
   }
   PetscCall(VecGetArrayRead(X, &x));
-  PetscCall(ContactGetEps(sc->contact, &eps));
+  PetscCall(ContactGetEps(r->contact, &eps));
   rebuild = (PetscBool)(!r->built || r->eps != eps);
   if (!rebuild) {
     PC        pc;
     PetscBool geometric;
 
-    PetscCall(CountChanges(sc, dim, x, PETSC_FALSE, &changes));
+    PetscCall(CountChanges(r, dim, x, PETSC_FALSE, &changes));
     PetscCall(KSPGetIterationNumber(ksp, &its));
     PetscCall(KSPGetConvergedReason(ksp, &reason));
     /* The boxes' geometric multigrid (PCMG) is not rebuilt for the count of changed nodes: its finest level is the
@@ -585,11 +575,11 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
     PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &geometric));
     geometric = (PetscBool)(geometric && !one_level); /* with one level its coarse solve factors the Jacobian itself (OneLevelMG()) */
     /* rebuild after a failed solve, or when the last solve needed twice the iterations of the first after the build */
-    rebuild = (PetscBool)((!geometric && changes > sc->opt->pc_reuse_changes) || reason < 0 || LinearSolveGrew(its, r->its_after_build));
+    rebuild = (PetscBool)((!geometric && changes > r->opt->pc_reuse_changes) || reason < 0 || LinearSolveGrew(its, r->its_after_build));
   }
   if (one_level) PetscCall(KSPSetReusePreconditioner(one_level, (PetscBool)!rebuild));
   if (rebuild) {
-    PetscCall(CountChanges(sc, dim, x, PETSC_TRUE, &changes));
+    PetscCall(CountChanges(r, dim, x, PETSC_TRUE, &changes));
     r->built           = PETSC_TRUE;
     r->eps             = eps;
     r->its_after_build = -1; /* set by the next call */
@@ -606,18 +596,17 @@ PetscErrorCode PcReuseDecide(SNES snes, DM dm, SolverCtx sc, Vec X)
 
 /* Called by the Jacobian evaluation once the Jacobian is assembled: records its contact rows for a build, or carries
    their change down the hierarchy. */
-PetscErrorCode PcReuseAfterJacobian(SNES snes, SolverCtx sc)
+PetscErrorCode PcReuseAfterJacobian(PcReuse *r, SNES snes)
 {
-  PcReuse               *r  = &sc->pc_reuse;
-  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
+  const ContactBulkRows *br = ContactBulkRowsOf(r->contact);
   PC                     pc;
   PetscInt               nlevels;
 
   PetscFunctionBeginUser;
-  if (!r->enabled || !sc->opt->pc_update || r->no_update || !br->jacobian_in_K) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!r->enabled || !r->opt->pc_update || r->no_update || !br->jacobian_in_K) PetscFunctionReturn(PETSC_SUCCESS);
   if (r->update) {
-    PetscCall(HierarchyLevels(snes, sc, &pc, &nlevels));
-    PetscCall(UpdateHierarchy(pc, nlevels, sc));
+    PetscCall(HierarchyLevels(snes, r, &pc, &nlevels));
+    PetscCall(UpdateHierarchy(pc, nlevels, r));
   } else if (r->record) {
     KSP       ksp;
     PetscBool is_gamg;
@@ -629,7 +618,7 @@ PetscErrorCode PcReuseAfterJacobian(SNES snes, SolverCtx sc)
     if (!is_gamg) PetscFunctionReturn(PETSC_SUCCESS);
     if (!r->recorded) PetscCall(PetscMalloc2(br->ptr[br->n], &r->built_vals, br->ptr[br->n], &r->dvals));
     r->recorded = PETSC_TRUE;
-    PetscCall(ContactRowValues(sc, r->built_vals));
+    PetscCall(ContactRowValues(r, r->built_vals));
     {
       const PetscInt nnz  = br->ptr[br->n];
       PetscBool      on_K = PETSC_TRUE;
@@ -638,17 +627,26 @@ PetscErrorCode PcReuseAfterJacobian(SNES snes, SolverCtx sc)
       for (PetscInt k = 0; k < nnz && on_K; ++k) on_K = (PetscBool)(r->built_vals[k] == br->vals[k]);
       PetscCall(MPIU_Allreduce(&on_K, &r->built_on_K, 1, MPIU_BOOL, MPI_LAND, PetscObjectComm((PetscObject)pc)));
     }
-    PetscCall(ProlongatorRowsSet(sc, PETSC_TRUE)); /* GAMG may reuse its prolongators: give them back whole */
-    PetscCall(DestroyProducts(r));                 /* a rebuild may make new prolongators: new patterns */
+    PetscCall(ProlongatorRowsSet(r, PETSC_TRUE)); /* GAMG may reuse its prolongators: give them back whole */
+    PetscCall(DestroyProducts(r));                /* a rebuild may make new prolongators: new patterns */
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Frees the state of the updates (with the problem: the next mesh has its own rows and hierarchy). */
-PetscErrorCode PcReuseDestroy(SolverCtx sc)
+/* What the reuse reads, for the life of the problem: the bulk operator K, in which the Jacobian is made
+   (ContactComputeJacobian()), the contact term and the solver's options. None is referenced. */
+PetscErrorCode PcReuseSetUp(PcReuse *r, Mat K, Contact contact, const SolverOptions *opt)
 {
-  PcReuse *r = &sc->pc_reuse;
+  PetscFunctionBeginUser;
+  r->K       = K;
+  r->contact = contact;
+  r->opt     = opt;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
 
+/* Frees the state of the updates (with the problem: the next mesh has its own rows and hierarchy). */
+PetscErrorCode PcReuseDestroy(PcReuse *r)
+{
   PetscFunctionBeginUser;
   PetscCall(DestroyProducts(r));
   PetscCall(PetscFree2(r->built_vals, r->dvals));
@@ -662,15 +660,18 @@ PetscErrorCode PcReuseDestroy(SolverCtx sc)
 
 /* Forgets the build, so that the next Newton step builds the preconditioner afresh, and gives up the coarse-level
    updates for the rest of the run (pc_recovery.c): every later preconditioner is a build, with its own smoother
-   estimates. enabled and the counts stay. */
-PetscErrorCode PcReuseReset(SolverCtx sc)
+   estimates. What it reads (PcReuseSetUp()), enabled and the counts stay. */
+PetscErrorCode PcReuseReset(PcReuse *r)
 {
-  PcReuse        *r       = &sc->pc_reuse;
-  const PetscBool enabled = r->enabled;
-  const PetscInt  builds = r->builds, updates = r->updates;
+  const PetscBool            enabled = r->enabled;
+  const PetscInt             builds = r->builds, updates = r->updates;
+  Mat                        K       = r->K;
+  Contact                    contact = r->contact;
+  const SolverOptions *const opt     = r->opt;
 
   PetscFunctionBeginUser;
-  PetscCall(PcReuseDestroy(sc));
+  PetscCall(PcReuseDestroy(r));
+  PetscCall(PcReuseSetUp(r, K, contact, opt));
   r->enabled   = enabled;
   r->builds    = builds;
   r->updates   = updates;

@@ -7,7 +7,7 @@
    -contact_coarse_mg: with another iterative preconditioner, the coarser boxes of nested iteration are solved by this
    geometric multigrid under the options prefix contact_coarse_, and the final mesh by the options' preconditioner. */
 #include "mesh.h"
-#include "solver_impl.h"
+#include "linear_impl.h"
 
 /* a 3D coarsest mesh of more unknowns is solved alone by GAMG, not by a factorization at each Newton step */
 #define MULTIGRID_COARSE_LU_ROWS_3D 10000
@@ -30,9 +30,9 @@ PetscErrorCode MultigridSetDefault(Multigrid mg, PetscBool is_default)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscBool MultigridIsDefault(const AppCtx *user)
+PetscBool MultigridIsDefault(Multigrid mg)
 {
-  return user->mg->is_default;
+  return mg->is_default;
 }
 
 /* Forgets the levels (the meshes no longer nest with the current one). */
@@ -53,20 +53,19 @@ PetscErrorCode MultigridDestroy(Multigrid *mg)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Whether the problem's mesh is a coarser box of nested iteration solved under -contact_coarse_mg. */
-static inline PetscBool MultigridOnCoarseBox(const AppCtx *user)
+/* Whether the problem's mesh (at grid level level) is a coarser box of nested iteration (box) solved under -contact_coarse_mg. */
+static inline PetscBool MultigridOnCoarseBox(Multigrid mg, PetscInt level, const MeshBox *box)
 {
-  return (PetscBool)(user->mg->coarse_mg && user->prob.level < user->box.coarse_levels);
+  return (PetscBool)(mg->coarse_mg && level < box->coarse_levels);
 }
 
 /* With -pc_type mg (the PC of snes, the fine mesh's problem) and P1/Q1, adds the interpolation from coarse to fine,
    refined once (vertex_source[]: MeshCreateBoxLevel(), MeshRefineRegular()). Both meshes' problems must be set up (their
    sections); fine's rows are its owned free components, coarse's columns its free components, a fixed coarse component
-   contributing nothing. */
-PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt vertex_source[], AppCtx *user)
+   contributing nothing. degree: the displacement's (the interpolation is P1/Q1's). */
+PetscErrorCode MultigridAddLevel(Multigrid mg, SNES snes, DM coarse, DM fine, const PetscInt vertex_source[], PetscInt degree)
 {
   MPI_Comm     comm = PetscObjectComm((PetscObject)fine);
-  Multigrid    mg   = user->mg;
   PetscSection cl, cg, fl, fg;
   PetscInt     dim, vStart, vEnd, cvb[2], ceb[2], m, n, rstart, cstart, cend, *dnz, *onz;
   Mat          P;
@@ -78,7 +77,7 @@ PetscErrorCode MultigridAddLevel(SNES snes, DM coarse, DM fine, const PetscInt v
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
-  if (!is_mg || user->opt->degree != 1) { /* the coarser meshes' interpolations, if any (-contact_coarse_mg), serve no longer */
+  if (!is_mg || degree != 1) { /* the coarser meshes' interpolations, if any (-contact_coarse_mg), serve no longer */
     PetscCall(MultigridClear(mg));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
@@ -182,28 +181,27 @@ static PetscErrorCode MultigridSetCoarseSolve(SNES snes, PC pc, PetscInt nfine, 
 
 /* With -pc_type mg, gives the SNES's PCMG one level per mesh solved so far (the current one the finest), the
    interpolations between them, and Galerkin coarse operators unless -pc_mg_galerkin says otherwise. The problem of the
-   options must have coarser meshes: a PCMG of one level would be its coarse solver alone. */
-PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
+   options must have coarser meshes: a PCMG of one level would be its coarse solver alone. level: the problem's grid
+   level; box: the mesh of the options (its coarser boxes); opt: the solver's options. */
+PetscErrorCode MultigridSetUpPC(Multigrid mg, SNES snes, PetscInt level, const MeshBox *box, const SolverOptions *opt)
 {
-  const Multigrid mg = user->mg;
-  KSP             ksp;
-  PC              pc;
-  PetscBool       is_mg;
-  PetscInt        nlevels, k;
-  const char     *prefix;
+  KSP         ksp;
+  PC          pc;
+  PetscBool   is_mg;
+  PetscInt    nlevels, k;
+  const char *prefix;
 
   PetscFunctionBeginUser;
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(PetscObjectTypeCompare((PetscObject)pc, PCMG, &is_mg));
   if (!is_mg) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCheck(mg->n > 0 || user->prob.level < user->box.coarse_levels + user->opt->solver.grid_sequence, PetscObjectComm((PetscObject)snes),
-             PETSC_ERR_USER_INPUT,
+  PetscCheck(mg->n > 0 || level < box->coarse_levels + opt->grid_sequence, PetscObjectComm((PetscObject)snes), PETSC_ERR_USER_INPUT,
              "-pc_type mg takes its levels from nested meshes, and this mesh has none: use the simplex box (-dm_plex_box_faces, "
              "-contact_coarse_levels) or -contact_grid_sequence N, or another -pc_type");
   PetscCall(PCGetOptionsPrefix(pc, &prefix));
   PetscCall(SolverGivenIndex(prefix, &k));
-  PetscCheck(!user->opt->solver.given.pc_mg_levels[k], PetscObjectComm((PetscObject)snes), PETSC_ERR_USER_INPUT,
+  PetscCheck(!opt->given.pc_mg_levels[k], PetscObjectComm((PetscObject)snes), PETSC_ERR_USER_INPUT,
              "-pc_mg_levels: the levels of -pc_type mg are the nested meshes (-contact_coarse_levels, -contact_grid_sequence)");
   PetscCall(PCMGGetLevels(pc, &nlevels));
   if (nlevels == mg->n + 1) { /* set up by an earlier solve on this mesh? */
@@ -226,7 +224,7 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
   PetscCall(PCMGSetLevels(pc, mg->n + 1, NULL));
   for (PetscInt l = 1; l <= mg->n; ++l) PetscCall(PCMGSetInterpolation(pc, l, mg->interp[l - 1]));
   PetscCall(MultigridSetCoarseSolve(snes, pc, mg->n, prefix));
-  if (MultigridOnCoarseBox(user) || user->mg->is_default) /* the smoothers of mg.yaml; options may change them */
+  if (MultigridOnCoarseBox(mg, level, box) || mg->is_default) /* the smoothers of mg.yaml; options may change them */
     for (PetscInt l = 1; l <= mg->n; ++l) {
       KSP smoother;
       PC  spc;
@@ -235,20 +233,21 @@ PetscErrorCode MultigridSetUpPC(SNES snes, const AppCtx *user)
       PetscCall(KSPGetPC(smoother, &spc));
       PetscCall(PCSetType(spc, PCJACOBI));
     }
-  if (!user->opt->solver.given.pc_mg_galerkin[k]) PetscCall(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH));
+  if (!opt->given.pc_mg_galerkin[k]) PetscCall(PCMGSetGalerkin(pc, PC_MG_GALERKIN_BOTH));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* -contact_coarse_mg, on a coarser box of nested iteration: the linear solver is CG with the geometric multigrid of the
    boxes solved so far (MultigridSetUpPC() gives it its levels before each solve; Chebyshev smoothers with point Jacobi,
    LU on the coarsest box), read from the options under the prefix contact_coarse_ (-contact_coarse_ksp_rtol,
-   -contact_coarse_mg_levels_ksp_max_it, ...): the options without it are the final mesh's. */
-PetscErrorCode MultigridSetCoarseBoxSolver(KSP ksp, const AppCtx *user)
+   -contact_coarse_mg_levels_ksp_max_it, ...): the options without it are the final mesh's. level: the problem's grid
+   level; box: the mesh of the options. */
+PetscErrorCode MultigridSetCoarseBoxSolver(Multigrid mg, KSP ksp, PetscInt level, const MeshBox *box)
 {
   PC pc;
 
   PetscFunctionBeginUser;
-  if (!MultigridOnCoarseBox(user)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!MultigridOnCoarseBox(mg, level, box)) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(KSPSetOptionsPrefix(ksp, "contact_coarse_"));
   PetscCall(KSPSetType(ksp, KSPCG));
   PetscCall(KSPGetPC(ksp, &pc));

@@ -9,7 +9,7 @@
    not. An estimate costs ten products with the finest matrix at each update; the bound, a pass
    over the contact rows. The coarse levels still estimate again: their estimates cost little. */
 #include "contact.h"
-#include "solver_impl.h"
+#include "linear_impl.h"
 
 /* The finest level's smoother if it is Chebyshev with point Jacobi (the case the bound covers), else NULL. */
 static PetscErrorCode FinestChebyshevJacobi(PC pc, PetscInt nlevels, KSP *smoother)
@@ -89,10 +89,9 @@ static PetscErrorCode FreshEstimate(Mat A, PetscInt steps, PetscReal *emin, Pets
 /* beta above: Gershgorin's bound of the top eigenvalue of D_P^-1/2 P D_P^-1/2, P = J - K in the contact rows (jvals
    holds J's values there, K's pattern); PETSC_MAX_REAL if P's diagonal cannot bound it (a negative diagonal entry, or
    an entry in a row or column with a zero diagonal). */
-static PetscErrorCode PenaltyBound(SolverCtx sc, const PetscScalar jvals[], PetscReal *beta)
+static PetscErrorCode PenaltyBound(PcReuse *r, const PetscScalar jvals[], PetscReal *beta)
 {
-  const ContactBulkRows *br = ContactBulkRowsOf(sc->contact);
-  PcReuse               *r  = &sc->pc_reuse;
+  const ContactBulkRows *br = ContactBulkRowsOf(r->contact);
   PetscInt               rstart;
   PetscScalar           *d;
   const PetscScalar     *dcol;
@@ -100,10 +99,10 @@ static PetscErrorCode PenaltyBound(SolverCtx sc, const PetscScalar jvals[], Pets
 
   PetscFunctionBeginUser;
   if (!r->pdiag) {
-    PetscCall(MatCreateVecs(sc->K, &r->pdiag, NULL));
+    PetscCall(MatCreateVecs(r->K, &r->pdiag, NULL));
     PetscCall(VecDuplicate(br->x, &r->pcols));
   }
-  PetscCall(MatGetOwnershipRange(sc->K, &rstart, NULL));
+  PetscCall(MatGetOwnershipRange(r->K, &rstart, NULL));
   PetscCall(VecSet(r->pdiag, 0.0));
   PetscCall(VecGetArray(r->pdiag, &d));
   for (PetscInt row = 0; row < br->n; ++row) d[br->rows[row] - rstart] = jvals[br->diag[row]] - br->vals[br->diag[row]];
@@ -129,7 +128,7 @@ static PetscErrorCode PenaltyBound(SolverCtx sc, const PetscScalar jvals[], Pets
     local = PetscMax(local, sum);
   }
   PetscCall(VecRestoreArrayRead(r->pcols, &dcol));
-  PetscCall(MPIU_Allreduce(&local, beta, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)sc->K)));
+  PetscCall(MPIU_Allreduce(&local, beta, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)r->K)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -165,18 +164,17 @@ static PetscErrorCode ReadBuildEstimate(KSP smoother, const SolverGiven *given, 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SmootherBoundFinest(PC pc, PetscInt nlevels, SolverCtx sc, const PetscScalar jvals[], PetscBool check)
+PetscErrorCode SmootherBoundFinest(PcReuse *r, PC pc, PetscInt nlevels, const PetscScalar jvals[], PetscBool check)
 {
-  PcReuse  *r = &sc->pc_reuse;
   KSP       smoother;
   PetscReal beta, top, emin, emax;
 
   PetscFunctionBeginUser;
   PetscCall(FinestChebyshevJacobi(pc, nlevels, &smoother));
   if (!smoother) PetscFunctionReturn(PETSC_SUCCESS);
-  if (!r->bound_read) PetscCall(ReadBuildEstimate(smoother, &sc->opt->given, r));
+  if (!r->bound_read) PetscCall(ReadBuildEstimate(smoother, &r->opt->given, r));
   if (!r->bound_set) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(PenaltyBound(sc, jvals, &beta));
+  PetscCall(PenaltyBound(r, jvals, &beta));
   if (beta < PETSC_MAX_REAL)
     top = PetscMax(r->est_max, beta);
   else { /* no bound: estimate, as Chebyshev would */

@@ -8,13 +8,12 @@
    a close guess meets the forcing term almost at once, and Newton, left with the guess as its step, needs more steps.
    The test stays so set for later solves, where it changes nothing unless the options ask for a nonzero initial guess,
    which it then measures the same way. */
-#include "solver_impl.h"
+#include "linear.h"
 
-/* At the SNES's set-up: what the options asked of its KSP. */
-PetscErrorCode SolverStepGuessSetUp(KSP ksp, SolverCtx sc)
+/* At the SNES's set-up: what the options asked of its KSP (given: the solver's options given, SolverGiven). */
+PetscErrorCode SolverStepGuessSetUp(SolverStepGuess *sg, KSP ksp, const SolverGiven *given)
 {
-  SolverStepGuess *sg = &sc->step_guess;
-  const char      *prefix;
+  const char *prefix;
 
   PetscFunctionBeginUser;
   PetscCall(VecDestroy(&sg->du));
@@ -24,27 +23,27 @@ PetscErrorCode SolverStepGuessSetUp(KSP ksp, SolverCtx sc)
     PetscInt k;
 
     PetscCall(SolverGivenIndex(prefix, &k));
-    sg->user_rnorm0 = sc->opt->given.use_initial_rnorm[k]; /* -ksp_converged_use_initial_residual_norm */
+    sg->user_rnorm0 = given->use_initial_rnorm[k]; /* -ksp_converged_use_initial_residual_norm */
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The next solve's first linear solve starts from the Newton step that the change du of the solution (the user's
    units) predicts. du is referenced until that linear solve, or the end of that solve (SolverStepGuessDrop()). */
-PetscErrorCode SolverSetStepGuess(SolverCtx sc, Vec du)
+PetscErrorCode SolverStepGuessSet(SolverStepGuess *sg, Vec du)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscObjectReference((PetscObject)du));
-  PetscCall(VecDestroy(&sc->step_guess.du));
-  sc->step_guess.du = du;
+  PetscCall(VecDestroy(&sg->du));
+  sg->du = du;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Before each linear solve (SolverPreSolve()): the guess, if one is pending, else the options' initial guess. */
-PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, SolverCtx sc)
+/* Before each linear solve (SolverPreSolve()): the guess, if one is pending, else the options' initial guess.
+   snes_scale: U, the SNES iterating on u/U. */
+PetscErrorCode SolverStepGuessPreSolve(SolverStepGuess *sg, KSP ksp, Vec x, PetscReal snes_scale)
 {
-  SolverStepGuess *sg = &sc->step_guess;
-  PetscBool        preonly;
+  PetscBool preonly;
 
   PetscFunctionBeginUser;
   PetscCall(KSPSetInitialGuessNonzero(ksp, sg->nonzero));
@@ -52,7 +51,7 @@ PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, SolverCtx sc)
   PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &preonly)); /* a factorization alone takes no guess */
   if (!preonly) {
     PetscCall(VecCopy(sg->du, x)); /* Newton's step y of the SNES, x~_next = x~ - y with x~ = u / U: y = -du / U */
-    PetscCall(VecScale(x, -1.0 / sc->snes_scale));
+    PetscCall(VecScale(x, -1.0 / snes_scale));
     PetscCall(KSPSetInitialGuessNonzero(ksp, PETSC_TRUE));
     if (!sg->user_rnorm0) PetscCall(KSPConvergedDefaultSetUMIRNorm(ksp));
   }
@@ -60,9 +59,9 @@ PetscErrorCode SolverStepGuessPreSolve(KSP ksp, Vec x, SolverCtx sc)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SolverStepGuessDrop(SolverCtx sc)
+PetscErrorCode SolverStepGuessDrop(SolverStepGuess *sg)
 {
   PetscFunctionBeginUser;
-  PetscCall(VecDestroy(&sc->step_guess.du));
+  PetscCall(VecDestroy(&sg->du));
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -7,20 +7,20 @@
    This pre-solve (part of SolverPreSolve() in newton.c) replaces PETSc's (KSPPreSolve_SNESEW(), installed with the
    SNES's KSP); without the guard its terms are PETSc's exactly. Other versions (-snes_ksp_ew_version) keep PETSc's.
    One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
-#include "solver_impl.h"
+#include "linear.h"
 
 #define EW_ENDGAME 10.0 /* a step expected to land within this factor of Newton's target ... */
 #define EW_FINISH 0.3   /* ... is solved to this fraction of it */
 
-/* Before a linear solve (SolverPreSolve()): its tolerance, if the forcing is on. */
-PetscErrorCode SolverForcingPreSolve(KSP ksp, SolverCtx sc)
+/* Before a linear solve (SolverPreSolve()): its tolerance, if the forcing is on. ref: the residual that -snes_rtol
+   reduces, in the user's units (the core's SolverStopReference()); snes_scale: U, the SNES seeing F/U. */
+PetscErrorCode SolverForcingPreSolve(SolverForcing *fc, KSP ksp, PetscReal ref, PetscReal snes_scale)
 {
-  SolverForcing *fc   = &sc->forcing;
-  SNES           snes = fc->snes;
-  PetscInt       it;
-  PetscReal      norm, rtol, rtol_0, rtol_max, gamma, alpha, threshold, srtol, atol, stol, target;
-  PetscInt       maxit, maxf;
-  PetscBool      ew;
+  SNES      snes = fc->snes;
+  PetscInt  it;
+  PetscReal norm, rtol, rtol_0, rtol_max, gamma, alpha, threshold, srtol, atol, stol, target;
+  PetscInt  maxit, maxf;
+  PetscBool ew;
 
   PetscFunctionBeginUser;
   if (!snes) PetscFunctionReturn(PETSC_SUCCESS);
@@ -38,11 +38,8 @@ PetscErrorCode SolverForcingPreSolve(KSP ksp, SolverCtx sc)
     if (stol_ew > threshold) rtol = PetscMax(rtol, stol_ew);
   }
   if (fc->guard > 0.0 && norm > 0.0) {
-    PetscReal ref;
-
     PetscCall(SNESGetTolerances(snes, &atol, &srtol, &stol, &maxit, &maxf));
-    ref    = SolverStopReference(sc); /* SolverConverged()'s, in the user's units; the SNES sees F/U */
-    target = srtol * (ref / sc->snes_scale);
+    target = srtol * (ref / snes_scale); /* SolverConverged()'s reference, in the user's units; the SNES sees F/U */
     rtol   = PetscMax(rtol, fc->guard * target / norm);
     /* the endgame: where this step is to land within EW_ENDGAME times the target, it is solved to EW_FINISH times it, so
        that it ends Newton instead of leaving one more step of a V-cycle's start, an assembly and a line search (CG's
@@ -60,21 +57,21 @@ PetscErrorCode SolverForcingPreSolve(KSP ksp, SolverCtx sc)
 }
 
 /* Records the forcing's parameters if Eisenstat-Walker's version 2 is on (SolverForcingPreSolve() then computes the
-   terms); *petsc_presolve: another version is on, whose pre-solve is PETSc's own and must stay. */
-PetscErrorCode SolverForcingSetUp(SNES snes, SolverCtx sc, PetscBool *petsc_presolve)
+   terms); guard: -contact_ew_guard; *petsc_presolve: another version is on, whose pre-solve is PETSc's own and must stay. */
+PetscErrorCode SolverForcingSetUp(SolverForcing *fc, SNES snes, PetscReal guard, PetscBool *petsc_presolve)
 {
   PetscBool ew;
   PetscInt  version;
 
   PetscFunctionBeginUser;
-  PetscCall(PetscMemzero(&sc->forcing, sizeof(sc->forcing)));
+  PetscCall(PetscMemzero(fc, sizeof(*fc)));
   *petsc_presolve = PETSC_FALSE;
   PetscCall(SNESKSPGetUseEW(snes, &ew));
   if (!ew) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESKSPGetParametersEW(snes, &version, NULL, NULL, NULL, NULL, NULL, NULL));
   *petsc_presolve = (PetscBool)(version != 2);
   if (version != 2) PetscFunctionReturn(PETSC_SUCCESS);
-  sc->forcing.snes  = snes;
-  sc->forcing.guard = sc->opt->ew_guard;
+  fc->snes  = snes;
+  fc->guard = guard;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
