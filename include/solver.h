@@ -56,7 +56,7 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
 PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked);
 PetscErrorCode GridSequenceBarsSizes(DM dm, const AppCtx *user);
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
-PetscErrorCode EpsSweepTangent(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscBool *ok);
+PetscErrorCode EpsSweepTangent(SNES snes, DM dm, Contact ct, Vec u, Vec dir, PetscInt *ksp_its_total, PetscBool *ok);
 /* adapt.c: -adapt_cycles, the adaptive refinement driven by the error estimate */
 PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad);
 PetscErrorCode AdaptCheck(DM dm, const AppCtx *user);
@@ -89,5 +89,5 @@ PetscErrorCode FineSmootherSetUp(KSP ksp, const SolverGiven *g);
 
 /* bandwidth.c */
 PetscErrorCode BandwidthGetOptions(MPI_Comm comm, PetscBool *measure);
-PetscErrorCode BandwidthMeasure(SNES snes, AppCtx *user);
+PetscErrorCode BandwidthMeasure(SNES snes, PetscBool measure, Bandwidth *b);
 PetscErrorCode BandwidthWrite(const Bandwidth *b, PetscViewer v);

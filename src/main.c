@@ -359,7 +359,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(PetscTime(&t1));
   user.rec.stats.time_total = t1 - t0;
   PetscCall(RecordPeakMemory(comm, &user.rec.stats));
-  PetscCall(BandwidthMeasure(snes, &user));          /* -perf_bandwidth: after the peak memory, which its vectors would raise */
+  /* -perf_bandwidth: after the peak memory, which its vectors would raise */
+  PetscCall(BandwidthMeasure(snes, opt.perf_bandwidth, &user.rec.stats.bandwidth));
   PetscCall(OptionsCheckAllUsed(comm, PETSC_FALSE)); /* the options read during the solve too */
   PetscCall(PrintSummary(dm, &user, u));
   PetscCall(WriteOutput(dm, &user, u));

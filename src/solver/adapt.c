@@ -309,7 +309,7 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
   eps_new = eps / CYCLE_EPS_RATIO;
   PetscCall(ContactSetEps(user->contact, dm, eps_new));
   PetscCall(VecDuplicate(u, &dir));
-  PetscCall(EpsSweepTangent(snes, dm, user, u, dir, &ok));
+  PetscCall(EpsSweepTangent(snes, dm, user->contact, u, dir, &user->rec.stats.ksp_its_total, &ok));
   if (ok) { /* u(eps_new) = u + (eps_new - eps) du/deps, du/deps = dir eps_new / eps^2 */
     PetscCall(VecDuplicate(u, &u_new));
     PetscCall(VecWAXPY(u_new, (eps_new - eps) * eps_new / (eps * eps), dir, u));
