@@ -59,9 +59,9 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
 PetscErrorCode EpsSweepTangent(SNES snes, DM dm, Contact ct, Vec u, Vec dir, PetscInt *ksp_its_total, PetscBool *ok);
 /* adapt.c: -adapt_cycles, the adaptive refinement driven by the error estimate */
 PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad);
-PetscErrorCode AdaptCheck(DM dm, const AppCtx *user);
+PetscErrorCode AdaptCheck(DM dm, const RunOptions *opt, Contact ct, const MeshBox *box, const Scene *scene);
 PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter write);
-PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user);
+PetscErrorCode AdaptView(MPI_Comm comm, const AdaptOptions *ad, const RunRecord *rec, PetscBool exact);
 PetscErrorCode AdaptWrite(MPI_Comm comm, const AdaptOptions *ad, const RunRecord *rec, PetscInt dim, PetscViewer v); /* /run's and /cycles */
 PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u); /* penetration_tol.c: -contact_penetration_tol */
 PetscErrorCode PenetrationTolWrite(Contact ct, const RunStats *s, PetscViewer v);

@@ -70,7 +70,7 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
     }
   }
   PetscCall(LoadPathView(comm, user));
-  PetscCall(AdaptView(comm, user));
+  PetscCall(AdaptView(comm, &user->opt->adapt, &user->rec, (PetscBool)(user->scene.exact != NULL)));
   PetscCall(EstimateView(comm, &user->rec.estimate, &user->rec.errors));
   PetscCall(BarsView(comm, &user->rec.bars));
   PetscCall(ContactChecksWarnings(comm, &s->checks, PETSC_TRUE, NULL));
@@ -276,7 +276,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   }
   PetscCall(EstimateCheckSupported(dm, opt.estimate, opt.estimate_given, opt.degree)); /* -estimate on a discretization it does not cover */
   PetscCall(BarsCheck(comm, opt.bars, user.box.coarse_levels + opt.solver.grid_sequence, user.contact)); /* -bars without three nested meshes */
-  PetscCall(AdaptCheck(dm, &user));                                                                      /* -adapt_cycles where it cannot refine */
+  PetscCall(AdaptCheck(dm, &opt, user.contact, &user.box, &user.scene));                                 /* -adapt_cycles where it cannot refine */
   PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(BarsReset(&user.rec.bars));
   { /* initial overlap, an obstacle facing away, a curved boundary refined on its chords, a locking body: warnings */
