@@ -68,9 +68,9 @@ PetscErrorCode PenetrationTolWrite(Contact ct, const RunStats *s, PetscViewer v)
 
 /* load_path.c: -load_steps, -load_path */
 PetscErrorCode LoadPathGetOptions(MPI_Comm comm, LoadPathOptions *lp);
-PetscErrorCode LoadPathSetUp(MPI_Comm comm, AppCtx *user);
+PetscErrorCode LoadPathSetUp(MPI_Comm comm, const RunOptions *opt, Contact ct, Scene *scene);
 PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u);
-PetscErrorCode LoadPathView(MPI_Comm comm, const AppCtx *user);
+PetscErrorCode LoadPathView(MPI_Comm comm, const LoadPathOptions *lp, const Scene *scene, const RunRecord *rec);
 PetscErrorCode LoadPathWrite(MPI_Comm comm, const Scene *scene, const RunStats *s, const StepRecord st[], PetscInt n, PetscInt dim,
                              PetscViewer v); /* /steps */
 

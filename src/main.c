@@ -69,7 +69,7 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
                             (double)r->time_solve, r->converged ? "" : "  FAILED"));
     }
   }
-  PetscCall(LoadPathView(comm, user));
+  PetscCall(LoadPathView(comm, &user->opt->load_path, &user->scene, &user->rec));
   PetscCall(AdaptView(comm, &user->opt->adapt, &user->rec, (PetscBool)(user->scene.exact != NULL)));
   PetscCall(EstimateView(comm, &user->rec.estimate, &user->rec.errors));
   PetscCall(BarsView(comm, &user->rec.bars));
@@ -264,7 +264,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   }
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));        /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
-  PetscCall(LoadPathSetUp(comm, &user));                                  /* a load path: the scene at its first factor */
+  PetscCall(LoadPathSetUp(comm, &opt, user.contact, &user.scene));        /* a load path: the scene at its first factor */
   PetscCall(GridSequenceBarsSizes(dm, &user));                            /* -bars on tetrahedra: the final mesh's eps on the levels below it */
   if (opt.adapt.cycles || (opt.bars && opt.adapt.model[0]))               /* one eps on Gamma_C: the remeshed meshes do not nest */
     PetscCall(MeshSetContactCellSizes(dm, user.scene.bcs.ncontact, user.scene.bcs.contact_ids));
