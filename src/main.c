@@ -265,8 +265,9 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));        /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(LoadPathSetUp(comm, &opt, user.contact, &user.scene));        /* a load path: the scene at its first factor */
-  PetscCall(GridSequenceBarsSizes(dm, &user));                            /* -bars on tetrahedra: the final mesh's eps on the levels below it */
-  if (opt.adapt.cycles || (opt.bars && opt.adapt.model[0]))               /* one eps on Gamma_C: the remeshed meshes do not nest */
+  /* -bars on tetrahedra: the final mesh's eps on the levels below it */
+  PetscCall(GridSequenceBarsSizes(dm, &opt, user.contact, &user.box, user.prob.level));
+  if (opt.adapt.cycles || (opt.bars && opt.adapt.model[0])) /* one eps on Gamma_C: the remeshed meshes do not nest */
     PetscCall(MeshSetContactCellSizes(dm, user.scene.bcs.ncontact, user.scene.bcs.contact_ids));
   PetscCall(ProblemSetUp(dm, &user, &snes));
   { /* before the solve, not after it */

@@ -712,7 +712,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
       break;
     }
     if (remesh)
-      PetscCall(GridSequenceRemesh(dm, user, snes, u, marked));
+      PetscCall(GridSequenceRemesh(dm, user, snes, u, marked, 1.0));
     else
       PetscCall(GridSequenceRefine(dm, user, snes, u, marked));
     PetscCall(PetscTime(&t1));
