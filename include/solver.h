@@ -52,28 +52,28 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOpt
                                          PetscInt *min_levels, PetscBool *coarse_mg, PetscBool *default_mg);
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u);
 PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked);
-PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked);
-PetscErrorCode GridSequenceBarsSizes(DM dm, const AppCtx *user);
+PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked, PetscReal unmarked);
+PetscErrorCode GridSequenceBarsSizes(DM dm, const RunOptions *opt, Contact ct, const MeshBox *box, PetscInt level);
 PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u);
-PetscErrorCode EpsSweepTangent(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscBool *ok);
+PetscErrorCode EpsSweepTangent(SNES snes, DM dm, Contact ct, Vec u, Vec dir, PetscInt *ksp_its_total, PetscBool *ok);
 /* adapt.c: -adapt_cycles, the adaptive refinement driven by the error estimate */
 PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad);
-PetscErrorCode AdaptCheck(DM dm, const AppCtx *user);
+PetscErrorCode AdaptCheck(DM dm, const RunOptions *opt, Contact ct, const MeshBox *box, const Scene *scene);
 PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter write);
-PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user);
+PetscErrorCode AdaptView(MPI_Comm comm, const AdaptOptions *ad, const RunRecord *rec, PetscBool exact);
 PetscErrorCode AdaptWrite(MPI_Comm comm, const AdaptOptions *ad, const RunRecord *rec, PetscInt dim, PetscViewer v); /* /run's and /cycles */
 PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u); /* penetration_tol.c: -contact_penetration_tol */
 PetscErrorCode PenetrationTolWrite(Contact ct, const RunStats *s, PetscViewer v);
 
 /* load_path.c: -load_steps, -load_path */
 PetscErrorCode LoadPathGetOptions(MPI_Comm comm, LoadPathOptions *lp);
-PetscErrorCode LoadPathSetUp(MPI_Comm comm, AppCtx *user);
+PetscErrorCode LoadPathSetUp(MPI_Comm comm, const RunOptions *opt, Contact ct, Scene *scene);
 PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u);
-PetscErrorCode LoadPathView(MPI_Comm comm, const AppCtx *user);
+PetscErrorCode LoadPathView(MPI_Comm comm, const LoadPathOptions *lp, const Scene *scene, const RunRecord *rec);
 PetscErrorCode LoadPathWrite(MPI_Comm comm, const Scene *scene, const RunStats *s, const StepRecord st[], PetscInt n, PetscInt dim,
                              PetscViewer v); /* /steps */
 
 /* bandwidth.c */
 PetscErrorCode BandwidthGetOptions(MPI_Comm comm, PetscBool *measure);
-PetscErrorCode BandwidthMeasure(SNES snes, AppCtx *user);
+PetscErrorCode BandwidthMeasure(SNES snes, PetscBool measure, Bandwidth *b);
 PetscErrorCode BandwidthWrite(const Bandwidth *b, PetscViewer v);

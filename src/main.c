@@ -70,8 +70,8 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
                             (double)r->time_solve, r->converged ? "" : "  FAILED"));
     }
   }
-  PetscCall(LoadPathView(comm, user));
-  PetscCall(AdaptView(comm, user));
+  PetscCall(LoadPathView(comm, &user->opt->load_path, &user->scene, &user->rec));
+  PetscCall(AdaptView(comm, &user->opt->adapt, &user->rec, (PetscBool)(user->scene.exact != NULL)));
   PetscCall(EstimateView(comm, &user->rec.estimate, &user->rec.errors));
   PetscCall(BarsView(comm, &user->rec.bars));
   PetscCall(ContactChecksWarnings(comm, &s->checks, PETSC_TRUE, NULL));
@@ -265,9 +265,10 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   }
   PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));        /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
-  PetscCall(LoadPathSetUp(comm, &user));                                  /* a load path: the scene at its first factor */
-  PetscCall(GridSequenceBarsSizes(dm, &user));                            /* -bars on tetrahedra: the final mesh's eps on the levels below it */
-  if (opt.adapt.cycles || (opt.bars && opt.adapt.model[0]))               /* one eps on Gamma_C: the remeshed meshes do not nest */
+  PetscCall(LoadPathSetUp(comm, &opt, user.contact, &user.scene));        /* a load path: the scene at its first factor */
+  /* -bars on tetrahedra: the final mesh's eps on the levels below it */
+  PetscCall(GridSequenceBarsSizes(dm, &opt, user.contact, &user.box, user.prob.level));
+  if (opt.adapt.cycles || (opt.bars && opt.adapt.model[0])) /* one eps on Gamma_C: the remeshed meshes do not nest */
     PetscCall(MeshSetContactCellSizes(dm, user.scene.bcs.ncontact, user.scene.bcs.contact_ids));
   PetscCall(ProblemSetUp(dm, &user, &snes));
   { /* before the solve, not after it */
@@ -277,7 +278,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   }
   PetscCall(EstimateCheckSupported(dm, opt.estimate, opt.estimate_given, opt.degree)); /* -estimate on a discretization it does not cover */
   PetscCall(BarsCheck(comm, opt.bars, user.box.coarse_levels + opt.solver.grid_sequence, user.contact)); /* -bars without three nested meshes */
-  PetscCall(AdaptCheck(dm, &user));                                                                      /* -adapt_cycles where it cannot refine */
+  PetscCall(AdaptCheck(dm, &opt, user.contact, &user.box, &user.scene));                                 /* -adapt_cycles where it cannot refine */
   PetscCall(EstimateReset(&user.rec.estimate));
   PetscCall(BarsReset(&user.rec.bars));
   { /* initial overlap, an obstacle facing away, a curved boundary refined on its chords, a locking body: warnings */
@@ -360,7 +361,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(PetscTime(&t1));
   user.rec.stats.time_total = t1 - t0;
   PetscCall(RecordPeakMemory(comm, &user.rec.stats));
-  PetscCall(BandwidthMeasure(snes, &user));          /* -perf_bandwidth: after the peak memory, which its vectors would raise */
+  /* -perf_bandwidth: after the peak memory, which its vectors would raise */
+  PetscCall(BandwidthMeasure(snes, opt.perf_bandwidth, &user.rec.stats.bandwidth));
   PetscCall(OptionsCheckAllUsed(comm, PETSC_FALSE)); /* the options read during the solve too */
   PetscCall(PrintSummary(dm, &user, u));
   PetscCall(WriteOutput(dm, &user, u));

@@ -163,11 +163,11 @@ PetscErrorCode AdaptGetOptions(MPI_Comm comm, AdaptOptions *ad)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* What the adaptive cycles cannot do yet, refused before the solve. */
-PetscErrorCode AdaptCheck(DM dm, const AppCtx *user)
+/* What the adaptive cycles (and -bars's remeshed levels) cannot do yet with the options opt, the contact ct, the mesh
+   box and the scene, refused before the solve. */
+PetscErrorCode AdaptCheck(DM dm, const RunOptions *opt, Contact ct, const MeshBox *box, const Scene *scene)
 {
   MPI_Comm              comm = PetscObjectComm((PetscObject)dm);
-  const RunOptions     *opt  = user->opt;
   const ContactOptions *copt;
   PetscInt              dim;
   PetscBool             simplex, is_mg;
@@ -190,10 +190,10 @@ PetscErrorCode AdaptCheck(DM dm, const AppCtx *user)
   if (!opt->adapt.cycles) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexIsSimplex(dm, &simplex));
-  PetscCall(ContactGetOptions(user->contact, &copt));
+  PetscCall(ContactGetOptions(ct, &copt));
   PetscCheck(simplex, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles refines triangles and tetrahedra only, not %s",
              dim == 3 ? "hexahedra" : "quadrilaterals");
-  PetscCheck(dim == 2 || opt->adapt.model[0] || !user->box.from_file, comm, PETSC_ERR_USER_INPUT,
+  PetscCheck(dim == 2 || opt->adapt.model[0] || !box->from_file, comm, PETSC_ERR_USER_INPUT,
              "-adapt_cycles on a 3D mesh file needs the Gmsh model of the body (-adapt_model FILE.geo), which Gmsh meshes again at each cycle: "
              "PETSc 3.18 as Debian builds it has no conforming local refinement of tetrahedra (scripts/make_mesh.py --model FILE.geo writes the "
              "model of its meshes)");
@@ -207,7 +207,7 @@ PetscErrorCode AdaptCheck(DM dm, const AppCtx *user)
   PetscCheck(!opt->load_path.n, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles with a load path (-load_steps, -load_path) is not supported yet");
   /* the cycles adapt the mesh to the solution at the obstacle's given translation, and force control would move it on
      the last mesh only: the bars printed would belong to another state than the one written */
-  PetscCheck(!SceneForceControlled(&user->scene), comm, PETSC_ERR_USER_INPUT,
+  PetscCheck(!SceneForceControlled(scene), comm, PETSC_ERR_USER_INPUT,
              "-adapt_cycles and -accuracy with -obstacle_force are not supported yet: the cycles adapt to one position of the obstacle, and "
              "force control would move it on the last mesh only, so that the bars would be those of another state than the one written; give "
              "the obstacle's translation instead (a force-controlled run on a fixed mesh reports the translation it found)");
@@ -216,13 +216,13 @@ PetscErrorCode AdaptCheck(DM dm, const AppCtx *user)
   PetscCheck(!is_mg, comm, PETSC_ERR_USER_INPUT,
              "-adapt_cycles with -pc_type mg is not supported yet: use GAMG (options/solvers/gamg.yaml) or MUMPS");
   PetscCall(MeshRemeshCheckModel(dm, opt->adapt.model)); /* a model the cycles could not remesh, before the first solve */
-  PetscCheck(opt->adapt.model[0] || !user->box.from_file || user->box.curved_ridges < MESH_CURVED_RIDGES_MIN, comm, PETSC_ERR_USER_INPUT,
+  PetscCheck(opt->adapt.model[0] || !box->from_file || box->curved_ridges < MESH_CURVED_RIDGES_MIN, comm, PETSC_ERR_USER_INPUT,
              "-adapt_cycles: the mesh file's boundary turns by less than 20 degrees at %" PetscInt_FMT
              " of its vertices (one at %g, %g), a curved boundary's chords: the refinement would split them on the chords, and the "
              "answer would be the file's polygon's, not the curved body's (the Hertz cylinder meshed at h = 0.05: its contact width 27%% short "
              "after 10 cycles): give the body's Gmsh model (-adapt_model FILE.geo; scripts/make_mesh.py --model FILE.geo writes it), "
              "which Gmsh meshes again at each cycle, its boundary exact",
-             user->box.curved_ridges, (double)user->box.curved_x[0], (double)user->box.curved_x[1]);
+             box->curved_ridges, (double)box->curved_x[0], (double)box->curved_x[1]);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -309,7 +309,7 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
   eps_new = eps / CYCLE_EPS_RATIO;
   PetscCall(ContactSetEps(user->contact, dm, eps_new));
   PetscCall(VecDuplicate(u, &dir));
-  PetscCall(EpsSweepTangent(snes, dm, user, u, dir, &ok));
+  PetscCall(EpsSweepTangent(snes, dm, user->contact, u, dir, &user->rec.stats.ksp_its_total, &ok));
   if (ok) { /* u(eps_new) = u + (eps_new - eps) du/deps, du/deps = dir eps_new / eps^2 */
     PetscCall(VecDuplicate(u, &u_new));
     PetscCall(VecWAXPY(u_new, (eps_new - eps) * eps_new / (eps * eps), dir, u));
@@ -473,16 +473,14 @@ static PetscReal AdaptFraction(const AdaptOptions *ad, const PetscBool target[],
    whose bar's penalty part alone is above the tolerance on this cycle and the one before, both cycles with a bar
    (CycleBarsPenaltyPart()). The mesh's part falls with the cycles, the penalty's tends to the penalty problem's own
    error, which a fixed eps keeps (docs/estimate.md, "A fixed eps"). Returns the first such quantity (-1: none). */
-static PetscInt FixedEpsHolds(const AppCtx *user, const PetscBool target[], PetscInt k)
+static PetscInt FixedEpsHolds(const AdaptOptions *ad, Contact ct, const CycleRecord cycles[], const PetscBool target[], PetscInt k)
 {
-  const AdaptOptions *ad = &user->opt->adapt;
-
-  if (!(ad->accuracy > 0.0) || k < 1 || ContactGetEpsScaling(user->contact) != CONTACT_EPS_FIXED) return -1;
+  if (!(ad->accuracy > 0.0) || k < 1 || ContactGetEpsScaling(ct) != CONTACT_EPS_FIXED) return -1;
   for (PetscInt q = 0; q < ACCURACY_NUM; ++q) {
     PetscBool above = target[q];
 
     for (PetscInt m = k - 1; m <= k && above; ++m) {
-      const CycleRecord *c = &user->rec.cycles[m];
+      const CycleRecord *c = &cycles[m];
 
       above = (PetscBool)(!PetscIsNanReal(c->bar[q]) && CycleBarsPenaltyPart(c, q) > ad->accuracy * PetscAbsReal(c->value[q]));
     }
@@ -511,22 +509,19 @@ static PetscErrorCode AdaptCycleMemory(MPI_Comm comm, PetscReal *mb)
    (g the last growth of the unknowns), p = 1.2 in 2D and 4/3 in 3D, a sparse direct factorization's fill (n log n and
    n^(4/3) on 2D and 3D meshes), which bounds an iterative solver's. The difference leaves out what does not grow with
    the mesh: the libraries and the set-up, much of it loaded after the options phase. */
-static PetscReal AdaptMemoryAt(const AppCtx *user, PetscInt k, PetscInt dim, PetscReal n)
+static PetscReal AdaptMemoryAt(const CycleRecord c[], PetscInt k, PetscInt dim, PetscReal n)
 {
-  const CycleRecord *c  = user->rec.cycles;
-  const PetscReal    p  = dim == 3 ? 4.0 / 3.0 : 1.2;
-  const PetscReal    nk = PetscPowReal((PetscReal)c[k].n_dofs, p), nk1 = PetscPowReal((PetscReal)c[k - 1].n_dofs, p), at = PetscPowReal(n, p);
-  const PetscReal    grown = PetscMax(c[k].memory_mb - c[k - 1].memory_mb, 0.0);
+  const PetscReal p  = dim == 3 ? 4.0 / 3.0 : 1.2;
+  const PetscReal nk = PetscPowReal((PetscReal)c[k].n_dofs, p), nk1 = PetscPowReal((PetscReal)c[k - 1].n_dofs, p), at = PetscPowReal(n, p);
+  const PetscReal grown = PetscMax(c[k].memory_mb - c[k - 1].memory_mb, 0.0);
 
   return c[k].memory_mb + (nk > nk1 ? grown * (at - nk) / (nk - nk1) : 0.0);
 }
 
-static void AdaptPredictMemory(const AppCtx *user, PetscInt k, PetscInt dim, PetscReal *mb, PetscReal *growth)
+static void AdaptPredictMemory(const CycleRecord c[], PetscInt k, PetscInt dim, PetscReal *mb, PetscReal *growth)
 {
-  const CycleRecord *c = user->rec.cycles;
-
   *growth = PetscMax((PetscReal)c[k].n_dofs / (PetscReal)c[k - 1].n_dofs, 1.0);
-  *mb     = AdaptMemoryAt(user, k, dim, *growth * (PetscReal)c[k].n_dofs);
+  *mb     = AdaptMemoryAt(c, k, dim, *growth * (PetscReal)c[k].n_dofs);
 }
 
 /* Whether -accuracy is out of reach within -adapt_max_memory: a quantity asked for whose bar falls so slowly with the
@@ -539,12 +534,10 @@ static void AdaptPredictMemory(const AppCtx *user, PetscInt k, PetscInt dim, Pet
    and the margin covers its extrapolation. A run given -adapt_cycles or -adapt_max_dofs runs on to them (the user's
    budget). Returns the quantity that needs the largest mesh (-1: none), that mesh's unknowns, its memory and its rate. */
 #define ADAPT_REACH_MARGIN 4.0
-static PetscInt AdaptOutOfReach(const AppCtx *user, const PetscBool target[], PetscInt k, PetscInt dim, PetscReal *n_need, PetscReal *mb_need,
-                                PetscReal *rate)
+static PetscInt AdaptOutOfReach(const AdaptOptions *ad, const CycleRecord c[], const PetscBool target[], PetscInt k, PetscInt dim, PetscReal *n_need,
+                                PetscReal *mb_need, PetscReal *rate)
 {
-  const AdaptOptions *ad    = &user->opt->adapt;
-  const CycleRecord  *c     = user->rec.cycles;
-  PetscInt            worst = -1;
+  PetscInt worst = -1;
 
   *n_need = *mb_need = *rate = 0.0;
   if (!(ad->accuracy > 0.0) || ad->run_to_budget || !(ad->max_memory > 0.0) || k < 1) return -1;
@@ -570,7 +563,7 @@ static PetscInt AdaptOutOfReach(const AppCtx *user, const PetscBool target[], Pe
     }
   }
   if (worst < 0) return -1;
-  *mb_need = PetscIsInfReal(*n_need) ? PETSC_INFINITY : AdaptMemoryAt(user, k, dim, *n_need);
+  *mb_need = PetscIsInfReal(*n_need) ? PETSC_INFINITY : AdaptMemoryAt(c, k, dim, *n_need);
   return *mb_need > ADAPT_REACH_MARGIN * ad->max_memory ? worst : -1;
 }
 
@@ -581,20 +574,17 @@ static PetscInt AdaptOutOfReach(const AppCtx *user, const PetscBool target[], Pe
    that the writes cost at most about 1/ADAPT_CHECKPOINT_RATIO of the run (docs/running.md); the small first cycles'
    writes cost as much as their solves, while a long run's cycles, each far dearer than a write, are each written. */
 #define ADAPT_CHECKPOINT_RATIO 20.0
-static PetscErrorCode AdaptCheckpoint(DM dm, AppCtx *user, Vec u, PetscInt k, OutputWriter write)
+/* What a signal during the checkpoint of cycle c (the k-th) into the file output says as the run dies. */
+static PetscErrorCode AdaptCheckpointNote(MPI_Comm comm, const char output[], const CycleRecord *c, PetscInt k)
 {
-  const CycleRecord *c = &user->rec.cycles[k];
-  char               note[1024];
+  char note[1024];
 
   PetscFunctionBeginUser;
-  if (!write) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscSNPrintf(note, sizeof(note),
                           "signorini: interrupted during adaptive cycle %" PetscInt_FMT ": %s holds cycle %" PetscInt_FMT " (%" PetscInt_FMT
                           " dofs), with /run adapt_stop = interrupted\n",
-                          k + 1, user->opt->output, k, c->n_dofs));
-  PetscCall(OutputFileStageSignalNote(PetscObjectComm((PetscObject)dm), note));
-  user->rec.adapt_stop = ADAPT_STOP_INTERRUPTED;
-  PetscCall(write(dm, user, u));
+                          k + 1, output, k, c->n_dofs));
+  PetscCall(OutputFileStageSignalNote(comm, note));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -632,13 +622,13 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     c->accurate    = Accurate(ad, user->rec.accuracy_target, c);
     c->marked_edge = 0;
     at_max         = (PetscBool)(ad->max_dofs > 0 && c->n_dofs >= ad->max_dofs);
-    fixed_eps      = c->accurate ? -1 : FixedEpsHolds(user, user->rec.accuracy_target, k);
+    fixed_eps      = c->accurate ? -1 : FixedEpsHolds(ad, user->contact, user->rec.cycles, user->rec.accuracy_target, k);
     PetscCall(AdaptCycleMemory(PetscObjectComm((PetscObject)*dm), &c->memory_mb));
     at_memory = PETSC_FALSE;
     if (!c->accurate && !at_max && fixed_eps < 0 && k < ad->cycles && ad->max_memory > 0.0 && k > 0) { /* from the first measured growth */
-      AdaptPredictMemory(user, k, dim, &next_mb, &growth);
+      AdaptPredictMemory(user->rec.cycles, k, dim, &next_mb, &growth);
       at_memory = (PetscBool)(next_mb > ad->max_memory);
-      if (!at_memory) unreachable = AdaptOutOfReach(user, user->rec.accuracy_target, k, dim, &n_need, &mb_need, &rate);
+      if (!at_memory) unreachable = AdaptOutOfReach(ad, user->rec.cycles, user->rec.accuracy_target, k, dim, &n_need, &mb_need, &rate);
     }
     if (!c->accurate && k < ad->cycles && user->rec.stats.converged && !at_max && fixed_eps < 0 && !at_memory && unreachable < 0) {
       PetscCall(EstimateMark(*dm, &user->rec.estimate, user->rec.adapt_fraction, &marked, &c->marked));
@@ -664,7 +654,11 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
       PetscLogDouble w0, w1;
 
       PetscCall(PetscTime(&w0));
-      PetscCall(AdaptCheckpoint(*dm, user, *u, k, write));
+      if (write) {
+        PetscCall(AdaptCheckpointNote(PetscObjectComm((PetscObject)*dm), user->opt->output, c, k));
+        user->rec.adapt_stop = ADAPT_STOP_INTERRUPTED;
+        PetscCall(write(*dm, user, *u));
+      }
       PetscCall(PetscTime(&w1));
       ck_cost = PetscMax(w1 - w0, 1e-6);
       PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ck_cost, 1, MPI_DOUBLE, MPI_MAX, PetscObjectComm((PetscObject)*dm))); /* alike on every rank */
@@ -718,7 +712,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
       break;
     }
     if (remesh)
-      PetscCall(GridSequenceRemesh(dm, user, snes, u, marked));
+      PetscCall(GridSequenceRemesh(dm, user, snes, u, marked, 1.0));
     else
       PetscCall(GridSequenceRefine(dm, user, snes, u, marked));
     PetscCall(PetscTime(&t1));
@@ -739,52 +733,51 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The cycles in the summary, one line each, and -accuracy's outcome: the last cycle's quantities with their bars. */
-PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
+/* The cycles of the record rec in the summary, one line each (with the true error where the scene knows the exact
+   solution), and -accuracy's outcome: the last cycle's quantities with their bars. */
+PetscErrorCode AdaptView(MPI_Comm comm, const AdaptOptions *ad, const RunRecord *rec, PetscBool exact)
 {
-  const AdaptOptions *ad = &user->opt->adapt;
-
   PetscFunctionBeginUser;
-  if (!user->rec.ncycles) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!rec->ncycles) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscPrintf(comm, "  adaptive cycles (-adapt_fraction %g): cycle  dofs        cells       estimate    %s  marked  Newton  Krylov\n",
-                        (double)user->rec.adapt_fraction, user->scene.exact ? "error      " : ""));
-  for (PetscInt k = 0; k < user->rec.ncycles; ++k) {
-    const CycleRecord *c       = &user->rec.cycles[k];
+                        (double)rec->adapt_fraction, exact ? "error      " : ""));
+  for (PetscInt k = 0; k < rec->ncycles; ++k) {
+    const CycleRecord *c       = &rec->cycles[k];
     char               err[32] = "";
 
-    if (user->scene.exact) PetscCall(PetscSNPrintf(err, sizeof(err), "%.4e  ", (double)c->error_energy));
+    if (exact) PetscCall(PetscSNPrintf(err, sizeof(err), "%.4e  ", (double)c->error_energy));
     PetscCall(PetscPrintf(comm,
                           "                                           %5" PetscInt_FMT "  %-10" PetscInt_FMT "  %-10" PetscInt_FMT
                           "  %.4e  %s%6" PetscInt_FMT "  %6" PetscInt_FMT "  %6" PetscInt_FMT "\n",
                           k, c->n_dofs, c->n_cells, (double)c->estimate, err, c->marked, c->newton_its, c->ksp_its));
   }
-  if (user->rec.adapt_stop == ADAPT_STOP_MAX_DOFS && !(ad->accuracy > 0.0))
+  if (rec->adapt_stop == ADAPT_STOP_MAX_DOFS && !(ad->accuracy > 0.0))
     PetscCall(PetscPrintf(comm, "  the cycles stopped at -adapt_max_dofs %" PetscInt_FMT ": the last mesh has %" PetscInt_FMT " dofs\n", ad->max_dofs,
-                          user->rec.cycles[user->rec.ncycles - 1].n_dofs));
-  if (ad->accuracy > 0.0 && user->rec.cycles[user->rec.ncycles - 1].norm == 0.0 && user->rec.cycles[user->rec.ncycles - 1].estimate == 0.0) {
+                          rec->cycles[rec->ncycles - 1].n_dofs));
+  if (ad->accuracy > 0.0 && rec->cycles[rec->ncycles - 1].norm == 0.0 && rec->cycles[rec->ncycles - 1].estimate == 0.0) {
     /* u = 0 exactly (no load, no contact): every quantity and its error are zero, and no bar is relative to anything */
     PetscCall(PetscPrintf(comm,
                           "  WARNING: -accuracy %g: the solution is zero (no load acts and the obstacle does not press on the body: u = 0 exactly, "
                           "with no error to refine); check the loads and the obstacle's position\n",
                           (double)ad->accuracy));
   } else if (ad->accuracy > 0.0) {
-    const CycleRecord *c = &user->rec.cycles[user->rec.ncycles - 1];
+    const CycleRecord *c = &rec->cycles[rec->ncycles - 1];
 
     if (c->accurate)
       PetscCall(PetscPrintf(comm, "  accuracy %g reached at cycle %" PetscInt_FMT " (%" PetscInt_FMT " dofs):\n", (double)ad->accuracy,
-                            user->rec.ncycles - 1, c->n_dofs));
+                            rec->ncycles - 1, c->n_dofs));
     else
       PetscCall(PetscPrintf(
           comm, "  WARNING: accuracy %g not reached after %" PetscInt_FMT " cycles (%" PetscInt_FMT " dofs)%s%s%s; the last cycle's bars:\n",
-          (double)ad->accuracy, user->rec.ncycles - 1, c->n_dofs, UnseenHolds(ad, c) ? ": the mesh does not see the contact at some nodes" : "",
+          (double)ad->accuracy, rec->ncycles - 1, c->n_dofs, UnseenHolds(ad, c) ? ": the mesh does not see the contact at some nodes" : "",
           !c->converged ? ": the last solve failed" : "",
-          user->rec.adapt_stop == ADAPT_STOP_MAX_DOFS       ? ": the mesh reached -adapt_max_dofs"
-          : user->rec.adapt_stop == ADAPT_STOP_MAX_MEMORY   ? ": the next cycle would exceed -adapt_max_memory"
-          : user->rec.adapt_stop == ADAPT_STOP_FIXED_EPS    ? ": the fixed eps's penalty part of a bar is above the tolerance (-penalty_eps)"
-          : user->rec.adapt_stop == ADAPT_STOP_OUT_OF_REACH ? ": a bar falls too slowly to reach it within -adapt_max_memory"
-                                                            : ""));
+          rec->adapt_stop == ADAPT_STOP_MAX_DOFS       ? ": the mesh reached -adapt_max_dofs"
+          : rec->adapt_stop == ADAPT_STOP_MAX_MEMORY   ? ": the next cycle would exceed -adapt_max_memory"
+          : rec->adapt_stop == ADAPT_STOP_FIXED_EPS    ? ": the fixed eps's penalty part of a bar is above the tolerance (-penalty_eps)"
+          : rec->adapt_stop == ADAPT_STOP_OUT_OF_REACH ? ": a bar falls too slowly to reach it within -adapt_max_memory"
+                                                       : ""));
     for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
-      if (!user->rec.accuracy_target[k]) continue;
+      if (!rec->accuracy_target[k]) continue;
       if (PetscIsNanReal(c->bar[k]))
         PetscCall(PetscPrintf(comm, "    %-14s %.6g, no bar yet (no earlier cycle twice as coarse: N^(-1/dim) twice the last one's)\n",
                               AccuracyQuantities[k], (double)c->value[k]));
@@ -793,10 +786,10 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AppCtx *user)
                               (double)(100.0 * c->bar[k] / PetscAbsReal(c->value[k])),
                               k == ACCURACY_ENERGY ? " (the energy norm and the error estimate)" : ""));
     }
-    if (OnlyEnergyHolds(ad, user->rec.accuracy_target, c)) {
+    if (OnlyEnergyHolds(ad, rec->accuracy_target, c)) {
       char names[256];
 
-      PetscCall(ContactTargetNames(user->rec.accuracy_target, names, sizeof(names)));
+      PetscCall(ContactTargetNames(rec->accuracy_target, names, sizeof(names)));
       PetscCall(PetscPrintf(comm,
                             "  only the energy's bar is above the tolerance: the energy norm's error lies over the whole body, and on a body much "
                             "larger than its contact zone it falls slowly; -accuracy_quantity %s asks for the contact quantities alone\n",

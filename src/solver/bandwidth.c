@@ -125,17 +125,17 @@ static PetscErrorCode VCycleBytes(PC pc, PetscReal *bytes)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode BandwidthMeasure(SNES snes, AppCtx *user)
+/* -perf_bandwidth (measure): the bandwidths with the final Jacobian of snes and its preconditioner, into b. */
+PetscErrorCode BandwidthMeasure(SNES snes, PetscBool measure, Bandwidth *b)
 {
   MPI_Comm     comm = PetscObjectComm((PetscObject)snes);
-  Bandwidth   *b    = &user->rec.stats.bandwidth;
   BandwidthCtx c;
   KSP          ksp;
   PetscMPIInt  size;
   PetscReal    t, bytes;
 
   PetscFunctionBeginUser;
-  if (!user->opt->perf_bandwidth) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!measure) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCallMPI(MPI_Comm_size(comm, &size));
   b->measured = PETSC_TRUE;
   /* the triad */

@@ -19,12 +19,12 @@
 /* The first new value has no earlier solution to extrapolate from: its start follows the tangent of the solution path
    at the last eps instead. F(u; eps) = K u + r0 + P(u; eps) with the penalty term P proportional to 1/eps, so
    du/deps = J^-1 P(u; eps) / eps, J the Jacobian, which K and the SNES's preconditioner still hold from the last Newton
-   step. dir = J^-1 P(u; eps_new), solved loosely (CG to 1e-2, the preconditioner shared); the step to eps_new is
-   (eps_new - eps) du/deps = dir (eps_new - eps) eps_new / eps^2. Its CG iterations count in ksp_its_total. *ok is false
+   step. dir = J^-1 P(u; eps_new), P the contact ct's at its new eps, solved loosely (CG to 1e-2, the preconditioner shared); the step to eps_new is
+   (eps_new - eps) du/deps = dir (eps_new - eps) eps_new / eps^2. Its CG iterations are added to *ksp_its_total (the run's). *ok is false
    if CG did not converge. A few Gauss points at the edge of the contact zone may flip on the tangent, so its guess is
    taken where its residual is 100 times lower than the last solution's, whatever its active points; the secant's rule
    (the same active points) would refuse it. */
-PetscErrorCode EpsSweepTangent(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscBool *ok)
+PetscErrorCode EpsSweepTangent(SNES snes, DM dm, Contact ct, Vec u, Vec dir, PetscInt *ksp_its_total, PetscBool *ok)
 {
   KSP                ksp, tangent;
   PC                 pc;
@@ -39,7 +39,7 @@ PetscErrorCode EpsSweepTangent(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, P
   PetscCall(KSPGetPC(ksp, &pc));
   PetscCall(VecDuplicate(u, &rhs));
   PetscCall(VecZeroEntries(rhs));
-  PetscCall(ContactAddResidual(user->contact, dm, u, rhs)); /* P(u; eps_new) */
+  PetscCall(ContactAddResidual(ct, dm, u, rhs)); /* P(u; eps_new) */
   PetscCall(KSPCreate(PetscObjectComm((PetscObject)snes), &tangent));
   PetscCall(KSPSetType(tangent, KSPCG));
   PetscCall(KSPSetOperators(tangent, A, P));
@@ -48,7 +48,7 @@ PetscErrorCode EpsSweepTangent(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, P
   PetscCall(KSPSolve(tangent, rhs, dir));
   PetscCall(KSPGetConvergedReason(tangent, &reason));
   PetscCall(KSPGetIterationNumber(tangent, &its));
-  user->rec.stats.ksp_its_total += its;
+  *ksp_its_total += its;
   *ok = (PetscBool)(reason > 0);
   PetscCall(KSPDestroy(&tangent));
   PetscCall(VecDestroy(&rhs));
@@ -107,7 +107,7 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
     } else if (k == 1 && eps != eps_last) { /* the tangent (a sweep is the penalty's: ContactSetFromOptions()) */
       PetscBool ok = PETSC_FALSE;
 
-      PetscCall(EpsSweepTangent(snes, dm, user, u, dir, &ok));
+      PetscCall(EpsSweepTangent(snes, dm, user->contact, u, dir, &user->rec.stats.ksp_its_total, &ok));
       if (ok) PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, (eps - eps_last) * eps / (eps_last * eps_last), 1e-2, PETSC_FALSE));
     }
     PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));

@@ -12,12 +12,12 @@
 #include "physics.h"
 #include "solver.h"
 
-/* The solution u on dm as a local vector, with the Dirichlet values (inserted by ProblemSetUp()). */
-static PetscErrorCode LocalSolution(DM dm, const AppCtx *user, Vec u, Vec *loc)
+/* The solution u on dm as a local vector, with the Dirichlet values of loc_bc (the problem's, inserted by ProblemSetUp()). */
+static PetscErrorCode LocalSolution(DM dm, Vec loc_bc, Vec u, Vec *loc)
 {
   PetscFunctionBeginUser;
   PetscCall(DMCreateLocalVector(dm, loc));
-  PetscCall(VecCopy(user->prob.loc_bc, *loc));
+  PetscCall(VecCopy(loc_bc, *loc));
   PetscCall(DMGlobalToLocal(dm, u, INSERT_VALUES, *loc));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -44,7 +44,7 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   Vec       loc, fine_loc;
 
   PetscFunctionBeginUser;
-  PetscCall(LocalSolution(*dm, user, *u, &loc));
+  PetscCall(LocalSolution(*dm, user->prob.loc_bc, *u, &loc));
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user, snes));
   if (marked) {
@@ -56,7 +56,7 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   } else
     PetscCall(MeshRefineRegular(*dm, 1, &fine, &parent, &vertex_source));
   user->prob.level++;
-  PetscCall(GridSequenceBarsSizes(fine, user)); /* -bars on tetrahedra: the final mesh's eps on this level */
+  PetscCall(GridSequenceBarsSizes(fine, user->opt, user->contact, &user->box, user->prob.level)); /* -bars on tetrahedra: the final mesh's eps here */
   if (marked) PetscCall(MeshSetContactCellSizes(fine, user->scene.bcs.ncontact, user->scene.bcs.contact_ids)); /* one eps on Gamma_C */
   PetscCall(ProblemSetUp(fine, user, snes));
   PetscCall(MultigridAddLevel(user->mg, *snes, *dm, fine, vertex_source, user->opt->degree)); /* with -pc_type mg */
@@ -82,10 +82,10 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
 
 /* The next mesh of the adaptive cycles from the Gmsh model (-adapt_model; the 3D box of the options without it;
    MeshRemesh()): each cell asks for its mean
-   edge length, halved where marked, and Gmsh meshes the model with these sizes. The meshes do not nest: the last
-   solution is carried to the new mesh by locating each new vertex in the old mesh (MeshTransferApply()), the next
-   solve's start. */
-static PetscErrorCode Remesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked, PetscReal unmarked)
+   edge length, halved where marked and scaled by unmarked elsewhere (1 for the cycles, 0.5 for -bars's levels), and
+   Gmsh meshes the model with these sizes. The meshes do not nest: the last solution is carried to the new mesh by
+   locating each new vertex in the old mesh (MeshTransferApply()), the next solve's start. */
+PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked, PetscReal unmarked)
 {
   DM           fine;
   PetscReal   *size;
@@ -103,7 +103,7 @@ static PetscErrorCode Remesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel m
     if (marked) PetscCall(DMLabelGetValue(marked, c, &value));
     size[c - cStart] *= value == DM_ADAPT_REFINE ? 0.5 : unmarked;
   }
-  PetscCall(LocalSolution(*dm, user, *u, &loc));
+  PetscCall(LocalSolution(*dm, user->prob.loc_bc, *u, &loc));
   PetscCall(MeshTransferCreateFromField(*dm, loc, &tr));
   if (user->rec.bars.pressure_recorded) PetscCall(BarsPressureTransferCreate(*dm, &user->rec.bars, loc, &tr_p)); /* -bars's 2h pressure */
   PetscCall(VecDestroy(u));
@@ -122,41 +122,35 @@ static PetscErrorCode Remesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel m
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked)
-{
-  PetscFunctionBeginUser;
-  PetscCall(Remesh(dm, user, snes, u, marked, 1.0));
-  PetscFunctionReturn(PETSC_SUCCESS);
-}
-
 /* -bars with the body's Gmsh model (-adapt_model): the levels of -contact_grid_sequence are the model meshed again at
-   half the cells' sizes (Remesh()), not the mesh refined on its chords, so that the finest level's body is the curved
-   body. The levels do not nest: the pressure's band carries the 2h level's nodal pressures to the final mesh's nodes
-   by the remeshing's transfer (BarsPressureTransferCreate()), and eps, one value on Gamma_C on each level
+   half the cells' sizes (GridSequenceRemesh()), not the mesh refined on its chords, so that the finest level's body is
+   the curved body. The levels do not nest: the pressure's band carries the 2h level's nodal pressures to the final
+   mesh's nodes by the remeshing's transfer (BarsPressureTransferCreate()), and eps, one value on Gamma_C on each level
    (MeshSetContactCellSizes()), is the same on all three: that of the first mesh's smallest contact cell halved at
    each level (GridSequenceBarsEps()), so that the levels differ by their meshes alone (a remeshed level's own
    smallest cell does not halve with its sizes). */
 static PetscErrorCode GridSequenceRemeshHalf(DM *dm, AppCtx *user, SNES *snes, Vec *u)
 {
   PetscFunctionBeginUser;
-  PetscCall(Remesh(dm, user, snes, u, NULL, 0.5));
+  PetscCall(GridSequenceRemesh(dm, user, snes, u, NULL, 0.5));
   user->rec.bars.remeshed = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Newton's relative tolerance on a box below the one of the options (-contact_coarse_levels): -contact_coarse_rtol where
-   looser than -snes_rtol. Its solution is only the next level's initial guess, whose own error is of the order of h. */
-static PetscErrorCode GridSequenceSetTolerance(SNES snes, const AppCtx *user)
+/* Newton's relative tolerance on level `level` when it is a box below the one of the options (the coarse_levels of
+   -contact_coarse_levels): -contact_coarse_rtol where looser than -snes_rtol. Its solution is only the next level's
+   initial guess, whose own error is of the order of h. */
+static PetscErrorCode GridSequenceSetTolerance(SNES snes, const RunOptions *opt, PetscInt coarse_levels, PetscInt level)
 {
-  const PetscInt nlevels = user->box.coarse_levels + user->opt->solver.grid_sequence;
+  const PetscInt nlevels = coarse_levels + opt->solver.grid_sequence;
   PetscReal      atol, rtol, stol;
   PetscInt       maxit, maxf;
 
   PetscFunctionBeginUser;
-  if (user->prob.level >= user->box.coarse_levels) PetscFunctionReturn(PETSC_SUCCESS);
-  if (user->opt->bars && user->prob.level >= nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS); /* they serve the bars */
+  if (level >= coarse_levels) PetscFunctionReturn(PETSC_SUCCESS);
+  if (opt->bars && level >= nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS); /* they serve the bars */
   PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
-  if (user->opt->solver.coarse_rtol > rtol) PetscCall(SNESSetTolerances(snes, atol, user->opt->solver.coarse_rtol, stol, maxit, maxf));
+  if (opt->solver.coarse_rtol > rtol) PetscCall(SNESSetTolerances(snes, atol, opt->solver.coarse_rtol, stol, maxit, maxf));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -211,53 +205,53 @@ PetscErrorCode GridSequenceCoarseRequest(MPI_Comm comm, Contact ct, const RunOpt
    the two levels below the final one gets instead the size of its descendants on the final mesh (MeshDescendantSizes(),
    the mean of their diameters^power: the mean of their eps), measured on the mesh refined for that purpose and
    destroyed; the final mesh keeps its own diameters, so that the answer is the run's without -bars. Triangles,
-   quadrilaterals and hexahedra halve exactly and need none of it; nor do the boxes (built, not refined). */
-PetscErrorCode GridSequenceBarsSizes(DM dm, const AppCtx *user)
+   quadrilaterals and hexahedra halve exactly and need none of it; nor do the boxes (built, not refined). dm is level
+   `level` of the sequence of the options opt from the mesh box, ct the contact whose eps follows the cells. */
+PetscErrorCode GridSequenceBarsSizes(DM dm, const RunOptions *opt, Contact ct, const MeshBox *box, PetscInt level)
 {
-  const PetscInt        nlevels = user->box.coarse_levels + user->opt->solver.grid_sequence;
+  const PetscInt        nlevels = box->coarse_levels + opt->solver.grid_sequence;
   const ContactOptions *copt;
   PetscInt              dim;
   PetscBool             simplex;
   PetscReal            *sizes, hmax;
 
   PetscFunctionBeginUser;
-  if (!user->opt->bars || ContactGetEpsScaling(user->contact) != CONTACT_EPS_MESH || (user->box.is_box && user->opt->degree == 1))
-    PetscFunctionReturn(PETSC_SUCCESS);
-  if (user->prob.level >= nlevels || user->prob.level < nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(ContactGetOptions(user->contact, &copt));
+  if (!opt->bars || ContactGetEpsScaling(ct) != CONTACT_EPS_MESH || (box->is_box && opt->degree == 1)) PetscFunctionReturn(PETSC_SUCCESS);
+  if (level >= nlevels || level < nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetOptions(ct, &copt));
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(DMPlexIsSimplex(dm, &simplex));
   if (dim != 3 || !simplex) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(MeshDescendantSizes(dm, nlevels - user->prob.level, copt->eps_power, &sizes, &hmax));
+  PetscCall(MeshDescendantSizes(dm, nlevels - level, copt->eps_power, &sizes, &hmax));
   PetscCall(MeshSetCellSizes(dm, hmax, sizes));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* -bars: the two levels below the final one solve at the final mesh's eps, so that the three differ by their
    discretization alone: eps = eps0 h^power / M with h halved at each level up to the final one (the local factors are the
-   same on nested meshes). The levels below them only give the next its initial guess, at their own eps. */
-static PetscErrorCode GridSequenceBarsEps(SNES snes, AppCtx *user, PetscInt nlevels)
+   same on nested meshes). The levels below them only give the next its initial guess, at their own eps. snes solves
+   level `level` of nlevels with the contact ct; bars holds the remeshed levels' one eps. */
+static PetscErrorCode GridSequenceBarsEps(SNES snes, const RunOptions *opt, Contact ct, PetscInt level, PetscInt nlevels, ErrorBars *bars)
 {
   const ContactOptions *copt;
   PetscReal             eps;
   DM                    dm;
 
   PetscFunctionBeginUser;
-  if (!user->opt->bars || ContactGetEpsScaling(user->contact) != CONTACT_EPS_MESH || user->prob.level < nlevels - (BARS_LEVELS - 1))
-    PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(ContactGetOptions(user->contact, &copt));
+  if (!opt->bars || ContactGetEpsScaling(ct) != CONTACT_EPS_MESH || level < nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetOptions(ct, &copt));
   PetscCall(SNESGetDM(snes, &dm));
-  if (user->opt->adapt.model[0]) { /* the remeshed levels' one eps, from the first bars level's own (GridSequenceRemeshHalf()) */
-    if (user->prob.level == nlevels - (BARS_LEVELS - 1)) {
-      PetscCall(ContactGetEps(user->contact, &eps));
-      user->rec.bars.eps_levels = eps * PetscPowReal(2.0, -(PetscReal)(BARS_LEVELS - 1) * copt->eps_power);
+  if (opt->adapt.model[0]) { /* the remeshed levels' one eps, from the first bars level's own (GridSequenceRemeshHalf()) */
+    if (level == nlevels - (BARS_LEVELS - 1)) {
+      PetscCall(ContactGetEps(ct, &eps));
+      bars->eps_levels = eps * PetscPowReal(2.0, -(PetscReal)(BARS_LEVELS - 1) * copt->eps_power);
     }
-    PetscCall(ContactSetEps(user->contact, dm, user->rec.bars.eps_levels));
+    PetscCall(ContactSetEps(ct, dm, bars->eps_levels));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  if (user->prob.level >= nlevels) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(ContactGetEps(user->contact, &eps));
-  PetscCall(ContactSetEps(user->contact, dm, eps * PetscPowReal(2.0, -(PetscReal)(nlevels - user->prob.level) * copt->eps_power)));
+  if (level >= nlevels) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetEps(ct, &eps));
+  PetscCall(ContactSetEps(ct, dm, eps * PetscPowReal(2.0, -(PetscReal)(nlevels - level) * copt->eps_power)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -323,15 +317,11 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* How a level starts from the coarser one's solution: as SolverStartFromCoarser() decides when -bars has solved both at
-   the same eps; otherwise as nested iteration does. */
-static PetscErrorCode GridSequenceStart(const AppCtx *user, PetscInt nlevels, SolverStart *start)
+/* Whether level `level` of nlevels starts from the coarser one's solution as SolverStartFromCoarser() decides: where
+   -bars (bars) has solved both at the same eps. The other levels start as nested iteration does. */
+static PetscBool GridSequenceStartsAsCoarser(PetscBool bars, PetscInt level, PetscInt nlevels)
 {
-  PetscFunctionBeginUser;
-  *start = SOLVER_START_COARSER_MESH;
-  if (!user->opt->bars || user->prob.level <= nlevels - (BARS_LEVELS - 1)) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(SolverStartFromCoarser(user, start));
-  PetscFunctionReturn(PETSC_SUCCESS);
+  return (PetscBool)(bars && level > nlevels - (BARS_LEVELS - 1));
 }
 
 PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
@@ -343,8 +333,8 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
   user->rec.bars.eps_done   = PETSC_FALSE;
   user->rec.bars.remeshed   = PETSC_FALSE;
   user->rec.bars.eps_levels = 0.0;
-  PetscCall(GridSequenceSetTolerance(*snes, user));
-  PetscCall(GridSequenceBarsEps(*snes, user, nlevels));
+  PetscCall(GridSequenceSetTolerance(*snes, user->opt, user->box.coarse_levels, user->prob.level));
+  PetscCall(GridSequenceBarsEps(*snes, user->opt, user->contact, user->prob.level, nlevels, &user->rec.bars));
   PetscCall(SolverSolve(*snes, user, *u, SOLVER_START_ZERO));
   PetscCall(GridSequenceBarsLevel(*snes, user, *u, nlevels));
   for (PetscInt l = 1; l <= nlevels; ++l) {
@@ -364,9 +354,10 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     PetscCall(PetscTime(&t1));
     user->prob.setup_time = t1 - t0; /* refinement, set-up and interpolation */
     user->rec.stats.time_setup += t1 - t0;
-    PetscCall(GridSequenceSetTolerance(*snes, user));
-    PetscCall(GridSequenceBarsEps(*snes, user, nlevels));
-    PetscCall(GridSequenceStart(user, nlevels, &start));
+    PetscCall(GridSequenceSetTolerance(*snes, user->opt, user->box.coarse_levels, user->prob.level));
+    PetscCall(GridSequenceBarsEps(*snes, user->opt, user->contact, user->prob.level, nlevels, &user->rec.bars));
+    start = SOLVER_START_COARSER_MESH;
+    if (GridSequenceStartsAsCoarser(user->opt->bars, user->prob.level, nlevels)) PetscCall(SolverStartFromCoarser(user, &start));
     PetscCall(SolverSolve(*snes, user, *u, failed ? SOLVER_START_ZERO : start));
     PetscCall(GridSequenceBarsLevel(*snes, user, *u, nlevels));
   }

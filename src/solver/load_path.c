@@ -42,28 +42,27 @@ PetscErrorCode LoadPathGetOptions(MPI_Comm comm, LoadPathOptions *lp)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* What a load path or force control cannot do yet, refused before the set-up; then the scene at the path's first
-   factor. */
-PetscErrorCode LoadPathSetUp(MPI_Comm comm, AppCtx *user)
+/* What a load path or force control cannot do yet with the options opt and the contact ct, refused before the set-up;
+   then the scene at the path's first factor. */
+PetscErrorCode LoadPathSetUp(MPI_Comm comm, const RunOptions *opt, Contact ct, Scene *scene)
 {
-  const RunOptions     *opt = user->opt;
   const ContactOptions *copt;
   const char           *what = opt->load_path.n ? "-load_steps and -load_path" : "-obstacle_force";
 
   PetscFunctionBeginUser;
-  if (!opt->load_path.n && !SceneForceControlled(&user->scene)) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(ContactGetOptions(user->contact, &copt));
-  PetscCall(SceneCheckLoadPath(comm, &user->scene, what));
+  if (!opt->load_path.n && !SceneForceControlled(scene)) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(ContactGetOptions(ct, &copt));
+  PetscCall(SceneCheckLoadPath(comm, scene, what));
   /* a capability, not an operation: the refusal names the method to give, and force control's position secant follows
      the penalty's force, smooth in the obstacle's position where SNESVI's reaction is not */
-  PetscCheck(ContactHasPenalty(user->contact) || !(user->scene.obstacle.force > 0.0), comm, PETSC_ERR_USER_INPUT,
+  PetscCheck(ContactHasPenalty(ct) || !(scene->obstacle.force > 0.0), comm, PETSC_ERR_USER_INPUT,
              "-obstacle_force works with -contact_method penalty (its positions' warm solves and force secant are the penalty's)");
   PetscCheck(!opt->bars, comm, PETSC_ERR_USER_INPUT, "-bars measures one load state: give it without %s", what);
   PetscCheck(copt->n_sweep <= 1, comm, PETSC_ERR_USER_INPUT, "-penalty_eps0_sweep and %s both solve a sequence: give one of them", what);
-  PetscCheck(!(copt->penetration_tol > 0.0 && user->scene.obstacle.force > 0.0), comm, PETSC_ERR_USER_INPUT,
+  PetscCheck(!(copt->penetration_tol > 0.0 && scene->obstacle.force > 0.0), comm, PETSC_ERR_USER_INPUT,
              "-contact_penetration_tol and -obstacle_force both move a solve's data (eps, the obstacle's position): give one of them");
   PetscCheck(!opt->verify.reference[0], comm, PETSC_ERR_USER_INPUT, "-reference compares one load state: give it without %s", what);
-  PetscCall(SceneSetLoadFactor(&user->scene, opt->load_path.n ? opt->load_path.factor[0] : 1.0)); /* keeps the data at the factor 1 */
+  PetscCall(SceneSetLoadFactor(scene, opt->load_path.n ? opt->load_path.factor[0] : 1.0)); /* keeps the data at the factor 1 */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -86,11 +85,12 @@ static PetscErrorCode ProblemUpdateData(DM dm, AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* A force and a position of the obstacle along the unit direction of its full translation (the force positive as
-   the obstacle presses): of the solution PostprocessContact() last measured (ForceAlong()) or of a recorded step. */
-static void Along(const AppCtx *user, const PetscReal force[3], const PetscReal translate[3], PetscReal *f, PetscReal *s)
+/* A force and a position of the obstacle along the unit direction of the scene's full translation (the force positive
+   as the obstacle presses): of the solution PostprocessContact() last measured into st (ForceAlong()) at the scene's
+   translation, or of a recorded step. */
+static void Along(const Scene *scene, const PetscReal force[3], const PetscReal translate[3], PetscReal *f, PetscReal *s)
 {
-  const PetscReal *dir = user->scene.full_load.translate;
+  const PetscReal *dir = scene->full_load.translate;
   PetscReal        len = 0.0;
 
   *f = *s = 0.0;
@@ -102,35 +102,35 @@ static void Along(const AppCtx *user, const PetscReal force[3], const PetscReal 
   }
 }
 
-static void ForceAlong(const AppCtx *user, PetscReal *f, PetscReal *s)
+static void ForceAlong(const Scene *scene, const RunStats *st, PetscReal *f, PetscReal *s)
 {
-  Along(user, user->rec.stats.contact_force_vector, user->scene.obstacle.translate, f, s);
+  Along(scene, st->contact_force_vector, scene->obstacle.translate, f, s);
 }
 
-/* The force's local power of the obstacle's position, from the last two steps (1.5 for a sphere's indentation), in
-   [1, 3]; 1 before there are two. */
-static PetscReal ForcePower(const AppCtx *user)
+/* The force's local power of the obstacle's position, from the last two of the nsteps steps recorded (1.5 for a
+   sphere's indentation), in [1, 3]; 1 before there are two. */
+static PetscReal ForcePower(const Scene *scene, const StepRecord steps[], PetscInt nsteps)
 {
   PetscReal power = 1.0;
 
-  if (user->rec.nsteps >= 2) {
+  if (nsteps >= 2) {
     PetscReal         f1, s1, f2, s2;
-    const StepRecord *st = &user->rec.steps[user->rec.nsteps - 2];
+    const StepRecord *st = &steps[nsteps - 2];
 
-    Along(user, st[0].q.force, st[0].obstacle_translate, &f1, &s1);
-    Along(user, st[1].q.force, st[1].obstacle_translate, &f2, &s2);
+    Along(scene, st[0].q.force, st[0].obstacle_translate, &f1, &s1);
+    Along(scene, st[1].q.force, st[1].obstacle_translate, &f2, &s2);
     if (f1 > 0.0 && f2 > f1 && s1 > 0.0 && s2 > s1) power = PetscMin(PetscMax(PetscLogReal(f2 / f1) / PetscLogReal(s2 / s1), 1.0), 3.0);
   }
   return power;
 }
 
-/* The body's depth along the obstacle's direction of motion: the extent of its vertices' projections on it, over all
-   ranks. Force control moves the obstacle at most that far from its unloaded position: beyond, it would pass through
-   the body (the gap and the normal are taken at the undeformed position), and a target that needs more is out of the
-   small-deformation model's reach. */
-static PetscErrorCode BodyDepth(DM dm, const AppCtx *user, PetscReal *depth)
+/* The body's depth along the obstacle's direction of motion (the scene's full translation): the extent of its
+   vertices' projections on it, over all ranks. Force control moves the obstacle at most that far from its unloaded
+   position: beyond, it would pass through the body (the gap and the normal are taken at the undeformed position), and
+   a target that needs more is out of the small-deformation model's reach. */
+static PetscErrorCode BodyDepth(DM dm, const Scene *scene, PetscReal *depth)
 {
-  const PetscReal   *dir = user->scene.full_load.translate;
+  const PetscReal   *dir = scene->full_load.translate;
   Vec                coords;
   const PetscScalar *x;
   PetscInt           n, cdim;
@@ -192,7 +192,7 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
   PetscFunctionBeginUser;
   *ok   = PETSC_FALSE;
   *its  = 0;
-  power = ForcePower(user);
+  power = ForcePower(&user->scene, user->rec.steps, user->rec.nsteps);
   PetscCall(VecDuplicate(u, &u_prev)); /* the solution at s_prev: u = 0 at s = 0, before the obstacle presses */
   PetscCall(VecDuplicate(u, &dir));
   PetscCall(VecZeroEntries(u_prev));
@@ -200,9 +200,9 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
   if (user->prob.load_norm > 0.0)
     PetscCall(SNESSetTolerances(snes, atol, PetscMin(rtol, FORCE_CONTROL_SOLVE_TOL * FORCE_CONTROL_RTOL * target / user->prob.load_norm), stol, maxit,
                                 maxf));
-  PetscCall(BodyDepth(dm, user, &depth));
+  PetscCall(BodyDepth(dm, &user->scene, &depth));
   PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-  ForceAlong(user, &f, &s);
+  ForceAlong(&user->scene, &user->rec.stats, &f, &s);
   for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && user->rec.stats.converged; ++it) {
     PetscReal s_next;
 
@@ -261,7 +261,7 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
     s_prev = s, f_prev = f;
     PetscCall(SolverSolveWarm(snes, user, u, "force control")); /* from zero where Newton stalls at a kink of the penalty */
     PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-    ForceAlong(user, &f, &s);
+    ForceAlong(&user->scene, &user->rec.stats, &f, &s);
     ++*its;
   }
   PetscCall(SNESSetTolerances(snes, atol, rtol, stol, maxit, maxf));
@@ -283,7 +283,7 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
 
 static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u, PetscBool *ok, PetscInt *its)
 {
-  const PetscReal power = ForcePower(user);
+  const PetscReal power = ForcePower(&user->scene, user->rec.steps, user->rec.nsteps);
   PetscReal       f, s, f_prev = 0.0, s_prev = 0.0;
   PetscBool       have_prev = PETSC_FALSE;
 
@@ -291,7 +291,7 @@ static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u,
   *ok  = PETSC_FALSE;
   *its = 0;
   PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-  ForceAlong(user, &f, &s);
+  ForceAlong(&user->scene, &user->rec.stats, &f, &s);
   for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && user->rec.stats.converged; ++it) {
     PetscReal s_next, move, d;
 
@@ -315,40 +315,42 @@ static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u,
     PetscCall(ProblemUpdateData(dm, user));
     PetscCall(SolverSolveWarm(snes, user, u, "force control"));
     PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-    ForceAlong(user, &f, &s);
+    ForceAlong(&user->scene, &user->rec.stats, &f, &s);
     ++*its;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The step just solved at factor t: its quantities (PostprocessContact()), its solves' records from first_record on
-   (summed: force control solves several positions) and its state at the vertices (OutputStateFields(): the output's
-   time series). */
-static PetscErrorCode LoadPathRecordStep(DM dm, AppCtx *user, Vec u, PetscReal t, PetscInt first_record, PetscBool ok)
+/* The step just solved at factor t, of a path of n steps, into the record rec: its quantities (PostprocessContact()
+   with the contact ct, the problem prob, the scene's boundary conditions and the material mat), its solves' records
+   from first_record on (summed: force control solves several positions) and its state at the vertices
+   (OutputStateFields(): the output's time series). */
+static PetscErrorCode LoadPathRecordStep(DM dm, Contact ct, const Problem *prob, const Scene *scene, const Material *mat, PetscInt n, Vec u,
+                                         PetscReal t, PetscInt first_record, PetscBool ok, RunRecord *rec)
 {
   StepRecord *s;
 
   PetscFunctionBeginUser;
-  if (!user->rec.steps) {
-    PetscCall(PetscCalloc1(user->opt->load_path.n, &user->rec.steps));
-    PetscCall(PetscCalloc1(user->opt->load_path.n * OUTPUT_STATE_FIELDS, &user->rec.step_fields));
+  if (!rec->steps) {
+    PetscCall(PetscCalloc1(n, &rec->steps));
+    PetscCall(PetscCalloc1(n * OUTPUT_STATE_FIELDS, &rec->step_fields));
   }
-  s = &user->rec.steps[user->rec.nsteps];
-  PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-  PetscCall(OutputStateFields(dm, user->contact, user->prob.loc_bc, u, &user->rec.step_fields[user->rec.nsteps * OUTPUT_STATE_FIELDS]));
-  user->rec.nsteps++;
-  PostprocessGetQuantities(&user->rec.stats, &s->q);
+  s = &rec->steps[rec->nsteps];
+  PetscCall(PostprocessContact(dm, ct, prob, &scene->bcs, mat, u, &rec->stats));
+  PetscCall(OutputStateFields(dm, ct, prob->loc_bc, u, &rec->step_fields[rec->nsteps * OUTPUT_STATE_FIELDS]));
+  rec->nsteps++;
+  PostprocessGetQuantities(&rec->stats, &s->q);
   s->factor        = t;
-  s->contact_force = user->rec.stats.contact_force;
-  for (PetscInt c = 0; c < 3; ++c) s->obstacle_translate[c] = user->scene.obstacle.translate[c];
+  s->contact_force = rec->stats.contact_force;
+  for (PetscInt c = 0; c < 3; ++c) s->obstacle_translate[c] = scene->obstacle.translate[c];
   s->newton_its = s->ksp_its = 0;
   s->time                    = 0.0;
-  for (PetscInt i = first_record; i < user->rec.nrecords; ++i) {
-    s->newton_its += user->rec.records[i].newton_its;
-    s->ksp_its += user->rec.records[i].ksp_its;
-    s->time += user->rec.records[i].time_solve;
+  for (PetscInt i = first_record; i < rec->nrecords; ++i) {
+    s->newton_its += rec->records[i].newton_its;
+    s->ksp_its += rec->records[i].ksp_its;
+    s->time += rec->records[i].time_solve;
   }
-  s->converged = (PetscBool)(user->rec.records[user->rec.nrecords - 1].converged && ok && user->rec.stats.converged);
+  s->converged = (PetscBool)(rec->records[rec->nrecords - 1].converged && ok && rec->stats.converged);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -397,7 +399,7 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
   PetscFunctionBeginUser;
   PetscCall(LoadPathForce(dm, user, snes, u, &ok)); /* the first step's force, or the run's one force without a path */
   if (!lp->n) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[0], first, ok));
+  PetscCall(LoadPathRecordStep(dm, user->contact, &user->prob, &user->scene, &user->opt->material, lp->n, u, lp->factor[0], first, ok, &user->rec));
   if (lp->n > 1) {
     PetscCall(VecDuplicate(u, &prev));
     PetscCall(VecDuplicate(u, &dir));
@@ -408,7 +410,7 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
     PetscReal       f, s;
 
     first = user->rec.nrecords;
-    ForceAlong(user, &f, &s);
+    ForceAlong(&user->scene, &user->rec.stats, &f, &s);
     PetscCall(SceneSetLoadFactor(&user->scene, lp->factor[k]));
     if (force) PetscCall(SceneSetObstaclePosition(&user->scene, s)); /* the last step's position */
     PetscCall(ProblemUpdateData(dm, user));
@@ -422,39 +424,40 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
     PetscCall(SolverSolveWarm(snes, user, u, "load path")); /* from zero where the guess's active set is too far off */
     PetscCall(PenetrationTolSolve(dm, user, snes, u));      /* -contact_penetration_tol at every step, from the last step's eps (or multipliers) */
     PetscCall(LoadPathForce(dm, user, snes, u, &ok));
-    PetscCall(LoadPathRecordStep(dm, user, u, lp->factor[k], first, ok));
+    PetscCall(LoadPathRecordStep(dm, user->contact, &user->prob, &user->scene, &user->opt->material, lp->n, u, lp->factor[k], first, ok, &user->rec));
   }
   PetscCall(VecDestroy(&prev));
   PetscCall(VecDestroy(&dir));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The steps in the summary, one line each, and where force control left the obstacle. */
-PetscErrorCode LoadPathView(MPI_Comm comm, const AppCtx *user)
+/* The steps of the path lp recorded in rec in the summary, one line each, and where force control left the scene's
+   obstacle. */
+PetscErrorCode LoadPathView(MPI_Comm comm, const LoadPathOptions *lp, const Scene *scene, const RunRecord *rec)
 {
   PetscFunctionBeginUser;
-  if (SceneForceControlled(&user->scene)) {
+  if (SceneForceControlled(scene)) {
     PetscReal f, s;
 
-    ForceAlong(user, &f, &s);
+    ForceAlong(scene, &rec->stats, &f, &s);
     PetscCall(PetscPrintf(comm,
                           "  force control: the obstacle %g along its direction presses with %.10g (target %g; %" PetscInt_FMT " positions solved)\n",
-                          (double)s, (double)f, (double)user->scene.obstacle.force, user->rec.stats.force_control_its));
+                          (double)s, (double)f, (double)scene->obstacle.force, rec->stats.force_control_its));
   }
-  if (!user->rec.nsteps) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!rec->nsteps) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(
       PetscPrintf(comm, "  load path: step  factor      contact force  largest pressure  contact size  penetration  energy        Newton  Krylov\n"));
-  for (PetscInt k = 0; k < user->rec.nsteps; ++k) {
-    const StepRecord *s = &user->rec.steps[k];
+  for (PetscInt k = 0; k < rec->nsteps; ++k) {
+    const StepRecord *s = &rec->steps[k];
 
     PetscCall(PetscPrintf(
         comm, "             %4" PetscInt_FMT "  %-10.4g  %-13.6g  %-16.6g  %-12.6g  %-11.4g  %-12.6g  %6" PetscInt_FMT "  %6" PetscInt_FMT "%s\n",
         k + 1, (double)s->factor, (double)s->contact_force, (double)s->q.pressure_max, (double)s->q.contact_size, (double)s->q.penetration_max,
         (double)s->q.energy, s->newton_its, s->ksp_its, s->converged ? "" : "  FAILED"));
   }
-  if (user->rec.nsteps < user->opt->load_path.n || !user->rec.steps[user->rec.nsteps - 1].converged)
-    PetscCall(PetscPrintf(comm, "  load path: stopped at step %" PetscInt_FMT " of %" PetscInt_FMT " (factor %g), whose solve failed\n",
-                          user->rec.nsteps, user->opt->load_path.n, (double)user->rec.steps[user->rec.nsteps - 1].factor));
+  if (rec->nsteps < lp->n || !rec->steps[rec->nsteps - 1].converged)
+    PetscCall(PetscPrintf(comm, "  load path: stopped at step %" PetscInt_FMT " of %" PetscInt_FMT " (factor %g), whose solve failed\n", rec->nsteps,
+                          lp->n, (double)rec->steps[rec->nsteps - 1].factor));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
