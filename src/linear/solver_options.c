@@ -93,10 +93,11 @@ PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts)
                              "state (needs a Krylov method, not -ksp_type preonly)",
                              NULL, opts->pc_reuse, &opts->pc_reuse, NULL));
   opts->pc_recovery = PETSC_TRUE;
-  PetscCall(PetscOptionsBool("-contact_pc_recovery",
-                             "After a breakdown of the preconditioner (DIVERGED_INDEFINITE_PC, DIVERGED_PC_FAILED, ...), go on from the last "
-                             "Newton iterate with a fresh build, then GMRES, then a direct solve (counted in /run pc_breakdowns)",
-                             NULL, opts->pc_recovery, &opts->pc_recovery, NULL));
+  PetscCall(PetscOptionsBool(
+      "-contact_pc_recovery",
+      "After a breakdown of the preconditioner (DIVERGED_INDEFINITE_PC, DIVERGED_PC_FAILED, ...), go on from the last "
+      "Newton iterate with a fresh build, then safer smoother bounds for a multigrid, then a direct solve (counted in /run pc_breakdowns)",
+      NULL, opts->pc_recovery, &opts->pc_recovery, NULL));
   opts->pc_reuse_changes = 20;
   PetscCall(PetscOptionsInt("-contact_pc_reuse_changes", "Rebuild when more contact nodes than this changed state since the last build", NULL,
                             opts->pc_reuse_changes, &opts->pc_reuse_changes, NULL));
