@@ -257,7 +257,8 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
     }
     PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
     PetscCall(ProblemUpdateData(dm, user));
-    PetscCall(SolverSecantStart(snes, dm, user, u, u_prev, dir, (PetscBool)(s != s_prev), s != s_prev ? (s_next - s) / (s - s_prev) : 0.0, 1.0));
+    PetscCall(SolverSecantStart(snes, dm, user->contact, user->prob.sctx, u, u_prev, dir, (PetscBool)(s != s_prev),
+                                s != s_prev ? (s_next - s) / (s - s_prev) : 0.0, 1.0));
     s_prev = s, f_prev = f;
     PetscCall(SolverSolveWarm(snes, user, u, "force control")); /* from zero where Newton stalls at a kink of the penalty */
     PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
@@ -419,7 +420,8 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
          none start from the last step's solution, which their solve needs no better guess than */
       const PetscBool secant = (PetscBool)(!force && t_last != t_prev && ContactHasPenalty(user->contact));
 
-      PetscCall(SolverSecantStart(snes, dm, user, u, prev, dir, secant, secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0, 1.0));
+      PetscCall(SolverSecantStart(snes, dm, user->contact, user->prob.sctx, u, prev, dir, secant,
+                                  secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0, 1.0));
     }
     PetscCall(SolverSolveWarm(snes, user, u, "load path")); /* from zero where the guess's active set is too far off */
     PetscCall(PenetrationTolSolve(dm, user, snes, u));      /* -contact_penetration_tol at every step, from the last step's eps (or multipliers) */

@@ -88,7 +88,8 @@ static PetscErrorCode ContinuationSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
       PetscCall(VecDuplicate(u, &dir));
     }
     PetscCall(ContactSetEps(user->contact, dm, eps_new));
-    PetscCall(SolverSecantStart(snes, dm, user, u, prev, dir, secant, secant ? (eps_new - eps) / (eps - eps_prev) : 0.0, 0.0));
+    PetscCall(
+        SolverSecantStart(snes, dm, user->contact, user->prob.sctx, u, prev, dir, secant, secant ? (eps_new - eps) / (eps - eps_prev) : 0.0, 0.0));
     eps_prev = eps;
     eps      = eps_new;
     PetscCall(SolverSolveWarm(snes, user, u, "penetration tolerance")); /* from zero where it stalls at a kink of the penalty */

@@ -66,5 +66,7 @@ PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx
 PetscErrorCode SolverSetStepGuess(SolverCtx sc, Vec du);
 
 /* extrapolated_start.c */
-PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscReal factor, PetscReal relaxed, PetscBool step_guess);
-PetscErrorCode SolverSecantStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor, PetscReal relaxed);
+PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, Contact contact, SolverCtx sc, Vec u, Vec dir, PetscReal factor, PetscReal relaxed,
+                                       PetscBool step_guess);
+PetscErrorCode SolverSecantStart(SNES snes, DM dm, Contact contact, SolverCtx sc, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor,
+                                 PetscReal relaxed);
