@@ -8,20 +8,20 @@
 /* solver.c */
 /* the bound of Eisenstat-Walker's linear tolerances, the penalty method's default with an iterative preconditioner */
 #define SOLVER_EW_RTOL_MAX 0.01
-PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user);
-PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user);
-PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
-PetscErrorCode SolverComputeScales(DM dm, AppCtx *user);
+PetscErrorCode SolverAssembleBulk(DM dm, const RunOptions *opt, Problem *prob);
+PetscErrorCode SolverAssembleLoad(DM dm, const RunOptions *opt, const Scene *scene, Problem *prob);
+PetscErrorCode SolverCreateSNES(DM dm, Contact contact, const SolverOptions *opt, Problem *prob, Multigrid mg, const MeshBox *box, SNES *snes);
+PetscErrorCode SolverComputeScales(DM dm, Contact contact, Problem *prob);
 /* Where a solve starts: from zero, from the solution for a nearby eps (the sweep), or from a coarser mesh's (nested
    iteration); the last two are warm starts, and the first and last reach a small eps by continuation. */
 typedef enum { SOLVER_START_ZERO, SOLVER_START_NEARBY_EPS, SOLVER_START_COARSER_MESH } SolverStart;
 PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start);
-PetscErrorCode SolverStartFromCoarser(const AppCtx *user, SolverStart *start);
+PetscErrorCode SolverStartFromCoarser(Contact contact, SolverStart *start);
 /* A solve from the guess u (a load path's step, force control's position, the penetration tolerance's eps) that, where
    it stalls or fails, is solved again from zero as a direct run: never less reliable than the direct run */
 PetscErrorCode SolverSolveWarm(SNES snes, AppCtx *user, Vec u, const char what[]);
 /* The next solves of the problem stop once a Newton step's energy norm is below energy (0: at -snes_rtol only) */
-PetscErrorCode SolverSetStepEnergyStop(AppCtx *user, PetscReal energy);
+PetscErrorCode SolverSetStepEnergyStop(Problem *prob, PetscReal energy);
 /* |F| (user's units) that -snes_rtol is relative to in the current solve: its first, or for a warm start the load
    ||F(0)||, so that a warm start ends as tight as a start from zero */
 PetscErrorCode SolverResidualNorm(SNES snes, SolverCtx sc, Vec u, PetscReal *norm);

@@ -357,7 +357,7 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     PetscCall(GridSequenceSetTolerance(*snes, user->opt, user->box.coarse_levels, user->prob.level));
     PetscCall(GridSequenceBarsEps(*snes, user->opt, user->contact, user->prob.level, nlevels, &user->rec.bars));
     start = SOLVER_START_COARSER_MESH;
-    if (GridSequenceStartsAsCoarser(user->opt->bars, user->prob.level, nlevels)) PetscCall(SolverStartFromCoarser(user, &start));
+    if (GridSequenceStartsAsCoarser(user->opt->bars, user->prob.level, nlevels)) PetscCall(SolverStartFromCoarser(user->contact, &start));
     PetscCall(SolverSolve(*snes, user, *u, failed ? SOLVER_START_ZERO : start));
     PetscCall(GridSequenceBarsLevel(*snes, user, *u, nlevels));
   }

@@ -80,8 +80,8 @@ static PetscErrorCode ProblemUpdateData(DM dm, AppCtx *user)
   PetscCall(ContactGetEps(user->contact, &eps));
   PetscCall(ContactSetEps(user->contact, dm, eps));
   PetscCall(ContactSetLoad(user->contact, dm, &user->scene.obstacle));
-  PetscCall(SolverAssembleLoad(dm, user));
-  PetscCall(SolverComputeScales(dm, user));
+  PetscCall(SolverAssembleLoad(dm, user->opt, &user->scene, &user->prob));
+  PetscCall(SolverComputeScales(dm, user->contact, &user->prob));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

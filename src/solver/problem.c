@@ -41,11 +41,11 @@ PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes)
     PetscCall(MeshGetMaxCellSize(dm, user->prob.h, &cp.h)); /* h, or the mesh's own sizes (the bars' levels, grid_sequence.c) */
     PetscCall(ContactSetUp(user->contact, dm, &cp));        /* the contact set, eps, the penalty's faces or SNESVI's bounds */
   }
-  PetscCall(SolverAssembleBulk(dm, user));
-  PetscCall(SolverAssembleLoad(dm, user));
+  PetscCall(SolverAssembleBulk(dm, user->opt, &user->prob));
+  PetscCall(SolverAssembleLoad(dm, user->opt, &user->scene, &user->prob));
   PetscCall(SolverCtxCreate(user->prob.K, user->prob.r0, user->contact, &user->opt->solver, &user->rec.stats, &user->prob.sctx));
-  PetscCall(SolverComputeScales(dm, user));
-  PetscCall(SolverCreateSNES(dm, user, snes));
+  PetscCall(SolverComputeScales(dm, user->contact, &user->prob));
+  PetscCall(SolverCreateSNES(dm, user->contact, &user->opt->solver, &user->prob, user->mg, &user->box, snes));
   PetscCall(PetscTime(&t1));
   user->prob.setup_time = t1 - t0;
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -8,22 +8,22 @@
 #include "physics.h"
 #include "solver_impl.h"
 
-PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
+PetscErrorCode SolverAssembleBulk(DM dm, const RunOptions *opt, Problem *prob)
 {
-  const AssemblyP1Inputs p1 = {&user->opt->material, user->opt->solver.given.mat_type};
+  const AssemblyP1Inputs p1 = {&opt->material, opt->solver.given.mat_type};
   Vec                    locX;
   MatNullSpace           rigid;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetLocalVector(dm, &locX));
-  PetscCall(VecCopy(user->prob.loc_bc, locX)); /* u = 0 with the Dirichlet values, inserted once by ProblemSetUp() */
-  PetscCall(AssemblyCreateOperator(dm, user->prob.assembly, &p1, user->opt->assembly_check, locX, &user->prob.K));
+  PetscCall(VecCopy(prob->loc_bc, locX)); /* u = 0 with the Dirichlet values, inserted once by ProblemSetUp() */
+  PetscCall(AssemblyCreateOperator(dm, prob->assembly, &p1, opt->assembly_check, locX, &prob->K));
   PetscCall(DMRestoreLocalVector(dm, &locX));
-  if (user->opt->degree == 1)
-    PetscCall(ElasticityRigidBodyModesP1(dm, user->prob.r0, &rigid)); /* unknowns at the vertices only */
+  if (opt->degree == 1)
+    PetscCall(ElasticityRigidBodyModesP1(dm, prob->r0, &rigid)); /* unknowns at the vertices only */
   else
     PetscCall(DMPlexCreateRigidBody(dm, 0, &rigid));
-  PetscCall(MatSetNearNullSpace(user->prob.K, rigid));
+  PetscCall(MatSetNearNullSpace(prob->K, rigid));
   PetscCall(MatNullSpaceDestroy(&rigid));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -32,7 +32,7 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
    force), the surface loads and a scene's load in weak form, and its local copy loc_r0 with the fixed rows; and the
    energy of the Dirichlet lift, which these data fix. Assembled by ProblemSetUp() and again at each step of a load path
    (the data changed, K did not). */
-PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user)
+PetscErrorCode SolverAssembleLoad(DM dm, const RunOptions *opt, const Scene *scene, Problem *prob)
 {
   Vec       locX, locF;
   PetscReal weak_lift;
@@ -40,26 +40,25 @@ PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user)
   PetscFunctionBeginUser;
   PetscCall(DMGetLocalVector(dm, &locX));
   PetscCall(DMGetLocalVector(dm, &locF));
-  PetscCall(VecCopy(user->prob.loc_bc, locX));
+  PetscCall(VecCopy(prob->loc_bc, locX));
   PetscCall(VecZeroEntries(locF));
-  PetscCall(AssemblyResidual(dm, user->prob.assembly, &user->opt->material, locX, locF));
-  PetscCall(VecZeroEntries(user->prob.r0));
-  PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, user->prob.r0));
-  if (!user->prob.loc_r0) PetscCall(VecDuplicate(locF, &user->prob.loc_r0)); /* with the fixed rows, which the global vector drops */
-  PetscCall(VecCopy(locF, user->prob.loc_r0));
+  PetscCall(AssemblyResidual(dm, prob->assembly, &opt->material, locX, locF));
+  PetscCall(VecZeroEntries(prob->r0));
+  PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, prob->r0));
+  if (!prob->loc_r0) PetscCall(VecDuplicate(locF, &prob->loc_r0)); /* with the fixed rows, which the global vector drops */
+  PetscCall(VecCopy(locF, prob->loc_r0));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscCall(DMRestoreLocalVector(dm, &locF));
-  PetscCall(BoundaryAddLoads(dm, &user->scene.bcs, user->prob.face_sets, user->prob.loc_r0, user->prob.r0));
-  PetscCall(WeakDataAddToResidual(dm, &user->scene, &user->opt->material, &user->opt->verify, user->prob.loc_bc, user->prob.r0, &weak_lift));
-  PetscCall(
-      PostprocessLiftEnergy(dm, &user->opt->material, &user->prob, weak_lift, &user->prob.lift_energy)); /* a datum of the load state, not of u */
+  PetscCall(BoundaryAddLoads(dm, &scene->bcs, prob->face_sets, prob->loc_r0, prob->r0));
+  PetscCall(WeakDataAddToResidual(dm, scene, &opt->material, &opt->verify, prob->loc_bc, prob->r0, &weak_lift));
+  PetscCall(PostprocessLiftEnergy(dm, &opt->material, prob, weak_lift, &prob->lift_energy)); /* a datum of the load state, not of u */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The scales of the problem on this mesh: the load ||F(0)||_2, and the displacement scale U, the largest entry of
    the best displacement along F(0) (one steepest-descent step of the energy from u = 0: alpha F(0) with
    alpha = |F(0)|^2 / F(0).K F(0)), rounded to a power of 2. Only U's order of magnitude matters. */
-PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
+PetscErrorCode SolverComputeScales(DM dm, Contact contact, Problem *prob)
 {
   MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
   Vec         zero, F, KF;
@@ -67,25 +66,25 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
   PetscReal   finf, U = 1.0;
 
   PetscFunctionBeginUser;
-  PetscCall(VecDuplicate(user->prob.r0, &zero));
-  PetscCall(VecDuplicate(user->prob.r0, &F));
-  PetscCall(VecDuplicate(user->prob.r0, &KF));
+  PetscCall(VecDuplicate(prob->r0, &zero));
+  PetscCall(VecDuplicate(prob->r0, &F));
+  PetscCall(VecDuplicate(prob->r0, &KF));
   PetscCall(VecZeroEntries(zero));
-  PetscCall(SolverResidual(user->prob.sctx, dm, zero, F));
-  PetscCall(VecNorm(F, NORM_2, &user->prob.load_norm));
-  PetscCheck(!PetscIsInfOrNanReal(user->prob.load_norm), comm, PETSC_ERR_USER_INPUT,
+  PetscCall(SolverResidual(prob->sctx, dm, zero, F));
+  PetscCall(VecNorm(F, NORM_2, &prob->load_norm));
+  PetscCheck(!PetscIsInfOrNanReal(prob->load_norm), comm, PETSC_ERR_USER_INPUT,
              "The load of the problem is not finite (||F(0)|| = %g): check the loads, the material and the mesh coordinates",
-             (double)user->prob.load_norm);
-  if (user->prob.load_norm > 0.0) {
+             (double)prob->load_norm);
+  if (prob->load_norm > 0.0) {
     PetscCall(VecNorm(F, NORM_INFINITY, &finf));
-    PetscCall(ContactBulkMult(user->contact, user->prob.K, F, KF));
+    PetscCall(ContactBulkMult(contact, prob->K, F, KF));
     PetscCall(VecDot(F, KF, &fkf));
-    if (PetscRealPart(fkf) > 0.0) U = PetscSqr(user->prob.load_norm) / PetscRealPart(fkf) * finf;
+    if (PetscRealPart(fkf) > 0.0) U = PetscSqr(prob->load_norm) / PetscRealPart(fkf) * finf;
     if (!(U > 0.0) || PetscIsInfOrNanReal(U)) U = 1.0;
   }
-  user->prob.displacement_scale       = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
-  user->prob.sctx->load_norm          = user->prob.load_norm; /* the solver's copies of the problem's scales */
-  user->prob.sctx->displacement_scale = user->prob.displacement_scale;
+  prob->displacement_scale       = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
+  prob->sctx->load_norm          = prob->load_norm; /* the solver's copies of the problem's scales */
+  prob->sctx->displacement_scale = prob->displacement_scale;
   PetscCall(VecDestroy(&zero));
   PetscCall(VecDestroy(&F));
   PetscCall(VecDestroy(&KF));
@@ -97,27 +96,27 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
    a direct solve (MUMPS), robust for the small problems of a first run; for the penalty
    method inside CG, so that a factorization can serve as the preconditioner of later Newton steps (src/linear/pc_reuse.c).
    The Newton steps are as accurate as with a fresh factorization, also when it is reused. */
-static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
+static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, Contact contact, const SolverOptions *opt, const Problem *prob, Multigrid mg)
 {
   PC                           pc;
   PetscBool                    sbaij;
   const ContactSolverDefaults *defaults;
 
   PetscFunctionBeginUser;
-  if (MultigridIsDefault(user->mg)) { /* the 3D box that nests: CG with the boxes' geometric multigrid, as options/solvers/mg.yaml */
+  if (MultigridIsDefault(mg)) { /* the 3D box that nests: CG with the boxes' geometric multigrid, as options/solvers/mg.yaml */
     PetscCall(KSPSetType(ksp, KSPCG));
     PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
     PetscCall(KSPGetPC(ksp, &pc));
     PetscCall(PCSetType(pc, PCMG));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCall(ContactGetSolverDefaults(user->contact, &defaults));
-  PetscCall(KSPSetType(ksp, defaults->reuse_factorization && user->opt->solver.pc_reuse ? KSPCG : KSPPREONLY));
+  PetscCall(ContactGetSolverDefaults(contact, &defaults));
+  PetscCall(KSPSetType(ksp, defaults->reuse_factorization && opt->pc_reuse ? KSPCG : KSPPREONLY));
   PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
   PetscCall(KSPGetPC(ksp, &pc));
   /* K is symmetric positive definite: a symmetric block matrix (-dm_mat_type sbaij) holds its upper triangle only,
      which MUMPS factors by Cholesky and not by LU */
-  PetscCall(PetscObjectTypeCompareAny((PetscObject)user->prob.K, &sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)prob->K, &sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
   PetscCall(PCSetType(pc, sbaij ? PCCHOLESKY : PCLU));
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -133,9 +132,9 @@ static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
      are as loose as Newton allows. PETSc's bound, 0.9, lets the semismooth Newton cycle between active sets on
      steps too inexact to settle them; 0.01 does not (tests/test_performance.py). -snes_ksp_ew 0 restores the fixed
      -ksp_rtol. */
-static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
+static PetscErrorCode SolverSetIterativeDefaults(SNES snes, Contact contact, const SolverOptions *opt)
 {
-  const SolverGiven           *given = &user->opt->solver.given;
+  const SolverGiven           *given = &opt->given;
   KSP                          ksp;
   PC                           pc;
   PetscBool                    is_cg, is_factor;
@@ -147,7 +146,7 @@ static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
   PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPCG, &is_cg));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &is_factor, PCLU, PCCHOLESKY, ""));
   if (is_factor) PetscFunctionReturn(PETSC_SUCCESS); /* a factorization: CG converges in one or a few iterations anyway */
-  PetscCall(ContactGetSolverDefaults(user->contact, &defaults));
+  PetscCall(ContactGetSolverDefaults(contact, &defaults));
   {
     const char *prefix;
     PetscInt    k;
@@ -165,7 +164,7 @@ static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
+PetscErrorCode SolverCreateSNES(DM dm, Contact contact, const SolverOptions *opt, Problem *prob, Multigrid mg, const MeshBox *box, SNES *snes)
 {
   MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
   Mat       J;
@@ -177,11 +176,11 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscFunctionBeginUser;
   PetscCall(SNESCreate(comm, snes));
   PetscCall(SNESSetDM(*snes, dm));
-  PetscCall(ContactCreateJacobian(user->contact, dm, user->prob.K, &J)); /* K itself, or a copy the penalty Jacobian can be made in */
-  PetscCall(SNESSetFunction(*snes, NULL, SolverFormFunction, user->prob.sctx));
-  PetscCall(SNESSetJacobian(*snes, J, J, SolverFormJacobian, user->prob.sctx));
+  PetscCall(ContactCreateJacobian(contact, dm, prob->K, &J)); /* K itself, or a copy the penalty Jacobian can be made in */
+  PetscCall(SNESSetFunction(*snes, NULL, SolverFormFunction, prob->sctx));
+  PetscCall(SNESSetJacobian(*snes, J, J, SolverFormJacobian, prob->sctx));
   PetscCall(MatDestroy(&J));
-  PetscCall(ContactSetUpSNES(user->contact, dm, *snes)); /* SNESVI with its bounds, or semismooth Newton */
+  PetscCall(ContactSetUpSNES(contact, dm, *snes)); /* SNESVI with its bounds, or semismooth Newton */
   {
     SNESLineSearch ls;
 
@@ -190,12 +189,12 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscCall(SNESGetLineSearch(*snes, &ls));
     PetscCall(SNESLineSearchSetTolerances(ls, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, 0.0, PETSC_DEFAULT, PETSC_DEFAULT));
   }
-  PetscCall(SNESSetConvergenceTest(*snes, SolverConverged, user->prob.sctx, NULL));
+  PetscCall(SNESSetConvergenceTest(*snes, SolverConverged, prob->sctx, NULL));
   PetscCall(SNESGetKSP(*snes, &ksp));
-  PetscCall(SolverSetDefaultLinearSolver(ksp, user));
-  PetscCall(MultigridSetCoarseBoxSolver(user->mg, ksp, user->prob.level, &user->box)); /* -contact_coarse_mg on a coarser box */
+  PetscCall(SolverSetDefaultLinearSolver(ksp, contact, opt, prob, mg));
+  PetscCall(MultigridSetCoarseBoxSolver(mg, ksp, prob->level, box)); /* -contact_coarse_mg on a coarser box */
   PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(SNESMonitorSet(*snes, ContactMonitor, user->prob.sctx, NULL));
+  PetscCall(SNESMonitorSet(*snes, ContactMonitor, prob->sctx, NULL));
   PetscCall(SNESSetFromOptions(*snes));
   PetscCall(PCGetType(pc, &pc_type));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &is_multigrid, PCGAMG, PCMG, ""));
@@ -213,25 +212,25 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     const ContactSolverDefaults *defaults;
 
     PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &is_preonly));
-    PetscCall(ContactGetSolverDefaults(user->contact, &defaults));
-    user->prob.sctx->pc_reuse.enabled = (PetscBool)(defaults->reuse_factorization && user->opt->solver.pc_reuse && !is_preonly);
+    PetscCall(ContactGetSolverDefaults(contact, &defaults));
+    prob->sctx->pc_reuse.enabled = (PetscBool)(defaults->reuse_factorization && opt->pc_reuse && !is_preonly);
   }
-  PetscCall(SolverSetIterativeDefaults(*snes, user));
+  PetscCall(SolverSetIterativeDefaults(*snes, contact, opt));
   {
     PetscBool petsc_presolve, fine;
 
     /* Eisenstat-Walker's terms with the oversolving guard */
-    PetscCall(SolverForcingSetUp(&user->prob.sctx->forcing, *snes, user->opt->solver.ew_guard, &petsc_presolve));
-    PetscCall(SolverStepGuessSetUp(&user->prob.sctx->step_guess, ksp, &user->opt->solver.given));
-    if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, user->prob.sctx));
-    PetscCall(FineSmootherGiven(ksp, &user->opt->solver.given, &fine));
+    PetscCall(SolverForcingSetUp(&prob->sctx->forcing, *snes, opt->ew_guard, &petsc_presolve));
+    PetscCall(SolverStepGuessSetUp(&prob->sctx->step_guess, ksp, &opt->given));
+    if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, prob->sctx));
+    PetscCall(FineSmootherGiven(ksp, &opt->given, &fine));
     PetscCheck(!fine || is_multigrid, comm, PETSC_ERR_USER_INPUT,
                "-mg_fine_ksp_type and -mg_fine_pc_type need a multigrid preconditioner (-pc_type gamg or mg), not %s", pc_type);
     PetscCheck(
         !(petsc_presolve && fine), comm, PETSC_ERR_USER_INPUT,
         "-mg_fine_ksp_type and -mg_fine_pc_type need -snes_ksp_ew_version 2 (or no Eisenstat-Walker): another version keeps PETSc's own pre-solve");
   }
-  PetscCall(ContactCheckSNES(user->contact, *snes, user->prob.K)); /* the SNES type and the matrix the method can use */
+  PetscCall(ContactCheckSNES(contact, *snes, prob->K)); /* the SNES type and the matrix the method can use */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -346,16 +345,16 @@ static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *
    coarser solution already holds this problem's contact set to within the refinement. Otherwise as nested iteration
    does (SolverSolve()): below f h / M the new contact nodes, between an active and a free coarse one, start far off
    on the 1/eps scale. */
-PetscErrorCode SolverStartFromCoarser(const AppCtx *user, SolverStart *start)
+PetscErrorCode SolverStartFromCoarser(Contact contact, SolverStart *start)
 {
   const ContactOptions *copt;
   PetscReal             eps, eps_start;
 
   PetscFunctionBeginUser;
   *start = SOLVER_START_COARSER_MESH;
-  PetscCall(ContactGetOptions(user->contact, &copt));
-  PetscCall(ContactGetEps(user->contact, &eps));
-  PetscCall(ContactGetPenaltyScale(user->contact, &eps_start));
+  PetscCall(ContactGetOptions(contact, &copt));
+  PetscCall(ContactGetEps(contact, &eps));
+  PetscCall(ContactGetPenaltyScale(contact, &eps_start));
   if (eps > 0.0 && eps >= copt->continuation_factor * eps_start) *start = SOLVER_START_NEARBY_EPS; /* eps 0: a type without one */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -445,10 +444,10 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SolverSetStepEnergyStop(AppCtx *user, PetscReal energy)
+PetscErrorCode SolverSetStepEnergyStop(Problem *prob, PetscReal energy)
 {
   PetscFunctionBeginUser;
-  user->prob.sctx->step_energy_stop = energy;
+  prob->sctx->step_energy_stop = energy;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -501,7 +500,7 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
   if (is_vi) { /* its KSP holds the reduced system of the last active set */
     J = user->prob.K;
     PetscCall(KSPCreate(PetscObjectComm((PetscObject)snes), &ksp_vi));
-    PetscCall(SolverSetDefaultLinearSolver(ksp_vi, user));
+    PetscCall(SolverSetDefaultLinearSolver(ksp_vi, user->contact, &user->opt->solver, &user->prob, user->mg));
     PetscCall(KSPSetFromOptions(ksp_vi));
     ksp = ksp_vi;
   } else
