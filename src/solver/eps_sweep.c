@@ -112,7 +112,7 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
         PetscCall(SolverExtrapolatedStart(snes, dm, user->contact, user->prob.sctx, u, dir, (eps - eps_last) * eps / (eps_last * eps_last), 1e-2,
                                           PETSC_FALSE));
     }
-    PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
+    PetscCall(SolverSolve(snes, user->solver, u, SOLVER_START_NEARBY_EPS));
   }
   for (PetscInt j = 0; j < SWEEP_POINTS; ++j) PetscCall(VecDestroy(&hist[j]));
   PetscCall(VecDestroy(&dir));

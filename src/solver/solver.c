@@ -8,6 +8,29 @@
 #include "physics.h"
 #include "solver_impl.h"
 
+PetscErrorCode SolverCreate(const RunOptions *opt, Contact contact, Multigrid mg, const MeshBox *box, Problem *prob, RunRecord *rec, Solver *s)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(s));
+  (*s)->prob       = prob;
+  (*s)->contact    = contact;
+  (*s)->opt        = opt;
+  (*s)->mg         = mg;
+  (*s)->box        = box;
+  (*s)->stats      = &rec->stats;
+  (*s)->records    = &rec->records;
+  (*s)->nrecords   = &rec->nrecords;
+  (*s)->maxrecords = &rec->maxrecords;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode SolverDestroy(Solver *s)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(*s));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode SolverAssembleBulk(DM dm, const RunOptions *opt, Problem *prob)
 {
   const AssemblyP1Inputs p1 = {&opt->material, opt->solver.given.mat_type};
@@ -237,104 +260,104 @@ PetscErrorCode SolverCreateSNES(DM dm, Contact contact, const SolverOptions *opt
 /* Records the outcome of the last SNESSolve, with the iteration counts of all solves so far. A solve counts as
    converged only if PETSc says so and the residual fell by -snes_rtol or reached round-off for the load (or the
    user's -snes_atol): a stop on a small step or in the line search with a large residual is a failure. */
-static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, PetscInt *ksp)
+static PetscErrorCode RecordSolve(SNES snes, Solver s, PetscInt *newton, PetscInt *ksp)
 {
   PetscInt  its, lits, maxit, maxf;
   PetscReal fnorm, atol, rtol, stol, ref;
 
   PetscFunctionBeginUser;
-  PetscCall(SNESGetConvergedReason(snes, &user->rec.stats.reason));
+  PetscCall(SNESGetConvergedReason(snes, &s->stats->reason));
   PetscCall(SNESGetIterationNumber(snes, &its));
   PetscCall(SNESGetLinearSolveIterations(snes, &lits));
   PetscCall(SNESGetFunctionNorm(snes, &fnorm));
   PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
   *newton += its;
   *ksp += lits;
-  user->rec.stats.newton_its       = *newton;
-  user->rec.stats.ksp_its          = *ksp;
-  user->rec.stats.residual_norm    = fnorm * user->prob.displacement_scale; /* the SNES saw F/U */
-  user->rec.stats.residual_start   = user->prob.sctx->fnorm0;
-  ref                              = SolverStopReference(user->prob.sctx);
-  user->rec.stats.residual_reduced = (PetscBool)(user->rec.stats.residual_norm <= rtol * ref ||
-                                                 user->rec.stats.residual_norm <= user->opt->solver.load_rtol * user->prob.load_norm ||
-                                                 fnorm <= atol || user->prob.sctx->roundoff_stop || user->prob.sctx->energy_stop);
-  user->rec.stats.roundoff_stop    = user->prob.sctx->roundoff_stop;
-  user->rec.stats.converged        = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
-  PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
-  user->rec.stats.pc_builds = user->prob.sctx->pc_reuse.enabled ? user->prob.sctx->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
-  user->rec.stats.pc_updates        = user->prob.sctx->pc_reuse.updates;
-  user->rec.stats.pc_finest_updates = user->prob.sctx->pc_reuse.finest_updates;
+  s->stats->newton_its     = *newton;
+  s->stats->ksp_its        = *ksp;
+  s->stats->residual_norm  = fnorm * s->prob->displacement_scale; /* the SNES saw F/U */
+  s->stats->residual_start = s->prob->sctx->fnorm0;
+  ref                      = SolverStopReference(s->prob->sctx);
+  s->stats->residual_reduced =
+      (PetscBool)(s->stats->residual_norm <= rtol * ref || s->stats->residual_norm <= s->opt->solver.load_rtol * s->prob->load_norm ||
+                  fnorm <= atol || s->prob->sctx->roundoff_stop || s->prob->sctx->energy_stop);
+  s->stats->roundoff_stop = s->prob->sctx->roundoff_stop;
+  s->stats->converged     = (PetscBool)(s->stats->reason > 0 && s->stats->residual_reduced);
+  PetscCall(SNESKSPGetUseEW(snes, &s->stats->ksp_ew));
+  s->stats->pc_builds         = s->prob->sctx->pc_reuse.enabled ? s->prob->sctx->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
+  s->stats->pc_updates        = s->prob->sctx->pc_reuse.updates;
+  s->stats->pc_finest_updates = s->prob->sctx->pc_reuse.finest_updates;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Appends the outcome of the last SolverSolve() to the table of solves (/solves in the output). */
-static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal time_solve)
+static PetscErrorCode SolverAddRecord(SNES snes, Solver s, Vec u, PetscReal time_solve)
 {
   SolveRecord *r;
   DM           dm;
 
   PetscFunctionBeginUser;
-  if (user->rec.nrecords == user->rec.maxrecords) { /* grow */
+  if (*s->nrecords == *s->maxrecords) { /* grow */
     SolveRecord *grown;
 
-    user->rec.maxrecords = PetscMax(16, 2 * user->rec.maxrecords);
-    PetscCall(PetscMalloc1(user->rec.maxrecords, &grown));
-    if (user->rec.nrecords) PetscCall(PetscArraycpy(grown, user->rec.records, user->rec.nrecords));
-    PetscCall(PetscFree(user->rec.records));
-    user->rec.records = grown;
+    *s->maxrecords = PetscMax(16, 2 * (*s->maxrecords));
+    PetscCall(PetscMalloc1(*s->maxrecords, &grown));
+    if (*s->nrecords) PetscCall(PetscArraycpy(grown, *s->records, *s->nrecords));
+    PetscCall(PetscFree(*s->records));
+    *s->records = grown;
   }
-  r = &user->rec.records[user->rec.nrecords++];
+  r = &(*s->records)[(*s->nrecords)++];
   PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(ContactMaxNodePenetration(user->contact, u, &r->max_penetration));
+  PetscCall(ContactMaxNodePenetration(s->contact, u, &r->max_penetration));
   PetscCall(VecGetSize(u, &r->n_dofs));
-  r->level = user->prob.level;
-  r->h     = user->prob.h;
-  PetscCall(ContactGetEps(user->contact, &r->eps)); /* 0 for the types without eps */
-  r->newton_its         = user->rec.stats.newton_its;
-  r->ksp_its            = user->rec.stats.ksp_its;
-  r->pc_builds          = user->rec.stats.pc_builds;
-  r->converged          = user->rec.stats.converged;
-  r->time_setup         = user->prob.setup_time;
-  r->time_solve         = time_solve;
-  user->prob.setup_time = 0.0; /* counted once, with the first solve on the mesh */
+  r->level = s->prob->level;
+  r->h     = s->prob->h;
+  PetscCall(ContactGetEps(s->contact, &r->eps)); /* 0 for the types without eps */
+  r->newton_its       = s->stats->newton_its;
+  r->ksp_its          = s->stats->ksp_its;
+  r->pc_builds        = s->stats->pc_builds;
+  r->converged        = s->stats->converged;
+  r->time_setup       = s->prob->setup_time;
+  r->time_solve       = time_solve;
+  s->prob->setup_time = 0.0; /* counted once, with the first solve on the mesh */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* SNESSolve on x~ = u/U, or Q^T u/U in SNESVI's frames (and the bounds of SNESVI divided by U): see
    SolverIterateDisplacement(). */
-static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
+static PetscErrorCode SolverSNESSolve(SNES snes, Solver s, Vec u)
 {
-  const PetscReal U = user->prob.displacement_scale;
+  const PetscReal U = s->prob->displacement_scale;
 
   PetscFunctionBeginUser;
-  user->prob.sctx->snes_scale = U;
+  s->prob->sctx->snes_scale = U;
   PetscCall(VecScale(u, 1.0 / U));
-  PetscCall(ContactSolverFrame(user->contact, u, PETSC_TRUE)); /* the SNES's unknowns: Q^T u/U */
-  PetscCall(ContactScaleBounds(user->contact, 1.0 / U));
+  PetscCall(ContactSolverFrame(s->contact, u, PETSC_TRUE)); /* the SNES's unknowns: Q^T u/U */
+  PetscCall(ContactScaleBounds(s->contact, 1.0 / U));
   PetscCall(SNESSolve(snes, NULL, u));
-  PetscCall(SolverStepGuessDrop(&user->prob.sctx->step_guess)); /* unused if no linear solve came */
-  PetscCall(ContactSolverFrame(user->contact, u, PETSC_FALSE));
+  PetscCall(SolverStepGuessDrop(&s->prob->sctx->step_guess)); /* unused if no linear solve came */
+  PetscCall(ContactSolverFrame(s->contact, u, PETSC_FALSE));
   PetscCall(VecScale(u, U));
-  PetscCall(ContactScaleBounds(user->contact, U));
-  user->prob.sctx->snes_scale = 1.0;
+  PetscCall(ContactScaleBounds(s->contact, U));
+  s->prob->sctx->snes_scale = 1.0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* SolverSNESSolve() and RecordSolve(), then again from the last iterate after each recovery from a breakdown of the
    preconditioner (src/linear/pc_recovery.c) while one is left; the Newton steps and linear iterations of every attempt count. */
-static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *newton, PetscInt *ksp)
+static PetscErrorCode SolveRecovering(SNES snes, Solver s, Vec u, PetscInt *newton, PetscInt *ksp)
 {
-  const SolverCtx sc    = user->prob.sctx;
+  const SolverCtx sc    = s->prob->sctx;
   PetscBool       retry = PETSC_TRUE;
 
   PetscFunctionBeginUser;
-  PetscCall(SolverSNESSolve(snes, user, u));
-  PetscCall(RecordSolve(snes, user, newton, ksp));
-  while (!user->rec.stats.converged && retry) {
+  PetscCall(SolverSNESSolve(snes, s, u));
+  PetscCall(RecordSolve(snes, s, newton, ksp));
+  while (!s->stats->converged && retry) {
     PetscCall(PcRecoveryTry(&sc->pc_recovery, snes, sc->opt, &sc->pc_reuse, sc->stats, &retry));
     if (!retry) break;
-    PetscCall(SolverSNESSolve(snes, user, u));
-    PetscCall(RecordSolve(snes, user, newton, ksp));
+    PetscCall(SolverSNESSolve(snes, s, u));
+    PetscCall(RecordSolve(snes, s, newton, ksp));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -371,28 +394,28 @@ PetscErrorCode SolverStartFromCoarser(Contact contact, SolverStart *start)
    solution, and the only one (the energy is strictly convex on the admissible set): its residual is exactly zero, no
    point presses, and every multiplier is zero. A step of a load path at the factor 0 is such a state: from the last
    step's solution Newton would take steps down to round-off, whose penetrations raise the contact warnings. */
-static PetscErrorCode SolverZeroData(DM dm, AppCtx *user, PetscBool *zero)
+static PetscErrorCode SolverZeroData(DM dm, Solver s, PetscBool *zero)
 {
   PetscReal r0;
 
   PetscFunctionBeginUser;
   *zero = PETSC_FALSE;
-  PetscCall(VecNorm(user->prob.r0, NORM_INFINITY, &r0));
+  PetscCall(VecNorm(s->prob->r0, NORM_INFINITY, &r0));
   if (r0 != 0.0) PetscFunctionReturn(PETSC_SUCCESS);
   {
     Vec       zero_u;
     PetscReal d;
 
-    PetscCall(VecDuplicate(user->prob.r0, &zero_u));
+    PetscCall(VecDuplicate(s->prob->r0, &zero_u));
     PetscCall(VecZeroEntries(zero_u));
-    PetscCall(ContactMaxPenetration(user->contact, dm, zero_u, &d));
+    PetscCall(ContactMaxPenetration(s->contact, dm, zero_u, &d));
     PetscCall(VecDestroy(&zero_u));
     *zero = (PetscBool)(d <= 0.0);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
+PetscErrorCode SolverSolve(SNES snes, Solver s, Vec u, SolverStart start)
 {
   const PetscBool       warm = (PetscBool)(start != SOLVER_START_ZERO);
   PetscReal             eps_target, eps_start;
@@ -402,45 +425,45 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
   const ContactOptions *copt;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetOptions(user->contact, &copt));
+  PetscCall(ContactGetOptions(s->contact, &copt));
   PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(ContactGetEps(user->contact, &eps_target));
-  PetscCall(ContactGetPenaltyScale(user->contact, &eps_start));
+  PetscCall(ContactGetEps(s->contact, &eps_target));
+  PetscCall(ContactGetPenaltyScale(s->contact, &eps_start));
   if (!warm) PetscCall(VecZeroEntries(u));
   {
     PetscBool zero;
 
-    PetscCall(SolverZeroData(dm, user, &zero));
+    PetscCall(SolverZeroData(dm, s, &zero));
     if (zero) { /* u = 0 exactly: the SNES finds |F| = 0 at its start and stops there, converged in no step */
       PetscCall(VecZeroEntries(u));
-      PetscCall(ContactForgetMultipliers(user->contact));
+      PetscCall(ContactForgetMultipliers(s->contact));
     }
   }
   /* -pc_type mg: the levels of the meshes solved so far */
-  PetscCall(MultigridSetUpPC(user->mg, snes, user->prob.level, &user->box, &user->opt->solver));
-  user->prob.sctx->warm = warm;
+  PetscCall(MultigridSetUpPC(s->mg, snes, s->prob->level, s->box, &s->opt->solver));
+  s->prob->sctx->warm = warm;
   PetscCall(PetscTime(&t0));
-  user->prob.sctx->pc_reuse.builds         = 0; /* counted per solve */
-  user->prob.sctx->pc_reuse.updates        = 0;
-  user->prob.sctx->pc_reuse.finest_updates = 0;
-  user->rec.stats.continuation_stages      = 0;
+  s->prob->sctx->pc_reuse.builds         = 0; /* counted per solve */
+  s->prob->sctx->pc_reuse.updates        = 0;
+  s->prob->sctx->pc_reuse.finest_updates = 0;
+  s->stats->continuation_stages          = 0;
   if (start != SOLVER_START_NEARBY_EPS && copt->continuation && eps_target < eps_start) { /* both 0 for a type without eps */
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= copt->continuation_factor) {
-      PetscCall(ContactSetEps(user->contact, dm, eps));
-      PetscCall(SolveRecovering(snes, user, u, &newton, &ksp));
-      user->rec.stats.continuation_stages++;
-      if (!user->rec.stats.converged) break; /* reported as the failure of the whole solve */
+      PetscCall(ContactSetEps(s->contact, dm, eps));
+      PetscCall(SolveRecovering(snes, s, u, &newton, &ksp));
+      s->stats->continuation_stages++;
+      if (!s->stats->converged) break; /* reported as the failure of the whole solve */
     }
-    PetscCall(ContactSetEps(user->contact, dm, eps_target));
+    PetscCall(ContactSetEps(s->contact, dm, eps_target));
   }
-  if (user->rec.stats.continuation_stages == 0 || user->rec.stats.converged) {
-    PetscCall(SolveRecovering(snes, user, u, &newton, &ksp));
+  if (s->stats->continuation_stages == 0 || s->stats->converged) {
+    PetscCall(SolveRecovering(snes, s, u, &newton, &ksp));
   }
   PetscCall(PetscTime(&t1));
-  user->rec.stats.time_solve += t1 - t0;
-  user->rec.stats.newton_its_total += newton;
-  user->rec.stats.ksp_its_total += ksp;
-  PetscCall(SolverAddRecord(snes, user, u, t1 - t0));
+  s->stats->time_solve += t1 - t0;
+  s->stats->newton_its_total += newton;
+  s->stats->ksp_its_total += ksp;
+  PetscCall(SolverAddRecord(snes, s, u, t1 - t0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -459,21 +482,21 @@ PetscErrorCode SolverSetStepEnergyStop(Problem *prob, PetscReal energy)
    where the direct run converges in 13. So the warm solve stops once SOLVER_STALL_STEPS Newton steps have not halved
    |F| (SolverConverged()), or on any failure, and the problem is solved again from zero as a direct run would be; both
    solves are in /solves and the Newton steps of both count. */
-PetscErrorCode SolverSolveWarm(SNES snes, AppCtx *user, Vec u, const char what[])
+PetscErrorCode SolverSolveWarm(SNES snes, Solver s, Vec u, const char what[])
 {
   SNESConvergedReason reason;
   PetscInt            its;
 
   PetscFunctionBeginUser;
-  user->prob.sctx->stall_stop = PETSC_TRUE;
-  PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
-  user->prob.sctx->stall_stop = PETSC_FALSE;
-  if (user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
+  s->prob->sctx->stall_stop = PETSC_TRUE;
+  PetscCall(SolverSolve(snes, s, u, SOLVER_START_NEARBY_EPS));
+  s->prob->sctx->stall_stop = PETSC_FALSE;
+  if (s->stats->converged) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetConvergedReason(snes, &reason));
   PetscCall(SNESGetIterationNumber(snes, &its));
   PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes), "  %s: the warm solve %s (%s, %" PetscInt_FMT " Newton steps); solved again from zero\n",
                         what, reason == SNES_DIVERGED_LINE_SEARCH ? "stalled" : "failed", SNESConvergedReasons[reason], its));
-  PetscCall(SolverSolve(snes, user, u, SOLVER_START_ZERO));
+  PetscCall(SolverSolve(snes, s, u, SOLVER_START_ZERO));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -481,7 +504,7 @@ PetscErrorCode SolverSolveWarm(SNES snes, AppCtx *user, Vec u, const char what[]
    the 1-norm condition number of the Jacobian at the solution (for vi: of K). J is symmetric, so J^-T x is a solve with J.
    SNESVI's linear solver holds the reduced system of the last active set, so vi gets a linear solver of its own for K,
    set up as the SNES's (the same defaults and options). */
-PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
+PetscErrorCode SolverConditionEstimate(SNES snes, Solver s, Vec u)
 {
   KSP                ksp, ksp_vi = NULL;
   Mat                J;
@@ -492,15 +515,15 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
   PetscBool          is_vi;
 
   PetscFunctionBeginUser;
-  user->rec.stats.condition_1norm = PETSC_NAN;
-  if (!user->opt->solver.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
+  s->stats->condition_1norm = PETSC_NAN;
+  if (!s->opt->solver.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)snes, &is_vi, SNESVINEWTONRSLS, SNESVINEWTONSSLS, ""));
   if (is_vi) { /* its KSP holds the reduced system of the last active set */
-    J = user->prob.K;
+    J = s->prob->K;
     PetscCall(KSPCreate(PetscObjectComm((PetscObject)snes), &ksp_vi));
-    PetscCall(SolverSetDefaultLinearSolver(ksp_vi, user->contact, &user->opt->solver, &user->prob, user->mg));
+    PetscCall(SolverSetDefaultLinearSolver(ksp_vi, s->contact, &s->opt->solver, s->prob, s->mg));
     PetscCall(KSPSetFromOptions(ksp_vi));
     ksp = ksp_vi;
   } else
@@ -544,7 +567,7 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
     PetscCall(VecAssemblyBegin(x));
     PetscCall(VecAssemblyEnd(x));
   }
-  user->rec.stats.condition_1norm = normJ * est;
+  s->stats->condition_1norm = normJ * est;
   PetscCall(VecDestroy(&x));
   PetscCall(VecDestroy(&y));
   PetscCall(KSPDestroy(&ksp_vi));
