@@ -520,6 +520,7 @@ typedef struct {
    solved before it, and its record. */
 typedef struct _p_Contact   *Contact;   /* include/contact.h */
 typedef struct _n_Multigrid *Multigrid; /* the nested meshes' interpolations, private to src/linear/ (linear_impl.h) */
+typedef struct _n_Solver    *Solver;    /* the nonlinear core's solver object (include/solver.h), private to src/solver/ (solver_impl.h) */
 typedef struct {
   const RunOptions *opt;     /* read once before any set-up, then read only */
   Contact           contact; /* created and read from the options once, set up on the mesh of each problem */
@@ -528,6 +529,7 @@ typedef struct {
   Problem           prob;
   Multigrid         mg; /* the interpolations between the nested meshes solved so far */
   RunRecord         rec;
+  Solver            solver; /* the nonlinear core: what a solve reads (the problem, the Contact, the options) and where it records */
 } AppCtx;
 
 /* The writer of the run's output (src/main.c's, through io/output_hdf5.c's OutputWriteHDF5()), which main() hands to the adaptive cycles */

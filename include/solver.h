@@ -6,34 +6,39 @@
 #include "linear.h"
 
 /* solver.c */
+/* The solver object (Solver, include/signorini.h): what the solves of the run read, the problem on the current mesh, the
+   Contact, the options, the nested meshes' multigrid and the box, and where their outcome goes, the run's statistics and
+   the table of solves. Created once, after the options, the Contact, the multigrid and the mesh; it owns none of them. */
+PetscErrorCode SolverCreate(const RunOptions *opt, Contact contact, Multigrid mg, const MeshBox *box, Problem *prob, RunRecord *rec, Solver *s);
+PetscErrorCode SolverDestroy(Solver *s);
 /* the bound of Eisenstat-Walker's linear tolerances, the penalty method's default with an iterative preconditioner */
 #define SOLVER_EW_RTOL_MAX 0.01
-PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user);
-PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user);
-PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes);
-PetscErrorCode SolverComputeScales(DM dm, AppCtx *user);
+PetscErrorCode SolverAssembleBulk(DM dm, const RunOptions *opt, Problem *prob);
+PetscErrorCode SolverAssembleLoad(DM dm, const RunOptions *opt, const Scene *scene, Problem *prob);
+PetscErrorCode SolverCreateSNES(DM dm, Contact contact, const SolverOptions *opt, Problem *prob, Multigrid mg, const MeshBox *box, SNES *snes);
+PetscErrorCode SolverComputeScales(DM dm, Contact contact, Problem *prob);
 /* Where a solve starts: from zero, from the solution for a nearby eps (the sweep), or from a coarser mesh's (nested
    iteration); the last two are warm starts, and the first and last reach a small eps by continuation. */
 typedef enum { SOLVER_START_ZERO, SOLVER_START_NEARBY_EPS, SOLVER_START_COARSER_MESH } SolverStart;
-PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start);
-PetscErrorCode SolverStartFromCoarser(const AppCtx *user, SolverStart *start);
+PetscErrorCode SolverSolve(SNES snes, Solver s, Vec u, SolverStart start);
+PetscErrorCode SolverStartFromCoarser(Contact contact, SolverStart *start);
 /* A solve from the guess u (a load path's step, force control's position, the penetration tolerance's eps) that, where
    it stalls or fails, is solved again from zero as a direct run: never less reliable than the direct run */
-PetscErrorCode SolverSolveWarm(SNES snes, AppCtx *user, Vec u, const char what[]);
+PetscErrorCode SolverSolveWarm(SNES snes, Solver s, Vec u, const char what[]);
 /* The next solves of the problem stop once a Newton step's energy norm is below energy (0: at -snes_rtol only) */
-PetscErrorCode SolverSetStepEnergyStop(AppCtx *user, PetscReal energy);
+PetscErrorCode SolverSetStepEnergyStop(Problem *prob, PetscReal energy);
 /* |F| (user's units) that -snes_rtol is relative to in the current solve: its first, or for a warm start the load
    ||F(0)||, so that a warm start ends as tight as a start from zero */
 PetscErrorCode SolverResidualNorm(SNES snes, SolverCtx sc, Vec u, PetscReal *norm);
-PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u);
+PetscErrorCode SolverConditionEstimate(SNES snes, Solver s, Vec u);
 /* the solve's part of /run, and the table /solves */
 PetscErrorCode SolverWrite(const RunStats *s, const Problem *prob, const SolverOptions *sopt, PetscInt coarse_levels, PetscInt nsolves,
                            PetscViewer v);
 PetscErrorCode SolverWriteSolves(MPI_Comm comm, const SolveRecord records[], PetscInt n, PetscViewer v);
 
 /* problem.c, grid_sequence.c, eps_sweep.c */
-PetscErrorCode ProblemSetUp(DM dm, AppCtx *user, SNES *snes);
-PetscErrorCode ProblemDestroy(AppCtx *user, SNES *snes);
+PetscErrorCode ProblemSetUp(DM dm, Solver s, const Scene *scene, SNES *snes);
+PetscErrorCode ProblemDestroy(Solver s, SNES *snes);
 /* The coarsest box of nested iteration by default (-contact_coarse_levels -1) has at least this many cells per side:
    where each box builds its own preconditioner (a factorization, or an algebraic multigrid with -contact_coarse_mg 0),
    each coarser box costs that build; with the geometric multigrid (-pc_type mg, or the coarser boxes' solver of

@@ -270,7 +270,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(GridSequenceBarsSizes(dm, &opt, user.contact, &user.box, user.prob.level));
   if (opt.adapt.cycles || (opt.bars && opt.adapt.model[0])) /* one eps on Gamma_C: the remeshed meshes do not nest */
     PetscCall(MeshSetContactCellSizes(dm, user.scene.bcs.ncontact, user.scene.bcs.contact_ids));
-  PetscCall(ProblemSetUp(dm, &user, &snes));
+  PetscCall(SolverCreate(&opt, user.contact, user.mg, &user.box, &user.prob, &user.rec, &user.solver)); /* the solves' object, for the whole run */
+  PetscCall(ProblemSetUp(dm, user.solver, &user.scene, &snes));
   { /* before the solve, not after it */
     const VerifyRun verify = {.opt = &opt.verify, .scene = &user.scene, .mat = &opt.material, .degree = opt.degree};
 
@@ -303,7 +304,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(EpsSweepSolve(dm, &user, snes, u));
   PetscCall(PenetrationTolSolve(dm, &user, snes, u)); /* -contact_penetration_tol: eps lowered until the penetration is reached */
   PetscCall(LoadPathSolve(dm, &user, snes, u));       /* the steps after the first, each from the last */
-  PetscCall(SolverConditionEstimate(snes, &user, u));
+  PetscCall(SolverConditionEstimate(snes, user.solver, u));
   PetscCall(PostprocessContact(dm, user.contact, &user.prob, &user.scene.bcs, &opt.material, u, &user.rec.stats));
   if (opt.bars) { /* -bars: from the levels' quantities and this mesh's */
     Quantities q;
@@ -383,7 +384,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
                           SNESConvergedReasons[user.rec.stats.reason], user.rec.stats.newton_its, (double)user.rec.stats.residual_norm));
 
   PetscCall(VecDestroy(&u));
-  PetscCall(ProblemDestroy(&user, &snes));
+  PetscCall(ProblemDestroy(user.solver, &snes));
+  PetscCall(SolverDestroy(&user.solver));
   PetscCall(MultigridDestroy(&user.mg));
   PetscCall(DMDestroy(&dm));
   PetscCall(ContactDestroy(&user.contact));

@@ -723,10 +723,10 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
       PetscInt n_next;
 
       PetscCall(VecGetSize(*u, &n_next));
-      PetscCall(SolverSetStepEnergyStop(user, ad->newton_fraction * c->estimate * PetscPowReal((PetscReal)c->n_dofs / n_next, 1.0 / dim)));
+      PetscCall(SolverSetStepEnergyStop(&user->prob, ad->newton_fraction * c->estimate * PetscPowReal((PetscReal)c->n_dofs / n_next, 1.0 / dim)));
     }
-    PetscCall(SolverStartFromCoarser(user, &start));
-    PetscCall(SolverSolve(*snes, user, *u, start));
+    PetscCall(SolverStartFromCoarser(user->contact, &start));
+    PetscCall(SolverSolve(*snes, user->solver, *u, start));
   }
   PetscCall(EstimateReset(&user->rec.estimate)); /* the run's own, after the last solve, as without cycles */
   PetscCall(ErrorNormsReset(&user->rec.errors));

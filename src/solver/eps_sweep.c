@@ -103,14 +103,16 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
       for (PetscInt i = 0; i < n; ++i) distinct = (PetscBool)(distinct && e[n] != e[i]);
     if (n > 1 && eps != eps_last) { /* the polynomial through the last n solutions */
       PetscCall(ExtrapolationStep(n, hist, e, eps, dir));
-      PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, 1.0, 0.0, PETSC_TRUE));
+      PetscCall(SolverExtrapolatedStart(snes, dm, user->contact, user->prob.sctx, u, dir, 1.0, 0.0, PETSC_TRUE));
     } else if (k == 1 && eps != eps_last) { /* the tangent (a sweep is the penalty's: ContactSetFromOptions()) */
       PetscBool ok = PETSC_FALSE;
 
       PetscCall(EpsSweepTangent(snes, dm, user->contact, u, dir, &user->rec.stats.ksp_its_total, &ok));
-      if (ok) PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, (eps - eps_last) * eps / (eps_last * eps_last), 1e-2, PETSC_FALSE));
+      if (ok)
+        PetscCall(SolverExtrapolatedStart(snes, dm, user->contact, user->prob.sctx, u, dir, (eps - eps_last) * eps / (eps_last * eps_last), 1e-2,
+                                          PETSC_FALSE));
     }
-    PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
+    PetscCall(SolverSolve(snes, user->solver, u, SOLVER_START_NEARBY_EPS));
   }
   for (PetscInt j = 0; j < SWEEP_POINTS; ++j) PetscCall(VecDestroy(&hist[j]));
   PetscCall(VecDestroy(&dir));

@@ -10,7 +10,8 @@
    stalls. Such a guess that still lowers
    the residual gives, with step_guess, the first linear solve's initial guess instead (step_guess.c): Newton starts
    from u, with its active points, and CG from the step factor dir; dir is then scaled. */
-PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscReal factor, PetscReal relaxed, PetscBool step_guess)
+PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, Contact contact, SolverCtx sc, Vec u, Vec dir, PetscReal factor, PetscReal relaxed,
+                                       PetscBool step_guess)
 {
   Vec       guess;
   PetscReal f_last, f_guess;
@@ -19,14 +20,14 @@ PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Ve
   PetscFunctionBeginUser;
   PetscCall(VecDuplicate(u, &guess));
   PetscCall(VecWAXPY(guess, factor, dir, u));
-  PetscCall(ContactSameActivity(user->contact, dm, u, guess, &same));
-  PetscCall(SolverResidualNorm(snes, user->prob.sctx, u, &f_last)); /* every start needs both: the tangent's and the secant's rules */
-  PetscCall(SolverResidualNorm(snes, user->prob.sctx, guess, &f_guess));
+  PetscCall(ContactSameActivity(contact, dm, u, guess, &same));
+  PetscCall(SolverResidualNorm(snes, sc, u, &f_last)); /* every start needs both: the tangent's and the secant's rules */
+  PetscCall(SolverResidualNorm(snes, sc, guess, &f_guess));
   if ((same && f_guess < f_last) || f_guess < relaxed * f_last)
     PetscCall(VecCopy(guess, u));
   else if (step_guess && f_guess < f_last) {
     PetscCall(VecScale(dir, factor));
-    PetscCall(SolverSetStepGuess(user->prob.sctx, dir));
+    PetscCall(SolverSetStepGuess(sc, dir));
   }
   PetscCall(VecDestroy(&guess));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -35,13 +36,14 @@ PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Ve
 /* The start of a solve on the secant of the last two solutions: u <- u + factor (u - prev) where
    SolverExtrapolatedStart() takes it (use; relaxed as there), and prev <- the old u. Shared by a load path's steps
    (along the factor), force control's positions (along the position) and the penetration tolerance's values of eps. */
-PetscErrorCode SolverSecantStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor, PetscReal relaxed)
+PetscErrorCode SolverSecantStart(SNES snes, DM dm, Contact contact, SolverCtx sc, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor,
+                                 PetscReal relaxed)
 {
   PetscFunctionBeginUser;
   if (use) {
     PetscCall(VecWAXPY(dir, -1.0, prev, u));
     PetscCall(VecCopy(u, prev));
-    PetscCall(SolverExtrapolatedStart(snes, dm, user, u, dir, factor, relaxed, PETSC_TRUE));
+    PetscCall(SolverExtrapolatedStart(snes, dm, contact, sc, u, dir, factor, relaxed, PETSC_TRUE));
   } else
     PetscCall(VecCopy(u, prev));
   PetscFunctionReturn(PETSC_SUCCESS);

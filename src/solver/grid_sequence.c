@@ -46,7 +46,7 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   PetscFunctionBeginUser;
   PetscCall(LocalSolution(*dm, user->prob.loc_bc, *u, &loc));
   PetscCall(VecDestroy(u));
-  PetscCall(ProblemDestroy(user, snes));
+  PetscCall(ProblemDestroy(user->solver, snes));
   if (marked) {
     parent = NULL;
     PetscCall(MeshRefineMarked(*dm, marked, &fine, &vertex_source));
@@ -58,7 +58,7 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   user->prob.level++;
   PetscCall(GridSequenceBarsSizes(fine, user->opt, user->contact, &user->box, user->prob.level)); /* -bars on tetrahedra: the final mesh's eps here */
   if (marked) PetscCall(MeshSetContactCellSizes(fine, user->scene.bcs.ncontact, user->scene.bcs.contact_ids)); /* one eps on Gamma_C */
-  PetscCall(ProblemSetUp(fine, user, snes));
+  PetscCall(ProblemSetUp(fine, user->solver, &user->scene, snes));
   PetscCall(MultigridAddLevel(user->mg, *snes, *dm, fine, vertex_source, user->opt->degree)); /* with -pc_type mg */
   if (user->opt->degree == 1)
     PetscCall(MeshInterpolateVertexSources(*dm, fine, vertex_source, loc, &fine_loc)); /* exact and fast */
@@ -107,13 +107,13 @@ PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
   PetscCall(MeshTransferCreateFromField(*dm, loc, &tr));
   if (user->rec.bars.pressure_recorded) PetscCall(BarsPressureTransferCreate(*dm, &user->rec.bars, loc, &tr_p)); /* -bars's 2h pressure */
   PetscCall(VecDestroy(u));
-  PetscCall(ProblemDestroy(user, snes));
+  PetscCall(ProblemDestroy(user->solver, snes));
   PetscCall(MeshRemesh(*dm, user->opt->adapt.model, &user->box, size, &fine));
   PetscCall(VecDestroy(&loc));
   PetscCall(PetscFree(size));
   user->prob.level++;
   PetscCall(MeshSetContactCellSizes(fine, user->scene.bcs.ncontact, user->scene.bcs.contact_ids)); /* one eps on Gamma_C */
-  PetscCall(ProblemSetUp(fine, user, snes));
+  PetscCall(ProblemSetUp(fine, user->solver, &user->scene, snes));
   PetscCall(DMCreateLocalVector(fine, &loc));
   PetscCall(MeshTransferApply(tr, fine, loc));
   PetscCall(MeshTransferDestroy(&tr));
@@ -294,7 +294,7 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
     PetscCall(VecDuplicate(u, &u0));
     PetscCall(VecCopy(u, u0));
     PetscCall(ContactSetEps(user->contact, dm, b->eps_second));
-    PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
+    PetscCall(SolverSolve(snes, user->solver, u, SOLVER_START_NEARBY_EPS));
     if (user->rec.stats.converged) {
       PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
       PostprocessGetQuantities(&user->rec.stats, &b->eps_level);
@@ -335,7 +335,7 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
   user->rec.bars.eps_levels = 0.0;
   PetscCall(GridSequenceSetTolerance(*snes, user->opt, user->box.coarse_levels, user->prob.level));
   PetscCall(GridSequenceBarsEps(*snes, user->opt, user->contact, user->prob.level, nlevels, &user->rec.bars));
-  PetscCall(SolverSolve(*snes, user, *u, SOLVER_START_ZERO));
+  PetscCall(SolverSolve(*snes, user->solver, *u, SOLVER_START_ZERO));
   PetscCall(GridSequenceBarsLevel(*snes, user, *u, nlevels));
   for (PetscInt l = 1; l <= nlevels; ++l) {
     const PetscBool failed = (PetscBool)!user->rec.stats.converged;
@@ -357,8 +357,8 @@ PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
     PetscCall(GridSequenceSetTolerance(*snes, user->opt, user->box.coarse_levels, user->prob.level));
     PetscCall(GridSequenceBarsEps(*snes, user->opt, user->contact, user->prob.level, nlevels, &user->rec.bars));
     start = SOLVER_START_COARSER_MESH;
-    if (GridSequenceStartsAsCoarser(user->opt->bars, user->prob.level, nlevels)) PetscCall(SolverStartFromCoarser(user, &start));
-    PetscCall(SolverSolve(*snes, user, *u, failed ? SOLVER_START_ZERO : start));
+    if (GridSequenceStartsAsCoarser(user->opt->bars, user->prob.level, nlevels)) PetscCall(SolverStartFromCoarser(user->contact, &start));
+    PetscCall(SolverSolve(*snes, user->solver, *u, failed ? SOLVER_START_ZERO : start));
     PetscCall(GridSequenceBarsLevel(*snes, user, *u, nlevels));
   }
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -80,8 +80,8 @@ static PetscErrorCode ProblemUpdateData(DM dm, AppCtx *user)
   PetscCall(ContactGetEps(user->contact, &eps));
   PetscCall(ContactSetEps(user->contact, dm, eps));
   PetscCall(ContactSetLoad(user->contact, dm, &user->scene.obstacle));
-  PetscCall(SolverAssembleLoad(dm, user));
-  PetscCall(SolverComputeScales(dm, user));
+  PetscCall(SolverAssembleLoad(dm, user->opt, &user->scene, &user->prob));
+  PetscCall(SolverComputeScales(dm, user->contact, &user->prob));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -257,9 +257,10 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
     }
     PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
     PetscCall(ProblemUpdateData(dm, user));
-    PetscCall(SolverSecantStart(snes, dm, user, u, u_prev, dir, (PetscBool)(s != s_prev), s != s_prev ? (s_next - s) / (s - s_prev) : 0.0, 1.0));
+    PetscCall(SolverSecantStart(snes, dm, user->contact, user->prob.sctx, u, u_prev, dir, (PetscBool)(s != s_prev),
+                                s != s_prev ? (s_next - s) / (s - s_prev) : 0.0, 1.0));
     s_prev = s, f_prev = f;
-    PetscCall(SolverSolveWarm(snes, user, u, "force control")); /* from zero where Newton stalls at a kink of the penalty */
+    PetscCall(SolverSolveWarm(snes, user->solver, u, "force control")); /* from zero where Newton stalls at a kink of the penalty */
     PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
     ForceAlong(&user->scene, &user->rec.stats, &f, &s);
     ++*its;
@@ -313,7 +314,7 @@ static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u,
     s_prev = s, f_prev = f, have_prev = PETSC_TRUE;
     PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
     PetscCall(ProblemUpdateData(dm, user));
-    PetscCall(SolverSolveWarm(snes, user, u, "force control"));
+    PetscCall(SolverSolveWarm(snes, user->solver, u, "force control"));
     PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
     ForceAlong(&user->scene, &user->rec.stats, &f, &s);
     ++*its;
@@ -419,10 +420,11 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
          none start from the last step's solution, which their solve needs no better guess than */
       const PetscBool secant = (PetscBool)(!force && t_last != t_prev && ContactHasPenalty(user->contact));
 
-      PetscCall(SolverSecantStart(snes, dm, user, u, prev, dir, secant, secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0, 1.0));
+      PetscCall(SolverSecantStart(snes, dm, user->contact, user->prob.sctx, u, prev, dir, secant,
+                                  secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0, 1.0));
     }
-    PetscCall(SolverSolveWarm(snes, user, u, "load path")); /* from zero where the guess's active set is too far off */
-    PetscCall(PenetrationTolSolve(dm, user, snes, u));      /* -contact_penetration_tol at every step, from the last step's eps (or multipliers) */
+    PetscCall(SolverSolveWarm(snes, user->solver, u, "load path")); /* from zero where the guess's active set is too far off */
+    PetscCall(PenetrationTolSolve(dm, user, snes, u)); /* -contact_penetration_tol at every step, from the last step's eps (or multipliers) */
     PetscCall(LoadPathForce(dm, user, snes, u, &ok));
     PetscCall(LoadPathRecordStep(dm, user->contact, &user->prob, &user->scene, &user->opt->material, lp->n, u, lp->factor[k], first, ok, &user->rec));
   }

@@ -45,7 +45,7 @@ static PetscErrorCode UzawaSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscRea
   best = change;
   while (change > tol && user->rec.stats.converged && *solves < PENETRATION_TOL_MAX_UPDATES) {
     PetscCall(ContactAugment(user->contact, dm, u, PETSC_TRUE, &change));
-    PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
+    PetscCall(SolverSolve(snes, user->solver, u, SOLVER_START_NEARBY_EPS));
     ++*solves;
     PetscCall(ContactMaxPenetration(user->contact, dm, u, d_max));
     PetscCall(ContactAugment(user->contact, dm, u, PETSC_FALSE, &change));
@@ -88,10 +88,11 @@ static PetscErrorCode ContinuationSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
       PetscCall(VecDuplicate(u, &dir));
     }
     PetscCall(ContactSetEps(user->contact, dm, eps_new));
-    PetscCall(SolverSecantStart(snes, dm, user, u, prev, dir, secant, secant ? (eps_new - eps) / (eps - eps_prev) : 0.0, 0.0));
+    PetscCall(
+        SolverSecantStart(snes, dm, user->contact, user->prob.sctx, u, prev, dir, secant, secant ? (eps_new - eps) / (eps - eps_prev) : 0.0, 0.0));
     eps_prev = eps;
     eps      = eps_new;
-    PetscCall(SolverSolveWarm(snes, user, u, "penetration tolerance")); /* from zero where it stalls at a kink of the penalty */
+    PetscCall(SolverSolveWarm(snes, user->solver, u, "penetration tolerance")); /* from zero where it stalls at a kink of the penalty */
     ++*solves;
     PetscCall(ContactMaxPenetration(user->contact, dm, u, d_max));
   }

@@ -8,22 +8,45 @@
 #include "physics.h"
 #include "solver_impl.h"
 
-PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
+PetscErrorCode SolverCreate(const RunOptions *opt, Contact contact, Multigrid mg, const MeshBox *box, Problem *prob, RunRecord *rec, Solver *s)
 {
-  const AssemblyP1Inputs p1 = {&user->opt->material, user->opt->solver.given.mat_type};
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(s));
+  (*s)->prob       = prob;
+  (*s)->contact    = contact;
+  (*s)->opt        = opt;
+  (*s)->mg         = mg;
+  (*s)->box        = box;
+  (*s)->stats      = &rec->stats;
+  (*s)->records    = &rec->records;
+  (*s)->nrecords   = &rec->nrecords;
+  (*s)->maxrecords = &rec->maxrecords;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode SolverDestroy(Solver *s)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(*s));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+PetscErrorCode SolverAssembleBulk(DM dm, const RunOptions *opt, Problem *prob)
+{
+  const AssemblyP1Inputs p1 = {&opt->material, opt->solver.given.mat_type};
   Vec                    locX;
   MatNullSpace           rigid;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetLocalVector(dm, &locX));
-  PetscCall(VecCopy(user->prob.loc_bc, locX)); /* u = 0 with the Dirichlet values, inserted once by ProblemSetUp() */
-  PetscCall(AssemblyCreateOperator(dm, user->prob.assembly, &p1, user->opt->assembly_check, locX, &user->prob.K));
+  PetscCall(VecCopy(prob->loc_bc, locX)); /* u = 0 with the Dirichlet values, inserted once by ProblemSetUp() */
+  PetscCall(AssemblyCreateOperator(dm, prob->assembly, &p1, opt->assembly_check, locX, &prob->K));
   PetscCall(DMRestoreLocalVector(dm, &locX));
-  if (user->opt->degree == 1)
-    PetscCall(ElasticityRigidBodyModesP1(dm, user->prob.r0, &rigid)); /* unknowns at the vertices only */
+  if (opt->degree == 1)
+    PetscCall(ElasticityRigidBodyModesP1(dm, prob->r0, &rigid)); /* unknowns at the vertices only */
   else
     PetscCall(DMPlexCreateRigidBody(dm, 0, &rigid));
-  PetscCall(MatSetNearNullSpace(user->prob.K, rigid));
+  PetscCall(MatSetNearNullSpace(prob->K, rigid));
   PetscCall(MatNullSpaceDestroy(&rigid));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -32,7 +55,7 @@ PetscErrorCode SolverAssembleBulk(DM dm, AppCtx *user)
    force), the surface loads and a scene's load in weak form, and its local copy loc_r0 with the fixed rows; and the
    energy of the Dirichlet lift, which these data fix. Assembled by ProblemSetUp() and again at each step of a load path
    (the data changed, K did not). */
-PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user)
+PetscErrorCode SolverAssembleLoad(DM dm, const RunOptions *opt, const Scene *scene, Problem *prob)
 {
   Vec       locX, locF;
   PetscReal weak_lift;
@@ -40,26 +63,25 @@ PetscErrorCode SolverAssembleLoad(DM dm, AppCtx *user)
   PetscFunctionBeginUser;
   PetscCall(DMGetLocalVector(dm, &locX));
   PetscCall(DMGetLocalVector(dm, &locF));
-  PetscCall(VecCopy(user->prob.loc_bc, locX));
+  PetscCall(VecCopy(prob->loc_bc, locX));
   PetscCall(VecZeroEntries(locF));
-  PetscCall(AssemblyResidual(dm, user->prob.assembly, &user->opt->material, locX, locF));
-  PetscCall(VecZeroEntries(user->prob.r0));
-  PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, user->prob.r0));
-  if (!user->prob.loc_r0) PetscCall(VecDuplicate(locF, &user->prob.loc_r0)); /* with the fixed rows, which the global vector drops */
-  PetscCall(VecCopy(locF, user->prob.loc_r0));
+  PetscCall(AssemblyResidual(dm, prob->assembly, &opt->material, locX, locF));
+  PetscCall(VecZeroEntries(prob->r0));
+  PetscCall(DMLocalToGlobal(dm, locF, ADD_VALUES, prob->r0));
+  if (!prob->loc_r0) PetscCall(VecDuplicate(locF, &prob->loc_r0)); /* with the fixed rows, which the global vector drops */
+  PetscCall(VecCopy(locF, prob->loc_r0));
   PetscCall(DMRestoreLocalVector(dm, &locX));
   PetscCall(DMRestoreLocalVector(dm, &locF));
-  PetscCall(BoundaryAddLoads(dm, &user->scene.bcs, user->prob.face_sets, user->prob.loc_r0, user->prob.r0));
-  PetscCall(WeakDataAddToResidual(dm, &user->scene, &user->opt->material, &user->opt->verify, user->prob.loc_bc, user->prob.r0, &weak_lift));
-  PetscCall(
-      PostprocessLiftEnergy(dm, &user->opt->material, &user->prob, weak_lift, &user->prob.lift_energy)); /* a datum of the load state, not of u */
+  PetscCall(BoundaryAddLoads(dm, &scene->bcs, prob->face_sets, prob->loc_r0, prob->r0));
+  PetscCall(WeakDataAddToResidual(dm, scene, &opt->material, &opt->verify, prob->loc_bc, prob->r0, &weak_lift));
+  PetscCall(PostprocessLiftEnergy(dm, &opt->material, prob, weak_lift, &prob->lift_energy)); /* a datum of the load state, not of u */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The scales of the problem on this mesh: the load ||F(0)||_2, and the displacement scale U, the largest entry of
    the best displacement along F(0) (one steepest-descent step of the energy from u = 0: alpha F(0) with
    alpha = |F(0)|^2 / F(0).K F(0)), rounded to a power of 2. Only U's order of magnitude matters. */
-PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
+PetscErrorCode SolverComputeScales(DM dm, Contact contact, Problem *prob)
 {
   MPI_Comm    comm = PetscObjectComm((PetscObject)dm);
   Vec         zero, F, KF;
@@ -67,25 +89,25 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
   PetscReal   finf, U = 1.0;
 
   PetscFunctionBeginUser;
-  PetscCall(VecDuplicate(user->prob.r0, &zero));
-  PetscCall(VecDuplicate(user->prob.r0, &F));
-  PetscCall(VecDuplicate(user->prob.r0, &KF));
+  PetscCall(VecDuplicate(prob->r0, &zero));
+  PetscCall(VecDuplicate(prob->r0, &F));
+  PetscCall(VecDuplicate(prob->r0, &KF));
   PetscCall(VecZeroEntries(zero));
-  PetscCall(SolverResidual(user->prob.sctx, dm, zero, F));
-  PetscCall(VecNorm(F, NORM_2, &user->prob.load_norm));
-  PetscCheck(!PetscIsInfOrNanReal(user->prob.load_norm), comm, PETSC_ERR_USER_INPUT,
+  PetscCall(SolverResidual(prob->sctx, dm, zero, F));
+  PetscCall(VecNorm(F, NORM_2, &prob->load_norm));
+  PetscCheck(!PetscIsInfOrNanReal(prob->load_norm), comm, PETSC_ERR_USER_INPUT,
              "The load of the problem is not finite (||F(0)|| = %g): check the loads, the material and the mesh coordinates",
-             (double)user->prob.load_norm);
-  if (user->prob.load_norm > 0.0) {
+             (double)prob->load_norm);
+  if (prob->load_norm > 0.0) {
     PetscCall(VecNorm(F, NORM_INFINITY, &finf));
-    PetscCall(ContactBulkMult(user->contact, user->prob.K, F, KF));
+    PetscCall(ContactBulkMult(contact, prob->K, F, KF));
     PetscCall(VecDot(F, KF, &fkf));
-    if (PetscRealPart(fkf) > 0.0) U = PetscSqr(user->prob.load_norm) / PetscRealPart(fkf) * finf;
+    if (PetscRealPart(fkf) > 0.0) U = PetscSqr(prob->load_norm) / PetscRealPart(fkf) * finf;
     if (!(U > 0.0) || PetscIsInfOrNanReal(U)) U = 1.0;
   }
-  user->prob.displacement_scale       = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
-  user->prob.sctx->load_norm          = user->prob.load_norm; /* the solver's copies of the problem's scales */
-  user->prob.sctx->displacement_scale = user->prob.displacement_scale;
+  prob->displacement_scale       = (PetscReal)ldexp(1.0, (int)lround(PetscLog2Real(U)));
+  prob->sctx->load_norm          = prob->load_norm; /* the solver's copies of the problem's scales */
+  prob->sctx->displacement_scale = prob->displacement_scale;
   PetscCall(VecDestroy(&zero));
   PetscCall(VecDestroy(&F));
   PetscCall(VecDestroy(&KF));
@@ -97,27 +119,27 @@ PetscErrorCode SolverComputeScales(DM dm, AppCtx *user)
    a direct solve (MUMPS), robust for the small problems of a first run; for the penalty
    method inside CG, so that a factorization can serve as the preconditioner of later Newton steps (src/linear/pc_reuse.c).
    The Newton steps are as accurate as with a fresh factorization, also when it is reused. */
-static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
+static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, Contact contact, const SolverOptions *opt, const Problem *prob, Multigrid mg)
 {
   PC                           pc;
   PetscBool                    sbaij;
   const ContactSolverDefaults *defaults;
 
   PetscFunctionBeginUser;
-  if (MultigridIsDefault(user->mg)) { /* the 3D box that nests: CG with the boxes' geometric multigrid, as options/solvers/mg.yaml */
+  if (MultigridIsDefault(mg)) { /* the 3D box that nests: CG with the boxes' geometric multigrid, as options/solvers/mg.yaml */
     PetscCall(KSPSetType(ksp, KSPCG));
     PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
     PetscCall(KSPGetPC(ksp, &pc));
     PetscCall(PCSetType(pc, PCMG));
     PetscFunctionReturn(PETSC_SUCCESS);
   }
-  PetscCall(ContactGetSolverDefaults(user->contact, &defaults));
-  PetscCall(KSPSetType(ksp, defaults->reuse_factorization && user->opt->solver.pc_reuse ? KSPCG : KSPPREONLY));
+  PetscCall(ContactGetSolverDefaults(contact, &defaults));
+  PetscCall(KSPSetType(ksp, defaults->reuse_factorization && opt->pc_reuse ? KSPCG : KSPPREONLY));
   PetscCall(KSPSetTolerances(ksp, 1e-10, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT));
   PetscCall(KSPGetPC(ksp, &pc));
   /* K is symmetric positive definite: a symmetric block matrix (-dm_mat_type sbaij) holds its upper triangle only,
      which MUMPS factors by Cholesky and not by LU */
-  PetscCall(PetscObjectTypeCompareAny((PetscObject)user->prob.K, &sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
+  PetscCall(PetscObjectTypeCompareAny((PetscObject)prob->K, &sbaij, MATSEQSBAIJ, MATMPISBAIJ, ""));
   PetscCall(PCSetType(pc, sbaij ? PCCHOLESKY : PCLU));
   PetscCall(PCFactorSetMatSolverType(pc, MATSOLVERMUMPS));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -133,9 +155,9 @@ static PetscErrorCode SolverSetDefaultLinearSolver(KSP ksp, const AppCtx *user)
      are as loose as Newton allows. PETSc's bound, 0.9, lets the semismooth Newton cycle between active sets on
      steps too inexact to settle them; 0.01 does not (tests/test_performance.py). -snes_ksp_ew 0 restores the fixed
      -ksp_rtol. */
-static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
+static PetscErrorCode SolverSetIterativeDefaults(SNES snes, Contact contact, const SolverOptions *opt)
 {
-  const SolverGiven           *given = &user->opt->solver.given;
+  const SolverGiven           *given = &opt->given;
   KSP                          ksp;
   PC                           pc;
   PetscBool                    is_cg, is_factor;
@@ -147,7 +169,7 @@ static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
   PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPCG, &is_cg));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &is_factor, PCLU, PCCHOLESKY, ""));
   if (is_factor) PetscFunctionReturn(PETSC_SUCCESS); /* a factorization: CG converges in one or a few iterations anyway */
-  PetscCall(ContactGetSolverDefaults(user->contact, &defaults));
+  PetscCall(ContactGetSolverDefaults(contact, &defaults));
   {
     const char *prefix;
     PetscInt    k;
@@ -165,7 +187,7 @@ static PetscErrorCode SolverSetIterativeDefaults(SNES snes, const AppCtx *user)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
+PetscErrorCode SolverCreateSNES(DM dm, Contact contact, const SolverOptions *opt, Problem *prob, Multigrid mg, const MeshBox *box, SNES *snes)
 {
   MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
   Mat       J;
@@ -177,11 +199,11 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
   PetscFunctionBeginUser;
   PetscCall(SNESCreate(comm, snes));
   PetscCall(SNESSetDM(*snes, dm));
-  PetscCall(ContactCreateJacobian(user->contact, dm, user->prob.K, &J)); /* K itself, or a copy the penalty Jacobian can be made in */
-  PetscCall(SNESSetFunction(*snes, NULL, SolverFormFunction, user->prob.sctx));
-  PetscCall(SNESSetJacobian(*snes, J, J, SolverFormJacobian, user->prob.sctx));
+  PetscCall(ContactCreateJacobian(contact, dm, prob->K, &J)); /* K itself, or a copy the penalty Jacobian can be made in */
+  PetscCall(SNESSetFunction(*snes, NULL, SolverFormFunction, prob->sctx));
+  PetscCall(SNESSetJacobian(*snes, J, J, SolverFormJacobian, prob->sctx));
   PetscCall(MatDestroy(&J));
-  PetscCall(ContactSetUpSNES(user->contact, dm, *snes)); /* SNESVI with its bounds, or semismooth Newton */
+  PetscCall(ContactSetUpSNES(contact, dm, *snes)); /* SNESVI with its bounds, or semismooth Newton */
   {
     SNESLineSearch ls;
 
@@ -190,12 +212,12 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     PetscCall(SNESGetLineSearch(*snes, &ls));
     PetscCall(SNESLineSearchSetTolerances(ls, PETSC_DEFAULT, PETSC_DEFAULT, PETSC_DEFAULT, 0.0, PETSC_DEFAULT, PETSC_DEFAULT));
   }
-  PetscCall(SNESSetConvergenceTest(*snes, SolverConverged, user->prob.sctx, NULL));
+  PetscCall(SNESSetConvergenceTest(*snes, SolverConverged, prob->sctx, NULL));
   PetscCall(SNESGetKSP(*snes, &ksp));
-  PetscCall(SolverSetDefaultLinearSolver(ksp, user));
-  PetscCall(MultigridSetCoarseBoxSolver(user->mg, ksp, user->prob.level, &user->box)); /* -contact_coarse_mg on a coarser box */
+  PetscCall(SolverSetDefaultLinearSolver(ksp, contact, opt, prob, mg));
+  PetscCall(MultigridSetCoarseBoxSolver(mg, ksp, prob->level, box)); /* -contact_coarse_mg on a coarser box */
   PetscCall(KSPGetPC(ksp, &pc));
-  PetscCall(SNESMonitorSet(*snes, ContactMonitor, user->prob.sctx, NULL));
+  PetscCall(SNESMonitorSet(*snes, ContactMonitor, prob->sctx, NULL));
   PetscCall(SNESSetFromOptions(*snes));
   PetscCall(PCGetType(pc, &pc_type));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)pc, &is_multigrid, PCGAMG, PCMG, ""));
@@ -213,129 +235,129 @@ PetscErrorCode SolverCreateSNES(DM dm, AppCtx *user, SNES *snes)
     const ContactSolverDefaults *defaults;
 
     PetscCall(PetscObjectTypeCompare((PetscObject)ksp, KSPPREONLY, &is_preonly));
-    PetscCall(ContactGetSolverDefaults(user->contact, &defaults));
-    user->prob.sctx->pc_reuse.enabled = (PetscBool)(defaults->reuse_factorization && user->opt->solver.pc_reuse && !is_preonly);
+    PetscCall(ContactGetSolverDefaults(contact, &defaults));
+    prob->sctx->pc_reuse.enabled = (PetscBool)(defaults->reuse_factorization && opt->pc_reuse && !is_preonly);
   }
-  PetscCall(SolverSetIterativeDefaults(*snes, user));
+  PetscCall(SolverSetIterativeDefaults(*snes, contact, opt));
   {
     PetscBool petsc_presolve, fine;
 
     /* Eisenstat-Walker's terms with the oversolving guard */
-    PetscCall(SolverForcingSetUp(&user->prob.sctx->forcing, *snes, user->opt->solver.ew_guard, &petsc_presolve));
-    PetscCall(SolverStepGuessSetUp(&user->prob.sctx->step_guess, ksp, &user->opt->solver.given));
-    if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, user->prob.sctx));
-    PetscCall(FineSmootherGiven(ksp, &user->opt->solver.given, &fine));
+    PetscCall(SolverForcingSetUp(&prob->sctx->forcing, *snes, opt->ew_guard, &petsc_presolve));
+    PetscCall(SolverStepGuessSetUp(&prob->sctx->step_guess, ksp, &opt->given));
+    if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, prob->sctx));
+    PetscCall(FineSmootherGiven(ksp, &opt->given, &fine));
     PetscCheck(!fine || is_multigrid, comm, PETSC_ERR_USER_INPUT,
                "-mg_fine_ksp_type and -mg_fine_pc_type need a multigrid preconditioner (-pc_type gamg or mg), not %s", pc_type);
     PetscCheck(
         !(petsc_presolve && fine), comm, PETSC_ERR_USER_INPUT,
         "-mg_fine_ksp_type and -mg_fine_pc_type need -snes_ksp_ew_version 2 (or no Eisenstat-Walker): another version keeps PETSc's own pre-solve");
   }
-  PetscCall(ContactCheckSNES(user->contact, *snes, user->prob.K)); /* the SNES type and the matrix the method can use */
+  PetscCall(ContactCheckSNES(contact, *snes, prob->K)); /* the SNES type and the matrix the method can use */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Records the outcome of the last SNESSolve, with the iteration counts of all solves so far. A solve counts as
    converged only if PETSc says so and the residual fell by -snes_rtol or reached round-off for the load (or the
    user's -snes_atol): a stop on a small step or in the line search with a large residual is a failure. */
-static PetscErrorCode RecordSolve(SNES snes, AppCtx *user, PetscInt *newton, PetscInt *ksp)
+static PetscErrorCode RecordSolve(SNES snes, Solver s, PetscInt *newton, PetscInt *ksp)
 {
   PetscInt  its, lits, maxit, maxf;
   PetscReal fnorm, atol, rtol, stol, ref;
 
   PetscFunctionBeginUser;
-  PetscCall(SNESGetConvergedReason(snes, &user->rec.stats.reason));
+  PetscCall(SNESGetConvergedReason(snes, &s->stats->reason));
   PetscCall(SNESGetIterationNumber(snes, &its));
   PetscCall(SNESGetLinearSolveIterations(snes, &lits));
   PetscCall(SNESGetFunctionNorm(snes, &fnorm));
   PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
   *newton += its;
   *ksp += lits;
-  user->rec.stats.newton_its       = *newton;
-  user->rec.stats.ksp_its          = *ksp;
-  user->rec.stats.residual_norm    = fnorm * user->prob.displacement_scale; /* the SNES saw F/U */
-  user->rec.stats.residual_start   = user->prob.sctx->fnorm0;
-  ref                              = SolverStopReference(user->prob.sctx);
-  user->rec.stats.residual_reduced = (PetscBool)(user->rec.stats.residual_norm <= rtol * ref ||
-                                                 user->rec.stats.residual_norm <= user->opt->solver.load_rtol * user->prob.load_norm ||
-                                                 fnorm <= atol || user->prob.sctx->roundoff_stop || user->prob.sctx->energy_stop);
-  user->rec.stats.roundoff_stop    = user->prob.sctx->roundoff_stop;
-  user->rec.stats.converged        = (PetscBool)(user->rec.stats.reason > 0 && user->rec.stats.residual_reduced);
-  PetscCall(SNESKSPGetUseEW(snes, &user->rec.stats.ksp_ew));
-  user->rec.stats.pc_builds = user->prob.sctx->pc_reuse.enabled ? user->prob.sctx->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
-  user->rec.stats.pc_updates        = user->prob.sctx->pc_reuse.updates;
-  user->rec.stats.pc_finest_updates = user->prob.sctx->pc_reuse.finest_updates;
+  s->stats->newton_its     = *newton;
+  s->stats->ksp_its        = *ksp;
+  s->stats->residual_norm  = fnorm * s->prob->displacement_scale; /* the SNES saw F/U */
+  s->stats->residual_start = s->prob->sctx->fnorm0;
+  ref                      = SolverStopReference(s->prob->sctx);
+  s->stats->residual_reduced =
+      (PetscBool)(s->stats->residual_norm <= rtol * ref || s->stats->residual_norm <= s->opt->solver.load_rtol * s->prob->load_norm ||
+                  fnorm <= atol || s->prob->sctx->roundoff_stop || s->prob->sctx->energy_stop);
+  s->stats->roundoff_stop = s->prob->sctx->roundoff_stop;
+  s->stats->converged     = (PetscBool)(s->stats->reason > 0 && s->stats->residual_reduced);
+  PetscCall(SNESKSPGetUseEW(snes, &s->stats->ksp_ew));
+  s->stats->pc_builds         = s->prob->sctx->pc_reuse.enabled ? s->prob->sctx->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
+  s->stats->pc_updates        = s->prob->sctx->pc_reuse.updates;
+  s->stats->pc_finest_updates = s->prob->sctx->pc_reuse.finest_updates;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Appends the outcome of the last SolverSolve() to the table of solves (/solves in the output). */
-static PetscErrorCode SolverAddRecord(SNES snes, AppCtx *user, Vec u, PetscReal time_solve)
+static PetscErrorCode SolverAddRecord(SNES snes, Solver s, Vec u, PetscReal time_solve)
 {
   SolveRecord *r;
   DM           dm;
 
   PetscFunctionBeginUser;
-  if (user->rec.nrecords == user->rec.maxrecords) { /* grow */
+  if (*s->nrecords == *s->maxrecords) { /* grow */
     SolveRecord *grown;
 
-    user->rec.maxrecords = PetscMax(16, 2 * user->rec.maxrecords);
-    PetscCall(PetscMalloc1(user->rec.maxrecords, &grown));
-    if (user->rec.nrecords) PetscCall(PetscArraycpy(grown, user->rec.records, user->rec.nrecords));
-    PetscCall(PetscFree(user->rec.records));
-    user->rec.records = grown;
+    *s->maxrecords = PetscMax(16, 2 * (*s->maxrecords));
+    PetscCall(PetscMalloc1(*s->maxrecords, &grown));
+    if (*s->nrecords) PetscCall(PetscArraycpy(grown, *s->records, *s->nrecords));
+    PetscCall(PetscFree(*s->records));
+    *s->records = grown;
   }
-  r = &user->rec.records[user->rec.nrecords++];
+  r = &(*s->records)[(*s->nrecords)++];
   PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(ContactMaxNodePenetration(user->contact, u, &r->max_penetration));
+  PetscCall(ContactMaxNodePenetration(s->contact, u, &r->max_penetration));
   PetscCall(VecGetSize(u, &r->n_dofs));
-  r->level = user->prob.level;
-  r->h     = user->prob.h;
-  PetscCall(ContactGetEps(user->contact, &r->eps)); /* 0 for the types without eps */
-  r->newton_its         = user->rec.stats.newton_its;
-  r->ksp_its            = user->rec.stats.ksp_its;
-  r->pc_builds          = user->rec.stats.pc_builds;
-  r->converged          = user->rec.stats.converged;
-  r->time_setup         = user->prob.setup_time;
-  r->time_solve         = time_solve;
-  user->prob.setup_time = 0.0; /* counted once, with the first solve on the mesh */
+  r->level = s->prob->level;
+  r->h     = s->prob->h;
+  PetscCall(ContactGetEps(s->contact, &r->eps)); /* 0 for the types without eps */
+  r->newton_its       = s->stats->newton_its;
+  r->ksp_its          = s->stats->ksp_its;
+  r->pc_builds        = s->stats->pc_builds;
+  r->converged        = s->stats->converged;
+  r->time_setup       = s->prob->setup_time;
+  r->time_solve       = time_solve;
+  s->prob->setup_time = 0.0; /* counted once, with the first solve on the mesh */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* SNESSolve on x~ = u/U, or Q^T u/U in SNESVI's frames (and the bounds of SNESVI divided by U): see
    SolverIterateDisplacement(). */
-static PetscErrorCode SolverSNESSolve(SNES snes, AppCtx *user, Vec u)
+static PetscErrorCode SolverSNESSolve(SNES snes, Solver s, Vec u)
 {
-  const PetscReal U = user->prob.displacement_scale;
+  const PetscReal U = s->prob->displacement_scale;
 
   PetscFunctionBeginUser;
-  user->prob.sctx->snes_scale = U;
+  s->prob->sctx->snes_scale = U;
   PetscCall(VecScale(u, 1.0 / U));
-  PetscCall(ContactSolverFrame(user->contact, u, PETSC_TRUE)); /* the SNES's unknowns: Q^T u/U */
-  PetscCall(ContactScaleBounds(user->contact, 1.0 / U));
+  PetscCall(ContactSolverFrame(s->contact, u, PETSC_TRUE)); /* the SNES's unknowns: Q^T u/U */
+  PetscCall(ContactScaleBounds(s->contact, 1.0 / U));
   PetscCall(SNESSolve(snes, NULL, u));
-  PetscCall(SolverStepGuessDrop(&user->prob.sctx->step_guess)); /* unused if no linear solve came */
-  PetscCall(ContactSolverFrame(user->contact, u, PETSC_FALSE));
+  PetscCall(SolverStepGuessDrop(&s->prob->sctx->step_guess)); /* unused if no linear solve came */
+  PetscCall(ContactSolverFrame(s->contact, u, PETSC_FALSE));
   PetscCall(VecScale(u, U));
-  PetscCall(ContactScaleBounds(user->contact, U));
-  user->prob.sctx->snes_scale = 1.0;
+  PetscCall(ContactScaleBounds(s->contact, U));
+  s->prob->sctx->snes_scale = 1.0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* SolverSNESSolve() and RecordSolve(), then again from the last iterate after each recovery from a breakdown of the
    preconditioner (src/linear/pc_recovery.c) while one is left; the Newton steps and linear iterations of every attempt count. */
-static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *newton, PetscInt *ksp)
+static PetscErrorCode SolveRecovering(SNES snes, Solver s, Vec u, PetscInt *newton, PetscInt *ksp)
 {
-  const SolverCtx sc    = user->prob.sctx;
+  const SolverCtx sc    = s->prob->sctx;
   PetscBool       retry = PETSC_TRUE;
 
   PetscFunctionBeginUser;
-  PetscCall(SolverSNESSolve(snes, user, u));
-  PetscCall(RecordSolve(snes, user, newton, ksp));
-  while (!user->rec.stats.converged && retry) {
+  PetscCall(SolverSNESSolve(snes, s, u));
+  PetscCall(RecordSolve(snes, s, newton, ksp));
+  while (!s->stats->converged && retry) {
     PetscCall(PcRecoveryTry(&sc->pc_recovery, snes, sc->opt, &sc->pc_reuse, sc->stats, &retry));
     if (!retry) break;
-    PetscCall(SolverSNESSolve(snes, user, u));
-    PetscCall(RecordSolve(snes, user, newton, ksp));
+    PetscCall(SolverSNESSolve(snes, s, u));
+    PetscCall(RecordSolve(snes, s, newton, ksp));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -346,16 +368,16 @@ static PetscErrorCode SolveRecovering(SNES snes, AppCtx *user, Vec u, PetscInt *
    coarser solution already holds this problem's contact set to within the refinement. Otherwise as nested iteration
    does (SolverSolve()): below f h / M the new contact nodes, between an active and a free coarse one, start far off
    on the 1/eps scale. */
-PetscErrorCode SolverStartFromCoarser(const AppCtx *user, SolverStart *start)
+PetscErrorCode SolverStartFromCoarser(Contact contact, SolverStart *start)
 {
   const ContactOptions *copt;
   PetscReal             eps, eps_start;
 
   PetscFunctionBeginUser;
   *start = SOLVER_START_COARSER_MESH;
-  PetscCall(ContactGetOptions(user->contact, &copt));
-  PetscCall(ContactGetEps(user->contact, &eps));
-  PetscCall(ContactGetPenaltyScale(user->contact, &eps_start));
+  PetscCall(ContactGetOptions(contact, &copt));
+  PetscCall(ContactGetEps(contact, &eps));
+  PetscCall(ContactGetPenaltyScale(contact, &eps_start));
   if (eps > 0.0 && eps >= copt->continuation_factor * eps_start) *start = SOLVER_START_NEARBY_EPS; /* eps 0: a type without one */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -372,28 +394,28 @@ PetscErrorCode SolverStartFromCoarser(const AppCtx *user, SolverStart *start)
    solution, and the only one (the energy is strictly convex on the admissible set): its residual is exactly zero, no
    point presses, and every multiplier is zero. A step of a load path at the factor 0 is such a state: from the last
    step's solution Newton would take steps down to round-off, whose penetrations raise the contact warnings. */
-static PetscErrorCode SolverZeroData(DM dm, AppCtx *user, PetscBool *zero)
+static PetscErrorCode SolverZeroData(DM dm, Solver s, PetscBool *zero)
 {
   PetscReal r0;
 
   PetscFunctionBeginUser;
   *zero = PETSC_FALSE;
-  PetscCall(VecNorm(user->prob.r0, NORM_INFINITY, &r0));
+  PetscCall(VecNorm(s->prob->r0, NORM_INFINITY, &r0));
   if (r0 != 0.0) PetscFunctionReturn(PETSC_SUCCESS);
   {
     Vec       zero_u;
     PetscReal d;
 
-    PetscCall(VecDuplicate(user->prob.r0, &zero_u));
+    PetscCall(VecDuplicate(s->prob->r0, &zero_u));
     PetscCall(VecZeroEntries(zero_u));
-    PetscCall(ContactMaxPenetration(user->contact, dm, zero_u, &d));
+    PetscCall(ContactMaxPenetration(s->contact, dm, zero_u, &d));
     PetscCall(VecDestroy(&zero_u));
     *zero = (PetscBool)(d <= 0.0);
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
+PetscErrorCode SolverSolve(SNES snes, Solver s, Vec u, SolverStart start)
 {
   const PetscBool       warm = (PetscBool)(start != SOLVER_START_ZERO);
   PetscReal             eps_target, eps_start;
@@ -403,52 +425,52 @@ PetscErrorCode SolverSolve(SNES snes, AppCtx *user, Vec u, SolverStart start)
   const ContactOptions *copt;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetOptions(user->contact, &copt));
+  PetscCall(ContactGetOptions(s->contact, &copt));
   PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(ContactGetEps(user->contact, &eps_target));
-  PetscCall(ContactGetPenaltyScale(user->contact, &eps_start));
+  PetscCall(ContactGetEps(s->contact, &eps_target));
+  PetscCall(ContactGetPenaltyScale(s->contact, &eps_start));
   if (!warm) PetscCall(VecZeroEntries(u));
   {
     PetscBool zero;
 
-    PetscCall(SolverZeroData(dm, user, &zero));
+    PetscCall(SolverZeroData(dm, s, &zero));
     if (zero) { /* u = 0 exactly: the SNES finds |F| = 0 at its start and stops there, converged in no step */
       PetscCall(VecZeroEntries(u));
-      PetscCall(ContactForgetMultipliers(user->contact));
+      PetscCall(ContactForgetMultipliers(s->contact));
     }
   }
   /* -pc_type mg: the levels of the meshes solved so far */
-  PetscCall(MultigridSetUpPC(user->mg, snes, user->prob.level, &user->box, &user->opt->solver));
-  user->prob.sctx->warm = warm;
+  PetscCall(MultigridSetUpPC(s->mg, snes, s->prob->level, s->box, &s->opt->solver));
+  s->prob->sctx->warm = warm;
   PetscCall(PetscTime(&t0));
-  user->prob.sctx->pc_reuse.builds         = 0; /* counted per solve */
-  user->prob.sctx->pc_reuse.updates        = 0;
-  user->prob.sctx->pc_reuse.finest_updates = 0;
-  user->rec.stats.continuation_stages      = 0;
+  s->prob->sctx->pc_reuse.builds         = 0; /* counted per solve */
+  s->prob->sctx->pc_reuse.updates        = 0;
+  s->prob->sctx->pc_reuse.finest_updates = 0;
+  s->stats->continuation_stages          = 0;
   if (start != SOLVER_START_NEARBY_EPS && copt->continuation && eps_target < eps_start) { /* both 0 for a type without eps */
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= copt->continuation_factor) {
-      PetscCall(ContactSetEps(user->contact, dm, eps));
-      PetscCall(SolveRecovering(snes, user, u, &newton, &ksp));
-      user->rec.stats.continuation_stages++;
-      if (!user->rec.stats.converged) break; /* reported as the failure of the whole solve */
+      PetscCall(ContactSetEps(s->contact, dm, eps));
+      PetscCall(SolveRecovering(snes, s, u, &newton, &ksp));
+      s->stats->continuation_stages++;
+      if (!s->stats->converged) break; /* reported as the failure of the whole solve */
     }
-    PetscCall(ContactSetEps(user->contact, dm, eps_target));
+    PetscCall(ContactSetEps(s->contact, dm, eps_target));
   }
-  if (user->rec.stats.continuation_stages == 0 || user->rec.stats.converged) {
-    PetscCall(SolveRecovering(snes, user, u, &newton, &ksp));
+  if (s->stats->continuation_stages == 0 || s->stats->converged) {
+    PetscCall(SolveRecovering(snes, s, u, &newton, &ksp));
   }
   PetscCall(PetscTime(&t1));
-  user->rec.stats.time_solve += t1 - t0;
-  user->rec.stats.newton_its_total += newton;
-  user->rec.stats.ksp_its_total += ksp;
-  PetscCall(SolverAddRecord(snes, user, u, t1 - t0));
+  s->stats->time_solve += t1 - t0;
+  s->stats->newton_its_total += newton;
+  s->stats->ksp_its_total += ksp;
+  PetscCall(SolverAddRecord(snes, s, u, t1 - t0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode SolverSetStepEnergyStop(AppCtx *user, PetscReal energy)
+PetscErrorCode SolverSetStepEnergyStop(Problem *prob, PetscReal energy)
 {
   PetscFunctionBeginUser;
-  user->prob.sctx->step_energy_stop = energy;
+  prob->sctx->step_energy_stop = energy;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -460,21 +482,21 @@ PetscErrorCode SolverSetStepEnergyStop(AppCtx *user, PetscReal energy)
    where the direct run converges in 13. So the warm solve stops once SOLVER_STALL_STEPS Newton steps have not halved
    |F| (SolverConverged()), or on any failure, and the problem is solved again from zero as a direct run would be; both
    solves are in /solves and the Newton steps of both count. */
-PetscErrorCode SolverSolveWarm(SNES snes, AppCtx *user, Vec u, const char what[])
+PetscErrorCode SolverSolveWarm(SNES snes, Solver s, Vec u, const char what[])
 {
   SNESConvergedReason reason;
   PetscInt            its;
 
   PetscFunctionBeginUser;
-  user->prob.sctx->stall_stop = PETSC_TRUE;
-  PetscCall(SolverSolve(snes, user, u, SOLVER_START_NEARBY_EPS));
-  user->prob.sctx->stall_stop = PETSC_FALSE;
-  if (user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
+  s->prob->sctx->stall_stop = PETSC_TRUE;
+  PetscCall(SolverSolve(snes, s, u, SOLVER_START_NEARBY_EPS));
+  s->prob->sctx->stall_stop = PETSC_FALSE;
+  if (s->stats->converged) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetConvergedReason(snes, &reason));
   PetscCall(SNESGetIterationNumber(snes, &its));
   PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes), "  %s: the warm solve %s (%s, %" PetscInt_FMT " Newton steps); solved again from zero\n",
                         what, reason == SNES_DIVERGED_LINE_SEARCH ? "stalled" : "failed", SNESConvergedReasons[reason], its));
-  PetscCall(SolverSolve(snes, user, u, SOLVER_START_ZERO));
+  PetscCall(SolverSolve(snes, s, u, SOLVER_START_ZERO));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -482,7 +504,7 @@ PetscErrorCode SolverSolveWarm(SNES snes, AppCtx *user, Vec u, const char what[]
    the 1-norm condition number of the Jacobian at the solution (for vi: of K). J is symmetric, so J^-T x is a solve with J.
    SNESVI's linear solver holds the reduced system of the last active set, so vi gets a linear solver of its own for K,
    set up as the SNES's (the same defaults and options). */
-PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
+PetscErrorCode SolverConditionEstimate(SNES snes, Solver s, Vec u)
 {
   KSP                ksp, ksp_vi = NULL;
   Mat                J;
@@ -493,15 +515,15 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
   PetscBool          is_vi;
 
   PetscFunctionBeginUser;
-  user->rec.stats.condition_1norm = PETSC_NAN;
-  if (!user->opt->solver.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
+  s->stats->condition_1norm = PETSC_NAN;
+  if (!s->opt->solver.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)snes, &is_vi, SNESVINEWTONRSLS, SNESVINEWTONSSLS, ""));
   if (is_vi) { /* its KSP holds the reduced system of the last active set */
-    J = user->prob.K;
+    J = s->prob->K;
     PetscCall(KSPCreate(PetscObjectComm((PetscObject)snes), &ksp_vi));
-    PetscCall(SolverSetDefaultLinearSolver(ksp_vi, user));
+    PetscCall(SolverSetDefaultLinearSolver(ksp_vi, s->contact, &s->opt->solver, s->prob, s->mg));
     PetscCall(KSPSetFromOptions(ksp_vi));
     ksp = ksp_vi;
   } else
@@ -545,7 +567,7 @@ PetscErrorCode SolverConditionEstimate(SNES snes, AppCtx *user, Vec u)
     PetscCall(VecAssemblyBegin(x));
     PetscCall(VecAssemblyEnd(x));
   }
-  user->rec.stats.condition_1norm = normJ * est;
+  s->stats->condition_1norm = normJ * est;
   PetscCall(VecDestroy(&x));
   PetscCall(VecDestroy(&y));
   PetscCall(KSPDestroy(&ksp_vi));

@@ -13,6 +13,19 @@
    (SolverConverged()): it has stalled, and is solved again from zero. */
 #define SOLVER_STALL_STEPS 6
 
+/* The solver object (include/solver.h): what a solve reads and where its outcome goes; it owns none of them. */
+struct _n_Solver {
+  Problem          *prob; /* the problem on the current mesh: AppCtx's own for now, since the drivers still read user->prob directly */
+  Contact           contact;
+  const RunOptions *opt;
+  Multigrid         mg;  /* the nested meshes' multigrid (-pc_type mg) */
+  const MeshBox    *box; /* the box of the mesh options, whose levels the multigrid's are */
+  /* where the solves record: the run's statistics, and the table of solves (one record per solve) with its length and capacity */
+  RunStats     *stats;
+  SolveRecord **records;
+  PetscInt     *nrecords, *maxrecords;
+};
+
 struct _n_SolverCtx {
   /* the problem the callbacks solve: F(u) = K u + r0 + (contact term) */
   Mat                  K;       /* the bulk operator (the Jacobian is made in it: ContactComputeJacobian()) */
@@ -66,5 +79,7 @@ PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx
 PetscErrorCode SolverSetStepGuess(SolverCtx sc, Vec du);
 
 /* extrapolated_start.c */
-PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec dir, PetscReal factor, PetscReal relaxed, PetscBool step_guess);
-PetscErrorCode SolverSecantStart(SNES snes, DM dm, AppCtx *user, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor, PetscReal relaxed);
+PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, Contact contact, SolverCtx sc, Vec u, Vec dir, PetscReal factor, PetscReal relaxed,
+                                       PetscBool step_guess);
+PetscErrorCode SolverSecantStart(SNES snes, DM dm, Contact contact, SolverCtx sc, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor,
+                                 PetscReal relaxed);
