@@ -234,3 +234,23 @@ def test_the_method_answers_for_itself():
                 calls.append((os.path.relpath(path, ROOT), i + 1, "/*" in context))
     assert len(calls) <= 8, calls
     assert all(commented for _, _, commented in calls), [c for c in calls if not c[2]]
+
+
+APPCTX_FUNCTION = re.compile(r"^(?:static\s+)?(?:inline\s+)?[A-Za-z_][\w \*]*?\b(\w+)\s*\(([^;{}]*?)\)\s*\{", re.M | re.S)
+
+
+def test_functions_take_what_they_use():
+    """At most 25 function definitions take the whole run state AppCtx (issue 62: 135 did; the discretization, the
+    physics, the verification, the estimate, the output, the linear acceleration and the Newton core take none now,
+    only the drivers of src/solver/ and src/main.c, where they hand the state on). The layers below the drivers never
+    do."""
+    takers = []
+    for path, text in sources().items():
+        for m in APPCTX_FUNCTION.finditer(text):
+            if re.search(r"\bAppCtx\b", m.group(2)):
+                takers.append((path, m.group(1)))
+    assert len(takers) <= 25, takers
+    core = ("solver.c", "problem.c", "newton.c", "extrapolated_start.c", "contact_monitor.c")
+    below = [t for t in takers if not (t[0].startswith(os.path.join("src", "solver")) or t[0] == os.path.join("src", "main.c"))
+             or os.path.basename(t[0]) in core]
+    assert not below, below
