@@ -1,5 +1,5 @@
 """scripts/regression.py (make test): the record-and-compare tool that shows a change of structure keeps every number.
-Two runs recorded twice compare equal; a changed displacement, iteration count or attribute is found."""
+Two runs recorded twice compare equal; a changed displacement, iteration count, table row or attribute is found."""
 import os
 import shutil
 import subprocess
@@ -27,7 +27,7 @@ def test_regression_script_finds_a_changed_number(outdir):
         assert p.returncode == 0, p.stdout
     p = regression("--runs", runs, "compare", os.path.join(base, "a"), os.path.join(base, "b"))
     assert p.returncode == 0 and "2 same, 0 different" in p.stdout, p.stdout
-    for change in ("field", "iterations", "attribute"):
+    for change in ("field", "iterations", "table", "attribute"):
         c = os.path.join(base, "c")
         shutil.rmtree(c, ignore_errors=True)
         shutil.copytree(os.path.join(base, "b"), c)
@@ -36,6 +36,8 @@ def test_regression_script_finds_a_changed_number(outdir):
                 f["vertex_fields/displacement"][0, 1] *= 1.0 + 1e-10
             elif change == "iterations":
                 f["run"].attrs["newton_its"] = f["run"].attrs["newton_its"] + 1
+            elif change == "table":  # a row of /solves (the compare reads /solves, /steps and /cycles too)
+                f["solves/newton_its"][0] += 1
             else:
                 f["run"].attrs["extra"] = 1.0
         p = regression("--runs", runs, "compare", os.path.join(base, "a"), c)
