@@ -6,49 +6,47 @@
 #include <stdarg.h>
 #include "app.h"
 
-static PetscErrorCode RunAttrName(char name[], size_t len, const char format[], va_list ap)
+/* The attribute of /run whose name the format and its arguments make, of the given type. */
+static PetscErrorCode RunAttrWrite(PetscViewer v, PetscDataType type, const void *value, const char format[], va_list ap)
 {
+  char name[256];
+
   PetscFunctionBeginUser;
-  PetscCheck(vsnprintf(name, len, format, ap) < (int)len, PETSC_COMM_SELF, PETSC_ERR_PLIB, "The attribute name %s is too long", format);
+  PetscCheck(vsnprintf(name, sizeof(name), format, ap) < (int)sizeof(name), PETSC_COMM_SELF, PETSC_ERR_PLIB, "The attribute name %s is too long",
+             format);
+  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", name, type, value));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* va_end() runs before an error returns */
+#define RUN_ATTR(v, type, value, format)             \
+  do {                                               \
+    va_list        ap;                               \
+    PetscErrorCode ierr;                             \
+    va_start(ap, format);                            \
+    ierr = RunAttrWrite(v, type, value, format, ap); \
+    va_end(ap);                                      \
+    PetscCall(ierr);                                 \
+  } while (0)
+
 PetscErrorCode RunAttrReal(PetscViewer v, PetscReal value, const char format[], ...)
 {
-  char    name[256];
-  va_list ap;
-
   PetscFunctionBeginUser;
-  va_start(ap, format);
-  PetscCall(RunAttrName(name, sizeof(name), format, ap));
-  va_end(ap);
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", name, PETSC_REAL, &value));
+  RUN_ATTR(v, PETSC_REAL, &value, format);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode RunAttrInt(PetscViewer v, PetscInt value, const char format[], ...)
 {
-  char    name[256];
-  va_list ap;
-
   PetscFunctionBeginUser;
-  va_start(ap, format);
-  PetscCall(RunAttrName(name, sizeof(name), format, ap));
-  va_end(ap);
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", name, PETSC_INT, &value));
+  RUN_ATTR(v, PETSC_INT, &value, format);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode RunAttrString(PetscViewer v, const char value[], const char format[], ...)
 {
-  char    name[256];
-  va_list ap;
-
   PetscFunctionBeginUser;
-  va_start(ap, format);
-  PetscCall(RunAttrName(name, sizeof(name), format, ap));
-  va_end(ap);
-  PetscCall(PetscViewerHDF5WriteAttribute(v, "/run", name, PETSC_STRING, value));
+  RUN_ATTR(v, PETSC_STRING, value, format);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
