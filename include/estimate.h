@@ -27,7 +27,7 @@ PetscErrorCode EstimateView(MPI_Comm comm, const ErrorEstimate *est, const Error
 /* marking.c: the cells an adaptive refinement refines (Doerfler's bulk criterion) */
 PetscErrorCode EstimateMark(DM dm, const ErrorEstimate *est, PetscReal theta, DMLabel *marked, PetscInt *nmarked);
 /* cycle_bars.c: the bars of -accuracy's quantities on the adaptive cycles */
-#define CYCLE_EPS_RATIO 10.0 /* the quantities' penalty parts on a cycle: their values at eps / CYCLE_EPS_RATIO (src/solver/adapt.c) */
+#define CYCLE_EPS_RATIO 10.0 /* the quantities' penalty parts on a cycle: their values at eps / CYCLE_EPS_RATIO (src/drivers/adapt.c) */
 /* the values and bars of cycles[last], from the cycles before it */
 PetscErrorCode CycleBarsCompute(CycleRecord cycles[], PetscInt dim, PetscInt last);
 PetscReal      CycleBarsPenaltyPart(const CycleRecord *c, PetscInt k);

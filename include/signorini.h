@@ -377,7 +377,7 @@ typedef struct {
   PetscReal factor[LOAD_PATH_MAX];
 } LoadPathOptions;
 
-/* Adaptive refinement (-adapt_cycles, src/solver/adapt.c): the cycles of estimate, mark, refine and solve after the
+/* Adaptive refinement (-adapt_cycles, src/drivers/adapt.c): the cycles of estimate, mark, refine and solve after the
    first solve, and the fraction of the estimate's square the marked cells hold (Doerfler's theta). */
 typedef enum { ACCURACY_ENERGY, ACCURACY_FORCE, ACCURACY_PRESSURE, ACCURACY_SIZE, ACCURACY_PEAK, ACCURACY_NUM } AccuracyQuantity;
 extern const char *const AccuracyQuantities[];
@@ -496,40 +496,27 @@ typedef struct {
   SolverCtx    sctx;               /* the SNES's callbacks' context and the solver's own state (src/solver/solver_impl.h) */
 } Problem;
 
-/* What the run produced: statistics, one row per solve, error norms; the summary and the writer only read it. */
-typedef struct {
-  RunStats      stats;
-  SolveRecord  *records; /* one per solve, any number */
-  PetscInt      nrecords, maxrecords;
-  StepRecord   *steps;       /* one per step of a load path solved (the failed one included) */
-  Vec          *step_fields; /*   and its state at the vertices, OUTPUT_STATE_FIELDS per step (include/io.h) */
-  PetscInt      nsteps;
-  CycleRecord  *cycles; /* one per mesh of the adaptive refinement (-adapt_cycles) */
-  PetscInt      ncycles;
-  PetscReal     adapt_fraction;                /*   the fraction of the estimate's square they marked (Doerfler's theta) */
-  AdaptStop     adapt_stop;                    /*   and why they stopped */
-  PetscBool     accuracy_target[ACCURACY_NUM]; /* the quantities -accuracy asked for on this mesh's dimension (AdaptTargets()) */
-  ErrorNorms    errors;                        /* against the scene's exact solution */
-  ErrorNorms    ref_errors;                    /* against the -reference solution */
-  ErrorEstimate estimate;                      /* the a posteriori estimate of the error */
-  ErrorBars     bars;                          /* the error bars of the quantities (-bars) */
-  char          diagnostics_failed[1024];      /* the diagnostics that failed after the solve, with their messages ("" if none) */
-} RunRecord;
-
-/* The state of a run, by concern: its options, its scene, the problem on the current mesh, the hierarchy of the meshes
-   solved before it, and its record. */
+/* The state of a run, as a few handles and the diagnostics' results: its options, the Contact, the mesh's box, the
+   scene, the nested meshes' multigrid, the Newton core (which owns the problem on the current mesh, the run's
+   statistics and the table of solves), the drivers (each with its results: the cycles, the steps), and the results
+   of the diagnostics after the solve, each of its module's type. */
 typedef struct _p_Contact   *Contact;   /* include/contact.h */
 typedef struct _n_Multigrid *Multigrid; /* the nested meshes' interpolations, private to src/linear/ (linear_impl.h) */
-typedef struct _n_Solver    *Solver;    /* the nonlinear core's solver object (include/solver.h), private to src/solver/ (solver_impl.h) */
+typedef struct _n_Solver    *Solver;    /* the nonlinear core (include/solver.h), private to src/solver/ (solver_impl.h) */
+typedef struct _n_Drivers   *Drivers;   /* the outer strategies (include/drivers.h), private to src/drivers/ */
 typedef struct {
   const RunOptions *opt;     /* read once before any set-up, then read only */
   Contact           contact; /* created and read from the options once, set up on the mesh of each problem */
   MeshBox           box;     /* the simplex box of the mesh options, if the mesh is one (MeshCreate()) */
   Scene             scene;
-  Problem           prob;
-  Multigrid         mg; /* the interpolations between the nested meshes solved so far */
-  RunRecord         rec;
-  Solver            solver; /* the nonlinear core: what a solve reads (the problem, the Contact, the options) and where it records */
+  Multigrid         mg;                       /* the interpolations between the nested meshes solved so far */
+  Solver            solver;                   /* the nonlinear core: the problem, the statistics, the table of solves */
+  Drivers           drivers;                  /* the grid sequence, the adaptive cycles, the eps sweep, ..., the load path */
+  ErrorNorms        errors;                   /* against the scene's exact solution (src/verify/error_norms.c) */
+  ErrorNorms        ref_errors;               /* against the -reference solution (src/verify/reference.c) */
+  ErrorEstimate     estimate;                 /* the a posteriori estimate of the error (src/estimate/) */
+  ErrorBars         bars;                     /* the error bars of the quantities (-bars, src/estimate/bars.c) */
+  char              diagnostics_failed[1024]; /* the diagnostics that failed after the solve, with their messages ("" if none) */
 } AppCtx;
 
 /* The writer of the run's output (src/main.c's, through io/output_hdf5.c's OutputWriteHDF5()), which main() hands to the adaptive cycles */

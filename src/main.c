@@ -6,6 +6,7 @@ static const char help[] =
 #include "app.h"
 #include "contact.h"
 #include "discretization.h"
+#include "drivers.h"
 #include "estimate.h"
 #include "linear.h"
 #include "scenes.h"
@@ -17,19 +18,22 @@ static const char help[] =
 
 static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
 {
-  MPI_Comm        comm = PetscObjectComm((PetscObject)dm);
-  const RunStats *s    = &user->rec.stats;
-  PetscInt        dim, ndofs;
-  PetscMPIInt     size;
+  MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
+  const RunStats    *s    = SolverStats(user->solver);
+  const Problem     *prob = SolverProblem(user->solver);
+  const SolveRecord *records;
+  PetscInt           dim, ndofs, nrecords;
+  PetscMPIInt        size;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetSize(u, &ndofs));
+  PetscCall(SolverGetSolves(user->solver, &records, &nrecords));
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PetscPrintf(comm, "scene %s, %" PetscInt_FMT "D, ", user->scene.name, dim));
   PetscCall(ContactView(user->contact, PETSC_VIEWER_STDOUT_(comm))); /* method penalty (gauss quadrature, eps = ...) */
   PetscCall(PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, largest cell h = %g, %d rank(s)\n", user->opt->degree, ndofs,
-                        (double)user->prob.h, size));
+                        (double)prob->h, size));
   if (s->default_mg)
     PetscCall(PetscPrintf(comm,
                           "  linear solver: CG with the geometric multigrid of the %" PetscInt_FMT
@@ -50,18 +54,17 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
                               "h^2/8R, which eps does not reduce)"
                             : "",
                         (double)s->contact_force, (double)s->energy));
-  if (!PetscIsNanReal(user->rec.errors.h1))
+  if (!PetscIsNanReal(user->errors.h1))
     PetscCall(PetscPrintf(comm, "  error against the exact solution: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n",
-                          (double)user->rec.errors.h1, (double)user->rec.errors.l2, (double)user->rec.errors.pressure_l2,
-                          (double)user->rec.errors.pressure_dual));
-  if (!PetscIsNanReal(user->rec.ref_errors.h1))
+                          (double)user->errors.h1, (double)user->errors.l2, (double)user->errors.pressure_l2, (double)user->errors.pressure_dual));
+  if (!PetscIsNanReal(user->ref_errors.h1))
     PetscCall(PetscPrintf(comm, "  error against the reference: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n",
-                          (double)user->rec.ref_errors.h1, (double)user->rec.ref_errors.l2, (double)user->rec.ref_errors.pressure_l2,
-                          (double)user->rec.ref_errors.pressure_dual));
-  if (user->rec.nrecords > 1) {
+                          (double)user->ref_errors.h1, (double)user->ref_errors.l2, (double)user->ref_errors.pressure_l2,
+                          (double)user->ref_errors.pressure_dual));
+  if (nrecords > 1) {
     PetscCall(PetscPrintf(comm, "  solves: level   dofs        h           eps         Newton  Krylov  PC builds  setup s   solve s\n"));
-    for (PetscInt i = 0; i < user->rec.nrecords; ++i) {
-      const SolveRecord *r = &user->rec.records[i];
+    for (PetscInt i = 0; i < nrecords; ++i) {
+      const SolveRecord *r = &records[i];
 
       PetscCall(PetscPrintf(comm,
                             "          %5" PetscInt_FMT "  %9" PetscInt_FMT "  %.4e  %.4e  %6" PetscInt_FMT "  %6" PetscInt_FMT "  %9" PetscInt_FMT
@@ -70,14 +73,17 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
                             (double)r->time_solve, r->converged ? "" : "  FAILED"));
     }
   }
-  PetscCall(LoadPathView(comm, &user->opt->load_path, &user->scene, &user->rec));
-  PetscCall(AdaptView(comm, &user->opt->adapt, &user->rec, (PetscBool)(user->scene.exact != NULL)));
-  PetscCall(EstimateView(comm, &user->rec.estimate, &user->rec.errors));
-  PetscCall(BarsView(comm, &user->rec.bars));
+  {
+    const DriverReport r = {.opt = user->opt, .scene = &user->scene, .contact = user->contact, .stats = s, .dim = dim};
+
+    PetscCall(DriversView(user->drivers, comm, &r)); /* the adaptive cycles, the load path */
+  }
+  PetscCall(EstimateView(comm, &user->estimate, &user->errors));
+  PetscCall(BarsView(comm, &user->bars));
   PetscCall(ContactChecksWarnings(comm, &s->checks, PETSC_TRUE, NULL));
-  if (user->rec.diagnostics_failed[0])
+  if (user->diagnostics_failed[0])
     PetscCall(
-        PetscPrintf(comm, "  WARNING: written without a diagnostic that failed after the solve (exit status 4): %s\n", user->rec.diagnostics_failed));
+        PetscPrintf(comm, "  WARNING: written without a diagnostic that failed after the solve (exit status 4): %s\n", user->diagnostics_failed));
   if (s->pc_breakdowns) PetscCall(PetscPrintf(comm, "  preconditioner breakdowns: %" PetscInt_FMT " (%s)\n", s->pc_breakdowns, s->pc_recovery));
   if (s->continuation_stages)
     PetscCall(PetscPrintf(comm, "  eps continuation: %" PetscInt_FMT " solve(s) from eps = h/M before the target eps (counted in the Newton steps)\n",
@@ -103,51 +109,55 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
    order of the run: the scene, the method, the solve and its drivers, the distribution. */
 static PetscErrorCode WriteResults(DM dm, Vec u, PetscViewer v, void *ctx)
 {
-  const AppCtx *user = (const AppCtx *)ctx;
-  MPI_Comm      comm = PetscObjectComm((PetscObject)dm);
-  PetscInt      dim;
+  const AppCtx      *user  = (const AppCtx *)ctx;
+  MPI_Comm           comm  = PetscObjectComm((PetscObject)dm);
+  const RunStats    *stats = SolverStats(user->solver);
+  const SolveRecord *records;
+  PetscInt           dim, nrecords;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(RunAttrReal(v, user->rec.stats.time_total, "time_total"));
-  PetscCall(RunAttrReal(v, user->rec.stats.peak_memory_mb, "peak_memory_mb"));
-  PetscCall(RunAttrReal(v, user->rec.stats.peak_memory_total_mb, "peak_memory_total_mb"));
-  if (user->rec.diagnostics_failed[0]) PetscCall(RunAttrString(v, user->rec.diagnostics_failed, "diagnostics_failed"));
+  PetscCall(SolverGetSolves(user->solver, &records, &nrecords));
+  PetscCall(RunAttrReal(v, stats->time_total, "time_total"));
+  PetscCall(RunAttrReal(v, stats->peak_memory_mb, "peak_memory_mb"));
+  PetscCall(RunAttrReal(v, stats->peak_memory_total_mb, "peak_memory_total_mb"));
+  if (user->diagnostics_failed[0]) PetscCall(RunAttrString(v, user->diagnostics_failed, "diagnostics_failed"));
   PetscCall(MeshBoxWrite(&user->box, v));
   PetscCall(SceneWrite(&user->scene, &user->opt->material, dim, v));
   PetscCall(ContactWrite(user->contact, v));
-  PetscCall(PostprocessWrite(&user->rec.stats, &user->scene.bcs, dim, v));
-  PetscCall(ContactChecksWrite(comm, &user->rec.stats.checks, v));
-  PetscCall(VerifyWrite(&user->opt->verify, &user->rec.errors, &user->rec.ref_errors, v));
-  PetscCall(EstimateWrite(&user->rec.estimate, v));
-  PetscCall(BarsWrite(&user->rec.bars, v));
-  PetscCall(SolverWrite(&user->rec.stats, &user->prob, &user->opt->solver, user->box.coarse_levels, user->rec.nrecords, v));
-  PetscCall(SolverWriteSolves(comm, user->rec.records, user->rec.nrecords, v));
-  PetscCall(PenetrationTolWrite(user->contact, &user->rec.stats, v));
-  PetscCall(LoadPathWrite(comm, &user->scene, &user->rec.stats, user->rec.steps, user->rec.nsteps, dim, v));
-  PetscCall(AdaptWrite(comm, &user->opt->adapt, &user->rec, dim, v));
-  PetscCall(BandwidthWrite(&user->rec.stats.bandwidth, v));
-  PetscCall(MeshPartitionWrite(&user->rec.stats.partition, v));
+  PetscCall(PostprocessWrite(stats, &user->scene.bcs, dim, v));
+  PetscCall(ContactChecksWrite(comm, &stats->checks, v));
+  PetscCall(VerifyWrite(&user->opt->verify, &user->errors, &user->ref_errors, v));
+  PetscCall(EstimateWrite(&user->estimate, v));
+  PetscCall(BarsWrite(&user->bars, v));
+  PetscCall(SolverWrite(stats, SolverProblem(user->solver), &user->opt->solver, user->box.coarse_levels, nrecords, v));
+  PetscCall(SolverWriteSolves(comm, records, nrecords, v));
+  {
+    const DriverReport r = {.opt = user->opt, .scene = &user->scene, .contact = user->contact, .stats = stats, .dim = dim};
+
+    PetscCall(DriversWrite(user->drivers, comm, &r, v)); /* the cycles, the penetration tolerance, the steps */
+  }
+  PetscCall(BandwidthWrite(&stats->bandwidth, v));
+  PetscCall(MeshPartitionWrite(&stats->partition, v));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The output file: the mesh and the fields (src/io/), and the results (WriteResults()). */
 static PetscErrorCode WriteOutput(DM dm, const AppCtx *user, Vec u)
 {
-  const OutputContent out = {.path          = user->opt->output,
-                             .dmview        = user->opt->output_dmview,
-                             .contact       = user->contact,
-                             .loc_bc        = user->prob.loc_bc,
-                             .scene         = &user->scene,
-                             .degree        = user->opt->degree,
-                             .nsteps        = user->rec.nsteps,
-                             .step_fields   = user->rec.step_fields,
-                             .bars          = &user->rec.bars,
-                             .estimate      = &user->rec.estimate,
-                             .write_results = WriteResults,
-                             .ctx           = (void *)user};
+  OutputContent out = {.path          = user->opt->output,
+                       .dmview        = user->opt->output_dmview,
+                       .contact       = user->contact,
+                       .loc_bc        = SolverProblem(user->solver)->loc_bc,
+                       .scene         = &user->scene,
+                       .degree        = user->opt->degree,
+                       .bars          = &user->bars,
+                       .estimate      = &user->estimate,
+                       .write_results = WriteResults,
+                       .ctx           = (void *)user};
 
   PetscFunctionBeginUser;
+  PetscCall(DriversGetStepFields(user->drivers, &out.nsteps, &out.step_fields)); /* a load path's time series */
   PetscCall(OutputWriteHDF5(dm, u, &out));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -223,6 +233,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
 {
   AppCtx         user;
   RunOptions     opt;
+  Problem       *prob;  /* the solver's, on the current mesh */
+  RunStats      *stats; /* the solver's */
   DM             dm;
   SNES           snes;
   Vec            u;
@@ -237,6 +249,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(OutputFileInstallCleanup());
   PetscCall(OptionsCheckValuesGiven(comm)); /* -young_modulus without its value is not the default */
   PetscCall(SceneRegisterAll());
+  PetscCall(DriverRegisterAll());
   /* the options phase: every module reads its options once, into opt, which is read only after it */
   PetscCall(SceneGetOptions(comm, opt.scene_name, sizeof(opt.scene_name)));
   PetscCall(ElasticityGetOptions(comm, &opt.material, &opt.degree, &opt.section_check));
@@ -251,26 +264,29 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(AdaptGetOptions(comm, &opt.adapt));
   PetscCall(BandwidthGetOptions(comm, &opt.perf_bandwidth));
   user.opt = &opt;
+  PetscCall(DriversCreate(WriteOutput, &user.drivers)); /* the run's flow after the set-up: include/drivers.h */
 
   {
     PetscInt  coarse_requests[2], coarse_faces[3], coarse_min_levels;
-    PetscBool default_mg;
+    PetscBool coarse_mg, default_mg;
 
-    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, coarse_requests, coarse_faces, &coarse_min_levels, &user.rec.stats.coarse_mg,
-                                        &default_mg));
-    PetscCall(MultigridCreate(user.rec.stats.coarse_mg, &user.mg));
+    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, coarse_requests, coarse_faces, &coarse_min_levels, &coarse_mg, &default_mg));
+    PetscCall(MultigridCreate(coarse_mg, &user.mg));
     PetscCall(MeshCreate(comm, opt.solver.grid_sequence, coarse_requests, coarse_faces, coarse_min_levels, &user.box, &dm));
-    user.rec.stats.default_mg = (PetscBool)(default_mg && user.box.dim == 3 && user.box.coarse_levels > 0);
-    PetscCall(MultigridSetDefault(user.mg, user.rec.stats.default_mg));
+    PetscCall(SolverCreate(&opt, user.contact, user.mg, &user.box, &user.solver)); /* the solves' object, for the whole run */
+    prob              = SolverProblem(user.solver);
+    stats             = SolverStats(user.solver);
+    stats->coarse_mg  = coarse_mg;
+    stats->default_mg = (PetscBool)(default_mg && user.box.dim == 3 && user.box.coarse_levels > 0);
+    PetscCall(MultigridSetDefault(user.mg, stats->default_mg));
   }
-  PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));        /* the partitioner; the final mesh's cut is taken after the solve */
+  PetscCall(MeshPartitionGetStats(dm, &stats->partition));                /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(LoadPathSetUp(comm, &opt, user.contact, &user.scene));        /* a load path: the scene at its first factor */
   /* -bars on tetrahedra: the final mesh's eps on the levels below it */
-  PetscCall(GridSequenceBarsSizes(dm, &opt, user.contact, &user.box, user.prob.level));
+  PetscCall(GridSequenceBarsSizes(dm, &opt, user.contact, &user.box, prob->level));
   if (opt.adapt.cycles || (opt.bars && opt.adapt.model[0])) /* one eps on Gamma_C: the remeshed meshes do not nest */
     PetscCall(MeshSetContactCellSizes(dm, user.scene.bcs.ncontact, user.scene.bcs.contact_ids));
-  PetscCall(SolverCreate(&opt, user.contact, user.mg, &user.box, &user.prob, &user.rec, &user.solver)); /* the solves' object, for the whole run */
   PetscCall(ProblemSetUp(dm, user.solver, &user.scene, &snes));
   { /* before the solve, not after it */
     const VerifyRun verify = {.opt = &opt.verify, .scene = &user.scene, .mat = &opt.material, .degree = opt.degree};
@@ -280,8 +296,8 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(EstimateCheckSupported(dm, opt.estimate, opt.estimate_given, opt.degree)); /* -estimate on a discretization it does not cover */
   PetscCall(BarsCheck(comm, opt.bars, user.box.coarse_levels + opt.solver.grid_sequence, user.contact)); /* -bars without three nested meshes */
   PetscCall(AdaptCheck(dm, &opt, user.contact, &user.box, &user.scene));                                 /* -adapt_cycles where it cannot refine */
-  PetscCall(EstimateReset(&user.rec.estimate));
-  PetscCall(BarsReset(&user.rec.bars));
+  PetscCall(EstimateReset(&user.estimate));
+  PetscCall(BarsReset(&user.bars));
   { /* initial overlap, an obstacle facing away, a curved boundary refined on its chords, a locking body: warnings */
     const ContactChecksGeometryInputs in = {.contact          = user.contact,
                                             .scene            = &user.scene,
@@ -290,30 +306,26 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
                                             .box              = &user.box,
                                             .grid_refinements = opt.adapt.model[0] ? 0 : opt.solver.grid_sequence}; /* a model remeshes */
 
-    PetscCall(ContactChecksGeometry(dm, &in, &user.rec.stats.checks));
+    PetscCall(ContactChecksGeometry(dm, &in, &stats->checks));
   }
-  PetscCall(VecDuplicate(user.prob.r0, &u)); /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
+  PetscCall(VecDuplicate(prob->r0, &u)); /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
   PetscCall(DMSNESCheckFromOptions(snes, u));       /* -dmsnes_check: PETSc's checks against the exact solution */
   PetscCall(OptionsCheckAllUsed(comm, PETSC_TRUE)); /* a misspelled option before the solve, not after it */
   PetscCall(PetscTime(&t1));
-  user.rec.stats.time_setup = t1 - t0;
+  stats->time_setup = t1 - t0;
 
-  PetscCall(GridSequenceSolve(&dm, &user, &snes, &u));       /* one solve without nested iteration */
-  PetscCall(AdaptSolve(&dm, &user, &snes, &u, WriteOutput)); /* -adapt_cycles: refined where the estimate is largest; each cycle written */
-  PetscCall(EpsSweepSolve(dm, &user, snes, u));
-  PetscCall(PenetrationTolSolve(dm, &user, snes, u)); /* -contact_penetration_tol: eps lowered until the penetration is reached */
-  PetscCall(LoadPathSolve(dm, &user, snes, u));       /* the steps after the first, each from the last */
+  PetscCall(DriversSolve(user.drivers, &user, &dm, &snes, &u)); /* the first solve, the cycles, the sweep, ..., the load path */
   PetscCall(SolverConditionEstimate(snes, user.solver, u));
-  PetscCall(PostprocessContact(dm, user.contact, &user.prob, &user.scene.bcs, &opt.material, u, &user.rec.stats));
+  PetscCall(PostprocessContact(dm, user.contact, prob, &user.scene.bcs, &opt.material, u, stats));
   if (opt.bars) { /* -bars: from the levels' quantities and this mesh's */
     Quantities q;
 
-    PostprocessGetQuantities(&user.rec.stats, &q);
-    PetscCall(BarsCompute(dm, &user.scene.bcs, user.contact, &q, user.rec.stats.converged, &user.rec.bars));
+    PostprocessGetQuantities(stats, &q);
+    PetscCall(BarsCompute(dm, &user.scene.bcs, user.contact, &q, stats->converged, &user.bars));
   }
   /* cells across the contact zone, contact the mesh does not see: warnings */
-  PetscCall(ContactChecksResolution(dm, user.contact, &user.scene.bcs, user.rec.stats.contact_force_vector, u, &user.rec.stats.checks));
+  PetscCall(ContactChecksResolution(dm, user.contact, &user.scene.bcs, stats->contact_force_vector, u, &stats->checks));
   { /* diagnostics: a failure there is reported and the output written without them, never the solve lost */
     char       failed[512];
     Diagnostic d = {
@@ -324,65 +336,67 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
                            .mat     = &opt.material,
                            .degree  = opt.degree,
                            .contact = user.contact,
-                           .h       = user.prob.h,
-                           .loc_bc  = user.prob.loc_bc,
-                           .K       = user.prob.K},
+                           .h       = prob->h,
+                           .loc_bc  = prob->loc_bc,
+                           .K       = prob->K},
         .estimate       = {.scene   = &user.scene,
                            .mat     = &opt.material,
                            .verify  = &opt.verify,
                            .contact = user.contact,
                            .degree  = opt.degree,
-                           .loc_bc  = user.prob.loc_bc},
+                           .loc_bc  = prob->loc_bc},
         .estimate_asked = opt.estimate,
-        .errors         = &user.rec.errors,
-        .ref_errors     = &user.rec.ref_errors,
-        .est            = &user.rec.estimate,
+        .errors         = &user.errors,
+        .ref_errors     = &user.ref_errors,
+        .est            = &user.estimate,
     };
 
     PetscCall(AppDiagnosticRun("error norms", DiagnosticErrorNorms, &d, failed, sizeof(failed)));
     if (failed[0]) {
-      PetscCall(ErrorNormsReset(&user.rec.errors));
-      PetscCall(PetscStrlcat(user.rec.diagnostics_failed, failed, sizeof(user.rec.diagnostics_failed)));
+      PetscCall(ErrorNormsReset(&user.errors));
+      PetscCall(PetscStrlcat(user.diagnostics_failed, failed, sizeof(user.diagnostics_failed)));
     }
     PetscCall(AppDiagnosticRun("-reference comparison", DiagnosticReference, &d, failed, sizeof(failed)));
     if (failed[0]) {
-      PetscCall(ErrorNormsReset(&user.rec.ref_errors));
-      if (user.rec.diagnostics_failed[0]) PetscCall(PetscStrlcat(user.rec.diagnostics_failed, "; ", sizeof(user.rec.diagnostics_failed)));
-      PetscCall(PetscStrlcat(user.rec.diagnostics_failed, failed, sizeof(user.rec.diagnostics_failed)));
+      PetscCall(ErrorNormsReset(&user.ref_errors));
+      if (user.diagnostics_failed[0]) PetscCall(PetscStrlcat(user.diagnostics_failed, "; ", sizeof(user.diagnostics_failed)));
+      PetscCall(PetscStrlcat(user.diagnostics_failed, failed, sizeof(user.diagnostics_failed)));
     }
     PetscCall(AppDiagnosticRun("error estimate", DiagnosticEstimate, &d, failed, sizeof(failed)));
     if (failed[0]) {
-      PetscCall(EstimateReset(&user.rec.estimate));
-      if (user.rec.diagnostics_failed[0]) PetscCall(PetscStrlcat(user.rec.diagnostics_failed, "; ", sizeof(user.rec.diagnostics_failed)));
-      PetscCall(PetscStrlcat(user.rec.diagnostics_failed, failed, sizeof(user.rec.diagnostics_failed)));
+      PetscCall(EstimateReset(&user.estimate));
+      if (user.diagnostics_failed[0]) PetscCall(PetscStrlcat(user.diagnostics_failed, "; ", sizeof(user.diagnostics_failed)));
+      PetscCall(PetscStrlcat(user.diagnostics_failed, failed, sizeof(user.diagnostics_failed)));
     }
   }
-  PetscCall(PostprocessPenetration(&user.rec.errors, &user.rec.stats)); /* with the error norms' finer quadrature */
-  PetscCall(MeshPartitionGetStats(dm, &user.rec.stats.partition));      /* of the final mesh */
+  PetscCall(PostprocessPenetration(&user.errors, stats));  /* with the error norms' finer quadrature */
+  PetscCall(MeshPartitionGetStats(dm, &stats->partition)); /* of the final mesh */
   PetscCall(PetscTime(&t1));
-  user.rec.stats.time_total = t1 - t0;
-  PetscCall(RecordPeakMemory(comm, &user.rec.stats));
+  stats->time_total = t1 - t0;
+  PetscCall(RecordPeakMemory(comm, stats));
   /* -perf_bandwidth: after the peak memory, which its vectors would raise */
-  PetscCall(BandwidthMeasure(snes, opt.perf_bandwidth, &user.rec.stats.bandwidth));
+  PetscCall(BandwidthMeasure(snes, opt.perf_bandwidth, &stats->bandwidth));
   PetscCall(OptionsCheckAllUsed(comm, PETSC_FALSE)); /* the options read during the solve too */
   PetscCall(PrintSummary(dm, &user, u));
   PetscCall(WriteOutput(dm, &user, u));
   PetscCall(PetscPrintf(comm, "  output: %s\n", opt.output));
-  if (!user.rec.stats.converged && user.rec.stats.force_control_failed)
+  if (!stats->converged && stats->force_control_failed)
     PetscCall(PetscPrintf(comm, "ERROR: force control did not reach -obstacle_force %g (above: why); written with converged = 0\n",
                           (double)user.scene.obstacle.force));
-  else if (!user.rec.stats.converged && user.rec.stats.reason > 0)
+  else if (!stats->converged && stats->reason > 0)
     PetscCall(PetscPrintf(comm,
                           "ERROR: the nonlinear solve failed: it stopped with %s after %" PetscInt_FMT
                           " Newton steps at residual %g, which fell neither by -snes_rtol from %g nor to round-off for the load %g; written with "
                           "converged = 0\n",
-                          SNESConvergedReasons[user.rec.stats.reason], user.rec.stats.newton_its, (double)user.rec.stats.residual_norm,
-                          (double)user.rec.stats.residual_start, (double)user.prob.load_norm));
-  else if (!user.rec.stats.converged)
+                          SNESConvergedReasons[stats->reason], stats->newton_its, (double)stats->residual_norm, (double)stats->residual_start,
+                          (double)prob->load_norm));
+  else if (!stats->converged)
     PetscCall(PetscPrintf(comm,
                           "ERROR: the nonlinear solve failed: %s after %" PetscInt_FMT " Newton steps, residual %g; written with converged = 0\n",
-                          SNESConvergedReasons[user.rec.stats.reason], user.rec.stats.newton_its, (double)user.rec.stats.residual_norm));
+                          SNESConvergedReasons[stats->reason], stats->newton_its, (double)stats->residual_norm));
 
+  *converged      = stats->converged;
+  *diagnostics_ok = (PetscBool)!user.diagnostics_failed[0];
   PetscCall(VecDestroy(&u));
   PetscCall(ProblemDestroy(user.solver, &snes));
   PetscCall(SolverDestroy(&user.solver));
@@ -390,16 +404,11 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(DMDestroy(&dm));
   PetscCall(ContactDestroy(&user.contact));
   PetscCall(ContactFinalizePackage());
-  PetscCall(PetscFree(user.rec.records));
-  PetscCall(PetscFree(user.rec.steps));
-  PetscCall(PetscFree(user.rec.cycles));
-  for (PetscInt k = 0; k < user.rec.nsteps * OUTPUT_STATE_FIELDS; ++k) PetscCall(VecDestroy(&user.rec.step_fields[k]));
-  PetscCall(PetscFree(user.rec.step_fields));
-  PetscCall(EstimateReset(&user.rec.estimate));
-  PetscCall(BarsReset(&user.rec.bars));
+  PetscCall(DriversDestroy(&user.drivers));
+  PetscCall(EstimateReset(&user.estimate));
+  PetscCall(BarsReset(&user.bars));
   PetscCall(SceneFinalize());
-  *converged      = user.rec.stats.converged;
-  *diagnostics_ok = (PetscBool)!user.rec.diagnostics_failed[0];
+  PetscCall(DriverFinalize());
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

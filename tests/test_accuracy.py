@@ -1,4 +1,4 @@
-"""-accuracy TOL (src/solver/adapt.c, src/estimate/cycle_bars.c; issue 34): adaptive cycles until the error bars of the
+"""-accuracy TOL (src/drivers/adapt.c, src/estimate/cycle_bars.c; issue 34): adaptive cycles until the error bars of the
 quantities asked for are below TOL times their values. The bars come from the cycles themselves (Roache's two-level
 index with the safety factor 3 and the order 1, 1/2 for the zone's size, against the last two cycles with 4 and more
 times fewer unknowns; the force's penalty part apart, from the tangent of the solution path to eps/10 on each cycle,
@@ -188,7 +188,7 @@ def big_block(tmp_path_factory):
 
 
 def accurate(c, tol, quantities):
-    """Accurate() of src/solver/adapt.c recomputed from /cycles: a converged solve, the force the penalty law would put
+    """Accurate() of src/drivers/adapt.c recomputed from /cycles: a converged solve, the force the penalty law would put
     on the contact nodes the rule misses at most a tenth of tol times the force, and each bar at most tol times its
     value."""
     ok = (c["converged"] == 1) & ((c["unseen_contact"] == 0) | (c["unseen_force"] <= 0.1 * tol * np.abs(c["contact_force_value"])))

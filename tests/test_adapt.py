@@ -1,4 +1,4 @@
-"""Adaptive refinement (-adapt_cycles, src/solver/adapt.c; issue 34, its 2D part): each cycle estimates the error,
+"""Adaptive refinement (-adapt_cycles, src/drivers/adapt.c; issue 34, its 2D part): each cycle estimates the error,
 marks the cells that hold half of the estimate's square (Doerfler), refines them conformingly (PETSc's refine_sbr) and
 solves again from the interpolated solution. Checked against the manufactured solution's exact error, against uniform
 refinement, on 2 ranks against 1, on the boundary conditions of the refined faces, and on the refusals."""

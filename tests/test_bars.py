@@ -213,7 +213,7 @@ def test_a_zero_force_component_gets_the_bar_zero():
 
 def test_bars_with_the_gmsh_model_remesh_the_curved_body(tmp_path):
     """-bars -contact_grid_sequence 2 on make hertz's quarter disk graded to h_near = 0.006, with its Gmsh model
-    (-adapt_model): the levels are the model meshed again at halved sizes (src/solver/grid_sequence.c,
+    (-adapt_model): the levels are the model meshed again at halved sizes (src/drivers/grid_sequence.c,
     GridSequenceRemeshHalf()), so that the finest level's body is the curved cylinder, not the file's polygon whose
     chords the nested refinement splits. Without the model the largest pressure on the finest level is 7.4% above the
     closed form at the run's force (and a warning says the chords were refined); with it within 0.5% (measured

@@ -1,4 +1,4 @@
-"""-contact_penetration_tol d (src/solver/penetration_tol.c): the penalty run ends when its largest penetration, over
+"""-contact_penetration_tol d (src/drivers/penetration_tol.c): the penalty run ends when its largest penetration, over
 the contact nodes and the rule's points (/run max_penetration), is at most d, eps being lowered from the measured
 penetration. Checked on a ladder of tolerances and obstacles: the penetration written is at most d; the answer is the
 direct run's at the eps the run ended with (the continuation only finds eps); a tolerance out of reach fails the run

@@ -194,7 +194,7 @@ def test_sweep_starts_the_linear_solve_from_a_refused_extrapolation(ranks):
 
 def test_sweep_extrapolates_its_start_on_a_parabola_in_eps():
     """From the fourth value on, a sweep starts on the parabola in eps through the last three solutions
-    (src/solver/eps_sweep.c): u(eps) is smooth in eps while the active set stays, and the secant of two leaves its eps^2
+    (src/drivers/eps_sweep.c): u(eps) is smooth in eps while the active set stays, and the secant of two leaves its eps^2
     term. On the 256 x 256 square with GAMG (eps = h to 1e-7 h) the last four values took 2, 2, 1 and 1 Newton steps and
     33 or 34 CG iterations from the secant; from the parabola 2, 1, 1 and 0 (or 1), and 22 to 25 CG iterations (the
     counts move by an iteration or two with OpenBLAS's threads, which change the last bits of the eigenvalue estimates

@@ -97,7 +97,7 @@ PetscErrorCode ContactSetFromOptions(Contact ct)
   opts->penetration_tol = 0.0;
   PetscCall(PetscOptionsReal("-contact_penetration_tol",
                              "Largest penetration allowed, a length: eps is lowered from the measured penetration until it is reached "
-                             "(src/solver/penetration_tol.c)",
+                             "(src/drivers/penetration_tol.c)",
                              NULL, opts->penetration_tol, &opts->penetration_tol, &tol_set));
   PetscOptionsEnd();
   {

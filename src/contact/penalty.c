@@ -7,7 +7,7 @@
    The Contact type "al", the augmented Lagrangian, is the nodal rule's term with a multiplier lambda >= 0 at each
    contact node: (1/eps)[u . n - g + eps lambda]_+, updated between solves by Uzawa's rule
    lambda <- [lambda + (1/eps)(u . n - g)]_+ (ContactAugment(), driven by -contact_penetration_tol,
-   src/solver/penetration_tol.c) with eps kept. The shift s = eps lambda, a length, is what is stored:
+   src/drivers/penetration_tol.c) with eps kept. The shift s = eps lambda, a length, is what is stored:
    s <- [u . n - g + s]_+. At a fixed point u . n - g <= 0 wherever lambda > 0 is the pressure, and the penetration
    goes to zero with the updates while eps, and the conditioning, stay at h/E. Only the nodal rule: the Gauss rule's
    points over-constrain P1 (two points a face in 2D for one unknown a node), and Uzawa on them stalled at a largest

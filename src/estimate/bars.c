@@ -2,7 +2,7 @@
    largest penetration, the energy and the supports' reactions.
 
    The mesh's part. The grid sequence solves the problem on nested meshes h1 = h (the final one), h2 = 2h, h3 = 4h, all
-   at the final mesh's eps and to the final tolerance (src/solver/grid_sequence.c), so that a quantity Q differs between
+   at the final mesh's eps and to the final tolerance (src/drivers/grid_sequence.c), so that a quantity Q differs between
    them by its discretization error alone. If Q(h) = Q* + C h^p, the differences e21 = Q2 - Q1 and e32 = Q3 - Q2 have
    the ratio e21 / e32 = 2^-p, which gives the observed order p, and Richardson's extrapolation the error of Q1,
    e21 / (2^p - 1). Roache's grid convergence index (J. Fluids Eng. 116, 1994; ASME V&V 20-2009, section 2.4) multiplies

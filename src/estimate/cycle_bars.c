@@ -1,4 +1,4 @@
-/* Error bars of the quantities on the meshes of the adaptive refinement (-accuracy, src/solver/adapt.c).
+/* Error bars of the quantities on the meshes of the adaptive refinement (-accuracy, src/drivers/adapt.c).
 
    The meshes of the cycles are nested but not uniformly refined, so that -bars' three levels h, 2h, 4h do not exist.
    Their place is taken by the cycles themselves, each with the size h_k = N_k^(-1/dim) of its N_k unknowns (the size
@@ -20,7 +20,7 @@
    (MeshSetContactCellSizes()), and the penalty's error falls with it as the mesh's does; the differences between the
    cycles hold both.
    The force's two parts apart, where the cycles have their force at eps / R too (R = CYCLE_EPS_RATIO; -accuracy on the
-   force with the penalty method, src/solver/adapt.c): the penalty's part of cycle k is bounded as -bars bounds it
+   force with the penalty method, src/drivers/adapt.c): the penalty's part of cycle k is bounded as -bars bounds it
    (src/estimate/bars.c), d = F(eps) - F(eps / R) and bar_eps = |d| (1 + 3 / (R - 1)) at the order 1 in eps; the
    mesh's part compares the cycles' forces extrapolated to eps = 0, F0 = (R F(eps / R) - F(eps)) / (R - 1), at the
    order 2 of the force's mesh error (a functional of the displacement), with the same two cycles and safety factor 3;

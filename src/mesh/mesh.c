@@ -405,7 +405,7 @@ static PetscErrorCode MeshGetCellSizes(DM dm, PetscReal *hmax, const PetscReal *
 }
 
 /* The size of cell c that the penalty's eps follows (eps = eps0 h^power / M): its diameter, unless the mesh carries
-   sizes of its own (MeshSetCellSizes(): the error bars' coarser levels of a tetrahedral mesh, src/solver/grid_sequence.c). */
+   sizes of its own (MeshSetCellSizes(): the error bars' coarser levels of a tetrahedral mesh, src/drivers/grid_sequence.c). */
 PetscErrorCode MeshCellSize(DM dm, PetscInt c, PetscReal *h)
 {
   const PetscReal *sizes;
@@ -623,7 +623,7 @@ PetscErrorCode MeshPointGlobalIndices(PetscSection lsec, PetscSection gsec, Pets
 
 /* One size for every cell, the smallest diameter of the cells with a face on Gamma_C (the face sets ids[]): the
    penalty's eps is then one value over Gamma_C, eps = eps0 h_C^power / M, as the adaptive refinement needs
-   (src/solver/adapt.c). A local eps that follows each contact face's size jumps by 2 where a refined face meets an
+   (src/drivers/adapt.c). A local eps that follows each contact face's size jumps by 2 where a refined face meets an
    unrefined one; the penalty's stiffness 1/eps jumps with it, which the continuous P1 displacement cannot follow, and
    the nodal pressure oscillates from node to node (docs/estimate.md, "Adaptive refinement"). */
 PetscErrorCode MeshSetContactCellSizes(DM dm, PetscInt nids, const PetscInt ids[])

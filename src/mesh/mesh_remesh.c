@@ -1,4 +1,4 @@
-/* Remeshing a Gmsh model with a size field (-adapt_model, src/solver/adapt.c): the adaptive cycles' refinement where
+/* Remeshing a Gmsh model with a size field (-adapt_model, src/drivers/adapt.c): the adaptive cycles' refinement where
    the mesh's own cannot serve. PETSc 3.18 as Debian builds it refines triangles locally (skeleton-based refinement,
    mesh_refine.c) but not tetrahedra, and any refinement of a mesh file splits its curved boundary's edges on their
    chords, so that the body it solves stays the first mesh's polygon. Gmsh meshes the model itself, its curved

@@ -10,17 +10,17 @@
    stalls. Such a guess that still lowers
    the residual gives, with step_guess, the first linear solve's initial guess instead (step_guess.c): Newton starts
    from u, with its active points, and CG from the step factor dir; dir is then scaled. */
-PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, Contact contact, SolverCtx sc, Vec u, Vec dir, PetscReal factor, PetscReal relaxed,
-                                       PetscBool step_guess)
+PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, Solver s, Vec u, Vec dir, PetscReal factor, PetscReal relaxed, PetscBool step_guess)
 {
-  Vec       guess;
-  PetscReal f_last, f_guess;
-  PetscBool same;
+  const SolverCtx sc = s->prob.sctx;
+  Vec             guess;
+  PetscReal       f_last, f_guess;
+  PetscBool       same;
 
   PetscFunctionBeginUser;
   PetscCall(VecDuplicate(u, &guess));
   PetscCall(VecWAXPY(guess, factor, dir, u));
-  PetscCall(ContactSameActivity(contact, dm, u, guess, &same));
+  PetscCall(ContactSameActivity(s->contact, dm, u, guess, &same));
   PetscCall(SolverResidualNorm(snes, sc, u, &f_last)); /* every start needs both: the tangent's and the secant's rules */
   PetscCall(SolverResidualNorm(snes, sc, guess, &f_guess));
   if ((same && f_guess < f_last) || f_guess < relaxed * f_last)
@@ -36,14 +36,13 @@ PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, Contact contact, Solver
 /* The start of a solve on the secant of the last two solutions: u <- u + factor (u - prev) where
    SolverExtrapolatedStart() takes it (use; relaxed as there), and prev <- the old u. Shared by a load path's steps
    (along the factor), force control's positions (along the position) and the penetration tolerance's values of eps. */
-PetscErrorCode SolverSecantStart(SNES snes, DM dm, Contact contact, SolverCtx sc, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor,
-                                 PetscReal relaxed)
+PetscErrorCode SolverSecantStart(SNES snes, DM dm, Solver s, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor, PetscReal relaxed)
 {
   PetscFunctionBeginUser;
   if (use) {
     PetscCall(VecWAXPY(dir, -1.0, prev, u));
     PetscCall(VecCopy(u, prev));
-    PetscCall(SolverExtrapolatedStart(snes, dm, contact, sc, u, dir, factor, relaxed, PETSC_TRUE));
+    PetscCall(SolverExtrapolatedStart(snes, dm, s, u, dir, factor, relaxed, PETSC_TRUE));
   } else
     PetscCall(VecCopy(u, prev));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -8,26 +8,45 @@
 #include "physics.h"
 #include "solver_impl.h"
 
-PetscErrorCode SolverCreate(const RunOptions *opt, Contact contact, Multigrid mg, const MeshBox *box, Problem *prob, RunRecord *rec, Solver *s)
+PetscErrorCode SolverCreate(const RunOptions *opt, Contact contact, Multigrid mg, const MeshBox *box, Solver *s)
 {
   PetscFunctionBeginUser;
   PetscCall(PetscNew(s));
-  (*s)->prob       = prob;
-  (*s)->contact    = contact;
-  (*s)->opt        = opt;
-  (*s)->mg         = mg;
-  (*s)->box        = box;
-  (*s)->stats      = &rec->stats;
-  (*s)->records    = &rec->records;
-  (*s)->nrecords   = &rec->nrecords;
-  (*s)->maxrecords = &rec->maxrecords;
+  (*s)->contact = contact;
+  (*s)->opt     = opt;
+  (*s)->mg      = mg;
+  (*s)->box     = box;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 PetscErrorCode SolverDestroy(Solver *s)
 {
   PetscFunctionBeginUser;
+  if (!*s) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscFree((*s)->records));
   PetscCall(PetscFree(*s));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The problem on the current mesh, which ProblemSetUp() fills and each change of mesh replaces. */
+Problem *SolverProblem(Solver s)
+{
+  return &s->prob;
+}
+
+/* The run's statistics: the last solve's outcome and the counts over all solves, which the solves write and the
+   postprocessing, the checks and the drivers add to. */
+RunStats *SolverStats(Solver s)
+{
+  return &s->stats;
+}
+
+/* The table of solves, one record per solve (a level of the grid sequence, an eps of the sweep, a cycle, a step). */
+PetscErrorCode SolverGetSolves(Solver s, const SolveRecord **records, PetscInt *n)
+{
+  PetscFunctionBeginUser;
+  if (records) *records = s->records;
+  *n = s->nrecords;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -266,27 +285,27 @@ static PetscErrorCode RecordSolve(SNES snes, Solver s, PetscInt *newton, PetscIn
   PetscReal fnorm, atol, rtol, stol, ref;
 
   PetscFunctionBeginUser;
-  PetscCall(SNESGetConvergedReason(snes, &s->stats->reason));
+  PetscCall(SNESGetConvergedReason(snes, &s->stats.reason));
   PetscCall(SNESGetIterationNumber(snes, &its));
   PetscCall(SNESGetLinearSolveIterations(snes, &lits));
   PetscCall(SNESGetFunctionNorm(snes, &fnorm));
   PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
   *newton += its;
   *ksp += lits;
-  s->stats->newton_its     = *newton;
-  s->stats->ksp_its        = *ksp;
-  s->stats->residual_norm  = fnorm * s->prob->displacement_scale; /* the SNES saw F/U */
-  s->stats->residual_start = s->prob->sctx->fnorm0;
-  ref                      = SolverStopReference(s->prob->sctx);
-  s->stats->residual_reduced =
-      (PetscBool)(s->stats->residual_norm <= rtol * ref || s->stats->residual_norm <= s->opt->solver.load_rtol * s->prob->load_norm ||
-                  fnorm <= atol || s->prob->sctx->roundoff_stop || s->prob->sctx->energy_stop);
-  s->stats->roundoff_stop = s->prob->sctx->roundoff_stop;
-  s->stats->converged     = (PetscBool)(s->stats->reason > 0 && s->stats->residual_reduced);
-  PetscCall(SNESKSPGetUseEW(snes, &s->stats->ksp_ew));
-  s->stats->pc_builds         = s->prob->sctx->pc_reuse.enabled ? s->prob->sctx->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
-  s->stats->pc_updates        = s->prob->sctx->pc_reuse.updates;
-  s->stats->pc_finest_updates = s->prob->sctx->pc_reuse.finest_updates;
+  s->stats.newton_its     = *newton;
+  s->stats.ksp_its        = *ksp;
+  s->stats.residual_norm  = fnorm * s->prob.displacement_scale; /* the SNES saw F/U */
+  s->stats.residual_start = s->prob.sctx->fnorm0;
+  ref                     = SolverStopReference(s->prob.sctx);
+  s->stats.residual_reduced =
+      (PetscBool)(s->stats.residual_norm <= rtol * ref || s->stats.residual_norm <= s->opt->solver.load_rtol * s->prob.load_norm || fnorm <= atol ||
+                  s->prob.sctx->roundoff_stop || s->prob.sctx->energy_stop);
+  s->stats.roundoff_stop = s->prob.sctx->roundoff_stop;
+  s->stats.converged     = (PetscBool)(s->stats.reason > 0 && s->stats.residual_reduced);
+  PetscCall(SNESKSPGetUseEW(snes, &s->stats.ksp_ew));
+  s->stats.pc_builds         = s->prob.sctx->pc_reuse.enabled ? s->prob.sctx->pc_reuse.builds : *newton; /* without reuse: one per Newton step */
+  s->stats.pc_updates        = s->prob.sctx->pc_reuse.updates;
+  s->stats.pc_finest_updates = s->prob.sctx->pc_reuse.finest_updates;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -297,29 +316,29 @@ static PetscErrorCode SolverAddRecord(SNES snes, Solver s, Vec u, PetscReal time
   DM           dm;
 
   PetscFunctionBeginUser;
-  if (*s->nrecords == *s->maxrecords) { /* grow */
+  if (s->nrecords == s->maxrecords) { /* grow */
     SolveRecord *grown;
 
-    *s->maxrecords = PetscMax(16, 2 * (*s->maxrecords));
-    PetscCall(PetscMalloc1(*s->maxrecords, &grown));
-    if (*s->nrecords) PetscCall(PetscArraycpy(grown, *s->records, *s->nrecords));
-    PetscCall(PetscFree(*s->records));
-    *s->records = grown;
+    s->maxrecords = PetscMax(16, 2 * (s->maxrecords));
+    PetscCall(PetscMalloc1(s->maxrecords, &grown));
+    if (s->nrecords) PetscCall(PetscArraycpy(grown, s->records, s->nrecords));
+    PetscCall(PetscFree(s->records));
+    s->records = grown;
   }
-  r = &(*s->records)[(*s->nrecords)++];
+  r = &s->records[(s->nrecords)++];
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(ContactMaxNodePenetration(s->contact, u, &r->max_penetration));
   PetscCall(VecGetSize(u, &r->n_dofs));
-  r->level = s->prob->level;
-  r->h     = s->prob->h;
+  r->level = s->prob.level;
+  r->h     = s->prob.h;
   PetscCall(ContactGetEps(s->contact, &r->eps)); /* 0 for the types without eps */
-  r->newton_its       = s->stats->newton_its;
-  r->ksp_its          = s->stats->ksp_its;
-  r->pc_builds        = s->stats->pc_builds;
-  r->converged        = s->stats->converged;
-  r->time_setup       = s->prob->setup_time;
-  r->time_solve       = time_solve;
-  s->prob->setup_time = 0.0; /* counted once, with the first solve on the mesh */
+  r->newton_its      = s->stats.newton_its;
+  r->ksp_its         = s->stats.ksp_its;
+  r->pc_builds       = s->stats.pc_builds;
+  r->converged       = s->stats.converged;
+  r->time_setup      = s->prob.setup_time;
+  r->time_solve      = time_solve;
+  s->prob.setup_time = 0.0; /* counted once, with the first solve on the mesh */
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -327,19 +346,19 @@ static PetscErrorCode SolverAddRecord(SNES snes, Solver s, Vec u, PetscReal time
    SolverIterateDisplacement(). */
 static PetscErrorCode SolverSNESSolve(SNES snes, Solver s, Vec u)
 {
-  const PetscReal U = s->prob->displacement_scale;
+  const PetscReal U = s->prob.displacement_scale;
 
   PetscFunctionBeginUser;
-  s->prob->sctx->snes_scale = U;
+  s->prob.sctx->snes_scale = U;
   PetscCall(VecScale(u, 1.0 / U));
   PetscCall(ContactSolverFrame(s->contact, u, PETSC_TRUE)); /* the SNES's unknowns: Q^T u/U */
   PetscCall(ContactScaleBounds(s->contact, 1.0 / U));
   PetscCall(SNESSolve(snes, NULL, u));
-  PetscCall(SolverStepGuessDrop(&s->prob->sctx->step_guess)); /* unused if no linear solve came */
+  PetscCall(SolverStepGuessDrop(&s->prob.sctx->step_guess)); /* unused if no linear solve came */
   PetscCall(ContactSolverFrame(s->contact, u, PETSC_FALSE));
   PetscCall(VecScale(u, U));
   PetscCall(ContactScaleBounds(s->contact, U));
-  s->prob->sctx->snes_scale = 1.0;
+  s->prob.sctx->snes_scale = 1.0;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -347,13 +366,13 @@ static PetscErrorCode SolverSNESSolve(SNES snes, Solver s, Vec u)
    preconditioner (src/linear/pc_recovery.c) while one is left; the Newton steps and linear iterations of every attempt count. */
 static PetscErrorCode SolveRecovering(SNES snes, Solver s, Vec u, PetscInt *newton, PetscInt *ksp)
 {
-  const SolverCtx sc    = s->prob->sctx;
+  const SolverCtx sc    = s->prob.sctx;
   PetscBool       retry = PETSC_TRUE;
 
   PetscFunctionBeginUser;
   PetscCall(SolverSNESSolve(snes, s, u));
   PetscCall(RecordSolve(snes, s, newton, ksp));
-  while (!s->stats->converged && retry) {
+  while (!s->stats.converged && retry) {
     PetscCall(PcRecoveryTry(&sc->pc_recovery, snes, sc->opt, &sc->pc_reuse, sc->stats, &retry));
     if (!retry) break;
     PetscCall(SolverSNESSolve(snes, s, u));
@@ -400,13 +419,13 @@ static PetscErrorCode SolverZeroData(DM dm, Solver s, PetscBool *zero)
 
   PetscFunctionBeginUser;
   *zero = PETSC_FALSE;
-  PetscCall(VecNorm(s->prob->r0, NORM_INFINITY, &r0));
+  PetscCall(VecNorm(s->prob.r0, NORM_INFINITY, &r0));
   if (r0 != 0.0) PetscFunctionReturn(PETSC_SUCCESS);
   {
     Vec       zero_u;
     PetscReal d;
 
-    PetscCall(VecDuplicate(s->prob->r0, &zero_u));
+    PetscCall(VecDuplicate(s->prob.r0, &zero_u));
     PetscCall(VecZeroEntries(zero_u));
     PetscCall(ContactMaxPenetration(s->contact, dm, zero_u, &d));
     PetscCall(VecDestroy(&zero_u));
@@ -440,29 +459,29 @@ PetscErrorCode SolverSolve(SNES snes, Solver s, Vec u, SolverStart start)
     }
   }
   /* -pc_type mg: the levels of the meshes solved so far */
-  PetscCall(MultigridSetUpPC(s->mg, snes, s->prob->level, s->box, &s->opt->solver));
-  s->prob->sctx->warm = warm;
+  PetscCall(MultigridSetUpPC(s->mg, snes, s->prob.level, s->box, &s->opt->solver));
+  s->prob.sctx->warm = warm;
   PetscCall(PetscTime(&t0));
-  s->prob->sctx->pc_reuse.builds         = 0; /* counted per solve */
-  s->prob->sctx->pc_reuse.updates        = 0;
-  s->prob->sctx->pc_reuse.finest_updates = 0;
-  s->stats->continuation_stages          = 0;
+  s->prob.sctx->pc_reuse.builds         = 0; /* counted per solve */
+  s->prob.sctx->pc_reuse.updates        = 0;
+  s->prob.sctx->pc_reuse.finest_updates = 0;
+  s->stats.continuation_stages          = 0;
   if (start != SOLVER_START_NEARBY_EPS && copt->continuation && eps_target < eps_start) { /* both 0 for a type without eps */
     for (PetscReal eps = eps_start; eps > eps_target * 1.000001; eps *= copt->continuation_factor) {
       PetscCall(ContactSetEps(s->contact, dm, eps));
       PetscCall(SolveRecovering(snes, s, u, &newton, &ksp));
-      s->stats->continuation_stages++;
-      if (!s->stats->converged) break; /* reported as the failure of the whole solve */
+      s->stats.continuation_stages++;
+      if (!s->stats.converged) break; /* reported as the failure of the whole solve */
     }
     PetscCall(ContactSetEps(s->contact, dm, eps_target));
   }
-  if (s->stats->continuation_stages == 0 || s->stats->converged) {
+  if (s->stats.continuation_stages == 0 || s->stats.converged) {
     PetscCall(SolveRecovering(snes, s, u, &newton, &ksp));
   }
   PetscCall(PetscTime(&t1));
-  s->stats->time_solve += t1 - t0;
-  s->stats->newton_its_total += newton;
-  s->stats->ksp_its_total += ksp;
+  s->stats.time_solve += t1 - t0;
+  s->stats.newton_its_total += newton;
+  s->stats.ksp_its_total += ksp;
   PetscCall(SolverAddRecord(snes, s, u, t1 - t0));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -488,10 +507,10 @@ PetscErrorCode SolverSolveWarm(SNES snes, Solver s, Vec u, const char what[])
   PetscInt            its;
 
   PetscFunctionBeginUser;
-  s->prob->sctx->stall_stop = PETSC_TRUE;
+  s->prob.sctx->stall_stop = PETSC_TRUE;
   PetscCall(SolverSolve(snes, s, u, SOLVER_START_NEARBY_EPS));
-  s->prob->sctx->stall_stop = PETSC_FALSE;
-  if (s->stats->converged) PetscFunctionReturn(PETSC_SUCCESS);
+  s->prob.sctx->stall_stop = PETSC_FALSE;
+  if (s->stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetConvergedReason(snes, &reason));
   PetscCall(SNESGetIterationNumber(snes, &its));
   PetscCall(PetscPrintf(PetscObjectComm((PetscObject)snes), "  %s: the warm solve %s (%s, %" PetscInt_FMT " Newton steps); solved again from zero\n",
@@ -515,15 +534,15 @@ PetscErrorCode SolverConditionEstimate(SNES snes, Solver s, Vec u)
   PetscBool          is_vi;
 
   PetscFunctionBeginUser;
-  s->stats->condition_1norm = PETSC_NAN;
+  s->stats.condition_1norm = PETSC_NAN;
   if (!s->opt->solver.condition_estimate) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetKSP(snes, &ksp));
   PetscCall(SNESGetJacobian(snes, &J, NULL, NULL, NULL));
   PetscCall(PetscObjectTypeCompareAny((PetscObject)snes, &is_vi, SNESVINEWTONRSLS, SNESVINEWTONSSLS, ""));
   if (is_vi) { /* its KSP holds the reduced system of the last active set */
-    J = s->prob->K;
+    J = s->prob.K;
     PetscCall(KSPCreate(PetscObjectComm((PetscObject)snes), &ksp_vi));
-    PetscCall(SolverSetDefaultLinearSolver(ksp_vi, s->contact, &s->opt->solver, s->prob, s->mg));
+    PetscCall(SolverSetDefaultLinearSolver(ksp_vi, s->contact, &s->opt->solver, &s->prob, s->mg));
     PetscCall(KSPSetFromOptions(ksp_vi));
     ksp = ksp_vi;
   } else
@@ -567,7 +586,7 @@ PetscErrorCode SolverConditionEstimate(SNES snes, Solver s, Vec u)
     PetscCall(VecAssemblyBegin(x));
     PetscCall(VecAssemblyEnd(x));
   }
-  s->stats->condition_1norm = normJ * est;
+  s->stats.condition_1norm = normJ * est;
   PetscCall(VecDestroy(&x));
   PetscCall(VecDestroy(&y));
   PetscCall(KSPDestroy(&ksp_vi));

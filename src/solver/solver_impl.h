@@ -13,17 +13,18 @@
    (SolverConverged()): it has stalled, and is solved again from zero. */
 #define SOLVER_STALL_STEPS 6
 
-/* The solver object (include/solver.h): what a solve reads and where its outcome goes; it owns none of them. */
+/* The solver object (include/solver.h): the problem on the current mesh, which it owns, what its solves read (the
+   Contact, the options, the nested meshes' multigrid and the box, which it does not), and their outcome, which it
+   owns: the run's statistics and the table of solves (one record per solve, with its length and capacity). */
 struct _n_Solver {
-  Problem          *prob; /* the problem on the current mesh: AppCtx's own for now, since the drivers still read user->prob directly */
+  Problem           prob;
   Contact           contact;
   const RunOptions *opt;
   Multigrid         mg;  /* the nested meshes' multigrid (-pc_type mg) */
   const MeshBox    *box; /* the box of the mesh options, whose levels the multigrid's are */
-  /* where the solves record: the run's statistics, and the table of solves (one record per solve) with its length and capacity */
-  RunStats     *stats;
-  SolveRecord **records;
-  PetscInt     *nrecords, *maxrecords;
+  RunStats          stats;
+  SolveRecord      *records;
+  PetscInt          nrecords, maxrecords;
 };
 
 struct _n_SolverCtx {
@@ -77,9 +78,3 @@ PetscErrorCode ContactMonitor(SNES snes, PetscInt it, PetscReal fnorm, void *ctx
 
 /* newton.c: the next solve's first linear solve starts from the Newton step du predicts (SolverStepGuessSet()) */
 PetscErrorCode SolverSetStepGuess(SolverCtx sc, Vec du);
-
-/* extrapolated_start.c */
-PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, Contact contact, SolverCtx sc, Vec u, Vec dir, PetscReal factor, PetscReal relaxed,
-                                       PetscBool step_guess);
-PetscErrorCode SolverSecantStart(SNES snes, DM dm, Contact contact, SolverCtx sc, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor,
-                                 PetscReal relaxed);

@@ -29,8 +29,19 @@
 #include "mesh.h"
 #include "physics.h"
 #include "scenes.h"
-#include "solver.h"
+#include "drivers_impl.h"
 #include "verify.h"
+
+/* The adaptive cycles' results: one record per mesh (/cycles), the quantities -accuracy asks for on the mesh's
+   dimension (AdaptTargets()), the fraction of the estimate's square the marked cells hold (Doerfler's theta) and why
+   the cycles stopped. */
+typedef struct {
+  CycleRecord *cycles;
+  PetscInt     ncycles;
+  PetscBool    target[ACCURACY_NUM];
+  PetscReal    fraction;
+  AdaptStop    stop;
+} Adapt;
 
 #define ADAPT_ACCURACY_CYCLES 40 /* -accuracy's most cycles unless -adapt_cycles says */
 
@@ -228,23 +239,27 @@ PetscErrorCode AdaptCheck(DM dm, const RunOptions *opt, Contact ct, const MeshBo
 
 /* The cycle's row of /cycles: the mesh and its solve (the last record), the estimate of its solution and, where the
    scene knows it, the true error. */
-static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
+static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Adapt *a, Vec u, PetscInt k)
 {
-  CycleRecord       *c = &user->rec.cycles[k];
-  const SolveRecord *r = &user->rec.records[user->rec.nrecords - 1];
-  PetscInt           cStart, cEnd, local;
+  Problem           *prob  = SolverProblem(user->solver);
+  RunStats          *stats = SolverStats(user->solver);
+  CycleRecord       *c     = &a->cycles[k];
+  const SolveRecord *records, *r;
+  PetscInt           cStart, cEnd, local, nrecords;
 
   PetscFunctionBeginUser;
-  PetscCall(EstimateReset(&user->rec.estimate));
+  PetscCall(SolverGetSolves(user->solver, &records, &nrecords));
+  r = &records[nrecords - 1];
+  PetscCall(EstimateReset(&user->estimate));
   if (user->opt->estimate) { /* always: -adapt_cycles refuses -estimate false (AdaptCheck()) */
     const EstimateRun run = {.scene   = &user->scene,
                              .mat     = &user->opt->material,
                              .verify  = &user->opt->verify,
                              .contact = user->contact,
                              .degree  = user->opt->degree,
-                             .loc_bc  = user->prob.loc_bc};
+                             .loc_bc  = prob->loc_bc};
 
-    PetscCall(EstimateCompute(dm, &run, u, &user->rec.estimate));
+    PetscCall(EstimateCompute(dm, &run, u, &user->estimate));
   }
   PetscCall(DMPlexGetHeightStratum(dm, 0, &cStart, &cEnd));
   local = cEnd - cStart;
@@ -254,11 +269,11 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
   c->ksp_its          = r->ksp_its;
   c->time_solve       = r->time_solve;
   c->converged        = r->converged;
-  c->estimate         = user->rec.estimate.total;
-  c->estimate_penalty = user->rec.estimate.part[ESTIMATE_PENALTY];
-  c->norm             = user->rec.estimate.norm;
-  PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-  PostprocessGetQuantities(&user->rec.stats, &c->q);
+  c->estimate         = user->estimate.total;
+  c->estimate_penalty = user->estimate.part[ESTIMATE_PENALTY];
+  c->norm             = user->estimate.norm;
+  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
+  PostprocessGetQuantities(stats, &c->q);
   c->marked = 0;
   for (PetscInt q = 0; q < ACCURACY_NUM; ++q) c->value_eps[q] = PETSC_NAN;
   c->eps       = PETSC_NAN;
@@ -274,14 +289,14 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
                            .mat     = &user->opt->material,
                            .degree  = user->opt->degree,
                            .contact = user->contact,
-                           .h       = user->prob.h,
-                           .loc_bc  = user->prob.loc_bc,
-                           .K       = user->prob.K};
+                           .h       = prob->h,
+                           .loc_bc  = prob->loc_bc,
+                           .K       = prob->K};
 
-    PetscCall(ErrorNormsCompute(dm, &run, u, &user->rec.errors));
-    c->error_energy = user->rec.errors.energy;
+    PetscCall(ErrorNormsCompute(dm, &run, u, &user->errors));
+    c->error_energy = user->errors.energy;
   }
-  user->rec.ncycles = k + 1;
+  a->ncycles = k + 1;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -290,10 +305,12 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Vec u, PetscInt k)
    tangent of the solution path from the cycle's solution (one linear solve with its preconditioner, EpsSweepTangent(),
    whose iterations count in the run's totals); the cycle records them. The cycle's solution, eps and contact state stay
    as they were. No values if the tangent's solve fails. */
-static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes, Vec u, CycleRecord *c)
+static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, const Adapt *a, SNES snes, Vec u, CycleRecord *c)
 {
+  Problem            *prob   = SolverProblem(user->solver);
+  RunStats           *stats  = SolverStats(user->solver);
   const AdaptOptions *ad     = &user->opt->adapt;
-  const PetscBool    *target = user->rec.accuracy_target;
+  const PetscBool    *target = a->target;
   PetscReal           eps, eps_new;
   PetscBool           ok = PETSC_FALSE;
   PetscInt            dim;
@@ -309,12 +326,12 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
   eps_new = eps / CYCLE_EPS_RATIO;
   PetscCall(ContactSetEps(user->contact, dm, eps_new));
   PetscCall(VecDuplicate(u, &dir));
-  PetscCall(EpsSweepTangent(snes, dm, user->contact, u, dir, &user->rec.stats.ksp_its_total, &ok));
+  PetscCall(EpsSweepTangent(snes, dm, user->contact, u, dir, &stats->ksp_its_total, &ok));
   if (ok) { /* u(eps_new) = u + (eps_new - eps) du/deps, du/deps = dir eps_new / eps^2 */
     PetscCall(VecDuplicate(u, &u_new));
     PetscCall(VecWAXPY(u_new, (eps_new - eps) * eps_new / (eps * eps), dir, u));
-    PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u_new, &user->rec.stats));
-    PostprocessGetQuantities(&user->rec.stats, &q);
+    PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u_new, stats));
+    PostprocessGetQuantities(stats, &q);
     c->value_eps[ACCURACY_FORCE]    = PostprocessForceMagnitude(&q, dim);
     c->value_eps[ACCURACY_PRESSURE] = q.pressure_max;
     c->value_eps[ACCURACY_SIZE]     = q.contact_size;
@@ -324,7 +341,7 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, SNES snes
   PetscCall(VecDestroy(&dir));
   PetscCall(ContactSetEps(user->contact, dm, eps));
   /* the contact state of the cycle's solution again */
-  PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
+  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -588,9 +605,15 @@ static PetscErrorCode AdaptCheckpointNote(MPI_Comm comm, const char output[], co
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter write)
+/* The adaptive cycles from the run's solution (-adapt_cycles, -accuracy): estimate, mark, refine or remesh, solve,
+   until the quantities asked for are accurate or a budget is spent; each finished cycle is written as a checkpoint
+   (d->checkpoint) where the cycles since the last write took long enough, so that an interrupted run keeps it. */
+static PetscErrorCode AdaptSolve(Driver d, AppCtx *user, DM *dm, SNES *snes, Vec *u)
 {
-  const AdaptOptions *ad = &user->opt->adapt;
+  RunStats           *stats = SolverStats(user->solver);
+  Adapt              *a     = (Adapt *)d->data;
+  const OutputWriter  write = d->checkpoint;
+  const AdaptOptions *ad    = &user->opt->adapt;
   PetscInt            dim;
   PetscBool           remesh;
   PetscLogDouble      t_last, time_mesh = 0.0, ck_cost = 0.0, ck_since = 0.0; /* the last checkpoint's write, and the cycles' time since */
@@ -600,12 +623,12 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
   if (!ad->cycles) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(DMGetDimension(*dm, &dim));
   remesh = (PetscBool)(ad->model[0] || dim == 3); /* Gmsh meshes the model, or the 3D box of the options, again (MeshRemesh()) */
-  AdaptTargets(ad, dim, user->rec.accuracy_target);
-  user->rec.adapt_fraction = AdaptFraction(ad, user->rec.accuracy_target, dim);
-  PetscCall(PetscCalloc1(ad->cycles + 1, &user->rec.cycles));
+  AdaptTargets(ad, dim, a->target);
+  a->fraction = AdaptFraction(ad, a->target, dim);
+  PetscCall(PetscCalloc1(ad->cycles + 1, &a->cycles));
   PetscCall(PetscTime(&t_last));
   for (PetscInt k = 0;; ++k) {
-    CycleRecord   *c      = &user->rec.cycles[k];
+    CycleRecord   *c      = &a->cycles[k];
     DMLabel        marked = NULL;
     PetscLogDouble t0, t1;
     SolverStart    start;
@@ -613,26 +636,26 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     PetscInt       fixed_eps, unreachable = -1;
     PetscReal      next_mb = 0.0, growth = 1.0, n_need = 0.0, mb_need = 0.0, rate = 0.0;
 
-    PetscCall(AdaptRecord(*dm, user, *u, k));
-    PetscCall(AdaptQuantitiesAtSmallerEps(*dm, user, *snes, *u, c));
+    PetscCall(AdaptRecord(*dm, user, a, *u, k));
+    PetscCall(AdaptQuantitiesAtSmallerEps(*dm, user, a, *snes, *u, c));
     c->time_mesh = time_mesh;
-    PetscCall(CycleBarsCompute(user->rec.cycles, dim, k));
+    PetscCall(CycleBarsCompute(a->cycles, dim, k));
     /* the cells around the contact the mesh misses */
     PetscCall(EstimateMarkUnseenContact(*dm, user->contact, *u, &marked, &c->unseen, &c->unseen_force));
-    c->accurate    = Accurate(ad, user->rec.accuracy_target, c);
+    c->accurate    = Accurate(ad, a->target, c);
     c->marked_edge = 0;
     at_max         = (PetscBool)(ad->max_dofs > 0 && c->n_dofs >= ad->max_dofs);
-    fixed_eps      = c->accurate ? -1 : FixedEpsHolds(ad, user->contact, user->rec.cycles, user->rec.accuracy_target, k);
+    fixed_eps      = c->accurate ? -1 : FixedEpsHolds(ad, user->contact, a->cycles, a->target, k);
     PetscCall(AdaptCycleMemory(PetscObjectComm((PetscObject)*dm), &c->memory_mb));
     at_memory = PETSC_FALSE;
     if (!c->accurate && !at_max && fixed_eps < 0 && k < ad->cycles && ad->max_memory > 0.0 && k > 0) { /* from the first measured growth */
-      AdaptPredictMemory(user->rec.cycles, k, dim, &next_mb, &growth);
+      AdaptPredictMemory(a->cycles, k, dim, &next_mb, &growth);
       at_memory = (PetscBool)(next_mb > ad->max_memory);
-      if (!at_memory) unreachable = AdaptOutOfReach(ad, user->rec.cycles, user->rec.accuracy_target, k, dim, &n_need, &mb_need, &rate);
+      if (!at_memory) unreachable = AdaptOutOfReach(ad, a->cycles, a->target, k, dim, &n_need, &mb_need, &rate);
     }
-    if (!c->accurate && k < ad->cycles && user->rec.stats.converged && !at_max && fixed_eps < 0 && !at_memory && unreachable < 0) {
-      PetscCall(EstimateMark(*dm, &user->rec.estimate, user->rec.adapt_fraction, &marked, &c->marked));
-      if (ad->mark_edge && ad->accuracy > 0.0 && user->rec.accuracy_target[ACCURACY_SIZE] &&
+    if (!c->accurate && k < ad->cycles && stats->converged && !at_max && fixed_eps < 0 && !at_memory && unreachable < 0) {
+      PetscCall(EstimateMark(*dm, &user->estimate, a->fraction, &marked, &c->marked));
+      if (ad->mark_edge && ad->accuracy > 0.0 && a->target[ACCURACY_SIZE] &&
           c->q.contact_size_band > ad->accuracy * PetscAbsReal(c->q.contact_size)) {
         PetscInt *faces, nfaces;
 
@@ -647,7 +670,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
     /* the slowest rank's time, so that every rank takes the checkpoint's decision below alike: a rank's own clock
        would have one rank enter the collective write and the other go on to the next cycle, and the run hang */
     PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &c->time_cycle, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)*dm)));
-    done = (PetscBool)(c->accurate || !user->rec.stats.converged || at_max || fixed_eps >= 0 || at_memory || unreachable >= 0 || k == ad->cycles ||
+    done = (PetscBool)(c->accurate || !stats->converged || at_max || fixed_eps >= 0 || at_memory || unreachable >= 0 || k == ad->cycles ||
                        (!c->marked && !c->marked_edge && !c->unseen)); /* done, or a zero estimate: nothing to refine */
     ck_since += c->time_cycle;
     if (!done && (ck_cost == 0.0 || ck_since >= ADAPT_CHECKPOINT_RATIO * ck_cost)) { /* what a signal during the next cycles leaves */
@@ -656,7 +679,7 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
       PetscCall(PetscTime(&w0));
       if (write) {
         PetscCall(AdaptCheckpointNote(PetscObjectComm((PetscObject)*dm), user->opt->output, c, k));
-        user->rec.adapt_stop = ADAPT_STOP_INTERRUPTED;
+        a->stop = ADAPT_STOP_INTERRUPTED;
         PetscCall(write(*dm, user, *u));
       }
       PetscCall(PetscTime(&w1));
@@ -664,17 +687,17 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
       PetscCall(MPIU_Allreduce(MPI_IN_PLACE, &ck_cost, 1, MPI_DOUBLE, MPI_MAX, PetscObjectComm((PetscObject)*dm))); /* alike on every rank */
       ck_since = 0.0;
     }
-    PetscCall(AdaptMonitor(PetscObjectComm((PetscObject)*dm), ad, user->rec.accuracy_target, c, k)); /* once it is written */
-    PetscCall(AdaptWarnEnergyAlone(PetscObjectComm((PetscObject)*dm), ad, user->rec.accuracy_target, c, k, &warned_energy));
+    PetscCall(AdaptMonitor(PetscObjectComm((PetscObject)*dm), ad, a->target, c, k)); /* once it is written */
+    PetscCall(AdaptWarnEnergyAlone(PetscObjectComm((PetscObject)*dm), ad, a->target, c, k, &warned_energy));
     if (done) {
-      user->rec.adapt_stop = c->accurate                  ? ADAPT_STOP_ACCURACY
-                             : !user->rec.stats.converged ? ADAPT_STOP_SOLVE_FAILED
-                             : at_max                     ? ADAPT_STOP_MAX_DOFS
-                             : fixed_eps >= 0             ? ADAPT_STOP_FIXED_EPS
-                             : at_memory                  ? ADAPT_STOP_MAX_MEMORY
-                             : unreachable >= 0           ? ADAPT_STOP_OUT_OF_REACH
-                             : k == ad->cycles            ? ADAPT_STOP_CYCLES
-                                                          : ADAPT_STOP_NOTHING_MARKED;
+      a->stop = c->accurate         ? ADAPT_STOP_ACCURACY
+                : !stats->converged ? ADAPT_STOP_SOLVE_FAILED
+                : at_max            ? ADAPT_STOP_MAX_DOFS
+                : fixed_eps >= 0    ? ADAPT_STOP_FIXED_EPS
+                : at_memory         ? ADAPT_STOP_MAX_MEMORY
+                : unreachable >= 0  ? ADAPT_STOP_OUT_OF_REACH
+                : k == ad->cycles   ? ADAPT_STOP_CYCLES
+                                    : ADAPT_STOP_NOTHING_MARKED;
       if (at_memory)
         PetscCall(PetscPrintf(PetscObjectComm((PetscObject)*dm),
                               "  the next cycle would take about %.0f MB (the last cycle's growth of memory scaled by its growth of the unknowns, "
@@ -723,24 +746,29 @@ PetscErrorCode AdaptSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u, OutputWriter
       PetscInt n_next;
 
       PetscCall(VecGetSize(*u, &n_next));
-      PetscCall(SolverSetStepEnergyStop(&user->prob, ad->newton_fraction * c->estimate * PetscPowReal((PetscReal)c->n_dofs / n_next, 1.0 / dim)));
+      PetscCall(SolverSetStepEnergyStop(SolverProblem(user->solver),
+                                        ad->newton_fraction * c->estimate * PetscPowReal((PetscReal)c->n_dofs / n_next, 1.0 / dim)));
     }
     PetscCall(SolverStartFromCoarser(user->contact, &start));
     PetscCall(SolverSolve(*snes, user->solver, *u, start));
   }
-  PetscCall(EstimateReset(&user->rec.estimate)); /* the run's own, after the last solve, as without cycles */
-  PetscCall(ErrorNormsReset(&user->rec.errors));
+  PetscCall(EstimateReset(&user->estimate)); /* the run's own, after the last solve, as without cycles */
+  PetscCall(ErrorNormsReset(&user->errors));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The cycles of the record rec in the summary, one line each (with the true error where the scene knows the exact
+/* The cycles in the summary, one line each (with the true error where the scene knows the exact
    solution), and -accuracy's outcome: the last cycle's quantities with their bars. */
-PetscErrorCode AdaptView(MPI_Comm comm, const AdaptOptions *ad, const RunRecord *rec, PetscBool exact)
+static PetscErrorCode AdaptView(Driver d, MPI_Comm comm, const DriverReport *r)
 {
+  const Adapt        *rec   = (const Adapt *)d->data;
+  const AdaptOptions *ad    = &r->opt->adapt;
+  const PetscBool     exact = (PetscBool)(r->scene->exact != NULL);
+
   PetscFunctionBeginUser;
   if (!rec->ncycles) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscPrintf(comm, "  adaptive cycles (-adapt_fraction %g): cycle  dofs        cells       estimate    %s  marked  Newton  Krylov\n",
-                        (double)rec->adapt_fraction, exact ? "error      " : ""));
+                        (double)rec->fraction, exact ? "error      " : ""));
   for (PetscInt k = 0; k < rec->ncycles; ++k) {
     const CycleRecord *c       = &rec->cycles[k];
     char               err[32] = "";
@@ -751,7 +779,7 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AdaptOptions *ad, const RunRecord 
                           "  %.4e  %s%6" PetscInt_FMT "  %6" PetscInt_FMT "  %6" PetscInt_FMT "\n",
                           k, c->n_dofs, c->n_cells, (double)c->estimate, err, c->marked, c->newton_its, c->ksp_its));
   }
-  if (rec->adapt_stop == ADAPT_STOP_MAX_DOFS && !(ad->accuracy > 0.0))
+  if (rec->stop == ADAPT_STOP_MAX_DOFS && !(ad->accuracy > 0.0))
     PetscCall(PetscPrintf(comm, "  the cycles stopped at -adapt_max_dofs %" PetscInt_FMT ": the last mesh has %" PetscInt_FMT " dofs\n", ad->max_dofs,
                           rec->cycles[rec->ncycles - 1].n_dofs));
   if (ad->accuracy > 0.0 && rec->cycles[rec->ncycles - 1].norm == 0.0 && rec->cycles[rec->ncycles - 1].estimate == 0.0) {
@@ -771,13 +799,13 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AdaptOptions *ad, const RunRecord 
           comm, "  WARNING: accuracy %g not reached after %" PetscInt_FMT " cycles (%" PetscInt_FMT " dofs)%s%s%s; the last cycle's bars:\n",
           (double)ad->accuracy, rec->ncycles - 1, c->n_dofs, UnseenHolds(ad, c) ? ": the mesh does not see the contact at some nodes" : "",
           !c->converged ? ": the last solve failed" : "",
-          rec->adapt_stop == ADAPT_STOP_MAX_DOFS       ? ": the mesh reached -adapt_max_dofs"
-          : rec->adapt_stop == ADAPT_STOP_MAX_MEMORY   ? ": the next cycle would exceed -adapt_max_memory"
-          : rec->adapt_stop == ADAPT_STOP_FIXED_EPS    ? ": the fixed eps's penalty part of a bar is above the tolerance (-penalty_eps)"
-          : rec->adapt_stop == ADAPT_STOP_OUT_OF_REACH ? ": a bar falls too slowly to reach it within -adapt_max_memory"
-                                                       : ""));
+          rec->stop == ADAPT_STOP_MAX_DOFS       ? ": the mesh reached -adapt_max_dofs"
+          : rec->stop == ADAPT_STOP_MAX_MEMORY   ? ": the next cycle would exceed -adapt_max_memory"
+          : rec->stop == ADAPT_STOP_FIXED_EPS    ? ": the fixed eps's penalty part of a bar is above the tolerance (-penalty_eps)"
+          : rec->stop == ADAPT_STOP_OUT_OF_REACH ? ": a bar falls too slowly to reach it within -adapt_max_memory"
+                                                 : ""));
     for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
-      if (!rec->accuracy_target[k]) continue;
+      if (!rec->target[k]) continue;
       if (PetscIsNanReal(c->bar[k]))
         PetscCall(PetscPrintf(comm, "    %-14s %.6g, no bar yet (no earlier cycle twice as coarse: N^(-1/dim) twice the last one's)\n",
                               AccuracyQuantities[k], (double)c->value[k]));
@@ -786,10 +814,10 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AdaptOptions *ad, const RunRecord 
                               (double)(100.0 * c->bar[k] / PetscAbsReal(c->value[k])),
                               k == ACCURACY_ENERGY ? " (the energy norm and the error estimate)" : ""));
     }
-    if (OnlyEnergyHolds(ad, rec->accuracy_target, c)) {
+    if (OnlyEnergyHolds(ad, rec->target, c)) {
       char names[256];
 
-      PetscCall(ContactTargetNames(rec->accuracy_target, names, sizeof(names)));
+      PetscCall(ContactTargetNames(rec->target, names, sizeof(names)));
       PetscCall(PetscPrintf(comm,
                             "  only the energy's bar is above the tolerance: the energy norm's error lies over the whole body, and on a body much "
                             "larger than its contact zone it falls slowly; -accuracy_quantity %s asks for the contact quantities alone\n",
@@ -802,22 +830,25 @@ PetscErrorCode AdaptView(MPI_Comm comm, const AdaptOptions *ad, const RunRecord 
 /* The cycles' part of /run (the fraction they marked, why they stopped, -adapt_max_dofs; with -accuracy, the tolerance,
    whether it was reached and the last cycle's values and bars of the quantities asked for), and the table /cycles:
    one row per mesh of the adaptive refinement. */
-PetscErrorCode AdaptWrite(MPI_Comm comm, const AdaptOptions *ad, const RunRecord *rec, PetscInt dim, PetscViewer v)
+static PetscErrorCode AdaptWrite(Driver d, MPI_Comm comm, const DriverReport *r, PetscViewer v)
 {
-  const PetscInt     n = rec->ncycles;
-  const CycleRecord *c = rec->cycles;
-  PetscReal         *col;
+  const Adapt        *rec = (const Adapt *)d->data;
+  const AdaptOptions *ad  = &r->opt->adapt;
+  const PetscInt      dim = r->dim;
+  const PetscInt      n   = rec->ncycles;
+  const CycleRecord  *c   = rec->cycles;
+  PetscReal          *col;
 
   PetscFunctionBeginUser;
   if (!n) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(RunAttrReal(v, rec->adapt_fraction, "adapt_fraction"));
-  PetscCall(RunAttrString(v, AdaptStops[rec->adapt_stop], "adapt_stop"));
+  PetscCall(RunAttrReal(v, rec->fraction, "adapt_fraction"));
+  PetscCall(RunAttrString(v, AdaptStops[rec->stop], "adapt_stop"));
   if (ad->max_dofs) PetscCall(RunAttrInt(v, ad->max_dofs, "adapt_max_dofs"));
   if (ad->accuracy > 0.0) {
     PetscCall(RunAttrReal(v, ad->accuracy, "accuracy"));
     PetscCall(RunAttrInt(v, c[n - 1].accurate, "accuracy_reached"));
     for (PetscInt k = 0; k < ACCURACY_NUM; ++k) {
-      if (!rec->accuracy_target[k]) continue;
+      if (!rec->target[k]) continue;
       PetscCall(RunAttrReal(v, c[n - 1].value[k], "accuracy_%s_value", AccuracyQuantities[k]));
       PetscCall(RunAttrReal(v, c[n - 1].bar[k], "accuracy_%s_bar", AccuracyQuantities[k]));
     }
@@ -874,5 +905,30 @@ PetscErrorCode AdaptWrite(MPI_Comm comm, const AdaptOptions *ad, const RunRecord
 #undef CYCLE_COLUMN
   PetscCall(PetscViewerHDF5PopGroup(v));
   PetscCall(PetscFree(col));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode AdaptDestroy(Driver d)
+{
+  Adapt *a = (Adapt *)d->data;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscFree(a->cycles));
+  PetscCall(PetscFree(d->data));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The adaptive cycles' driver. */
+PetscErrorCode DriverCreate_Adapt(Driver d)
+{
+  Adapt *a;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&a));
+  d->data        = a;
+  d->ops.solve   = AdaptSolve;
+  d->ops.view    = AdaptView;
+  d->ops.write   = AdaptWrite;
+  d->ops.destroy = AdaptDestroy;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

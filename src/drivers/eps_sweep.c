@@ -12,7 +12,7 @@
    point of a cubic saved one more CG iteration there (not kept).
    The second value starts on the tangent of the solution path at the first (EpsSweepTangent()). */
 #include "contact.h"
-#include "solver_impl.h"
+#include "drivers_impl.h"
 
 #define SWEEP_POINTS 3 /* the solutions the start's polynomial in eps goes through */
 
@@ -72,8 +72,12 @@ static PetscErrorCode ExtrapolationStep(PetscInt n, Vec hist[], const PetscReal 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
+static PetscErrorCode EpsSweepSolve(Driver d, AppCtx *user, DM *dmp, SNES *snesp, Vec *up)
 {
+  RunStats             *stats              = SolverStats(user->solver);
+  DM                    dm                 = *dmp;
+  SNES                  snes               = *snesp;
+  Vec                   u                  = *up;
   Vec                   hist[SWEEP_POINTS] = {NULL}, dir = NULL; /* the solutions for the last values, the newest first */
   PetscReal             e[SWEEP_POINTS] = {0.0}, eps;
   PetscInt              nh              = 0;
@@ -81,7 +85,7 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 
   PetscFunctionBeginUser;
   PetscCall(ContactGetOptions(user->contact, &copt));
-  for (PetscInt k = 1; k < copt->n_sweep && user->rec.stats.converged; ++k) {
+  for (PetscInt k = 1; k < copt->n_sweep && stats->converged; ++k) {
     PetscReal eps_last;
     PetscInt  n = 1;
 
@@ -103,18 +107,24 @@ PetscErrorCode EpsSweepSolve(DM dm, AppCtx *user, SNES snes, Vec u)
       for (PetscInt i = 0; i < n; ++i) distinct = (PetscBool)(distinct && e[n] != e[i]);
     if (n > 1 && eps != eps_last) { /* the polynomial through the last n solutions */
       PetscCall(ExtrapolationStep(n, hist, e, eps, dir));
-      PetscCall(SolverExtrapolatedStart(snes, dm, user->contact, user->prob.sctx, u, dir, 1.0, 0.0, PETSC_TRUE));
+      PetscCall(SolverExtrapolatedStart(snes, dm, user->solver, u, dir, 1.0, 0.0, PETSC_TRUE));
     } else if (k == 1 && eps != eps_last) { /* the tangent (a sweep is the penalty's: ContactSetFromOptions()) */
       PetscBool ok = PETSC_FALSE;
 
-      PetscCall(EpsSweepTangent(snes, dm, user->contact, u, dir, &user->rec.stats.ksp_its_total, &ok));
-      if (ok)
-        PetscCall(SolverExtrapolatedStart(snes, dm, user->contact, user->prob.sctx, u, dir, (eps - eps_last) * eps / (eps_last * eps_last), 1e-2,
-                                          PETSC_FALSE));
+      PetscCall(EpsSweepTangent(snes, dm, user->contact, u, dir, &stats->ksp_its_total, &ok));
+      if (ok) PetscCall(SolverExtrapolatedStart(snes, dm, user->solver, u, dir, (eps - eps_last) * eps / (eps_last * eps_last), 1e-2, PETSC_FALSE));
     }
     PetscCall(SolverSolve(snes, user->solver, u, SOLVER_START_NEARBY_EPS));
   }
   for (PetscInt j = 0; j < SWEEP_POINTS; ++j) PetscCall(VecDestroy(&hist[j]));
   PetscCall(VecDestroy(&dir));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The eps sweep's driver: its solves are rows of the solver's table of solves (/solves), its only results. */
+PetscErrorCode DriverCreate_EpsSweep(Driver d)
+{
+  PetscFunctionBeginUser;
+  d->ops.solve = EpsSweepSolve;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -10,7 +10,7 @@
 #include "estimate.h"
 #include "mesh.h"
 #include "physics.h"
-#include "solver.h"
+#include "drivers_impl.h"
 
 /* The solution u on dm as a local vector, with the Dirichlet values of loc_bc (the problem's, inserted by ProblemSetUp()). */
 static PetscErrorCode LocalSolution(DM dm, Vec loc_bc, Vec u, Vec *loc)
@@ -39,12 +39,13 @@ static PetscErrorCode TakeMesh(DM *dm, DM fine, Vec *fine_loc, Vec *u)
    its refinement where marked says, with *u interpolated as the initial guess (exact for nested P1/Q1). */
 PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked)
 {
+  Problem  *prob = SolverProblem(user->solver);
   DM        fine;
   PetscInt *parent, *vertex_source = NULL;
   Vec       loc, fine_loc;
 
   PetscFunctionBeginUser;
-  PetscCall(LocalSolution(*dm, user->prob.loc_bc, *u, &loc));
+  PetscCall(LocalSolution(*dm, prob->loc_bc, *u, &loc));
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user->solver, snes));
   if (marked) {
@@ -52,11 +53,11 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
     PetscCall(MeshRefineMarked(*dm, marked, &fine, &vertex_source));
   } else if (user->box.is_box && user->opt->degree == 1) { /* the box of twice as many cells, built directly */
     parent = NULL;
-    PetscCall(MeshCreateBoxLevel(*dm, &user->box, user->prob.level, &fine, &vertex_source));
+    PetscCall(MeshCreateBoxLevel(*dm, &user->box, prob->level, &fine, &vertex_source));
   } else
     PetscCall(MeshRefineRegular(*dm, 1, &fine, &parent, &vertex_source));
-  user->prob.level++;
-  PetscCall(GridSequenceBarsSizes(fine, user->opt, user->contact, &user->box, user->prob.level)); /* -bars on tetrahedra: the final mesh's eps here */
+  prob->level++;
+  PetscCall(GridSequenceBarsSizes(fine, user->opt, user->contact, &user->box, prob->level)); /* -bars on tetrahedra: the final mesh's eps here */
   if (marked) PetscCall(MeshSetContactCellSizes(fine, user->scene.bcs.ncontact, user->scene.bcs.contact_ids)); /* one eps on Gamma_C */
   PetscCall(ProblemSetUp(fine, user->solver, &user->scene, snes));
   PetscCall(MultigridAddLevel(user->mg, *snes, *dm, fine, vertex_source, user->opt->degree)); /* with -pc_type mg */
@@ -64,13 +65,13 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
     PetscCall(MeshInterpolateVertexSources(*dm, fine, vertex_source, loc, &fine_loc)); /* exact and fast */
   else
     PetscCall(MeshInterpolateFromParents(*dm, fine, parent, 1, &loc, &fine_loc));
-  if (user->rec.bars.pressure_recorded) { /* -bars: the 2h level's pressure, for the pressure's band on the final mesh */
+  if (user->bars.pressure_recorded) { /* -bars: the 2h level's pressure, for the pressure's band on the final mesh */
     PetscReal *fine_levels[2];
 
-    PetscCall(MeshInterpolateVertexArrays(*dm, fine, vertex_source, 2, user->rec.bars.pressure_levels, fine_levels));
+    PetscCall(MeshInterpolateVertexArrays(*dm, fine, vertex_source, 2, user->bars.pressure_levels, fine_levels));
     for (PetscInt k = 0; k < 2; ++k) {
-      PetscCall(PetscFree(user->rec.bars.pressure_levels[k]));
-      user->rec.bars.pressure_levels[k] = fine_levels[k];
+      PetscCall(PetscFree(user->bars.pressure_levels[k]));
+      user->bars.pressure_levels[k] = fine_levels[k];
     }
   }
   PetscCall(PetscFree(parent));
@@ -87,6 +88,7 @@ PetscErrorCode GridSequenceRefine(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
    locating each new vertex in the old mesh (MeshTransferApply()), the next solve's start. */
 PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLabel marked, PetscReal unmarked)
 {
+  Problem     *prob = SolverProblem(user->solver);
   DM           fine;
   PetscReal   *size;
   PetscInt     cStart, cEnd;
@@ -103,21 +105,21 @@ PetscErrorCode GridSequenceRemesh(DM *dm, AppCtx *user, SNES *snes, Vec *u, DMLa
     if (marked) PetscCall(DMLabelGetValue(marked, c, &value));
     size[c - cStart] *= value == DM_ADAPT_REFINE ? 0.5 : unmarked;
   }
-  PetscCall(LocalSolution(*dm, user->prob.loc_bc, *u, &loc));
+  PetscCall(LocalSolution(*dm, prob->loc_bc, *u, &loc));
   PetscCall(MeshTransferCreateFromField(*dm, loc, &tr));
-  if (user->rec.bars.pressure_recorded) PetscCall(BarsPressureTransferCreate(*dm, &user->rec.bars, loc, &tr_p)); /* -bars's 2h pressure */
+  if (user->bars.pressure_recorded) PetscCall(BarsPressureTransferCreate(*dm, &user->bars, loc, &tr_p)); /* -bars's 2h pressure */
   PetscCall(VecDestroy(u));
   PetscCall(ProblemDestroy(user->solver, snes));
   PetscCall(MeshRemesh(*dm, user->opt->adapt.model, &user->box, size, &fine));
   PetscCall(VecDestroy(&loc));
   PetscCall(PetscFree(size));
-  user->prob.level++;
+  prob->level++;
   PetscCall(MeshSetContactCellSizes(fine, user->scene.bcs.ncontact, user->scene.bcs.contact_ids)); /* one eps on Gamma_C */
   PetscCall(ProblemSetUp(fine, user->solver, &user->scene, snes));
   PetscCall(DMCreateLocalVector(fine, &loc));
   PetscCall(MeshTransferApply(tr, fine, loc));
   PetscCall(MeshTransferDestroy(&tr));
-  if (tr_p) PetscCall(BarsPressureTransferApply(fine, &user->rec.bars, loc, &tr_p));
+  if (tr_p) PetscCall(BarsPressureTransferApply(fine, &user->bars, loc, &tr_p));
   PetscCall(TakeMesh(dm, fine, &loc, u));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -133,7 +135,7 @@ static PetscErrorCode GridSequenceRemeshHalf(DM *dm, AppCtx *user, SNES *snes, V
 {
   PetscFunctionBeginUser;
   PetscCall(GridSequenceRemesh(dm, user, snes, u, NULL, 0.5));
-  user->rec.bars.remeshed = PETSC_TRUE;
+  user->bars.remeshed = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -263,24 +265,26 @@ static PetscErrorCode GridSequenceBarsEps(SNES snes, const RunOptions *opt, Cont
    widening that the final mesh has, the 2h level all of it; docs/estimate.md). */
 static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, PetscInt nlevels)
 {
-  ErrorBars     *b     = &user->rec.bars;
+  Problem       *prob  = SolverProblem(user->solver);
+  RunStats      *stats = SolverStats(user->solver);
+  ErrorBars     *b     = &user->bars;
   const PetscInt first = nlevels - (BARS_LEVELS - 1);
   DM             dm;
 
   PetscFunctionBeginUser;
-  if (!user->opt->bars || user->prob.level < first || user->prob.level >= nlevels || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!user->opt->bars || prob->level < first || prob->level >= nlevels || !stats->converged) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-  PostprocessGetQuantities(&user->rec.stats, &b->level[b->nlevels]);
-  b->level_h[b->nlevels++] = user->prob.h;
+  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
+  PostprocessGetQuantities(stats, &b->level[b->nlevels]);
+  b->level_h[b->nlevels++] = prob->h;
   /* a driver's question: the penalty's part of the bars is a second solve at eps / R, which a type without eps has not */
-  if (user->prob.level == first + BARS_EPS_LEVEL && !ContactHasPenalty(user->contact)) {
+  if (prob->level == first + BARS_EPS_LEVEL && !ContactHasPenalty(user->contact)) {
     const ContactSet *cs;
 
     PetscCall(ContactGetSet(user->contact, &cs));
     PetscCall(BarsRecordPressure(dm, user->contact, cs->pressure, NULL, b)); /* the pressure's band: no penalty part */
-  } else if (user->prob.level == first + BARS_EPS_LEVEL) {
-    const RunStats    saved = user->rec.stats;
+  } else if (prob->level == first + BARS_EPS_LEVEL) {
+    const RunStats    saved = *stats;
     const ContactSet *cs;
     PetscReal        *p_eps;
     Vec               u0;
@@ -295,9 +299,9 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
     PetscCall(VecCopy(u, u0));
     PetscCall(ContactSetEps(user->contact, dm, b->eps_second));
     PetscCall(SolverSolve(snes, user->solver, u, SOLVER_START_NEARBY_EPS));
-    if (user->rec.stats.converged) {
-      PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-      PostprocessGetQuantities(&user->rec.stats, &b->eps_level);
+    if (stats->converged) {
+      PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
+      PostprocessGetQuantities(stats, &b->eps_level);
       b->eps_done = PETSC_TRUE;
     }
     PetscCall(BarsRecordPressure(dm, user->contact, p_eps, b->eps_done ? cs->pressure : NULL, b));
@@ -306,12 +310,12 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
     PetscCall(VecCopy(u0, u));
     PetscCall(VecDestroy(&u0));
     {
-      RunStats now = user->rec.stats;
+      RunStats now = *stats;
 
-      user->rec.stats                  = saved;
-      user->rec.stats.newton_its_total = now.newton_its_total;
-      user->rec.stats.ksp_its_total    = now.ksp_its_total;
-      user->rec.stats.time_solve       = now.time_solve;
+      *stats                  = saved;
+      stats->newton_its_total = now.newton_its_total;
+      stats->ksp_its_total    = now.ksp_its_total;
+      stats->time_solve       = now.time_solve;
     }
   }
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -324,42 +328,55 @@ static PetscBool GridSequenceStartsAsCoarser(PetscBool bars, PetscInt level, Pet
   return (PetscBool)(bars && level > nlevels - (BARS_LEVELS - 1));
 }
 
-PetscErrorCode GridSequenceSolve(DM *dm, AppCtx *user, SNES *snes, Vec *u)
+/* The run's first solve, on the coarsest level of nested iteration, and a solve on each finer level from the coarser
+   one's solution (-contact_grid_sequence, and the coarser boxes of -contact_coarse_levels). */
+static PetscErrorCode GridSequenceSolve(Driver d, AppCtx *user, DM *dm, SNES *snes, Vec *u)
 {
+  Problem       *prob    = SolverProblem(user->solver);
+  RunStats      *stats   = SolverStats(user->solver);
   const PetscInt nlevels = user->box.coarse_levels + user->opt->solver.grid_sequence;
 
   PetscFunctionBeginUser;
-  user->rec.bars.nlevels    = 0;
-  user->rec.bars.eps_done   = PETSC_FALSE;
-  user->rec.bars.remeshed   = PETSC_FALSE;
-  user->rec.bars.eps_levels = 0.0;
-  PetscCall(GridSequenceSetTolerance(*snes, user->opt, user->box.coarse_levels, user->prob.level));
-  PetscCall(GridSequenceBarsEps(*snes, user->opt, user->contact, user->prob.level, nlevels, &user->rec.bars));
+  user->bars.nlevels    = 0;
+  user->bars.eps_done   = PETSC_FALSE;
+  user->bars.remeshed   = PETSC_FALSE;
+  user->bars.eps_levels = 0.0;
+  PetscCall(GridSequenceSetTolerance(*snes, user->opt, user->box.coarse_levels, prob->level));
+  PetscCall(GridSequenceBarsEps(*snes, user->opt, user->contact, prob->level, nlevels, &user->bars));
   PetscCall(SolverSolve(*snes, user->solver, *u, SOLVER_START_ZERO));
   PetscCall(GridSequenceBarsLevel(*snes, user, *u, nlevels));
   for (PetscInt l = 1; l <= nlevels; ++l) {
-    const PetscBool failed = (PetscBool)!user->rec.stats.converged;
+    const PetscBool failed = (PetscBool)!stats->converged;
     PetscLogDouble  t0, t1;
     SolverStart     start;
 
-    if (failed && user->prob.level >= user->box.coarse_levels) break; /* a failed level of -contact_grid_sequence ends it */
+    if (failed && prob->level >= user->box.coarse_levels) break; /* a failed level of -contact_grid_sequence ends it */
     if (failed)
       PetscCall(PetscPrintf(PetscObjectComm((PetscObject)*dm), "  nested iteration: level %" PetscInt_FMT " failed (%s), the next starts from zero\n",
-                            user->prob.level, SNESConvergedReasons[user->rec.stats.reason]));
+                            prob->level, SNESConvergedReasons[stats->reason]));
     PetscCall(PetscTime(&t0));
-    if (user->opt->bars && user->opt->adapt.model[0] && user->prob.level >= user->box.coarse_levels)
+    if (user->opt->bars && user->opt->adapt.model[0] && prob->level >= user->box.coarse_levels)
       PetscCall(GridSequenceRemeshHalf(dm, user, snes, u));
     else
       PetscCall(GridSequenceRefine(dm, user, snes, u, NULL));
     PetscCall(PetscTime(&t1));
-    user->prob.setup_time = t1 - t0; /* refinement, set-up and interpolation */
-    user->rec.stats.time_setup += t1 - t0;
-    PetscCall(GridSequenceSetTolerance(*snes, user->opt, user->box.coarse_levels, user->prob.level));
-    PetscCall(GridSequenceBarsEps(*snes, user->opt, user->contact, user->prob.level, nlevels, &user->rec.bars));
+    prob->setup_time = t1 - t0; /* refinement, set-up and interpolation */
+    stats->time_setup += t1 - t0;
+    PetscCall(GridSequenceSetTolerance(*snes, user->opt, user->box.coarse_levels, prob->level));
+    PetscCall(GridSequenceBarsEps(*snes, user->opt, user->contact, prob->level, nlevels, &user->bars));
     start = SOLVER_START_COARSER_MESH;
-    if (GridSequenceStartsAsCoarser(user->opt->bars, user->prob.level, nlevels)) PetscCall(SolverStartFromCoarser(user->contact, &start));
+    if (GridSequenceStartsAsCoarser(user->opt->bars, prob->level, nlevels)) PetscCall(SolverStartFromCoarser(user->contact, &start));
     PetscCall(SolverSolve(*snes, user->solver, *u, failed ? SOLVER_START_ZERO : start));
     PetscCall(GridSequenceBarsLevel(*snes, user, *u, nlevels));
   }
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The grid sequence's driver: its solves are rows of the solver's table of solves, and the levels' quantities the
+   -bars of the run (AppCtx's bars) read. */
+PetscErrorCode DriverCreate_GridSequence(Driver d)
+{
+  PetscFunctionBeginUser;
+  d->ops.solve = GridSequenceSolve;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

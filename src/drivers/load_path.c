@@ -9,8 +9,16 @@
 #include "io.h"
 #include "physics.h"
 #include "scenes.h"
-#include "solver_impl.h"
+#include "drivers_impl.h"
 #include <petscviewerhdf5.h>
+
+/* The load path driver's results: one record per step solved (the failed one included), and each step's state at
+   the vertices, OUTPUT_STATE_FIELDS per step (the output's time series). */
+typedef struct {
+  StepRecord *steps;
+  Vec        *step_fields;
+  PetscInt    nsteps;
+} LoadPath;
 
 PetscErrorCode LoadPathGetOptions(MPI_Comm comm, LoadPathOptions *lp)
 {
@@ -70,18 +78,19 @@ PetscErrorCode LoadPathSetUp(MPI_Comm comm, const RunOptions *opt, Contact ct, S
    the contact set's gaps, the load r0 and the scales follow. */
 static PetscErrorCode ProblemUpdateData(DM dm, AppCtx *user)
 {
+  Problem  *prob = SolverProblem(user->solver);
   PetscReal eps;
 
   PetscFunctionBeginUser;
-  PetscCall(VecZeroEntries(user->prob.loc_bc));
-  PetscCall(BoundaryInsertDirichlet(dm, &user->scene, user->prob.face_sets, user->opt->degree, user->prob.loc_bc));
+  PetscCall(VecZeroEntries(prob->loc_bc));
+  PetscCall(BoundaryInsertDirichlet(dm, &user->scene, prob->face_sets, user->opt->degree, prob->loc_bc));
   PetscCall(
       ElasticityUpdateConstants(dm, &user->opt->material, &user->scene)); /* the obstacle, the body force, the scene's loads; 1/eps is reset below */
   PetscCall(ContactGetEps(user->contact, &eps));
   PetscCall(ContactSetEps(user->contact, dm, eps));
   PetscCall(ContactSetLoad(user->contact, dm, &user->scene.obstacle));
-  PetscCall(SolverAssembleLoad(dm, user->opt, &user->scene, &user->prob));
-  PetscCall(SolverComputeScales(dm, user->contact, &user->prob));
+  PetscCall(SolverAssembleLoad(dm, user->opt, &user->scene, prob));
+  PetscCall(SolverComputeScales(dm, user->contact, prob));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -182,8 +191,10 @@ static PetscErrorCode BodyDepth(DM dm, const Scene *scene, PetscReal *depth)
    step's force there (4e-5, the load 0.0045) was exact to about 1e-6 relative, and the search stalled at 1.0e-8.
    Once the active set settles a solve is linear, so the tighter stop costs about one Newton step. *ok is false when
    the solve fails or the target is not reached in FORCE_CONTROL_MAX_ITS positions; *its counts the positions solved. */
-static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscReal target, PetscBool *ok, PetscInt *its)
+static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, const LoadPath *path, SNES snes, Vec u, PetscReal target, PetscBool *ok, PetscInt *its)
 {
+  Problem  *prob  = SolverProblem(user->solver);
+  RunStats *stats = SolverStats(user->solver);
   PetscReal f, s, f_prev = 0.0, s_prev = 0.0, s_lo = 0.0, f_lo = 0.0, s_hi = 0.0, f_hi = 0.0, atol, rtol, stol, power, depth = PETSC_MAX_REAL;
   PetscBool have_lo = PETSC_FALSE, have_hi = PETSC_FALSE;
   PetscInt  side = 0, maxit, maxf; /* side: the bracket's end kept last time (Illinois) */
@@ -192,18 +203,18 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
   PetscFunctionBeginUser;
   *ok   = PETSC_FALSE;
   *its  = 0;
-  power = ForcePower(&user->scene, user->rec.steps, user->rec.nsteps);
+  power = ForcePower(&user->scene, path->steps, path->nsteps);
   PetscCall(VecDuplicate(u, &u_prev)); /* the solution at s_prev: u = 0 at s = 0, before the obstacle presses */
   PetscCall(VecDuplicate(u, &dir));
   PetscCall(VecZeroEntries(u_prev));
   PetscCall(SNESGetTolerances(snes, &atol, &rtol, &stol, &maxit, &maxf));
-  if (user->prob.load_norm > 0.0)
-    PetscCall(SNESSetTolerances(snes, atol, PetscMin(rtol, FORCE_CONTROL_SOLVE_TOL * FORCE_CONTROL_RTOL * target / user->prob.load_norm), stol, maxit,
-                                maxf));
+  if (prob->load_norm > 0.0)
+    PetscCall(
+        SNESSetTolerances(snes, atol, PetscMin(rtol, FORCE_CONTROL_SOLVE_TOL * FORCE_CONTROL_RTOL * target / prob->load_norm), stol, maxit, maxf));
   PetscCall(BodyDepth(dm, &user->scene, &depth));
-  PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-  ForceAlong(&user->scene, &user->rec.stats, &f, &s);
-  for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && user->rec.stats.converged; ++it) {
+  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
+  ForceAlong(&user->scene, stats, &f, &s);
+  for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && stats->converged; ++it) {
     PetscReal s_next;
 
     if (PetscAbsReal(f - target) <= FORCE_CONTROL_RTOL * target) {
@@ -257,12 +268,12 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
     }
     PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
     PetscCall(ProblemUpdateData(dm, user));
-    PetscCall(SolverSecantStart(snes, dm, user->contact, user->prob.sctx, u, u_prev, dir, (PetscBool)(s != s_prev),
-                                s != s_prev ? (s_next - s) / (s - s_prev) : 0.0, 1.0));
+    PetscCall(
+        SolverSecantStart(snes, dm, user->solver, u, u_prev, dir, (PetscBool)(s != s_prev), s != s_prev ? (s_next - s) / (s - s_prev) : 0.0, 1.0));
     s_prev = s, f_prev = f;
     PetscCall(SolverSolveWarm(snes, user->solver, u, "force control")); /* from zero where Newton stalls at a kink of the penalty */
-    PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-    ForceAlong(&user->scene, &user->rec.stats, &f, &s);
+    PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
+    ForceAlong(&user->scene, stats, &f, &s);
     ++*its;
   }
   PetscCall(SNESSetTolerances(snes, atol, rtol, stol, maxit, maxf));
@@ -282,18 +293,20 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
    still overlap it: that is no release); behind the onset the state is u = 0 where the other loads are zero too. */
 #define FORCE_CONTROL_RELEASE 1e-6
 
-static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u, PetscBool *ok, PetscInt *its)
+static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, const LoadPath *path, SNES snes, Vec u, PetscBool *ok, PetscInt *its)
 {
-  const PetscReal power = ForcePower(&user->scene, user->rec.steps, user->rec.nsteps);
+  Problem        *prob  = SolverProblem(user->solver);
+  RunStats       *stats = SolverStats(user->solver);
+  const PetscReal power = ForcePower(&user->scene, path->steps, path->nsteps);
   PetscReal       f, s, f_prev = 0.0, s_prev = 0.0;
   PetscBool       have_prev = PETSC_FALSE;
 
   PetscFunctionBeginUser;
   *ok  = PETSC_FALSE;
   *its = 0;
-  PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-  ForceAlong(&user->scene, &user->rec.stats, &f, &s);
-  for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && user->rec.stats.converged; ++it) {
+  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
+  ForceAlong(&user->scene, stats, &f, &s);
+  for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && stats->converged; ++it) {
     PetscReal s_next, move, d;
 
     PetscCall(ContactMaxPenetration(user->contact, dm, u, &d));
@@ -315,66 +328,72 @@ static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, SNES snes, Vec u,
     PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
     PetscCall(ProblemUpdateData(dm, user));
     PetscCall(SolverSolveWarm(snes, user->solver, u, "force control"));
-    PetscCall(PostprocessContact(dm, user->contact, &user->prob, &user->scene.bcs, &user->opt->material, u, &user->rec.stats));
-    ForceAlong(&user->scene, &user->rec.stats, &f, &s);
+    PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
+    ForceAlong(&user->scene, stats, &f, &s);
     ++*its;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The step just solved at factor t, of a path of n steps, into the record rec: its quantities (PostprocessContact()
-   with the contact ct, the problem prob, the scene's boundary conditions and the material mat), its solves' records
-   from first_record on (summed: force control solves several positions) and its state at the vertices
-   (OutputStateFields(): the output's time series). */
-static PetscErrorCode LoadPathRecordStep(DM dm, Contact ct, const Problem *prob, const Scene *scene, const Material *mat, PetscInt n, Vec u,
-                                         PetscReal t, PetscInt first_record, PetscBool ok, RunRecord *rec)
+/* The step just solved at factor t, of a path of n steps, into the path's record: its quantities (PostprocessContact()
+   with the contact ct, the solver's problem, the scene's boundary conditions and the material mat, into the solver's
+   statistics), its solves' records from first_record on (summed: force control solves several positions) and its
+   state at the vertices (OutputStateFields(): the output's time series). */
+static PetscErrorCode LoadPathRecordStep(DM dm, Contact ct, Solver solver, const Scene *scene, const Material *mat, PetscInt n, Vec u, PetscReal t,
+                                         PetscInt first_record, PetscBool ok, LoadPath *path)
 {
-  StepRecord *s;
+  const Problem     *prob  = SolverProblem(solver);
+  RunStats          *stats = SolverStats(solver);
+  const SolveRecord *records;
+  PetscInt           nrecords;
+  StepRecord        *s;
 
   PetscFunctionBeginUser;
-  if (!rec->steps) {
-    PetscCall(PetscCalloc1(n, &rec->steps));
-    PetscCall(PetscCalloc1(n * OUTPUT_STATE_FIELDS, &rec->step_fields));
+  if (!path->steps) {
+    PetscCall(PetscCalloc1(n, &path->steps));
+    PetscCall(PetscCalloc1(n * OUTPUT_STATE_FIELDS, &path->step_fields));
   }
-  s = &rec->steps[rec->nsteps];
-  PetscCall(PostprocessContact(dm, ct, prob, &scene->bcs, mat, u, &rec->stats));
-  PetscCall(OutputStateFields(dm, ct, prob->loc_bc, u, &rec->step_fields[rec->nsteps * OUTPUT_STATE_FIELDS]));
-  rec->nsteps++;
-  PostprocessGetQuantities(&rec->stats, &s->q);
+  s = &path->steps[path->nsteps];
+  PetscCall(PostprocessContact(dm, ct, prob, &scene->bcs, mat, u, stats));
+  PetscCall(OutputStateFields(dm, ct, prob->loc_bc, u, &path->step_fields[path->nsteps * OUTPUT_STATE_FIELDS]));
+  path->nsteps++;
+  PostprocessGetQuantities(stats, &s->q);
   s->factor        = t;
-  s->contact_force = rec->stats.contact_force;
+  s->contact_force = stats->contact_force;
   for (PetscInt c = 0; c < 3; ++c) s->obstacle_translate[c] = scene->obstacle.translate[c];
   s->newton_its = s->ksp_its = 0;
   s->time                    = 0.0;
-  for (PetscInt i = first_record; i < rec->nrecords; ++i) {
-    s->newton_its += rec->records[i].newton_its;
-    s->ksp_its += rec->records[i].ksp_its;
-    s->time += rec->records[i].time_solve;
+  PetscCall(SolverGetSolves(solver, &records, &nrecords));
+  for (PetscInt i = first_record; i < nrecords; ++i) {
+    s->newton_its += records[i].newton_its;
+    s->ksp_its += records[i].ksp_its;
+    s->time += records[i].time_solve;
   }
-  s->converged = (PetscBool)(rec->records[rec->nrecords - 1].converged && ok && rec->stats.converged);
+  s->converged = (PetscBool)(records[nrecords - 1].converged && ok && stats->converged);
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Force control at the current load (-obstacle_force): the obstacle moved until it presses with the scene's force
    (the factor times -obstacle_force); a target not reached fails the solve, as a failed Newton solve does. */
-static PetscErrorCode LoadPathForce(DM dm, AppCtx *user, SNES snes, Vec u, PetscBool *ok)
+static PetscErrorCode LoadPathForce(DM dm, AppCtx *user, const LoadPath *path, SNES snes, Vec u, PetscBool *ok)
 {
-  PetscInt its;
+  RunStats *stats = SolverStats(user->solver);
+  PetscInt  its;
 
   PetscFunctionBeginUser;
   *ok = PETSC_TRUE;
-  if (!SceneForceControlled(&user->scene) || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!SceneForceControlled(&user->scene) || !stats->converged) PetscFunctionReturn(PETSC_SUCCESS);
   if (user->scene.obstacle.force > 0.0)
-    PetscCall(ForceControlSolve(dm, user, snes, u, user->scene.obstacle.force, ok, &its));
+    PetscCall(ForceControlSolve(dm, user, path, snes, u, user->scene.obstacle.force, ok, &its));
   else
-    PetscCall(ForceControlRelease(dm, user, snes, u, ok, &its)); /* the factor 0 */
-  user->rec.stats.force_control_its += its;
-  if (!*ok && user->rec.stats.converged) {
+    PetscCall(ForceControlRelease(dm, user, path, snes, u, ok, &its)); /* the factor 0 */
+  stats->force_control_its += its;
+  if (!*ok && stats->converged) {
     PetscCall(PetscPrintf(PetscObjectComm((PetscObject)dm),
                           "  force control: the force %g was not reached in %" PetscInt_FMT " position(s) of the obstacle\n",
                           (double)user->scene.obstacle.force, its));
-    user->rec.stats.converged            = PETSC_FALSE;
-    user->rec.stats.force_control_failed = PETSC_TRUE;
+    stats->converged            = PETSC_FALSE;
+    stats->force_control_failed = PETSC_TRUE;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -389,8 +408,13 @@ static PetscErrorCode LoadPathForce(DM dm, AppCtx *user, SNES snes, Vec u, Petsc
    Under force control each step starts at the last step's position and solution instead, and moves the obstacle to
    the step's force. A failed step ends the path: the output is its state, with converged = 0, and /steps holds the
    steps up to it. Without a path, force control at the run's one load. */
-PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
+static PetscErrorCode LoadPathSolve(Driver d, AppCtx *user, DM *dmp, SNES *snesp, Vec *up)
 {
+  RunStats              *stats = SolverStats(user->solver);
+  LoadPath              *path  = (LoadPath *)d->data;
+  DM                     dm    = *dmp;
+  SNES                   snes  = *snesp;
+  Vec                    u     = *up;
   const LoadPathOptions *lp    = &user->opt->load_path;
   const PetscBool        force = SceneForceControlled(&user->scene);
   Vec                    prev = NULL, dir = NULL;
@@ -398,20 +422,20 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
   PetscBool              ok;
 
   PetscFunctionBeginUser;
-  PetscCall(LoadPathForce(dm, user, snes, u, &ok)); /* the first step's force, or the run's one force without a path */
+  PetscCall(LoadPathForce(dm, user, path, snes, u, &ok)); /* the first step's force, or the run's one force without a path */
   if (!lp->n) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(LoadPathRecordStep(dm, user->contact, &user->prob, &user->scene, &user->opt->material, lp->n, u, lp->factor[0], first, ok, &user->rec));
+  PetscCall(LoadPathRecordStep(dm, user->contact, user->solver, &user->scene, &user->opt->material, lp->n, u, lp->factor[0], first, ok, path));
   if (lp->n > 1) {
     PetscCall(VecDuplicate(u, &prev));
     PetscCall(VecDuplicate(u, &dir));
     PetscCall(VecZeroEntries(prev)); /* u = 0 at t = 0 */
   }
-  for (PetscInt k = 1; k < lp->n && user->rec.stats.converged; ++k) {
+  for (PetscInt k = 1; k < lp->n && stats->converged; ++k) {
     const PetscReal t_last = lp->factor[k - 1], t_prev = k > 1 ? lp->factor[k - 2] : 0.0;
     PetscReal       f, s;
 
-    first = user->rec.nrecords;
-    ForceAlong(&user->scene, &user->rec.stats, &f, &s);
+    PetscCall(SolverGetSolves(user->solver, NULL, &first));
+    ForceAlong(&user->scene, stats, &f, &s);
     PetscCall(SceneSetLoadFactor(&user->scene, lp->factor[k]));
     if (force) PetscCall(SceneSetObstaclePosition(&user->scene, s)); /* the last step's position */
     PetscCall(ProblemUpdateData(dm, user));
@@ -420,46 +444,49 @@ PetscErrorCode LoadPathSolve(DM dm, AppCtx *user, SNES snes, Vec u)
          none start from the last step's solution, which their solve needs no better guess than */
       const PetscBool secant = (PetscBool)(!force && t_last != t_prev && ContactHasPenalty(user->contact));
 
-      PetscCall(SolverSecantStart(snes, dm, user->contact, user->prob.sctx, u, prev, dir, secant,
-                                  secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0, 1.0));
+      PetscCall(SolverSecantStart(snes, dm, user->solver, u, prev, dir, secant, secant ? (lp->factor[k] - t_last) / (t_last - t_prev) : 0.0, 1.0));
     }
     PetscCall(SolverSolveWarm(snes, user->solver, u, "load path")); /* from zero where the guess's active set is too far off */
-    PetscCall(PenetrationTolSolve(dm, user, snes, u)); /* -contact_penetration_tol at every step, from the last step's eps (or multipliers) */
-    PetscCall(LoadPathForce(dm, user, snes, u, &ok));
-    PetscCall(LoadPathRecordStep(dm, user->contact, &user->prob, &user->scene, &user->opt->material, lp->n, u, lp->factor[k], first, ok, &user->rec));
+    PetscCall(PenetrationTolReach(dm, user, snes, u)); /* -contact_penetration_tol at every step, from the last step's eps (or multipliers) */
+    PetscCall(LoadPathForce(dm, user, path, snes, u, &ok));
+    PetscCall(LoadPathRecordStep(dm, user->contact, user->solver, &user->scene, &user->opt->material, lp->n, u, lp->factor[k], first, ok, path));
   }
   PetscCall(VecDestroy(&prev));
   PetscCall(VecDestroy(&dir));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The steps of the path lp recorded in rec in the summary, one line each, and where force control left the scene's
+/* The steps of the path (-load_steps, -load_path) in the summary, one line each, and where force control left the scene's
    obstacle. */
-PetscErrorCode LoadPathView(MPI_Comm comm, const LoadPathOptions *lp, const Scene *scene, const RunRecord *rec)
+static PetscErrorCode LoadPathView(Driver d, MPI_Comm comm, const DriverReport *r)
 {
+  const LoadPath        *path  = (const LoadPath *)d->data;
+  const LoadPathOptions *lp    = &r->opt->load_path;
+  const Scene           *scene = r->scene;
+
   PetscFunctionBeginUser;
   if (SceneForceControlled(scene)) {
     PetscReal f, s;
 
-    ForceAlong(scene, &rec->stats, &f, &s);
+    ForceAlong(scene, r->stats, &f, &s);
     PetscCall(PetscPrintf(comm,
                           "  force control: the obstacle %g along its direction presses with %.10g (target %g; %" PetscInt_FMT " positions solved)\n",
-                          (double)s, (double)f, (double)scene->obstacle.force, rec->stats.force_control_its));
+                          (double)s, (double)f, (double)scene->obstacle.force, r->stats->force_control_its));
   }
-  if (!rec->nsteps) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!path->nsteps) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(
       PetscPrintf(comm, "  load path: step  factor      contact force  largest pressure  contact size  penetration  energy        Newton  Krylov\n"));
-  for (PetscInt k = 0; k < rec->nsteps; ++k) {
-    const StepRecord *s = &rec->steps[k];
+  for (PetscInt k = 0; k < path->nsteps; ++k) {
+    const StepRecord *s = &path->steps[k];
 
     PetscCall(PetscPrintf(
         comm, "             %4" PetscInt_FMT "  %-10.4g  %-13.6g  %-16.6g  %-12.6g  %-11.4g  %-12.6g  %6" PetscInt_FMT "  %6" PetscInt_FMT "%s\n",
         k + 1, (double)s->factor, (double)s->contact_force, (double)s->q.pressure_max, (double)s->q.contact_size, (double)s->q.penetration_max,
         (double)s->q.energy, s->newton_its, s->ksp_its, s->converged ? "" : "  FAILED"));
   }
-  if (rec->nsteps < lp->n || !rec->steps[rec->nsteps - 1].converged)
-    PetscCall(PetscPrintf(comm, "  load path: stopped at step %" PetscInt_FMT " of %" PetscInt_FMT " (factor %g), whose solve failed\n", rec->nsteps,
-                          lp->n, (double)rec->steps[rec->nsteps - 1].factor));
+  if (path->nsteps < lp->n || !path->steps[path->nsteps - 1].converged)
+    PetscCall(PetscPrintf(comm, "  load path: stopped at step %" PetscInt_FMT " of %" PetscInt_FMT " (factor %g), whose solve failed\n", path->nsteps,
+                          lp->n, (double)path->steps[path->nsteps - 1].factor));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -467,13 +494,17 @@ PetscErrorCode LoadPathView(MPI_Comm comm, const LoadPathOptions *lp, const Scen
    per step solved, the failed one included (the factor, the obstacle's translation and force, the supports' reactions,
    the contact size, the largest pressure and penetration, the energy, the solve's Newton steps, linear iterations,
    time and whether it converged). */
-PetscErrorCode LoadPathWrite(MPI_Comm comm, const Scene *scene, const RunStats *s, const StepRecord st[], PetscInt n, PetscInt dim, PetscViewer v)
+static PetscErrorCode LoadPathWrite(Driver d, MPI_Comm comm, const DriverReport *r, PetscViewer v)
 {
-  PetscReal *col;
-  char       name[128];
+  const LoadPath   *path  = (const LoadPath *)d->data;
+  const Scene      *scene = r->scene;
+  const StepRecord *st    = path->steps;
+  const PetscInt    n = path->nsteps, dim = r->dim;
+  PetscReal        *col;
+  char              name[128];
 
   PetscFunctionBeginUser;
-  if (SceneForceControlled(scene)) PetscCall(RunAttrInt(v, s->force_control_its, "force_control_its"));
+  if (SceneForceControlled(scene)) PetscCall(RunAttrInt(v, r->stats->force_control_its, "force_control_its"));
   if (!n) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMalloc1(n, &col));
   PetscCall(PetscViewerHDF5PushGroup(v, "/steps"));
@@ -510,5 +541,43 @@ PetscErrorCode LoadPathWrite(MPI_Comm comm, const Scene *scene, const RunStats *
 #undef STEP_COLUMN
   PetscCall(PetscViewerHDF5PopGroup(v));
   PetscCall(PetscFree(col));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode LoadPathFields(Driver d, PetscInt *nsteps, Vec const **fields)
+{
+  const LoadPath *path = (const LoadPath *)d->data;
+
+  PetscFunctionBeginUser;
+  *nsteps = path->nsteps;
+  *fields = path->step_fields;
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode LoadPathDestroy(Driver d)
+{
+  LoadPath *path = (LoadPath *)d->data;
+
+  PetscFunctionBeginUser;
+  for (PetscInt k = 0; k < path->nsteps * OUTPUT_STATE_FIELDS; ++k) PetscCall(VecDestroy(&path->step_fields[k]));
+  PetscCall(PetscFree(path->step_fields));
+  PetscCall(PetscFree(path->steps));
+  PetscCall(PetscFree(d->data));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The load path driver: the steps after the run's first, each from the last, and force control at each. */
+PetscErrorCode DriverCreate_LoadPath(Driver d)
+{
+  LoadPath *path;
+
+  PetscFunctionBeginUser;
+  PetscCall(PetscNew(&path));
+  d->data        = path;
+  d->ops.solve   = LoadPathSolve;
+  d->ops.view    = LoadPathView;
+  d->ops.write   = LoadPathWrite;
+  d->ops.fields  = LoadPathFields;
+  d->ops.destroy = LoadPathDestroy;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -19,7 +19,7 @@
    PENETRATION_TOL_MAX_SOLVES solves, or whose solve failed, is reported failed (converged = 0). Each solve is a row of /solves, with its eps and its
    largest penetration at the nodes. */
 #include "contact.h"
-#include "solver_impl.h"
+#include "drivers_impl.h"
 #include "app.h"
 
 #define PENETRATION_TOL_AIM 0.9
@@ -43,7 +43,7 @@ static PetscErrorCode UzawaSolve(DM dm, AppCtx *user, SNES snes, Vec u, PetscRea
   PetscFunctionBeginUser;
   PetscCall(ContactAugment(user->contact, dm, u, PETSC_FALSE, &change));
   best = change;
-  while (change > tol && user->rec.stats.converged && *solves < PENETRATION_TOL_MAX_UPDATES) {
+  while (change > tol && SolverStats(user->solver)->converged && *solves < PENETRATION_TOL_MAX_UPDATES) {
     PetscCall(ContactAugment(user->contact, dm, u, PETSC_TRUE, &change));
     PetscCall(SolverSolve(snes, user->solver, u, SOLVER_START_NEARBY_EPS));
     ++*solves;
@@ -77,7 +77,7 @@ static PetscErrorCode ContinuationSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
   PetscFunctionBeginUser;
   PetscCall(ContactGetOptions(user->contact, &copt));
   PetscCall(ContactGetEps(user->contact, &eps));
-  while (*d_max > tol && user->rec.stats.converged && *solves < PENETRATION_TOL_MAX_SOLVES) {
+  while (*d_max > tol && SolverStats(user->solver)->converged && *solves < PENETRATION_TOL_MAX_SOLVES) {
     const PetscReal eps_new = eps * PetscMax(PENETRATION_TOL_AIM * tol / *d_max, copt->continuation_factor);
     const PetscBool secant  = (PetscBool)(prev != NULL);
 
@@ -88,8 +88,7 @@ static PetscErrorCode ContinuationSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
       PetscCall(VecDuplicate(u, &dir));
     }
     PetscCall(ContactSetEps(user->contact, dm, eps_new));
-    PetscCall(
-        SolverSecantStart(snes, dm, user->contact, user->prob.sctx, u, prev, dir, secant, secant ? (eps_new - eps) / (eps - eps_prev) : 0.0, 0.0));
+    PetscCall(SolverSecantStart(snes, dm, user->solver, u, prev, dir, secant, secant ? (eps_new - eps) / (eps - eps_prev) : 0.0, 0.0));
     eps_prev = eps;
     eps      = eps_new;
     PetscCall(SolverSolveWarm(snes, user->solver, u, "penetration tolerance")); /* from zero where it stalls at a kink of the penalty */
@@ -102,8 +101,10 @@ static PetscErrorCode ContinuationSolve(DM dm, AppCtx *user, SNES snes, Vec u, P
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
+/* The continuation from the solution u to -contact_penetration_tol (nothing without it, or after a failed solve). */
+PetscErrorCode PenetrationTolReach(DM dm, AppCtx *user, SNES snes, Vec u)
 {
+  RunStats             *stats = SolverStats(user->solver);
   const ContactOptions *copt;
   MPI_Comm              comm = PetscObjectComm((PetscObject)dm);
   PetscReal             d_max, eps;
@@ -112,7 +113,7 @@ PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 
   PetscFunctionBeginUser;
   PetscCall(ContactGetOptions(user->contact, &copt));
-  if (!(copt->penetration_tol > 0.0) || !user->rec.stats.converged) PetscFunctionReturn(PETSC_SUCCESS);
+  if (!(copt->penetration_tol > 0.0) || !stats->converged) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(ContactMaxPenetration(user->contact, dm, u, &d_max));
   /* a driver's choice between two ways to the tolerance: Uzawa's updates of the type's multipliers, or a smaller eps */
   augment = ContactCanAugment(user->contact);
@@ -121,14 +122,14 @@ PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
   else
     PetscCall(ContinuationSolve(dm, user, snes, u, copt->penetration_tol, &d_max, &solves, &reached));
   PetscCall(ContactGetEps(user->contact, &eps));
-  user->rec.stats.penetration_tol_solves += solves; /* over the steps of a load path */
-  user->rec.stats.penetration_tol_measured = d_max;
-  if (user->rec.stats.converged && !reached) {
+  stats->penetration_tol_solves += solves; /* over the steps of a load path */
+  stats->penetration_tol_measured = d_max;
+  if (stats->converged && !reached) {
     PetscCall(PetscPrintf(
         comm, "  penetration tolerance: -contact_penetration_tol %g not reached after %" PetscInt_FMT " solves (the largest penetration %g%s)\n",
         (double)copt->penetration_tol, solves, (double)d_max, augment ? "; the multipliers still move by more than the tolerance" : ""));
-    user->rec.stats.converged = PETSC_FALSE;
-  } else if (user->rec.stats.converged)
+    stats->converged = PETSC_FALSE;
+  } else if (stats->converged)
     PetscCall(PetscPrintf(comm, "  penetration tolerance: the largest penetration %g <= %g at eps = %g, in %" PetscInt_FMT " solve(s)\n",
                           (double)d_max, (double)copt->penetration_tol, (double)eps, solves));
   PetscFunctionReturn(PETSC_SUCCESS);
@@ -136,14 +137,31 @@ PetscErrorCode PenetrationTolSolve(DM dm, AppCtx *user, SNES snes, Vec u)
 
 /* -contact_penetration_tol's part of /run: the solves that reached it (over a load path's steps) and the largest
    penetration it ended with, at the nodes and the rule's points; the tolerance itself is the contact's (ContactWrite()). */
-PetscErrorCode PenetrationTolWrite(Contact ct, const RunStats *s, PetscViewer v)
+static PetscErrorCode PenetrationTolWrite(Driver d, MPI_Comm comm, const DriverReport *r, PetscViewer v)
 {
   const ContactOptions *copt;
 
   PetscFunctionBeginUser;
-  PetscCall(ContactGetOptions(ct, &copt));
+  PetscCall(ContactGetOptions(r->contact, &copt));
   if (!(copt->penetration_tol > 0.0)) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(RunAttrInt(v, s->penetration_tol_solves, "penetration_tol_solves"));
-  PetscCall(RunAttrReal(v, s->penetration_tol_measured, "penetration_tol_measured"));
+  PetscCall(RunAttrInt(v, r->stats->penetration_tol_solves, "penetration_tol_solves"));
+  PetscCall(RunAttrReal(v, r->stats->penetration_tol_measured, "penetration_tol_measured"));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode PenetrationTolSolve(Driver d, AppCtx *user, DM *dm, SNES *snes, Vec *u)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PenetrationTolReach(*dm, user, *snes, *u));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The penetration tolerance's driver: on the final mesh, from the last solution (a load path's steps each reach the
+   tolerance again, from the last step's eps or multipliers). */
+PetscErrorCode DriverCreate_PenetrationTol(Driver d)
+{
+  PetscFunctionBeginUser;
+  d->ops.solve = PenetrationTolSolve;
+  d->ops.write = PenetrationTolWrite;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
