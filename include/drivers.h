@@ -10,11 +10,12 @@
 
 /* What a driver's summary and output read of the run besides its own results. */
 typedef struct {
-  const RunOptions *opt;
-  const Scene      *scene;
-  Contact           contact;
-  const RunStats   *stats;
-  PetscInt          dim;
+  const RunOptions         *opt;
+  const Scene              *scene;
+  Contact                   contact;
+  const RunStats           *stats;
+  const SolutionQuantities *quantities;
+  PetscInt                  dim;
 } DriverReport;
 
 /* drivers.c: the registry and the run's flow */

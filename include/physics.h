@@ -16,11 +16,11 @@ PetscErrorCode WeakDataExactStress(const Scene *scene, const Material *mat, Pets
 PetscErrorCode WeakDataExactNormalStress(const Scene *scene, const Material *mat, PetscInt dim, const PetscReal x[], PetscReal *sn);
 
 /* postprocess.c */
-PetscErrorCode PostprocessContact(DM dm, Contact contact, const Problem *prob, const BoundarySet *bcs, const Material *mat, Vec u, RunStats *st);
+PetscErrorCode PostprocessContact(DM dm, Contact contact, const Problem *prob, const BoundarySet *bcs, const Material *mat, Vec u,
+                                  SolutionQuantities *sq);
 PetscErrorCode PostprocessLiftEnergy(DM dm, const Material *mat, const Problem *prob, PetscReal weak_lift, PetscReal *energy);
-PetscErrorCode PostprocessPenetration(const ErrorNorms *errors, RunStats *st);
-void           PostprocessGetQuantities(const RunStats *st, Quantities *q);
-PetscErrorCode PostprocessWrite(const RunStats *s, const BoundarySet *bcs, PetscInt dim, PetscViewer v); /* the quantities in /run */
+PetscErrorCode PostprocessPenetration(const ErrorNorms *errors, SolutionQuantities *sq);
+PetscErrorCode PostprocessWrite(const SolutionQuantities *s, const BoundarySet *bcs, PetscInt dim, PetscViewer v); /* the quantities in /run */
 PetscReal      PostprocessForceMagnitude(const Quantities *q, PetscInt dim);
 /* contact_zone.c */
 PetscErrorCode PostprocessContactSize(DM dm, Contact contact, const BoundarySet *bcs, const Material *mat, Vec u, PetscReal *size, PetscReal *band);

@@ -298,6 +298,16 @@ typedef struct {
   PetscReal reaction[BOUNDARY_MAX][3]; /* the force of each clamp or slip face set's support on the body */
 } Quantities;
 
+/* The solution's quantities after a solve (PostprocessContact(), src/physics/postprocess.c): the quantities users read,
+   where the rule acts, the sum of the nodal normal reactions (q.force is the obstacle's force vector), and whether the
+   largest penetration is the finer quadrature's, between the rule's points (PostprocessPenetration()). */
+typedef struct {
+  Quantities q;
+  PetscInt   active_vertices;
+  PetscReal  contact_force;
+  PetscBool  penetration_between;
+} SolutionQuantities;
+
 typedef struct {
   PetscInt            newton_its, ksp_its;             /* of the last solve (the finest mesh, the last eps) */
   PetscInt            newton_its_total, ksp_its_total; /* of all solves: grid sequence levels, continuation, eps sweep */
@@ -321,23 +331,9 @@ typedef struct {
   PetscInt            pc_breakdowns;            /* preconditioner breakdowns recovered from (pc_recovery.c), */
   char                pc_recovery[512];         /*   and what was done, "; "-separated */
   PetscBool           ksp_ew;                   /* Eisenstat-Walker linear tolerances (-snes_ksp_ew) */
-  Bandwidth           bandwidth;
-  PetscReal           condition_1norm;                      /* estimate of cond_1 of the final Jacobian, NaN if not computed */
+  PetscReal           condition_1norm;          /* estimate of cond_1 of the final Jacobian, NaN if not computed */
   PetscReal           peak_memory_mb, peak_memory_total_mb; /* resident set size: maximum over ranks, and summed */
   PetscReal           time_setup, time_solve, time_total;
-  PetscInt            active_vertices;
-  PetscReal           max_penetration, contact_force, energy;
-  PetscBool           penetration_between;       /* max_penetration is the finer quadrature's, between the rule's points (PostprocessPenetration()) */
-  PetscReal           pressure_max;              /* the largest nodal contact pressure */
-  PetscReal           contact_size;              /* the contact zone's width (2D) or area (3D), PostprocessContactSize() */
-  PetscReal           contact_size_band;         /*   and the one-cell strip along its edge (its resolution on the mesh) */
-  PetscReal           pressure_max_step;         /* the largest pressure's change to its node's neighbours on Gamma_C */
-  PetscReal           pressure_peak;             /* the largest pressure recovered from the nodes around it (pressure_peak.c) */
-  PetscReal           pressure_peak_resolution;  /*   and its resolution (the fit's standard error or step) */
-  PetscReal           contact_force_vector[3];   /* the obstacle's force on the body: the sum of R = K u + r0 over the contact nodes */
-  PetscReal           reaction[BOUNDARY_MAX][3]; /* force the support of each clamp or slip face set exerts on the body */
-  MeshPartitionStats  partition;                 /* from MeshPartitionGetStats() */
-  ContactChecks       checks;                    /* the set-up's and the contact zone's warnings */
 } RunStats;
 
 /* Error bars of the quantities users read (-bars, src/estimate/bars.c): the mesh's part from the solutions on the three
@@ -505,18 +501,22 @@ typedef struct _n_Multigrid *Multigrid; /* the nested meshes' interpolations, pr
 typedef struct _n_Solver    *Solver;    /* the nonlinear core (include/solver.h), private to src/solver/ (solver_impl.h) */
 typedef struct _n_Drivers   *Drivers;   /* the outer strategies (include/drivers.h), private to src/drivers/ */
 typedef struct {
-  const RunOptions *opt;     /* read once before any set-up, then read only */
-  Contact           contact; /* created and read from the options once, set up on the mesh of each problem */
-  MeshBox           box;     /* the simplex box of the mesh options, if the mesh is one (MeshCreate()) */
-  Scene             scene;
-  Multigrid         mg;                       /* the interpolations between the nested meshes solved so far */
-  Solver            solver;                   /* the nonlinear core: the problem, the statistics, the table of solves */
-  Drivers           drivers;                  /* the grid sequence, the adaptive cycles, the eps sweep, ..., the load path */
-  ErrorNorms        errors;                   /* against the scene's exact solution (src/verify/error_norms.c) */
-  ErrorNorms        ref_errors;               /* against the -reference solution (src/verify/reference.c) */
-  ErrorEstimate     estimate;                 /* the a posteriori estimate of the error (src/estimate/) */
-  ErrorBars         bars;                     /* the error bars of the quantities (-bars, src/estimate/bars.c) */
-  char              diagnostics_failed[1024]; /* the diagnostics that failed after the solve, with their messages ("" if none) */
+  const RunOptions  *opt;     /* read once before any set-up, then read only */
+  Contact            contact; /* created and read from the options once, set up on the mesh of each problem */
+  MeshBox            box;     /* the simplex box of the mesh options, if the mesh is one (MeshCreate()) */
+  Scene              scene;
+  Multigrid          mg;                       /* the interpolations between the nested meshes solved so far */
+  Solver             solver;                   /* the nonlinear core: the problem, the statistics, the table of solves */
+  Drivers            drivers;                  /* the grid sequence, the adaptive cycles, the eps sweep, ..., the load path */
+  SolutionQuantities quantities;               /* of the last solution (src/physics/postprocess.c) */
+  ContactChecks      checks;                   /* the set-up's and the contact zone's warnings (src/physics/contact_checks.c) */
+  MeshPartitionStats partition;                /* the partitioner and the final mesh's cut (src/mesh/mesh_partition.c) */
+  Bandwidth          bandwidth;                /* -perf_bandwidth (src/solver/bandwidth.c) */
+  ErrorNorms         errors;                   /* against the scene's exact solution (src/verify/error_norms.c) */
+  ErrorNorms         ref_errors;               /* against the -reference solution (src/verify/reference.c) */
+  ErrorEstimate      estimate;                 /* the a posteriori estimate of the error (src/estimate/) */
+  ErrorBars          bars;                     /* the error bars of the quantities (-bars, src/estimate/bars.c) */
+  char               diagnostics_failed[1024]; /* the diagnostics that failed after the solve, with their messages ("" if none) */
 } AppCtx;
 
 /* The writer of the run's output (src/main.c's, through io/output_hdf5.c's OutputWriteHDF5()), which main() hands to the adaptive cycles */

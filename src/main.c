@@ -18,12 +18,13 @@ static const char help[] =
 
 static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
 {
-  MPI_Comm           comm = PetscObjectComm((PetscObject)dm);
-  const RunStats    *s    = SolverStats(user->solver);
-  const Problem     *prob = SolverProblem(user->solver);
-  const SolveRecord *records;
-  PetscInt           dim, ndofs, nrecords;
-  PetscMPIInt        size;
+  MPI_Comm                  comm = PetscObjectComm((PetscObject)dm);
+  const RunStats           *s    = SolverStats(user->solver);
+  const SolutionQuantities *sq   = &user->quantities;
+  const Problem            *prob = SolverProblem(user->solver);
+  const SolveRecord        *records;
+  PetscInt                  dim, ndofs, nrecords;
+  PetscMPIInt               size;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
@@ -48,12 +49,12 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
   PetscCall(PetscPrintf(comm, ", |F| = %g%s\n", (double)s->residual_norm,
                         s->roundoff_stop ? " (stopped at round-off: -snes_rtol asks for less than double precision can reach)" : ""));
   PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g%s, contact force %g, energy %.10g\n",
-                        s->active_vertices, (double)s->max_penetration,
-                        s->penetration_between
+                        sq->active_vertices, (double)sq->q.penetration_max,
+                        sq->penetration_between
                             ? " (between the nodes and the rule's points, where a curved obstacle cuts the straight faces by about "
                               "h^2/8R, which eps does not reduce)"
                             : "",
-                        (double)s->contact_force, (double)s->energy));
+                        (double)sq->contact_force, (double)sq->q.energy));
   if (!PetscIsNanReal(user->errors.h1))
     PetscCall(PetscPrintf(comm, "  error against the exact solution: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n",
                           (double)user->errors.h1, (double)user->errors.l2, (double)user->errors.pressure_l2, (double)user->errors.pressure_dual));
@@ -74,13 +75,13 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
     }
   }
   {
-    const DriverReport r = {.opt = user->opt, .scene = &user->scene, .contact = user->contact, .stats = s, .dim = dim};
+    const DriverReport r = {.opt = user->opt, .scene = &user->scene, .contact = user->contact, .stats = s, .quantities = sq, .dim = dim};
 
     PetscCall(DriversView(user->drivers, comm, &r)); /* the adaptive cycles, the load path */
   }
   PetscCall(EstimateView(comm, &user->estimate, &user->errors));
   PetscCall(BarsView(comm, &user->bars));
-  PetscCall(ContactChecksWarnings(comm, &s->checks, PETSC_TRUE, NULL));
+  PetscCall(ContactChecksWarnings(comm, &user->checks, PETSC_TRUE, NULL));
   if (user->diagnostics_failed[0])
     PetscCall(
         PetscPrintf(comm, "  WARNING: written without a diagnostic that failed after the solve (exit status 4): %s\n", user->diagnostics_failed));
@@ -92,12 +93,12 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
     PetscCall(PetscPrintf(comm, "  condition number estimate (1-norm) of the Jacobian: %.3e\n", (double)s->condition_1norm));
   PetscCall(PetscPrintf(comm, "  time: setup %.3f s, solve %.3f s, total %.3f s; peak memory %.1f MB per rank (max), %.1f MB in all\n", s->time_setup,
                         s->time_solve, s->time_total, (double)s->peak_memory_mb, (double)s->peak_memory_total_mb));
-  if (s->bandwidth.measured)
+  if (user->bandwidth.measured)
     PetscCall(PetscPrintf(comm, "  bandwidth: triad %.2f GB/s, MatMult %.2f GB/s (%.2f of it, %.2f ms), V-cycle %.2f GB/s (%.2f of it, %.2f ms)\n",
-                          (double)s->bandwidth.triad_gbs, (double)s->bandwidth.matmult_gbs,
-                          (double)(s->bandwidth.matmult_gbs / s->bandwidth.triad_gbs), (double)(1e3 * s->bandwidth.matmult_s),
-                          (double)s->bandwidth.vcycle_gbs, (double)(s->bandwidth.vcycle_gbs / s->bandwidth.triad_gbs),
-                          (double)(1e3 * s->bandwidth.vcycle_s)));
+                          (double)user->bandwidth.triad_gbs, (double)user->bandwidth.matmult_gbs,
+                          (double)(user->bandwidth.matmult_gbs / user->bandwidth.triad_gbs), (double)(1e3 * user->bandwidth.matmult_s),
+                          (double)user->bandwidth.vcycle_gbs, (double)(user->bandwidth.vcycle_gbs / user->bandwidth.triad_gbs),
+                          (double)(1e3 * user->bandwidth.vcycle_s)));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -125,20 +126,21 @@ static PetscErrorCode WriteResults(DM dm, Vec u, PetscViewer v, void *ctx)
   PetscCall(MeshBoxWrite(&user->box, v));
   PetscCall(SceneWrite(&user->scene, &user->opt->material, dim, v));
   PetscCall(ContactWrite(user->contact, v));
-  PetscCall(PostprocessWrite(stats, &user->scene.bcs, dim, v));
-  PetscCall(ContactChecksWrite(comm, &stats->checks, v));
+  PetscCall(PostprocessWrite(&user->quantities, &user->scene.bcs, dim, v));
+  PetscCall(ContactChecksWrite(comm, &user->checks, v));
   PetscCall(VerifyWrite(&user->opt->verify, &user->errors, &user->ref_errors, v));
   PetscCall(EstimateWrite(&user->estimate, v));
   PetscCall(BarsWrite(&user->bars, v));
   PetscCall(SolverWrite(stats, SolverProblem(user->solver), &user->opt->solver, user->box.coarse_levels, nrecords, v));
   PetscCall(SolverWriteSolves(comm, records, nrecords, v));
   {
-    const DriverReport r = {.opt = user->opt, .scene = &user->scene, .contact = user->contact, .stats = stats, .dim = dim};
+    const DriverReport r = {
+        .opt = user->opt, .scene = &user->scene, .contact = user->contact, .stats = stats, .quantities = &user->quantities, .dim = dim};
 
     PetscCall(DriversWrite(user->drivers, comm, &r, v)); /* the cycles, the penetration tolerance, the steps */
   }
-  PetscCall(BandwidthWrite(&stats->bandwidth, v));
-  PetscCall(MeshPartitionWrite(&stats->partition, v));
+  PetscCall(BandwidthWrite(&user->bandwidth, v));
+  PetscCall(MeshPartitionWrite(&user->partition, v));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -280,7 +282,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
     stats->default_mg = (PetscBool)(default_mg && user.box.dim == 3 && user.box.coarse_levels > 0);
     PetscCall(MultigridSetDefault(user.mg, stats->default_mg));
   }
-  PetscCall(MeshPartitionGetStats(dm, &stats->partition));                /* the partitioner; the final mesh's cut is taken after the solve */
+  PetscCall(MeshPartitionGetStats(dm, &user.partition));                  /* the partitioner; the final mesh's cut is taken after the solve */
   PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
   PetscCall(LoadPathSetUp(comm, &opt, user.contact, &user.scene));        /* a load path: the scene at its first factor */
   /* -bars on tetrahedra: the final mesh's eps on the levels below it */
@@ -306,7 +308,7 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
                                             .box              = &user.box,
                                             .grid_refinements = opt.adapt.model[0] ? 0 : opt.solver.grid_sequence}; /* a model remeshes */
 
-    PetscCall(ContactChecksGeometry(dm, &in, &stats->checks));
+    PetscCall(ContactChecksGeometry(dm, &in, &user.checks));
   }
   PetscCall(VecDuplicate(prob->r0, &u)); /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
   PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
@@ -317,15 +319,12 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
 
   PetscCall(DriversSolve(user.drivers, &user, &dm, &snes, &u)); /* the first solve, the cycles, the sweep, ..., the load path */
   PetscCall(SolverConditionEstimate(snes, user.solver, u));
-  PetscCall(PostprocessContact(dm, user.contact, prob, &user.scene.bcs, &opt.material, u, stats));
+  PetscCall(PostprocessContact(dm, user.contact, prob, &user.scene.bcs, &opt.material, u, &user.quantities));
   if (opt.bars) { /* -bars: from the levels' quantities and this mesh's */
-    Quantities q;
-
-    PostprocessGetQuantities(stats, &q);
-    PetscCall(BarsCompute(dm, &user.scene.bcs, user.contact, &q, stats->converged, &user.bars));
+    PetscCall(BarsCompute(dm, &user.scene.bcs, user.contact, &user.quantities.q, stats->converged, &user.bars));
   }
   /* cells across the contact zone, contact the mesh does not see: warnings */
-  PetscCall(ContactChecksResolution(dm, user.contact, &user.scene.bcs, stats->contact_force_vector, u, &stats->checks));
+  PetscCall(ContactChecksResolution(dm, user.contact, &user.scene.bcs, user.quantities.q.force, u, &user.checks));
   { /* diagnostics: a failure there is reported and the output written without them, never the solve lost */
     char       failed[512];
     Diagnostic d = {
@@ -369,13 +368,13 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
       PetscCall(PetscStrlcat(user.diagnostics_failed, failed, sizeof(user.diagnostics_failed)));
     }
   }
-  PetscCall(PostprocessPenetration(&user.errors, stats));  /* with the error norms' finer quadrature */
-  PetscCall(MeshPartitionGetStats(dm, &stats->partition)); /* of the final mesh */
+  PetscCall(PostprocessPenetration(&user.errors, &user.quantities)); /* with the error norms' finer quadrature */
+  PetscCall(MeshPartitionGetStats(dm, &user.partition));             /* of the final mesh */
   PetscCall(PetscTime(&t1));
   stats->time_total = t1 - t0;
   PetscCall(RecordPeakMemory(comm, stats));
   /* -perf_bandwidth: after the peak memory, which its vectors would raise */
-  PetscCall(BandwidthMeasure(snes, opt.perf_bandwidth, &stats->bandwidth));
+  PetscCall(BandwidthMeasure(snes, opt.perf_bandwidth, &user.bandwidth));
   PetscCall(OptionsCheckAllUsed(comm, PETSC_FALSE)); /* the options read during the solve too */
   PetscCall(PrintSummary(dm, &user, u));
   PetscCall(WriteOutput(dm, &user, u));

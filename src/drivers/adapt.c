@@ -241,9 +241,8 @@ PetscErrorCode AdaptCheck(DM dm, const RunOptions *opt, Contact ct, const MeshBo
    scene knows it, the true error. */
 static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Adapt *a, Vec u, PetscInt k)
 {
-  Problem           *prob  = SolverProblem(user->solver);
-  RunStats          *stats = SolverStats(user->solver);
-  CycleRecord       *c     = &a->cycles[k];
+  Problem           *prob = SolverProblem(user->solver);
+  CycleRecord       *c    = &a->cycles[k];
   const SolveRecord *records, *r;
   PetscInt           cStart, cEnd, local, nrecords;
 
@@ -272,8 +271,8 @@ static PetscErrorCode AdaptRecord(DM dm, AppCtx *user, Adapt *a, Vec u, PetscInt
   c->estimate         = user->estimate.total;
   c->estimate_penalty = user->estimate.part[ESTIMATE_PENALTY];
   c->norm             = user->estimate.norm;
-  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
-  PostprocessGetQuantities(stats, &c->q);
+  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, &user->quantities));
+  c->q      = user->quantities.q;
   c->marked = 0;
   for (PetscInt q = 0; q < ACCURACY_NUM; ++q) c->value_eps[q] = PETSC_NAN;
   c->eps       = PETSC_NAN;
@@ -330,8 +329,8 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, const Ada
   if (ok) { /* u(eps_new) = u + (eps_new - eps) du/deps, du/deps = dir eps_new / eps^2 */
     PetscCall(VecDuplicate(u, &u_new));
     PetscCall(VecWAXPY(u_new, (eps_new - eps) * eps_new / (eps * eps), dir, u));
-    PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u_new, stats));
-    PostprocessGetQuantities(stats, &q);
+    PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u_new, &user->quantities));
+    q                               = user->quantities.q;
     c->value_eps[ACCURACY_FORCE]    = PostprocessForceMagnitude(&q, dim);
     c->value_eps[ACCURACY_PRESSURE] = q.pressure_max;
     c->value_eps[ACCURACY_SIZE]     = q.contact_size;
@@ -341,7 +340,7 @@ static PetscErrorCode AdaptQuantitiesAtSmallerEps(DM dm, AppCtx *user, const Ada
   PetscCall(VecDestroy(&dir));
   PetscCall(ContactSetEps(user->contact, dm, eps));
   /* the contact state of the cycle's solution again */
-  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
+  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, &user->quantities));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 

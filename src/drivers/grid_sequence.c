@@ -274,8 +274,8 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
   PetscFunctionBeginUser;
   if (!user->opt->bars || prob->level < first || prob->level >= nlevels || !stats->converged) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(SNESGetDM(snes, &dm));
-  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
-  PostprocessGetQuantities(stats, &b->level[b->nlevels]);
+  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, &user->quantities));
+  b->level[b->nlevels]     = user->quantities.q;
   b->level_h[b->nlevels++] = prob->h;
   /* a driver's question: the penalty's part of the bars is a second solve at eps / R, which a type without eps has not */
   if (prob->level == first + BARS_EPS_LEVEL && !ContactHasPenalty(user->contact)) {
@@ -300,9 +300,9 @@ static PetscErrorCode GridSequenceBarsLevel(SNES snes, AppCtx *user, Vec u, Pets
     PetscCall(ContactSetEps(user->contact, dm, b->eps_second));
     PetscCall(SolverSolve(snes, user->solver, u, SOLVER_START_NEARBY_EPS));
     if (stats->converged) {
-      PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
-      PostprocessGetQuantities(stats, &b->eps_level);
-      b->eps_done = PETSC_TRUE;
+      PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, &user->quantities));
+      b->eps_level = user->quantities.q;
+      b->eps_done  = PETSC_TRUE;
     }
     PetscCall(BarsRecordPressure(dm, user->contact, p_eps, b->eps_done ? cs->pressure : NULL, b));
     PetscCall(PetscFree(p_eps));

@@ -95,7 +95,7 @@ static PetscErrorCode ProblemUpdateData(DM dm, AppCtx *user)
 }
 
 /* A force and a position of the obstacle along the unit direction of the scene's full translation (the force positive
-   as the obstacle presses): of the solution PostprocessContact() last measured into st (ForceAlong()) at the scene's
+   as the obstacle presses): of the solution PostprocessContact() last measured into sq (ForceAlong()) at the scene's
    translation, or of a recorded step. */
 static void Along(const Scene *scene, const PetscReal force[3], const PetscReal translate[3], PetscReal *f, PetscReal *s)
 {
@@ -111,9 +111,9 @@ static void Along(const Scene *scene, const PetscReal force[3], const PetscReal 
   }
 }
 
-static void ForceAlong(const Scene *scene, const RunStats *st, PetscReal *f, PetscReal *s)
+static void ForceAlong(const Scene *scene, const SolutionQuantities *sq, PetscReal *f, PetscReal *s)
 {
-  Along(scene, st->contact_force_vector, scene->obstacle.translate, f, s);
+  Along(scene, sq->q.force, scene->obstacle.translate, f, s);
 }
 
 /* The force's local power of the obstacle's position, from the last two of the nsteps steps recorded (1.5 for a
@@ -212,8 +212,8 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, const LoadPath *pat
     PetscCall(
         SNESSetTolerances(snes, atol, PetscMin(rtol, FORCE_CONTROL_SOLVE_TOL * FORCE_CONTROL_RTOL * target / prob->load_norm), stol, maxit, maxf));
   PetscCall(BodyDepth(dm, &user->scene, &depth));
-  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
-  ForceAlong(&user->scene, stats, &f, &s);
+  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, &user->quantities));
+  ForceAlong(&user->scene, &user->quantities, &f, &s);
   for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && stats->converged; ++it) {
     PetscReal s_next;
 
@@ -272,8 +272,8 @@ static PetscErrorCode ForceControlSolve(DM dm, AppCtx *user, const LoadPath *pat
         SolverSecantStart(snes, dm, user->solver, u, u_prev, dir, (PetscBool)(s != s_prev), s != s_prev ? (s_next - s) / (s - s_prev) : 0.0, 1.0));
     s_prev = s, f_prev = f;
     PetscCall(SolverSolveWarm(snes, user->solver, u, "force control")); /* from zero where Newton stalls at a kink of the penalty */
-    PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
-    ForceAlong(&user->scene, stats, &f, &s);
+    PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, &user->quantities));
+    ForceAlong(&user->scene, &user->quantities, &f, &s);
     ++*its;
   }
   PetscCall(SNESSetTolerances(snes, atol, rtol, stol, maxit, maxf));
@@ -304,8 +304,8 @@ static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, const LoadPath *p
   PetscFunctionBeginUser;
   *ok  = PETSC_FALSE;
   *its = 0;
-  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
-  ForceAlong(&user->scene, stats, &f, &s);
+  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, &user->quantities));
+  ForceAlong(&user->scene, &user->quantities, &f, &s);
   for (PetscInt it = 0; it < FORCE_CONTROL_MAX_ITS && stats->converged; ++it) {
     PetscReal s_next, move, d;
 
@@ -328,19 +328,19 @@ static PetscErrorCode ForceControlRelease(DM dm, AppCtx *user, const LoadPath *p
     PetscCall(SceneSetObstaclePosition(&user->scene, s_next));
     PetscCall(ProblemUpdateData(dm, user));
     PetscCall(SolverSolveWarm(snes, user->solver, u, "force control"));
-    PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, stats));
-    ForceAlong(&user->scene, stats, &f, &s);
+    PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &user->opt->material, u, &user->quantities));
+    ForceAlong(&user->scene, &user->quantities, &f, &s);
     ++*its;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* The step just solved at factor t, of a path of n steps, into the path's record: its quantities (PostprocessContact()
-   with the contact ct, the solver's problem, the scene's boundary conditions and the material mat, into the solver's
-   statistics), its solves' records from first_record on (summed: force control solves several positions) and its
+   with the contact ct, the solver's problem, the scene's boundary conditions and the material mat, into sq), its
+   solves' records from first_record on (summed: force control solves several positions) and its
    state at the vertices (OutputStateFields(): the output's time series). */
 static PetscErrorCode LoadPathRecordStep(DM dm, Contact ct, Solver solver, const Scene *scene, const Material *mat, PetscInt n, Vec u, PetscReal t,
-                                         PetscInt first_record, PetscBool ok, LoadPath *path)
+                                         PetscInt first_record, PetscBool ok, SolutionQuantities *sq, LoadPath *path)
 {
   const Problem     *prob  = SolverProblem(solver);
   RunStats          *stats = SolverStats(solver);
@@ -354,12 +354,12 @@ static PetscErrorCode LoadPathRecordStep(DM dm, Contact ct, Solver solver, const
     PetscCall(PetscCalloc1(n * OUTPUT_STATE_FIELDS, &path->step_fields));
   }
   s = &path->steps[path->nsteps];
-  PetscCall(PostprocessContact(dm, ct, prob, &scene->bcs, mat, u, stats));
+  PetscCall(PostprocessContact(dm, ct, prob, &scene->bcs, mat, u, sq));
   PetscCall(OutputStateFields(dm, ct, prob->loc_bc, u, &path->step_fields[path->nsteps * OUTPUT_STATE_FIELDS]));
   path->nsteps++;
-  PostprocessGetQuantities(stats, &s->q);
+  s->q             = sq->q;
   s->factor        = t;
-  s->contact_force = stats->contact_force;
+  s->contact_force = sq->contact_force;
   for (PetscInt c = 0; c < 3; ++c) s->obstacle_translate[c] = scene->obstacle.translate[c];
   s->newton_its = s->ksp_its = 0;
   s->time                    = 0.0;
@@ -424,7 +424,8 @@ static PetscErrorCode LoadPathSolve(Driver d, AppCtx *user, DM *dmp, SNES *snesp
   PetscFunctionBeginUser;
   PetscCall(LoadPathForce(dm, user, path, snes, u, &ok)); /* the first step's force, or the run's one force without a path */
   if (!lp->n) PetscFunctionReturn(PETSC_SUCCESS);
-  PetscCall(LoadPathRecordStep(dm, user->contact, user->solver, &user->scene, &user->opt->material, lp->n, u, lp->factor[0], first, ok, path));
+  PetscCall(LoadPathRecordStep(dm, user->contact, user->solver, &user->scene, &user->opt->material, lp->n, u, lp->factor[0], first, ok,
+                               &user->quantities, path));
   if (lp->n > 1) {
     PetscCall(VecDuplicate(u, &prev));
     PetscCall(VecDuplicate(u, &dir));
@@ -435,7 +436,7 @@ static PetscErrorCode LoadPathSolve(Driver d, AppCtx *user, DM *dmp, SNES *snesp
     PetscReal       f, s;
 
     PetscCall(SolverGetSolves(user->solver, NULL, &first));
-    ForceAlong(&user->scene, stats, &f, &s);
+    ForceAlong(&user->scene, &user->quantities, &f, &s);
     PetscCall(SceneSetLoadFactor(&user->scene, lp->factor[k]));
     if (force) PetscCall(SceneSetObstaclePosition(&user->scene, s)); /* the last step's position */
     PetscCall(ProblemUpdateData(dm, user));
@@ -449,7 +450,8 @@ static PetscErrorCode LoadPathSolve(Driver d, AppCtx *user, DM *dmp, SNES *snesp
     PetscCall(SolverSolveWarm(snes, user->solver, u, "load path")); /* from zero where the guess's active set is too far off */
     PetscCall(PenetrationTolReach(dm, user, snes, u)); /* -contact_penetration_tol at every step, from the last step's eps (or multipliers) */
     PetscCall(LoadPathForce(dm, user, path, snes, u, &ok));
-    PetscCall(LoadPathRecordStep(dm, user->contact, user->solver, &user->scene, &user->opt->material, lp->n, u, lp->factor[k], first, ok, path));
+    PetscCall(LoadPathRecordStep(dm, user->contact, user->solver, &user->scene, &user->opt->material, lp->n, u, lp->factor[k], first, ok,
+                                 &user->quantities, path));
   }
   PetscCall(VecDestroy(&prev));
   PetscCall(VecDestroy(&dir));
@@ -468,7 +470,7 @@ static PetscErrorCode LoadPathView(Driver d, MPI_Comm comm, const DriverReport *
   if (SceneForceControlled(scene)) {
     PetscReal f, s;
 
-    ForceAlong(scene, r->stats, &f, &s);
+    ForceAlong(scene, r->quantities, &f, &s);
     PetscCall(PetscPrintf(comm,
                           "  force control: the obstacle %g along its direction presses with %.10g (target %g; %" PetscInt_FMT " positions solved)\n",
                           (double)s, (double)f, (double)scene->obstacle.force, r->stats->force_control_its));

@@ -38,8 +38,9 @@ PetscErrorCode PostprocessLiftEnergy(DM dm, const Material *mat, const Problem *
      J(u_h) = 1/2 a(u_h, u_h) - L(u_h) + the contact term's energy,
    with 1/2 a(u_h, u_h) - L(u_h) = 1/2 w.K w + w.r0 + J(u_D): K the bulk operator on the free unknowns and r0 = A u_D - b
    there, so that w.r0 = a(u_D, w) - L(w). Of the solution u of the problem prob (K, r0, the scales) with the contact,
-   the boundary conditions bcs in the material; into the statistics st. */
-PetscErrorCode PostprocessContact(DM dm, Contact contact, const Problem *prob, const BoundarySet *bcs, const Material *mat, Vec u, RunStats *st)
+   the boundary conditions bcs in the material; into sq. */
+PetscErrorCode PostprocessContact(DM dm, Contact contact, const Problem *prob, const BoundarySet *bcs, const Material *mat, Vec u,
+                                  SolutionQuantities *sq)
 {
   ContactResult res;
   Vec           R;
@@ -53,23 +54,23 @@ PetscErrorCode PostprocessContact(DM dm, Contact contact, const Problem *prob, c
   PetscCall(VecAXPY(R, 1.0, prob->r0)); /* the bulk residual K u + r0, whose contact rows are the reactions */
   PetscCall(ContactPostProcess(contact, dm, R, u, prob->displacement_scale, &res));
   PetscCall(VecDestroy(&R));
-  for (PetscInt c = 0; c < 3; ++c) st->contact_force_vector[c] = res.force_vector[c];
-  PetscCall(BoundaryComputeReactions(dm, bcs, mat, prob, u, st->reaction));
-  st->max_penetration = res.max_penetration;
-  st->contact_force   = res.force;
-  st->active_vertices = res.active_vertices;
-  st->energy          = 0.5 * PetscRealPart(uKu) + PetscRealPart(r0u) + prob->lift_energy + res.energy;
+  for (PetscInt c = 0; c < 3; ++c) sq->q.force[c] = res.force_vector[c];
+  PetscCall(BoundaryComputeReactions(dm, bcs, mat, prob, u, sq->q.reaction));
+  sq->q.penetration_max = res.max_penetration;
+  sq->contact_force     = res.force;
+  sq->active_vertices   = res.active_vertices;
+  sq->q.energy          = 0.5 * PetscRealPart(uKu) + PetscRealPart(r0u) + prob->lift_energy + res.energy;
   {
     const ContactSet *cs;
     PetscReal         pmax = 0.0;
 
     PetscCall(ContactGetSet(contact, &cs));
     for (PetscInt i = 0; i < cs->n; ++i) pmax = PetscMax(pmax, cs->pressure[i]);
-    PetscCall(MPIU_Allreduce(&pmax, &st->pressure_max, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
+    PetscCall(MPIU_Allreduce(&pmax, &sq->q.pressure_max, 1, MPIU_REAL, MPIU_MAX, PetscObjectComm((PetscObject)dm)));
   }
-  PetscCall(PostprocessContactSize(dm, contact, bcs, mat, u, &st->contact_size, &st->contact_size_band));
-  PetscCall(PostprocessPressureStep(dm, contact, bcs, st->pressure_max, &st->pressure_max_step));
-  PetscCall(PostprocessPressurePeak(dm, contact, st->pressure_max, st->pressure_max_step, &st->pressure_peak, &st->pressure_peak_resolution));
+  PetscCall(PostprocessContactSize(dm, contact, bcs, mat, u, &sq->q.contact_size, &sq->q.contact_size_band));
+  PetscCall(PostprocessPressureStep(dm, contact, bcs, sq->q.pressure_max, &sq->q.pressure_max_step));
+  PetscCall(PostprocessPressurePeak(dm, contact, sq->q.pressure_max, sq->q.pressure_max_step, &sq->q.pressure_peak, &sq->q.pressure_peak_resolution));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -82,31 +83,15 @@ PetscReal PostprocessForceMagnitude(const Quantities *q, PetscInt dim)
   return PetscSqrtReal(f);
 }
 
-/* The quantities users read, as PostprocessContact() left them in the statistics st. */
-void PostprocessGetQuantities(const RunStats *st, Quantities *q)
-{
-  for (PetscInt c = 0; c < 3; ++c) q->force[c] = st->contact_force_vector[c];
-  q->pressure_max             = st->pressure_max;
-  q->contact_size             = st->contact_size;
-  q->contact_size_band        = st->contact_size_band;
-  q->pressure_max_step        = st->pressure_max_step;
-  q->pressure_peak            = st->pressure_peak;
-  q->pressure_peak_resolution = st->pressure_peak_resolution;
-  q->penetration_max          = st->max_penetration;
-  q->energy                   = st->energy;
-  for (PetscInt i = 0; i < BOUNDARY_MAX; ++i)
-    for (PetscInt c = 0; c < 3; ++c) q->reaction[i][c] = st->reaction[i][c];
-}
-
 /* The largest penetration of the run: that of the nodes and the rule's points (PostprocessContact()) and that of the
    finer quadrature of the error norms (ErrorNormsCompute(), errors), which a curved obstacle may reach between them;
-   into the statistics st. */
-PetscErrorCode PostprocessPenetration(const ErrorNorms *errors, RunStats *st)
+   into sq. */
+PetscErrorCode PostprocessPenetration(const ErrorNorms *errors, SolutionQuantities *sq)
 {
   PetscFunctionBeginUser;
-  if (!PetscIsNanReal(errors->penetration_max) && errors->penetration_max > st->max_penetration) {
-    st->max_penetration     = errors->penetration_max;
-    st->penetration_between = PETSC_TRUE;
+  if (!PetscIsNanReal(errors->penetration_max) && errors->penetration_max > sq->q.penetration_max) {
+    sq->q.penetration_max   = errors->penetration_max;
+    sq->penetration_between = PETSC_TRUE;
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -114,26 +99,26 @@ PetscErrorCode PostprocessPenetration(const ErrorNorms *errors, RunStats *st)
 /* The solution's quantities in /run (PostprocessContact()): where the rule acts, the largest penetration, the contact
    force and its vector, the energy, the largest pressure with its step and its recovered peak, the contact zone's size
    with its band, and the force of each clamp's and slip's support on the body (reaction_clamp_3_x, ...). */
-PetscErrorCode PostprocessWrite(const RunStats *s, const BoundarySet *bcs, PetscInt dim, PetscViewer v)
+PetscErrorCode PostprocessWrite(const SolutionQuantities *s, const BoundarySet *bcs, PetscInt dim, PetscViewer v)
 {
   PetscFunctionBeginUser;
   PetscCall(RunAttrInt(v, s->active_vertices, "active_vertices"));
-  PetscCall(RunAttrReal(v, s->max_penetration, "max_penetration"));
+  PetscCall(RunAttrReal(v, s->q.penetration_max, "max_penetration"));
   PetscCall(RunAttrReal(v, s->contact_force, "contact_force"));
-  PetscCall(RunAttrReal(v, s->energy, "energy"));
-  PetscCall(RunAttrReal(v, s->pressure_max, "pressure_max"));                         /* the largest nodal contact pressure */
-  PetscCall(RunAttrReal(v, s->contact_size, "contact_size"));                         /* the contact zone's width (2D) or area (3D) */
-  PetscCall(RunAttrReal(v, s->contact_size_band, "contact_size_band"));               /* the one-cell strip along its edge */
-  PetscCall(RunAttrReal(v, s->pressure_max_step, "pressure_max_step"));               /* the largest pressure's change to its neighbours */
-  PetscCall(RunAttrReal(v, s->pressure_peak, "pressure_peak"));                       /* the largest pressure recovered by a local fit */
-  PetscCall(RunAttrReal(v, s->pressure_peak_resolution, "pressure_peak_resolution")); /*   and its resolution */
-  for (PetscInt c = 0; c < dim; ++c) PetscCall(RunAttrReal(v, s->contact_force_vector[c], "contact_force_%c", "xyz"[c]));
+  PetscCall(RunAttrReal(v, s->q.energy, "energy"));
+  PetscCall(RunAttrReal(v, s->q.pressure_max, "pressure_max"));                         /* the largest nodal contact pressure */
+  PetscCall(RunAttrReal(v, s->q.contact_size, "contact_size"));                         /* the contact zone's width (2D) or area (3D) */
+  PetscCall(RunAttrReal(v, s->q.contact_size_band, "contact_size_band"));               /* the one-cell strip along its edge */
+  PetscCall(RunAttrReal(v, s->q.pressure_max_step, "pressure_max_step"));               /* the largest pressure's change to its neighbours */
+  PetscCall(RunAttrReal(v, s->q.pressure_peak, "pressure_peak"));                       /* the largest pressure recovered by a local fit */
+  PetscCall(RunAttrReal(v, s->q.pressure_peak_resolution, "pressure_peak_resolution")); /*   and its resolution */
+  for (PetscInt c = 0; c < dim; ++c) PetscCall(RunAttrReal(v, s->q.force[c], "contact_force_%c", "xyz"[c]));
   for (PetscInt i = 0; i < bcs->n; ++i) {
     const BoundaryCondition *bc = &bcs->bc[i];
 
     if (bc->kind != BC_CLAMP && bc->kind != BC_SLIP) continue;
     for (PetscInt c = 0; c < dim; ++c)
-      PetscCall(RunAttrReal(v, s->reaction[i][c], "reaction_%s_%s_%c", BoundaryKinds[bc->kind], bc->token, "xyz"[c]));
+      PetscCall(RunAttrReal(v, s->q.reaction[i][c], "reaction_%s_%s_%c", BoundaryKinds[bc->kind], bc->token, "xyz"[c]));
   }
   PetscFunctionReturn(PETSC_SUCCESS);
 }
