@@ -121,7 +121,9 @@ def test_refining_every_cell_is_the_uniform_box():
 
 BAD_ADAPT = {"quads": (SQUARE + ["-dm_plex_simplex", 0, "-adapt_cycles", 1], "-adapt_cycles refines triangles and tetrahedra only, not quadrilaterals"),
              "bars": (MMS + ["-dm_plex_box_faces", "16,16", "-bars", "-adapt_cycles", 1], "-adapt_cycles with -bars"),
-             "sweep": (SQUARE + ["-penalty_eps0_sweep", "1,0.1", "-adapt_cycles", 1], "-adapt_cycles with -penalty_eps0_sweep"),
+             "sweep": (SQUARE + ["-penalty_eps0_sweep", "1,0.1", "-accuracy", 0.1], "-accuracy bounds the error of one solve's state, and -penalty_eps0_sweep"),
+             "penetration_tol": (SQUARE + ["-contact_penetration_tol", "1e-3", "-accuracy", 0.1],
+                                 "-accuracy bounds the error of one solve's state, and -contact_penetration_tol"),
              "no_estimate": (SQUARE + ["-estimate", "false", "-adapt_cycles", 1], "cannot run with -estimate false"),
              "fraction": (SQUARE + ["-adapt_cycles", 1, "-adapt_fraction", 0], "-adapt_fraction must lie in (0, 1]"),
              "negative": (SQUARE + ["-adapt_cycles", -1], "-adapt_cycles must be >= 0"),
@@ -130,6 +132,23 @@ BAD_ADAPT = {"quads": (SQUARE + ["-dm_plex_simplex", 0, "-adapt_cycles", 1], "-a
              # (force 0.000121727 +- 6.3e-8) were of another state than the one written (force 1.0e-4)
              "force": (INDENT + ["-obstacle_translate", "0,-0.01", "-obstacle_force", "0.01", "-accuracy", 0.1],
                        "-adapt_cycles and -accuracy with -obstacle_force are not supported yet")}
+
+
+def test_an_eps_sweep_runs_on_the_adapted_mesh():
+    """The drivers compose (DRIVER_FLOW, src/drivers/drivers.c): the cycles adapt the mesh at the sweep's first eps,
+    and the sweep's later values are solved on their last mesh, each from the last. Two sweeps to the same last eps,
+    with and without a value between, give the same cycles and the same last state."""
+    outs = []
+    for name, sweep in (("two", "1,1e-3"), ("three", "1,1e-1,1e-3")):
+        _, h5 = run(SQUARE + ["-adapt_cycles", 2, "-penalty_eps0_sweep", sweep], f"adapt_sweep_{name}")
+        outs.append((cycles(h5), *load(h5)))
+    (c2, a2, f2), (c3, a3, f3) = outs
+    assert len(c2["n_dofs"]) == 3 and c2["n_dofs"][-1] > c2["n_dofs"][0] and np.array_equal(c2["n_dofs"], c3["n_dofs"])
+    assert a2["n_dofs"] == c2["n_dofs"][-1] and a2["converged"] == 1 and a3["converged"] == 1
+    assert abs(a2["eps"] - a3["eps"]) <= 1e-14 * a2["eps"]  # the last value's on the same mesh
+    for k in ("contact_force", "energy", "max_penetration"):
+        assert abs(a2[k] - a3[k]) <= 1e-8 * abs(a2[k]), (k, a2[k], a3[k])
+    assert np.abs(f2["displacement"] - f3["displacement"]).max() <= 1e-8 * np.abs(f2["displacement"]).max()
 
 
 def test_a_model_without_cycles_is_refused(tmp_path):

@@ -8,7 +8,7 @@ import h5py
 import numpy as np
 import pytest
 
-from harness import load, run, solve
+from harness import load, refused, run, solve
 from signorini import hertz
 
 SQUARE = ["-options_file", "options/square.yaml", "-contact_monitor", "false", "-snes_rtol", "1e-12"]
@@ -413,3 +413,36 @@ def test_hertz_along_a_force_controlled_path(outdir):
     for r in rows:
         assert abs(r["a_error"]) < 0.01 and abs(r["p0_error"]) < 0.01, r
     assert abs(rows[2]["load"] - rows[0]["load"]) <= 1e-8 * rows[0]["load"] and abs(rows[2]["a_h"] - rows[0]["a_h"]) <= 1e-6 * rows[0]["a_h"]
+
+
+@pytest.mark.parametrize("np_", [1, 2])
+def test_a_load_path_runs_on_the_adapted_mesh(outdir, np_):
+    """The drivers compose (DRIVER_FLOW, src/drivers/drivers.c): with -adapt_cycles the cycles adapt the mesh at the
+    path's first load state, and the path's later steps run on their last mesh. The cylinder's indentation grows its
+    contact zone; frictionless contact has no history, so the last state does not depend on the steps between: two
+    paths through 0.5 to 1, with and without a step at 0.75, give the same cycles and the same last state, on 1 and 2
+    ranks."""
+    data = INDENT + ["-obstacle_translate", "0,-0.02", "-adapt_cycles", "2"]
+    h5s = []
+    for name, path in (("two", "0.5,1"), ("three", "0.5,0.75,1")):
+        _, h5 = run(data + ["-load_path", path], f"adapted_path_{name}_np{np_}", np_=np_, output=os.path.join(outdir, f"{name}.h5"))
+        h5s.append(h5)
+    with h5py.File(h5s[0], "r") as f, h5py.File(h5s[1], "r") as g:
+        dofs = f["cycles"]["n_dofs"][:]
+        assert len(dofs) == 3 and dofs[-1] > dofs[0]  # the cycles refined the mesh
+        assert np.array_equal(dofs, g["cycles"]["n_dofs"][:])  # at the same first load state
+    st2, st3 = steps(h5s[0]), steps(h5s[1])
+    assert list(st3["factor"]) == [0.5, 0.75, 1.0] and st2["converged"].all() and st3["converged"].all()
+    assert st3["contact_size"][0] < st3["contact_size"][-1]  # the zone grows along the path
+    a2, f2 = load(h5s[0])
+    a3, f3 = load(h5s[1])
+    assert a2["n_dofs"] == dofs[-1]  # the path's last state is on the cycles' last mesh
+    for q in QUANTITIES:
+        assert abs(a2[q] - a3[q]) <= 1e-8 * abs(a2[q]) + 1e-12 * abs(a2["contact_force"]), (q, a2[q], a3[q])
+    assert np.max(np.abs(f2["displacement"] - f3["displacement"])) <= 1e-8 * np.max(np.abs(f2["displacement"]))
+
+
+def test_accuracy_with_a_load_path_is_refused():
+    """-accuracy bounds the error of one load state; a path solves others after it, so the bars written would be
+    another state's: refused before any solve, naming both."""
+    refused(INDENT + ["-accuracy", "0.1", "-load_steps", "2"], "accuracy_load_path", "-accuracy bounds the error of one load state")

@@ -213,9 +213,18 @@ PetscErrorCode AdaptCheck(DM dm, const RunOptions *opt, Contact ct, const MeshBo
   PetscCheck(opt->estimate, comm, PETSC_ERR_USER_INPUT,
              "-adapt_cycles refines where the error estimate is largest: it cannot run with -estimate false");
   PetscCheck(!opt->bars, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles with -bars is not supported yet: the bars need three uniformly nested meshes");
-  PetscCheck(copt->n_sweep <= 1, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles with -penalty_eps0_sweep is not supported yet");
-  PetscCheck(copt->penetration_tol <= 0.0, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles with -contact_penetration_tol is not supported yet");
-  PetscCheck(!opt->load_path.n, comm, PETSC_ERR_USER_INPUT, "-adapt_cycles with a load path (-load_steps, -load_path) is not supported yet");
+  /* The drivers after the cycles (DRIVER_FLOW, src/drivers/drivers.c) solve on the cycles' last mesh: the eps sweep, the
+     penetration tolerance and the load path from the cycles' state. -accuracy bounds the error of that one state, which
+     they would change after its bars were computed, so that the bars written would be those of another state. */
+  PetscCheck(!(opt->adapt.accuracy > 0.0 && copt->n_sweep > 1), comm, PETSC_ERR_USER_INPUT,
+             "-accuracy bounds the error of one solve's state, and -penalty_eps0_sweep solves again at other eps after it: give one of them "
+             "(-adapt_cycles N adapts the mesh, and the sweep then runs on its last mesh)");
+  PetscCheck(!(opt->adapt.accuracy > 0.0 && copt->penetration_tol > 0.0), comm, PETSC_ERR_USER_INPUT,
+             "-accuracy bounds the error of one solve's state, and -contact_penetration_tol lowers eps after it: give one of them "
+             "(-adapt_cycles N adapts the mesh, and the penetration tolerance is then reached on its last mesh)");
+  PetscCheck(!(opt->adapt.accuracy > 0.0 && opt->load_path.n), comm, PETSC_ERR_USER_INPUT,
+             "-accuracy bounds the error of one load state, and a load path (-load_steps, -load_path) solves others after it: give one of them "
+             "(-adapt_cycles N adapts the mesh to the path's first load state, and the path then runs on its last mesh)");
   /* the cycles adapt the mesh to the solution at the obstacle's given translation, and force control would move it on
      the last mesh only: the bars printed would belong to another state than the one written */
   PetscCheck(!SceneForceControlled(scene), comm, PETSC_ERR_USER_INPUT,
