@@ -29,3 +29,9 @@ PetscErrorCode RunAttrReal(PetscViewer v, PetscReal value, const char format[], 
 PetscErrorCode RunAttrInt(PetscViewer v, PetscInt value, const char format[], ...) PETSC_ATTRIBUTE_FORMAT(3, 4);
 PetscErrorCode RunAttrString(PetscViewer v, const char value[], const char format[], ...) PETSC_ATTRIBUTE_FORMAT(3, 4);
 PetscErrorCode RunColumn(MPI_Comm comm, PetscViewer v, const char name[], PetscInt n, const PetscReal values[]);
+/* A column of a table of n rows, `i` its row: col[i] = expr for each i (col, n reals of work), written by RunColumn(). */
+#define RUN_TABLE_COLUMN(comm, v, label, n, col, expr)    \
+  do {                                                    \
+    for (PetscInt i = 0; i < (n); ++i) (col)[i] = (expr); \
+    PetscCall(RunColumn(comm, v, label, n, col));         \
+  } while (0)

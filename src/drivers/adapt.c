@@ -863,11 +863,7 @@ static PetscErrorCode AdaptWrite(Driver d, MPI_Comm comm, const DriverReport *r,
   }
   PetscCall(PetscMalloc1(n, &col));
   PetscCall(PetscViewerHDF5PushGroup(v, "/cycles"));
-#define CYCLE_COLUMN(label, expr)                     \
-  do {                                                \
-    for (PetscInt i = 0; i < n; ++i) col[i] = (expr); \
-    PetscCall(RunColumn(comm, v, label, n, col));     \
-  } while (0)
+#define CYCLE_COLUMN(label, expr) RUN_TABLE_COLUMN(comm, v, label, n, col, expr)
   CYCLE_COLUMN("n_dofs", (PetscReal)c[i].n_dofs);
   CYCLE_COLUMN("n_cells", (PetscReal)c[i].n_cells);
   CYCLE_COLUMN("estimate", c[i].estimate);

@@ -510,11 +510,7 @@ static PetscErrorCode LoadPathWrite(Driver d, MPI_Comm comm, const DriverReport 
   if (!n) PetscFunctionReturn(PETSC_SUCCESS);
   PetscCall(PetscMalloc1(n, &col));
   PetscCall(PetscViewerHDF5PushGroup(v, "/steps"));
-#define STEP_COLUMN(label, expr)                      \
-  do {                                                \
-    for (PetscInt i = 0; i < n; ++i) col[i] = (expr); \
-    PetscCall(RunColumn(comm, v, label, n, col));     \
-  } while (0)
+#define STEP_COLUMN(label, expr) RUN_TABLE_COLUMN(comm, v, label, n, col, expr)
   STEP_COLUMN("factor", st[i].factor);
   STEP_COLUMN("contact_force", st[i].contact_force);
   for (PetscInt c = 0; c < dim; ++c) {
