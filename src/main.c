@@ -229,13 +229,184 @@ static PetscErrorCode DiagnosticEstimate(void *ctx)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The options phase: every module reads its options once, into opt, which is read only after it; the Contact reads its
+   own (-contact_method, -penalty_*). */
+static PetscErrorCode RunGetOptions(MPI_Comm comm, RunOptions *opt, Contact *contact)
+{
+  PetscFunctionBeginUser;
+  PetscCall(SceneGetOptions(comm, opt->scene_name, sizeof(opt->scene_name)));
+  PetscCall(ElasticityGetOptions(comm, &opt->material, &opt->degree, &opt->section_check));
+  PetscCall(ContactCreate(comm, contact));
+  PetscCall(ContactSetFromOptions(*contact)); /* -contact_method, -penalty_* */
+  PetscCall(SolverGetOptions(comm, &opt->solver));
+  PetscCall(VerifyGetOptions(comm, &opt->verify));
+  PetscCall(EstimateGetOptions(comm, opt));
+  PetscCall(AssemblyGetOptions(comm, &opt->assembly, &opt->assembly_check));
+  PetscCall(OutputGetOptions(comm, opt));
+  PetscCall(LoadPathGetOptions(comm, &opt->load_path));
+  PetscCall(AdaptGetOptions(comm, &opt->adapt));
+  PetscCall(BandwidthGetOptions(comm, &opt->perf_bandwidth));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The set-up, before any solve: the mesh, the solver object, the scene, the problem on the mesh and its SNES, and every
+   check of the input that needs them (a -reference file, -estimate, -bars, -adapt_cycles, misspelled options), with the
+   set-up's warnings; u, the solution vector, zero. */
+static PetscErrorCode RunSetUp(MPI_Comm comm, AppCtx *user, DM *dm, SNES *snes, Vec *u)
+{
+  const RunOptions *opt = user->opt;
+  Problem          *prob;
+  RunStats         *stats;
+
+  PetscFunctionBeginUser;
+  {
+    PetscInt  coarse_requests[2], coarse_faces[3], coarse_min_levels;
+    PetscBool coarse_mg, default_mg;
+
+    PetscCall(GridSequenceCoarseRequest(comm, user->contact, opt, coarse_requests, coarse_faces, &coarse_min_levels, &coarse_mg, &default_mg));
+    PetscCall(MultigridCreate(coarse_mg, &user->mg));
+    PetscCall(MeshCreate(comm, opt->solver.grid_sequence, coarse_requests, coarse_faces, coarse_min_levels, &user->box, dm));
+    PetscCall(SolverCreate(opt, user->contact, user->mg, &user->box, &user->solver)); /* the solves' object, for the whole run */
+    prob              = SolverProblem(user->solver);
+    stats             = SolverStats(user->solver);
+    stats->coarse_mg  = coarse_mg;
+    stats->default_mg = (PetscBool)(default_mg && user->box.dim == 3 && user->box.coarse_levels > 0);
+    PetscCall(MultigridSetDefault(user->mg, stats->default_mg));
+  }
+  PetscCall(MeshPartitionGetStats(*dm, &user->partition));                    /* the partitioner; the final mesh's cut is taken after the solve */
+  PetscCall(SceneCreate(opt->scene_name, *dm, &opt->material, &user->scene)); /* its options, once for every level */
+  PetscCall(LoadPathSetUp(comm, opt, user->contact, &user->scene));           /* a load path: the scene at its first factor */
+  /* -bars on tetrahedra: the final mesh's eps on the levels below it */
+  PetscCall(GridSequenceBarsSizes(*dm, opt, user->contact, &user->box, prob->level));
+  if (opt->adapt.cycles || (opt->bars && opt->adapt.model[0])) /* one eps on Gamma_C: the remeshed meshes do not nest */
+    PetscCall(MeshSetContactCellSizes(*dm, user->scene.bcs.ncontact, user->scene.bcs.contact_ids));
+  PetscCall(ProblemSetUp(*dm, user->solver, &user->scene, snes));
+  { /* before the solve, not after it */
+    const VerifyRun verify = {.opt = &opt->verify, .scene = &user->scene, .mat = &opt->material, .degree = opt->degree};
+
+    PetscCall(ReferenceCheckFile(*dm, &verify));
+  }
+  PetscCall(EstimateCheckSupported(*dm, opt->estimate, opt->estimate_given, opt->degree)); /* -estimate on a discretization it does not cover */
+  PetscCall(BarsCheck(comm, opt->bars, user->box.coarse_levels + opt->solver.grid_sequence, user->contact)); /* -bars without three nested meshes */
+  PetscCall(AdaptCheck(*dm, opt, user->contact, &user->box, &user->scene)); /* -adapt_cycles where it cannot refine */
+  PetscCall(EstimateReset(&user->estimate));
+  PetscCall(BarsReset(&user->bars));
+  { /* initial overlap, an obstacle facing away, a curved boundary refined on its chords, a locking body: warnings */
+    const ContactChecksGeometryInputs in = {.contact          = user->contact,
+                                            .scene            = &user->scene,
+                                            .material         = &opt->material,
+                                            .degree           = opt->degree,
+                                            .box              = &user->box,
+                                            .grid_refinements = opt->adapt.model[0] ? 0 : opt->solver.grid_sequence}; /* a model remeshes */
+
+    PetscCall(ContactChecksGeometry(*dm, &in, &user->checks));
+  }
+  PetscCall(VecDuplicate(prob->r0, u)); /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
+  PetscCall(PetscObjectSetName((PetscObject)*u, "displacement"));
+  PetscCall(DMSNESCheckFromOptions(*snes, *u));     /* -dmsnes_check: PETSc's checks against the exact solution */
+  PetscCall(OptionsCheckAllUsed(comm, PETSC_TRUE)); /* a misspelled option before the solve, not after it */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* After the drivers' solves: the quantities of the solution, its bars and warnings, and the diagnostics (the error norms,
+   the -reference comparison, the estimate), each of which is reported and left out where it fails, never the solve lost. */
+static PetscErrorCode RunDiagnostics(DM dm, SNES snes, Vec u, AppCtx *user)
+{
+  const RunOptions *opt   = user->opt;
+  const Problem    *prob  = SolverProblem(user->solver);
+  const RunStats   *stats = SolverStats(user->solver);
+
+  PetscFunctionBeginUser;
+  PetscCall(SolverConditionEstimate(snes, user->solver, u));
+  PetscCall(PostprocessContact(dm, user->contact, prob, &user->scene.bcs, &opt->material, u, &user->quantities));
+  if (opt->bars) { /* -bars: from the levels' quantities and this mesh's */
+    PetscCall(BarsCompute(dm, &user->scene.bcs, user->contact, &user->quantities.q, stats->converged, &user->bars));
+  }
+  /* cells across the contact zone, contact the mesh does not see: warnings */
+  PetscCall(ContactChecksResolution(dm, user->contact, &user->scene.bcs, user->quantities.q.force, u, &user->checks));
+  { /* diagnostics: a failure there is reported and the output written without them, never the solve lost */
+    char       failed[512];
+    Diagnostic d = {
+        .dm             = dm,
+        .u              = u,
+        .verify         = {.opt     = &opt->verify,
+                           .scene   = &user->scene,
+                           .mat     = &opt->material,
+                           .degree  = opt->degree,
+                           .contact = user->contact,
+                           .h       = prob->h,
+                           .loc_bc  = prob->loc_bc,
+                           .K       = prob->K},
+        .estimate       = {.scene   = &user->scene,
+                           .mat     = &opt->material,
+                           .verify  = &opt->verify,
+                           .contact = user->contact,
+                           .degree  = opt->degree,
+                           .loc_bc  = prob->loc_bc},
+        .estimate_asked = opt->estimate,
+        .errors         = &user->errors,
+        .ref_errors     = &user->ref_errors,
+        .est            = &user->estimate,
+    };
+
+    PetscCall(AppDiagnosticRun("error norms", DiagnosticErrorNorms, &d, failed, sizeof(failed)));
+    if (failed[0]) {
+      PetscCall(ErrorNormsReset(&user->errors));
+      PetscCall(PetscStrlcat(user->diagnostics_failed, failed, sizeof(user->diagnostics_failed)));
+    }
+    PetscCall(AppDiagnosticRun("-reference comparison", DiagnosticReference, &d, failed, sizeof(failed)));
+    if (failed[0]) {
+      PetscCall(ErrorNormsReset(&user->ref_errors));
+      if (user->diagnostics_failed[0]) PetscCall(PetscStrlcat(user->diagnostics_failed, "; ", sizeof(user->diagnostics_failed)));
+      PetscCall(PetscStrlcat(user->diagnostics_failed, failed, sizeof(user->diagnostics_failed)));
+    }
+    PetscCall(AppDiagnosticRun("error estimate", DiagnosticEstimate, &d, failed, sizeof(failed)));
+    if (failed[0]) {
+      PetscCall(EstimateReset(&user->estimate));
+      if (user->diagnostics_failed[0]) PetscCall(PetscStrlcat(user->diagnostics_failed, "; ", sizeof(user->diagnostics_failed)));
+      PetscCall(PetscStrlcat(user->diagnostics_failed, failed, sizeof(user->diagnostics_failed)));
+    }
+  }
+  PetscCall(PostprocessPenetration(&user->errors, &user->quantities)); /* with the error norms' finer quadrature */
+  PetscCall(MeshPartitionGetStats(dm, &user->partition));              /* of the final mesh */
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* The summary, the output file, and a failed solve's reason on its last line. */
+static PetscErrorCode RunReport(DM dm, const AppCtx *user, Vec u)
+{
+  MPI_Comm        comm  = PetscObjectComm((PetscObject)dm);
+  const RunStats *stats = SolverStats(user->solver);
+  const Problem  *prob  = SolverProblem(user->solver);
+
+  PetscFunctionBeginUser;
+  PetscCall(PrintSummary(dm, user, u));
+  PetscCall(WriteOutput(dm, user, u));
+  PetscCall(PetscPrintf(comm, "  output: %s\n", user->opt->output));
+  if (!stats->converged && stats->force_control_failed)
+    PetscCall(PetscPrintf(comm, "ERROR: force control did not reach -obstacle_force %g (above: why); written with converged = 0\n",
+                          (double)user->scene.obstacle.force));
+  else if (!stats->converged && stats->reason > 0)
+    PetscCall(PetscPrintf(comm,
+                          "ERROR: the nonlinear solve failed: it stopped with %s after %" PetscInt_FMT
+                          " Newton steps at residual %g, which fell neither by -snes_rtol from %g nor to round-off for the load %g; written with "
+                          "converged = 0\n",
+                          SNESConvergedReasons[stats->reason], stats->newton_its, (double)stats->residual_norm, (double)stats->residual_start,
+                          (double)prob->load_norm));
+  else if (!stats->converged)
+    PetscCall(PetscPrintf(comm,
+                          "ERROR: the nonlinear solve failed: %s after %" PetscInt_FMT " Newton steps, residual %g; written with converged = 0\n",
+                          SNESConvergedReasons[stats->reason], stats->newton_its, (double)stats->residual_norm));
+
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The run, from the options to the output; *converged says whether the nonlinear solve converged. An error returns here
    and then to main(), which ends the run as the error asks (AppErrorExit()). */
 static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
 {
   AppCtx         user;
   RunOptions     opt;
-  Problem       *prob;  /* the solver's, on the current mesh */
   RunStats      *stats; /* the solver's */
   DM             dm;
   SNES           snes;
@@ -252,148 +423,24 @@ static PetscErrorCode Run(PetscBool *converged, PetscBool *diagnostics_ok)
   PetscCall(OptionsCheckValuesGiven(comm)); /* -young_modulus without its value is not the default */
   PetscCall(SceneRegisterAll());
   PetscCall(DriverRegisterAll());
-  /* the options phase: every module reads its options once, into opt, which is read only after it */
-  PetscCall(SceneGetOptions(comm, opt.scene_name, sizeof(opt.scene_name)));
-  PetscCall(ElasticityGetOptions(comm, &opt.material, &opt.degree, &opt.section_check));
-  PetscCall(ContactCreate(comm, &user.contact));
-  PetscCall(ContactSetFromOptions(user.contact)); /* -contact_method, -penalty_* */
-  PetscCall(SolverGetOptions(comm, &opt.solver));
-  PetscCall(VerifyGetOptions(comm, &opt.verify));
-  PetscCall(EstimateGetOptions(comm, &opt));
-  PetscCall(AssemblyGetOptions(comm, &opt.assembly, &opt.assembly_check));
-  PetscCall(OutputGetOptions(comm, &opt));
-  PetscCall(LoadPathGetOptions(comm, &opt.load_path));
-  PetscCall(AdaptGetOptions(comm, &opt.adapt));
-  PetscCall(BandwidthGetOptions(comm, &opt.perf_bandwidth));
+  PetscCall(RunGetOptions(comm, &opt, &user.contact));
   user.opt = &opt;
   PetscCall(DriversCreate(WriteOutput, &user.drivers)); /* the run's flow after the set-up: include/drivers.h */
 
-  {
-    PetscInt  coarse_requests[2], coarse_faces[3], coarse_min_levels;
-    PetscBool coarse_mg, default_mg;
-
-    PetscCall(GridSequenceCoarseRequest(comm, user.contact, &opt, coarse_requests, coarse_faces, &coarse_min_levels, &coarse_mg, &default_mg));
-    PetscCall(MultigridCreate(coarse_mg, &user.mg));
-    PetscCall(MeshCreate(comm, opt.solver.grid_sequence, coarse_requests, coarse_faces, coarse_min_levels, &user.box, &dm));
-    PetscCall(SolverCreate(&opt, user.contact, user.mg, &user.box, &user.solver)); /* the solves' object, for the whole run */
-    prob              = SolverProblem(user.solver);
-    stats             = SolverStats(user.solver);
-    stats->coarse_mg  = coarse_mg;
-    stats->default_mg = (PetscBool)(default_mg && user.box.dim == 3 && user.box.coarse_levels > 0);
-    PetscCall(MultigridSetDefault(user.mg, stats->default_mg));
-  }
-  PetscCall(MeshPartitionGetStats(dm, &user.partition));                  /* the partitioner; the final mesh's cut is taken after the solve */
-  PetscCall(SceneCreate(opt.scene_name, dm, &opt.material, &user.scene)); /* its options, once for every level */
-  PetscCall(LoadPathSetUp(comm, &opt, user.contact, &user.scene));        /* a load path: the scene at its first factor */
-  /* -bars on tetrahedra: the final mesh's eps on the levels below it */
-  PetscCall(GridSequenceBarsSizes(dm, &opt, user.contact, &user.box, prob->level));
-  if (opt.adapt.cycles || (opt.bars && opt.adapt.model[0])) /* one eps on Gamma_C: the remeshed meshes do not nest */
-    PetscCall(MeshSetContactCellSizes(dm, user.scene.bcs.ncontact, user.scene.bcs.contact_ids));
-  PetscCall(ProblemSetUp(dm, user.solver, &user.scene, &snes));
-  { /* before the solve, not after it */
-    const VerifyRun verify = {.opt = &opt.verify, .scene = &user.scene, .mat = &opt.material, .degree = opt.degree};
-
-    PetscCall(ReferenceCheckFile(dm, &verify));
-  }
-  PetscCall(EstimateCheckSupported(dm, opt.estimate, opt.estimate_given, opt.degree)); /* -estimate on a discretization it does not cover */
-  PetscCall(BarsCheck(comm, opt.bars, user.box.coarse_levels + opt.solver.grid_sequence, user.contact)); /* -bars without three nested meshes */
-  PetscCall(AdaptCheck(dm, &opt, user.contact, &user.box, &user.scene));                                 /* -adapt_cycles where it cannot refine */
-  PetscCall(EstimateReset(&user.estimate));
-  PetscCall(BarsReset(&user.bars));
-  { /* initial overlap, an obstacle facing away, a curved boundary refined on its chords, a locking body: warnings */
-    const ContactChecksGeometryInputs in = {.contact          = user.contact,
-                                            .scene            = &user.scene,
-                                            .material         = &opt.material,
-                                            .degree           = opt.degree,
-                                            .box              = &user.box,
-                                            .grid_refinements = opt.adapt.model[0] ? 0 : opt.solver.grid_sequence}; /* a model remeshes */
-
-    PetscCall(ContactChecksGeometry(dm, &in, &user.checks));
-  }
-  PetscCall(VecDuplicate(prob->r0, &u)); /* a global vector of dm (DMCreateGlobalVector() would scan every mesh point again) */
-  PetscCall(PetscObjectSetName((PetscObject)u, "displacement"));
-  PetscCall(DMSNESCheckFromOptions(snes, u));       /* -dmsnes_check: PETSc's checks against the exact solution */
-  PetscCall(OptionsCheckAllUsed(comm, PETSC_TRUE)); /* a misspelled option before the solve, not after it */
+  PetscCall(RunSetUp(comm, &user, &dm, &snes, &u));
+  stats = SolverStats(user.solver);
   PetscCall(PetscTime(&t1));
   stats->time_setup = t1 - t0;
 
   PetscCall(DriversSolve(user.drivers, &user, &dm, &snes, &u)); /* the first solve, the cycles, the sweep, ..., the load path */
-  PetscCall(SolverConditionEstimate(snes, user.solver, u));
-  PetscCall(PostprocessContact(dm, user.contact, prob, &user.scene.bcs, &opt.material, u, &user.quantities));
-  if (opt.bars) { /* -bars: from the levels' quantities and this mesh's */
-    PetscCall(BarsCompute(dm, &user.scene.bcs, user.contact, &user.quantities.q, stats->converged, &user.bars));
-  }
-  /* cells across the contact zone, contact the mesh does not see: warnings */
-  PetscCall(ContactChecksResolution(dm, user.contact, &user.scene.bcs, user.quantities.q.force, u, &user.checks));
-  { /* diagnostics: a failure there is reported and the output written without them, never the solve lost */
-    char       failed[512];
-    Diagnostic d = {
-        .dm             = dm,
-        .u              = u,
-        .verify         = {.opt     = &opt.verify,
-                           .scene   = &user.scene,
-                           .mat     = &opt.material,
-                           .degree  = opt.degree,
-                           .contact = user.contact,
-                           .h       = prob->h,
-                           .loc_bc  = prob->loc_bc,
-                           .K       = prob->K},
-        .estimate       = {.scene   = &user.scene,
-                           .mat     = &opt.material,
-                           .verify  = &opt.verify,
-                           .contact = user.contact,
-                           .degree  = opt.degree,
-                           .loc_bc  = prob->loc_bc},
-        .estimate_asked = opt.estimate,
-        .errors         = &user.errors,
-        .ref_errors     = &user.ref_errors,
-        .est            = &user.estimate,
-    };
-
-    PetscCall(AppDiagnosticRun("error norms", DiagnosticErrorNorms, &d, failed, sizeof(failed)));
-    if (failed[0]) {
-      PetscCall(ErrorNormsReset(&user.errors));
-      PetscCall(PetscStrlcat(user.diagnostics_failed, failed, sizeof(user.diagnostics_failed)));
-    }
-    PetscCall(AppDiagnosticRun("-reference comparison", DiagnosticReference, &d, failed, sizeof(failed)));
-    if (failed[0]) {
-      PetscCall(ErrorNormsReset(&user.ref_errors));
-      if (user.diagnostics_failed[0]) PetscCall(PetscStrlcat(user.diagnostics_failed, "; ", sizeof(user.diagnostics_failed)));
-      PetscCall(PetscStrlcat(user.diagnostics_failed, failed, sizeof(user.diagnostics_failed)));
-    }
-    PetscCall(AppDiagnosticRun("error estimate", DiagnosticEstimate, &d, failed, sizeof(failed)));
-    if (failed[0]) {
-      PetscCall(EstimateReset(&user.estimate));
-      if (user.diagnostics_failed[0]) PetscCall(PetscStrlcat(user.diagnostics_failed, "; ", sizeof(user.diagnostics_failed)));
-      PetscCall(PetscStrlcat(user.diagnostics_failed, failed, sizeof(user.diagnostics_failed)));
-    }
-  }
-  PetscCall(PostprocessPenetration(&user.errors, &user.quantities)); /* with the error norms' finer quadrature */
-  PetscCall(MeshPartitionGetStats(dm, &user.partition));             /* of the final mesh */
+  PetscCall(RunDiagnostics(dm, snes, u, &user));
   PetscCall(PetscTime(&t1));
   stats->time_total = t1 - t0;
   PetscCall(RecordPeakMemory(comm, stats));
   /* -perf_bandwidth: after the peak memory, which its vectors would raise */
   PetscCall(BandwidthMeasure(snes, opt.perf_bandwidth, &user.bandwidth));
   PetscCall(OptionsCheckAllUsed(comm, PETSC_FALSE)); /* the options read during the solve too */
-  PetscCall(PrintSummary(dm, &user, u));
-  PetscCall(WriteOutput(dm, &user, u));
-  PetscCall(PetscPrintf(comm, "  output: %s\n", opt.output));
-  if (!stats->converged && stats->force_control_failed)
-    PetscCall(PetscPrintf(comm, "ERROR: force control did not reach -obstacle_force %g (above: why); written with converged = 0\n",
-                          (double)user.scene.obstacle.force));
-  else if (!stats->converged && stats->reason > 0)
-    PetscCall(PetscPrintf(comm,
-                          "ERROR: the nonlinear solve failed: it stopped with %s after %" PetscInt_FMT
-                          " Newton steps at residual %g, which fell neither by -snes_rtol from %g nor to round-off for the load %g; written with "
-                          "converged = 0\n",
-                          SNESConvergedReasons[stats->reason], stats->newton_its, (double)stats->residual_norm, (double)stats->residual_start,
-                          (double)prob->load_norm));
-  else if (!stats->converged)
-    PetscCall(PetscPrintf(comm,
-                          "ERROR: the nonlinear solve failed: %s after %" PetscInt_FMT " Newton steps, residual %g; written with converged = 0\n",
-                          SNESConvergedReasons[stats->reason], stats->newton_its, (double)stats->residual_norm));
-
+  PetscCall(RunReport(dm, &user, u));
   *converged      = stats->converged;
   *diagnostics_ok = (PetscBool)!user.diagnostics_failed[0];
   PetscCall(VecDestroy(&u));
