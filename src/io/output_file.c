@@ -9,6 +9,7 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <limits.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -67,8 +68,9 @@ static void OutputFileCleanUpAtExit(void)
 }
 
 /* The termination signals may be delivered to any thread of the process (Open MPI, PMIx and OpenBLAS start threads of
-   their own), so they cannot be held back by a signal mask. While the main thread creates the temporaries or renames
-   the pair, a signal is only recorded; it takes effect when the main thread leaves that critical section. */
+   their own), so they cannot be held back by a signal mask; the handler sends them on to the main thread. While the
+   main thread creates the temporaries or renames the pair, a signal is only recorded; it takes effect when the main
+   thread leaves that critical section. */
 static volatile sig_atomic_t output_critical = 0; /* the main thread is creating temporaries or renaming the pair */
 static volatile sig_atomic_t output_pending  = 0; /* a termination signal that arrived meanwhile */
 
@@ -86,8 +88,18 @@ static void OutputFileDie(int sig)
   (void)raise(sig); /* die of the signal, as without the handler */
 }
 
+/* The thread that writes the output (the one that installed the handler). A signal delivered to another thread is sent
+   on to it: a handler on another thread would remove the temporaries while the main thread goes on writing, and the
+   main thread could create a temporary again (HDF5 opens it with O_CREAT) in the moment before the process dies, which
+   would leave it behind. On the main thread the write is interrupted while the handler runs. */
+static pthread_t output_main_thread;
+
 static void OutputFileSignalHandler(int sig)
 {
+  if (!pthread_equal(pthread_self(), output_main_thread)) { /* pthread_self() and pthread_kill() are async-signal-safe */
+    (void)pthread_kill(output_main_thread, sig);
+    return;
+  }
   if (output_critical)
     output_pending = sig;
   else
@@ -120,6 +132,7 @@ PetscErrorCode OutputFileInstallCleanup(void)
   output_mode = 0666 & ~mask;
   (void)umask(mask);
   PetscCheck(atexit(OutputFileCleanUpAtExit) == 0, PETSC_COMM_SELF, PETSC_ERR_SYS, "atexit() failed");
+  output_main_thread = pthread_self();
   memset(&sa, 0, sizeof(sa));
   sa.sa_handler = OutputFileSignalHandler;
   sigemptyset(&sa.sa_mask);
