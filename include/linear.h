@@ -4,12 +4,28 @@
  * terms of the inexact Newton (ew_forcing.c), the step guess (step_guess.c), the geometric multigrid of the nested
  * meshes (multigrid.c) and the solver's options (solver_options.c). A layer below the core: each component takes its
  * own state and what it reads (the Contact, the options, the record, the SNES's scale); the core keeps the states in
- * its context (src/solver/solver_impl.h) and calls them from its callbacks and around its solves, never the reverse. */
+ * its context (src/solver/solver_impl.h). The components that act at each Newton step or linear solve attach
+ * themselves to PETSc's hooks (the SNES's Jacobian evaluation, the KSP's pre-solve) and read the core through a
+ * LinearCore; the core's own callbacks call none of them. */
 #pragma once
 #include "signorini.h"
 
+/* What the linear layer reads of the Newton core while it solves, through two of the core's functions, so that it does
+   not see the core's context: the displacement of an iterate X of the SNES in the user's units (the SNES's scaling and
+   SNESVI's rotated frames), and the current solve's stopping reference (the residual -snes_rtol is relative to) and the
+   SNES's scale. */
+typedef struct {
+  PetscErrorCode (*displacement)(void *core, Vec X, Vec *u);
+  PetscErrorCode (*scales)(void *core, PetscReal *stop_reference, PetscReal *snes_scale);
+  void *core;
+} LinearCore;
+
 /* State of the preconditioner reuse (pc_reuse.c). */
 typedef struct {
+  /* how it is attached (PcReuseAttach()): around the SNES's Jacobian evaluation, the core's, with what it reads of the core */
+  LinearCore core;
+  PetscErrorCode (*jacobian)(SNES, Vec, Mat, Mat, void *);
+  void *jacobian_ctx;
   /* what it reads (PcReuseSetUp()) */
   Mat                  K;       /* the bulk operator, in which the Jacobian is made */
   Contact              contact; /* the contact term, its rows of K (ContactBulkRowsOf()) */
@@ -91,16 +107,27 @@ typedef struct {
 PetscErrorCode SolverGetOptions(MPI_Comm comm, SolverOptions *opts);
 PetscErrorCode SolverGivenIndex(const char prefix[], PetscInt *k);
 
-/* pc_reuse.c: before and after each Jacobian's assembly */
+/* pc_reuse.c: attached around the SNES's Jacobian evaluation, it decides before each Jacobian's assembly whether the
+   preconditioner is built again, and after it records the build's contact rows or updates the GAMG hierarchy */
 PetscErrorCode PcReuseSetUp(PcReuse *r, Mat K, Contact contact, const SolverOptions *opt);
-PetscErrorCode PcReuseDecide(PcReuse *r, SNES snes, DM dm, Vec X);
-PetscErrorCode PcReuseAfterJacobian(PcReuse *r, SNES snes);
+PetscErrorCode PcReuseAttach(PcReuse *r, SNES snes, const LinearCore *core);
 PetscErrorCode PcReuseDestroy(PcReuse *r);
 
 /* pc_recovery.c: after a failed SNESSolve */
 PetscErrorCode PcRecoveryTry(PcRecovery *rec, SNES snes, const SolverOptions *opt, PcReuse *reuse, RunStats *stats, PetscBool *retry);
 
-/* ew_forcing.c, step_guess.c, fine_smoother.c: at the SNES's set-up, and before each linear solve (the core's KSP pre-solve) */
+/* The linear layer's KSP pre-solve (presolve.c): before each linear solve, the finest smoother's -mg_fine_ options,
+   the step guess and the forcing term, in that order. */
+typedef struct {
+  const SolverGiven *given;
+  SolverStepGuess   *step_guess;
+  SolverForcing     *forcing;
+  LinearCore         core;
+} LinearPreSolve;
+PetscErrorCode LinearPreSolveAttach(LinearPreSolve *ps, KSP ksp, const SolverGiven *given, SolverStepGuess *sg, SolverForcing *fc,
+                                    const LinearCore *core);
+
+/* ew_forcing.c, step_guess.c, fine_smoother.c: at the SNES's set-up, and before each linear solve (LinearPreSolve) */
 PetscErrorCode SolverForcingSetUp(SolverForcing *fc, SNES snes, PetscReal guard, PetscBool *petsc_presolve);
 PetscErrorCode SolverForcingPreSolve(SolverForcing *fc, KSP ksp, PetscReal ref, PetscReal snes_scale);
 PetscErrorCode SolverStepGuessSetUp(SolverStepGuess *sg, KSP ksp, const SolverGiven *given);

@@ -4,7 +4,7 @@
    (-snes_rtol times |F| at the start, or times the load for a warm start). Near the solution version 2's terms fall
    superlinearly, so the last linear solve can go orders of magnitude below what Newton needs. The guard only loosens a
    term, never beyond -snes_ksp_ew_rtolmax.
-   This pre-solve (part of SolverPreSolve() in newton.c) replaces PETSc's (KSPPreSolve_SNESEW(), installed with the
+   This pre-solve (part of the linear layer's, presolve.c) replaces PETSc's (KSPPreSolve_SNESEW(), installed with the
    SNES's KSP); without the guard its terms are PETSc's exactly. Other versions (-snes_ksp_ew_version) keep PETSc's.
    One of PETSc 3.18's mirrors (docs/decisions.md, "PETSc 3.18's mirrors"). */
 #include "linear.h"
@@ -12,7 +12,7 @@
 #define EW_ENDGAME 10.0 /* a step expected to land within this factor of Newton's target ... */
 #define EW_FINISH 0.3   /* ... is solved to this fraction of it */
 
-/* Before a linear solve (SolverPreSolve()): its tolerance, if the forcing is on. ref: the residual that -snes_rtol
+/* Before a linear solve (the linear layer's pre-solve, presolve.c): its tolerance, if the forcing is on. ref: the residual that -snes_rtol
    reduces, in the user's units (the core's SolverStopReference()); snes_scale: U, the SNES seeing F/U. */
 PetscErrorCode SolverForcingPreSolve(SolverForcing *fc, KSP ksp, PetscReal ref, PetscReal snes_scale)
 {

@@ -15,6 +15,8 @@ struct _n_Multigrid {
 
 /* pc_reuse.c: forgets the build (pc_recovery.c) */
 PetscErrorCode PcReuseReset(PcReuse *r);
+PetscErrorCode PcReuseDecide(PcReuse *r, SNES snes, DM dm, Vec X);
+PetscErrorCode PcReuseAfterJacobian(PcReuse *r, SNES snes);
 
 /* smoother_bound.c: the finest level's Chebyshev interval at each update of a GAMG hierarchy (pc_reuse.c) */
 PetscErrorCode SmootherBoundFinest(PcReuse *r, PC pc, PetscInt nlevels, const PetscScalar jvals[], PetscBool check);

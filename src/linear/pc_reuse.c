@@ -635,6 +635,41 @@ PetscErrorCode PcReuseAfterJacobian(PcReuse *r, SNES snes)
 
 /* What the reuse reads, for the life of the problem: the bulk operator K, in which the Jacobian is made
    (ContactComputeJacobian()), the contact term and the solver's options. None is referenced. */
+/* The SNES's Jacobian evaluation with the reuse around it: the decision at the iterate's displacement (the core's
+   LinearCore), the core's own evaluation, then the record or the update. The order is the one of a Jacobian callback
+   that calls them itself; SNESComputeJacobian() applies the lag the decision set (SNESSetLagPreconditioner()) once this
+   returns. */
+static PetscErrorCode PcReuseJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
+{
+  PcReuse *r = (PcReuse *)ctx;
+  DM       dm;
+  Vec      u;
+
+  PetscFunctionBeginUser;
+  PetscCall(SNESGetDM(snes, &dm));
+  PetscCall((*r->core.displacement)(r->core.core, X, &u));
+  PetscCall(PcReuseDecide(r, snes, dm, u));
+  PetscCall((*r->jacobian)(snes, X, J, P, r->jacobian_ctx));
+  PetscCall(PcReuseAfterJacobian(r, snes));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+/* Attaches the reuse to the SNES: its Jacobian evaluation, the core's callback, is wrapped by PcReuseJacobian(), with
+   the same matrices. A PC type wrapping the inner PC would see neither the iterate nor the SNES's lag, which the
+   decision needs, and an SNES update hook (SNESSetUpdate()) has no context; docs/decisions.md, "The acceleration's
+   hooks". */
+PetscErrorCode PcReuseAttach(PcReuse *r, SNES snes, const LinearCore *core)
+{
+  Mat A, P;
+
+  PetscFunctionBeginUser;
+  r->core = *core;
+  PetscCall(SNESGetJacobian(snes, &A, &P, &r->jacobian, &r->jacobian_ctx));
+  PetscCheck(r->jacobian, PetscObjectComm((PetscObject)snes), PETSC_ERR_ARG_WRONGSTATE, "The SNES has no Jacobian callback to attach the reuse to");
+  PetscCall(SNESSetJacobian(snes, A, P, PcReuseJacobian, r));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 PetscErrorCode PcReuseSetUp(PcReuse *r, Mat K, Contact contact, const SolverOptions *opt)
 {
   PetscFunctionBeginUser;
@@ -660,21 +695,27 @@ PetscErrorCode PcReuseDestroy(PcReuse *r)
 
 /* Forgets the build, so that the next Newton step builds the preconditioner afresh, and gives up the coarse-level
    updates for the rest of the run (pc_recovery.c): every later preconditioner is a build, with its own smoother
-   estimates. What it reads (PcReuseSetUp()), enabled and the counts stay. */
+   estimates. What it reads (PcReuseSetUp()), its attachment (PcReuseAttach()), enabled and the counts stay. */
 PetscErrorCode PcReuseReset(PcReuse *r)
 {
   const PetscBool            enabled = r->enabled;
   const PetscInt             builds = r->builds, updates = r->updates;
-  Mat                        K       = r->K;
-  Contact                    contact = r->contact;
-  const SolverOptions *const opt     = r->opt;
+  Mat                        K                            = r->K;
+  Contact                    contact                      = r->contact;
+  const SolverOptions *const opt                          = r->opt;
+  const LinearCore           core                         = r->core;
+  PetscErrorCode (*jacobian)(SNES, Vec, Mat, Mat, void *) = r->jacobian;
+  void *jacobian_ctx                                      = r->jacobian_ctx;
 
   PetscFunctionBeginUser;
   PetscCall(PcReuseDestroy(r));
   PetscCall(PcReuseSetUp(r, K, contact, opt));
-  r->enabled   = enabled;
-  r->builds    = builds;
-  r->updates   = updates;
-  r->no_update = PETSC_TRUE;
+  r->core         = core; /* still attached */
+  r->jacobian     = jacobian;
+  r->jacobian_ctx = jacobian_ctx;
+  r->enabled      = enabled;
+  r->builds       = builds;
+  r->updates      = updates;
+  r->no_update    = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

@@ -39,7 +39,7 @@ PetscErrorCode SolverStepGuessSet(SolverStepGuess *sg, Vec du)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Before each linear solve (SolverPreSolve()): the guess, if one is pending, else the options' initial guess.
+/* Before each linear solve (the linear layer's pre-solve, presolve.c): the guess, if one is pending, else the options' initial guess.
    snes_scale: U, the SNES iterating on u/U. */
 PetscErrorCode SolverStepGuessPreSolve(SolverStepGuess *sg, KSP ksp, Vec x, PetscReal snes_scale)
 {

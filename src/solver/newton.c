@@ -113,11 +113,9 @@ PetscErrorCode SolverFormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
   PetscFunctionBeginUser;
   PetscCall(SNESGetDM(snes, &dm));
   PetscCall(SolverIterateDisplacement(sc, X, &u));
-  /* J = K for the types without a contact Jacobian, which ContactComputeJacobian() leaves, and the factorization's reuse
-     is off for them (SolverCreateSNES()) */
-  PetscCall(PcReuseDecide(&sc->pc_reuse, snes, dm, u));
+  /* J = K for the types without a contact Jacobian, which ContactComputeJacobian() leaves; the preconditioner's reuse
+     wraps this callback where it is on (PcReuseAttach(), src/linear/pc_reuse.c) */
   PetscCall(ContactComputeJacobian(sc->contact, dm, u, sc->K, P)); /* P is K itself, or a copy (SBAIJ: no row access) */
-  PetscCall(PcReuseAfterJacobian(&sc->pc_reuse, snes));            /* records the build's contact rows, or updates the GAMG hierarchy */
   if (J != P) {
     PetscCall(MatAssemblyBegin(J, MAT_FINAL_ASSEMBLY));
     PetscCall(MatAssemblyEnd(J, MAT_FINAL_ASSEMBLY));
@@ -245,15 +243,28 @@ PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscRea
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* Before each linear solve: the finest multigrid smoother's -mg_fine_ options (fine_smoother.c), the initial guess
-   (step_guess.c), then the linear tolerance of the inexact Newton (ew_forcing.c), all in src/linear/. */
-PetscErrorCode SolverPreSolve(KSP ksp, Vec b, Vec x, void *ctx)
+/* What the linear layer reads of the core (LinearCore, include/linear.h): the displacement of an iterate, and the
+   current solve's stopping reference and scale. */
+static PetscErrorCode SolverCoreDisplacement(void *core, Vec X, Vec *u)
 {
-  SolverCtx sc = (SolverCtx)ctx;
+  PetscFunctionBeginUser;
+  PetscCall(SolverIterateDisplacement((SolverCtx)core, X, u));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+static PetscErrorCode SolverCoreScales(void *core, PetscReal *stop_reference, PetscReal *snes_scale)
+{
+  const SolverCtx sc = (SolverCtx)core;
 
   PetscFunctionBeginUser;
-  PetscCall(FineSmootherSetUp(ksp, &sc->opt->given));
-  PetscCall(SolverStepGuessPreSolve(&sc->step_guess, ksp, x, sc->snes_scale));
-  PetscCall(SolverForcingPreSolve(&sc->forcing, ksp, SolverStopReference(sc), sc->snes_scale));
+  *stop_reference = SolverStopReference(sc);
+  *snes_scale     = sc->snes_scale;
   PetscFunctionReturn(PETSC_SUCCESS);
+}
+
+void SolverCtxLinearCore(SolverCtx sc, LinearCore *core)
+{
+  core->displacement = SolverCoreDisplacement;
+  core->scales       = SolverCoreScales;
+  core->core         = sc;
 }

@@ -208,12 +208,13 @@ static PetscErrorCode SolverSetIterativeDefaults(SNES snes, Contact contact, con
 
 PetscErrorCode SolverCreateSNES(DM dm, Contact contact, const SolverOptions *opt, Problem *prob, Multigrid mg, const MeshBox *box, SNES *snes)
 {
-  MPI_Comm  comm = PetscObjectComm((PetscObject)dm);
-  Mat       J;
-  KSP       ksp;
-  PC        pc;
-  PetscBool is_multigrid;
-  PCType    pc_type;
+  MPI_Comm   comm = PetscObjectComm((PetscObject)dm);
+  Mat        J;
+  KSP        ksp;
+  PC         pc;
+  PetscBool  is_multigrid;
+  PCType     pc_type;
+  LinearCore core; /* what the linear layer's hooks read of the core */
 
   PetscFunctionBeginUser;
   PetscCall(SNESCreate(comm, snes));
@@ -257,6 +258,8 @@ PetscErrorCode SolverCreateSNES(DM dm, Contact contact, const SolverOptions *opt
     PetscCall(ContactGetSolverDefaults(contact, &defaults));
     prob->sctx->pc_reuse.enabled = (PetscBool)(defaults->reuse_factorization && opt->pc_reuse && !is_preonly);
   }
+  SolverCtxLinearCore(prob->sctx, &core);
+  if (prob->sctx->pc_reuse.enabled) PetscCall(PcReuseAttach(&prob->sctx->pc_reuse, *snes, &core)); /* around the Jacobian */
   PetscCall(SolverSetIterativeDefaults(*snes, contact, opt));
   {
     PetscBool petsc_presolve, fine;
@@ -264,7 +267,8 @@ PetscErrorCode SolverCreateSNES(DM dm, Contact contact, const SolverOptions *opt
     /* Eisenstat-Walker's terms with the oversolving guard */
     PetscCall(SolverForcingSetUp(&prob->sctx->forcing, *snes, opt->ew_guard, &petsc_presolve));
     PetscCall(SolverStepGuessSetUp(&prob->sctx->step_guess, ksp, &opt->given));
-    if (!petsc_presolve) PetscCall(KSPSetPreSolve(ksp, SolverPreSolve, prob->sctx));
+    if (!petsc_presolve)
+      PetscCall(LinearPreSolveAttach(&prob->sctx->presolve, ksp, &opt->given, &prob->sctx->step_guess, &prob->sctx->forcing, &core));
     PetscCall(FineSmootherGiven(ksp, &opt->given, &fine));
     PetscCheck(!fine || is_multigrid, comm, PETSC_ERR_USER_INPUT,
                "-mg_fine_ksp_type and -mg_fine_pc_type need a multigrid preconditioner (-pc_type gamg or mg), not %s", pc_type);

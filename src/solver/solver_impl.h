@@ -54,6 +54,7 @@ struct _n_SolverCtx {
   PcRecovery      pc_recovery;
   SolverForcing   forcing;
   SolverStepGuess step_guess;
+  LinearPreSolve  presolve;
 };
 
 /* The residual that -snes_rtol reduces (SolverConverged() in newton.c, and the forcing terms of src/linear/ew_forcing.c): the
@@ -69,7 +70,7 @@ PetscErrorCode SolverCtxDestroy(SolverCtx *sc);
 PetscErrorCode SolverFormFunction(SNES snes, Vec X, Vec F, void *ctx);
 PetscErrorCode SolverFormJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx);
 PetscErrorCode SolverConverged(SNES snes, PetscInt it, PetscReal xnorm, PetscReal snorm, PetscReal fnorm, SNESConvergedReason *reason, void *ctx);
-PetscErrorCode SolverPreSolve(KSP ksp, Vec b, Vec x, void *ctx);
+void           SolverCtxLinearCore(SolverCtx sc, LinearCore *core);
 PetscErrorCode SolverIterateDisplacement(SolverCtx sc, Vec X, Vec *u);
 PetscErrorCode SolverResidual(SolverCtx sc, DM dm, Vec u, Vec F);
 
