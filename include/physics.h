@@ -20,6 +20,7 @@ PetscErrorCode PostprocessContact(DM dm, Contact contact, const Problem *prob, c
                                   SolutionQuantities *sq);
 PetscErrorCode PostprocessLiftEnergy(DM dm, const Material *mat, const Problem *prob, PetscReal weak_lift, PetscReal *energy);
 PetscErrorCode PostprocessPenetration(const ErrorNorms *errors, SolutionQuantities *sq);
+PetscErrorCode PostprocessView(MPI_Comm comm, const SolutionQuantities *sq);                                       /* the summary's line */
 PetscErrorCode PostprocessWrite(const SolutionQuantities *s, const BoundarySet *bcs, PetscInt dim, PetscViewer v); /* the quantities in /run */
 PetscReal      PostprocessForceMagnitude(const Quantities *q, PetscInt dim);
 /* contact_zone.c */

@@ -40,10 +40,9 @@ PetscErrorCode SolverResidualNorm(SNES snes, SolverCtx sc, Vec u, PetscReal *nor
 PetscErrorCode SolverExtrapolatedStart(SNES snes, DM dm, Solver s, Vec u, Vec dir, PetscReal factor, PetscReal relaxed, PetscBool step_guess);
 PetscErrorCode SolverSecantStart(SNES snes, DM dm, Solver s, Vec u, Vec prev, Vec dir, PetscBool use, PetscReal factor, PetscReal relaxed);
 PetscErrorCode SolverConditionEstimate(SNES snes, Solver s, Vec u);
-/* the solve's part of /run, and the table /solves */
-PetscErrorCode SolverWrite(const RunStats *s, const Problem *prob, const SolverOptions *sopt, PetscInt coarse_levels, PetscInt nsolves,
-                           PetscViewer v);
-PetscErrorCode SolverWriteSolves(MPI_Comm comm, const SolveRecord records[], PetscInt n, PetscViewer v);
+/* solver_output.c: the solver's record in the summary, and its part of /run with the table /solves */
+PetscErrorCode SolverView(Solver s, MPI_Comm comm);
+PetscErrorCode SolverWrite(Solver s, MPI_Comm comm, PetscViewer v);
 
 /* problem.c: the problem on one mesh (its section, K, r0, the SNES), which the Solver owns */
 PetscErrorCode ProblemSetUp(DM dm, Solver s, const Scene *scene, SNES *snes);
@@ -52,4 +51,5 @@ PetscErrorCode ProblemDestroy(Solver s, SNES *snes);
 /* bandwidth.c */
 PetscErrorCode BandwidthGetOptions(MPI_Comm comm, PetscBool *measure);
 PetscErrorCode BandwidthMeasure(SNES snes, PetscBool measure, Bandwidth *b);
+PetscErrorCode BandwidthView(MPI_Comm comm, const Bandwidth *b);
 PetscErrorCode BandwidthWrite(const Bandwidth *b, PetscViewer v);

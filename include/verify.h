@@ -34,4 +34,5 @@ PetscErrorCode ErrorNormsCompute(DM dm, const VerifyRun *run, Vec u, ErrorNorms 
 PetscErrorCode ReferenceCompute(DM dm, const VerifyRun *run, Vec u, ErrorNorms *e);
 /* before the solve: the -reference file fits the run (reads run's opt, scene, mat and degree only) */
 PetscErrorCode ReferenceCheckFile(DM dm, const VerifyRun *run);
+PetscErrorCode VerifyView(MPI_Comm comm, const ErrorNorms *errors, const ErrorNorms *ref_errors); /* their lines of the summary */
 PetscErrorCode VerifyWrite(const VerifyOptions *opt, const ErrorNorms *errors, const ErrorNorms *ref_errors, PetscViewer v); /* their part of /run */

@@ -16,66 +16,28 @@ static const char help[] =
 #include "verify.h"
 #include "io.h"
 
+/* The summary: the run's first line, then each module's own lines (its ...View()), in the order of the run. */
 static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
 {
-  MPI_Comm                  comm = PetscObjectComm((PetscObject)dm);
-  const RunStats           *s    = SolverStats(user->solver);
-  const SolutionQuantities *sq   = &user->quantities;
-  const Problem            *prob = SolverProblem(user->solver);
-  const SolveRecord        *records;
-  PetscInt                  dim, ndofs, nrecords;
-  PetscMPIInt               size;
+  MPI_Comm        comm = PetscObjectComm((PetscObject)dm);
+  const RunStats *s    = SolverStats(user->solver);
+  PetscInt        dim, ndofs;
+  PetscMPIInt     size;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(VecGetSize(u, &ndofs));
-  PetscCall(SolverGetSolves(user->solver, &records, &nrecords));
   PetscCallMPI(MPI_Comm_size(comm, &size));
   PetscCall(PetscPrintf(comm, "scene %s, %" PetscInt_FMT "D, ", user->scene.name, dim));
   PetscCall(ContactView(user->contact, PETSC_VIEWER_STDOUT_(comm))); /* method penalty (gauss quadrature, eps = ...) */
   PetscCall(PetscPrintf(comm, ", P%" PetscInt_FMT ", %" PetscInt_FMT " dofs, largest cell h = %g, %d rank(s)\n", user->opt->degree, ndofs,
-                        (double)prob->h, size));
-  if (s->default_mg)
-    PetscCall(PetscPrintf(comm,
-                          "  linear solver: CG with the geometric multigrid of the %" PetscInt_FMT
-                          " nested boxes (the default on a 3D box that nests; "
-                          "-pc_type lu for MUMPS)\n",
-                          user->box.coarse_levels + user->opt->solver.grid_sequence + 1));
-  PetscCall(PetscPrintf(comm,
-                        "  SNES %s: %" PetscInt_FMT " Newton steps, %" PetscInt_FMT " linear iterations, %" PetscInt_FMT " preconditioner builds",
-                        SNESConvergedReasons[s->reason], s->newton_its, s->ksp_its, s->pc_builds));
-  if (s->pc_updates) PetscCall(PetscPrintf(comm, " and %" PetscInt_FMT " coarse-level updates", s->pc_updates));
-  if (s->pc_finest_updates) PetscCall(PetscPrintf(comm, " (and %" PetscInt_FMT " of the finest level only)", s->pc_finest_updates));
-  PetscCall(PetscPrintf(comm, ", |F| = %g%s\n", (double)s->residual_norm,
-                        s->roundoff_stop ? " (stopped at round-off: -snes_rtol asks for less than double precision can reach)" : ""));
-  PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g%s, contact force %g, energy %.10g\n",
-                        sq->active_vertices, (double)sq->q.penetration_max,
-                        sq->penetration_between
-                            ? " (between the nodes and the rule's points, where a curved obstacle cuts the straight faces by about "
-                              "h^2/8R, which eps does not reduce)"
-                            : "",
-                        (double)sq->contact_force, (double)sq->q.energy));
-  if (!PetscIsNanReal(user->errors.h1))
-    PetscCall(PetscPrintf(comm, "  error against the exact solution: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n",
-                          (double)user->errors.h1, (double)user->errors.l2, (double)user->errors.pressure_l2, (double)user->errors.pressure_dual));
-  if (!PetscIsNanReal(user->ref_errors.h1))
-    PetscCall(PetscPrintf(comm, "  error against the reference: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n",
-                          (double)user->ref_errors.h1, (double)user->ref_errors.l2, (double)user->ref_errors.pressure_l2,
-                          (double)user->ref_errors.pressure_dual));
-  if (nrecords > 1) {
-    PetscCall(PetscPrintf(comm, "  solves: level   dofs        h           eps         Newton  Krylov  PC builds  setup s   solve s\n"));
-    for (PetscInt i = 0; i < nrecords; ++i) {
-      const SolveRecord *r = &records[i];
-
-      PetscCall(PetscPrintf(comm,
-                            "          %5" PetscInt_FMT "  %9" PetscInt_FMT "  %.4e  %.4e  %6" PetscInt_FMT "  %6" PetscInt_FMT "  %9" PetscInt_FMT
-                            "  %8.3f  %8.3f%s\n",
-                            r->level, r->n_dofs, (double)r->h, (double)r->eps, r->newton_its, r->ksp_its, r->pc_builds, (double)r->time_setup,
-                            (double)r->time_solve, r->converged ? "" : "  FAILED"));
-    }
-  }
+                        (double)SolverProblem(user->solver)->h, size));
+  PetscCall(SolverView(user->solver, comm)); /* the solves */
+  PetscCall(PostprocessView(comm, &user->quantities));
+  PetscCall(VerifyView(comm, &user->errors, &user->ref_errors));
   {
-    const DriverReport r = {.opt = user->opt, .scene = &user->scene, .contact = user->contact, .stats = s, .quantities = sq, .dim = dim};
+    const DriverReport r = {
+        .opt = user->opt, .scene = &user->scene, .contact = user->contact, .stats = s, .quantities = &user->quantities, .dim = dim};
 
     PetscCall(DriversView(user->drivers, comm, &r)); /* the adaptive cycles, the load path */
   }
@@ -85,20 +47,9 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
   if (user->diagnostics_failed[0])
     PetscCall(
         PetscPrintf(comm, "  WARNING: written without a diagnostic that failed after the solve (exit status 4): %s\n", user->diagnostics_failed));
-  if (s->pc_breakdowns) PetscCall(PetscPrintf(comm, "  preconditioner breakdowns: %" PetscInt_FMT " (%s)\n", s->pc_breakdowns, s->pc_recovery));
-  if (s->continuation_stages)
-    PetscCall(PetscPrintf(comm, "  eps continuation: %" PetscInt_FMT " solve(s) from eps = h/M before the target eps (counted in the Newton steps)\n",
-                          s->continuation_stages));
-  if (!PetscIsNanReal(s->condition_1norm))
-    PetscCall(PetscPrintf(comm, "  condition number estimate (1-norm) of the Jacobian: %.3e\n", (double)s->condition_1norm));
   PetscCall(PetscPrintf(comm, "  time: setup %.3f s, solve %.3f s, total %.3f s; peak memory %.1f MB per rank (max), %.1f MB in all\n", s->time_setup,
                         s->time_solve, s->time_total, (double)s->peak_memory_mb, (double)s->peak_memory_total_mb));
-  if (user->bandwidth.measured)
-    PetscCall(PetscPrintf(comm, "  bandwidth: triad %.2f GB/s, MatMult %.2f GB/s (%.2f of it, %.2f ms), V-cycle %.2f GB/s (%.2f of it, %.2f ms)\n",
-                          (double)user->bandwidth.triad_gbs, (double)user->bandwidth.matmult_gbs,
-                          (double)(user->bandwidth.matmult_gbs / user->bandwidth.triad_gbs), (double)(1e3 * user->bandwidth.matmult_s),
-                          (double)user->bandwidth.vcycle_gbs, (double)(user->bandwidth.vcycle_gbs / user->bandwidth.triad_gbs),
-                          (double)(1e3 * user->bandwidth.vcycle_s)));
+  PetscCall(BandwidthView(comm, &user->bandwidth));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
@@ -110,15 +61,13 @@ static PetscErrorCode PrintSummary(DM dm, const AppCtx *user, Vec u)
    order of the run: the scene, the method, the solve and its drivers, the distribution. */
 static PetscErrorCode WriteResults(DM dm, Vec u, PetscViewer v, void *ctx)
 {
-  const AppCtx      *user  = (const AppCtx *)ctx;
-  MPI_Comm           comm  = PetscObjectComm((PetscObject)dm);
-  const RunStats    *stats = SolverStats(user->solver);
-  const SolveRecord *records;
-  PetscInt           dim, nrecords;
+  const AppCtx   *user  = (const AppCtx *)ctx;
+  MPI_Comm        comm  = PetscObjectComm((PetscObject)dm);
+  const RunStats *stats = SolverStats(user->solver);
+  PetscInt        dim;
 
   PetscFunctionBeginUser;
   PetscCall(DMGetDimension(dm, &dim));
-  PetscCall(SolverGetSolves(user->solver, &records, &nrecords));
   PetscCall(RunAttrReal(v, stats->time_total, "time_total"));
   PetscCall(RunAttrReal(v, stats->peak_memory_mb, "peak_memory_mb"));
   PetscCall(RunAttrReal(v, stats->peak_memory_total_mb, "peak_memory_total_mb"));
@@ -131,8 +80,7 @@ static PetscErrorCode WriteResults(DM dm, Vec u, PetscViewer v, void *ctx)
   PetscCall(VerifyWrite(&user->opt->verify, &user->errors, &user->ref_errors, v));
   PetscCall(EstimateWrite(&user->estimate, v));
   PetscCall(BarsWrite(&user->bars, v));
-  PetscCall(SolverWrite(stats, SolverProblem(user->solver), &user->opt->solver, user->box.coarse_levels, nrecords, v));
-  PetscCall(SolverWriteSolves(comm, records, nrecords, v));
+  PetscCall(SolverWrite(user->solver, comm, v)); /* with /solves */
   {
     const DriverReport r = {
         .opt = user->opt, .scene = &user->scene, .contact = user->contact, .stats = stats, .quantities = &user->quantities, .dim = dim};

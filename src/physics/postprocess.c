@@ -96,6 +96,21 @@ PetscErrorCode PostprocessPenetration(const ErrorNorms *errors, SolutionQuantiti
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The solution's line of the summary: where the rule acts, the largest penetration (and where the finer quadrature
+   found it), the contact force and the energy. */
+PetscErrorCode PostprocessView(MPI_Comm comm, const SolutionQuantities *sq)
+{
+  PetscFunctionBeginUser;
+  PetscCall(PetscPrintf(comm, "  contact: %" PetscInt_FMT " active vertices, max penetration %g%s, contact force %g, energy %.10g\n",
+                        sq->active_vertices, (double)sq->q.penetration_max,
+                        sq->penetration_between
+                            ? " (between the nodes and the rule's points, where a curved obstacle cuts the straight faces by about "
+                              "h^2/8R, which eps does not reduce)"
+                            : "",
+                        (double)sq->contact_force, (double)sq->q.energy));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The solution's quantities in /run (PostprocessContact()): where the rule acts, the largest penetration, the contact
    force and its vector, the energy, the largest pressure with its step and its recovered peak, the contact zone's size
    with its band, and the force of each clamp's and slip's support on the body (reaction_clamp_3_x, ...). */

@@ -172,6 +172,17 @@ PetscErrorCode BandwidthMeasure(SNES snes, PetscBool measure, Bandwidth *b)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The summary's line of -perf_bandwidth: each bandwidth and its part of the triad's, with the times. */
+PetscErrorCode BandwidthView(MPI_Comm comm, const Bandwidth *b)
+{
+  PetscFunctionBeginUser;
+  if (!b->measured) PetscFunctionReturn(PETSC_SUCCESS);
+  PetscCall(PetscPrintf(comm, "  bandwidth: triad %.2f GB/s, MatMult %.2f GB/s (%.2f of it, %.2f ms), V-cycle %.2f GB/s (%.2f of it, %.2f ms)\n",
+                        (double)b->triad_gbs, (double)b->matmult_gbs, (double)(b->matmult_gbs / b->triad_gbs), (double)(1e3 * b->matmult_s),
+                        (double)b->vcycle_gbs, (double)(b->vcycle_gbs / b->triad_gbs), (double)(1e3 * b->vcycle_s)));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* -perf_bandwidth's part of /run: the bandwidths and the times they come from (nothing without it). */
 PetscErrorCode BandwidthWrite(const Bandwidth *b, PetscViewer v)
 {

@@ -303,6 +303,19 @@ static PetscErrorCode ErrorNormsWrite(const char prefix[], const ErrorNorms *e, 
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
+/* The summary's lines of the error norms, against the exact solution and against the -reference, where they exist. */
+PetscErrorCode VerifyView(MPI_Comm comm, const ErrorNorms *errors, const ErrorNorms *ref_errors)
+{
+  PetscFunctionBeginUser;
+  if (!PetscIsNanReal(errors->h1))
+    PetscCall(PetscPrintf(comm, "  error against the exact solution: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n", (double)errors->h1,
+                          (double)errors->l2, (double)errors->pressure_l2, (double)errors->pressure_dual));
+  if (!PetscIsNanReal(ref_errors->h1))
+    PetscCall(PetscPrintf(comm, "  error against the reference: H1 %.4e, L2 %.4e, pressure L2 %.4e, pressure H^-1/2 %.4e\n", (double)ref_errors->h1,
+                          (double)ref_errors->l2, (double)ref_errors->pressure_l2, (double)ref_errors->pressure_dual));
+  PetscFunctionReturn(PETSC_SUCCESS);
+}
+
 /* The verification's part of /run: the penetration's norms, the errors against the scene's exact solution (error_*)
    and against -reference (reference_error_*, with the reference's file), and the finer quadrature they took. */
 PetscErrorCode VerifyWrite(const VerifyOptions *opt, const ErrorNorms *errors, const ErrorNorms *ref_errors, PetscViewer v)
