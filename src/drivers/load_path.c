@@ -418,7 +418,7 @@ static PetscErrorCode LoadPathSolve(Driver d, AppCtx *user, DM *dmp, SNES *snesp
   const LoadPathOptions *lp    = &user->opt->load_path;
   const PetscBool        force = SceneForceControlled(&user->scene);
   Vec                    prev = NULL, dir = NULL;
-  PetscInt               first = 0;
+  PetscInt               first = 0; /* the first step counts every solve before it: the levels of the grid sequence, the cycles */
   PetscBool              ok;
 
   PetscFunctionBeginUser;
