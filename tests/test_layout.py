@@ -252,3 +252,51 @@ def test_functions_take_what_they_use():
     assert len(takers) <= 25, takers
     below = [t for t in takers if not (t[0].startswith(os.path.join("src", "drivers")) or t[0] == os.path.join("src", "main.c"))]
     assert not below, below
+
+
+CALLBACK_SETTERS = re.compile(r"\b(?:SNESSetFunction|SNESSetJacobian|SNESSetConvergenceTest|SNESMonitorSet|SNESSetUpdate|KSPSetPreSolve|KSPSetPostSolve)\s*\(([^;]*)\)\s*\)\s*;")
+
+
+def function_bodies(text):
+    """{name: body} of the functions a file defines (static or not), by matching their braces."""
+    bodies = {}
+    for m in FUNCTION.finditer(text):
+        start = text.find("{", m.end())
+        if start < 0 or ";" in text[m.end():start]:
+            continue  # a declaration
+        depth, i = 0, start
+        while i < len(text):
+            depth += {"{": 1, "}": -1}.get(text[i], 0)
+            if depth == 0:
+                break
+            i += 1
+        bodies[m.group(1)] = text[start:i + 1]
+    return bodies
+
+
+def test_the_core_callbacks_call_nothing_of_linear():
+    """The linear acceleration attaches itself to the SNES through PETSc's hooks (docs/design.md, "Layout"): the Newton
+    core's callbacks, the functions src/solver/ hands to the SNES and its KSP, and the static functions of their files
+    they call, call no function of src/linear/, and src/solver/ sets no KSP pre-solve of its own."""
+    texts = sources()
+    defined, _ = call_graph(texts)
+    linear = {name for name, where in defined.items() if folder(where) == "linear"}
+    core = {p: t for p, t in texts.items() if folder(p) == "solver"}
+    bodies = {}
+    for t in core.values():
+        for name, body in function_bodies(t).items():
+            bodies.setdefault(name, body)
+    callbacks = {n for t in core.values() for m in CALLBACK_SETTERS.finditer(t) for n in re.findall(r"\b[A-Z]\w*\b", m.group(1)) if n in bodies}
+    assert {"SolverFormFunction", "SolverFormJacobian", "SolverConverged", "ContactMonitor"} <= callbacks, callbacks
+    assert not [p for p, t in core.items() if re.search(r"\bKSPSetPreSolve\s*\(", t)]
+    seen, todo, found = set(), sorted(callbacks), []
+    while todo:  # the callbacks and what they call inside src/solver/
+        name = todo.pop()
+        if name in seen or name not in bodies:
+            continue
+        seen.add(name)
+        called = set(re.findall(r"\b([A-Z]\w*)\s*\(", bodies[name]))
+        found += [(name, c) for c in sorted(called & linear)]
+        todo += sorted(called - linear)
+    assert len(seen) >= 6, sorted(seen)  # the walk found the callbacks' bodies
+    assert not found, found

@@ -646,18 +646,20 @@ static PetscErrorCode PcReuseJacobian(SNES snes, Vec X, Mat J, Mat P, void *ctx)
   Vec      u;
 
   PetscFunctionBeginUser;
-  PetscCall(SNESGetDM(snes, &dm));
-  PetscCall((*r->core.displacement)(r->core.core, X, &u));
-  PetscCall(PcReuseDecide(r, snes, dm, u));
+  if (r->enabled) { /* off (SNESVI, a direct solve, -contact_pc_reuse 0): the core's evaluation alone */
+    PetscCall(SNESGetDM(snes, &dm));
+    PetscCall((*r->core.displacement)(r->core.core, X, &u));
+    PetscCall(PcReuseDecide(r, snes, dm, u));
+  }
   PetscCall((*r->jacobian)(snes, X, J, P, r->jacobian_ctx));
-  PetscCall(PcReuseAfterJacobian(r, snes));
+  if (r->enabled) PetscCall(PcReuseAfterJacobian(r, snes));
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
 /* Attaches the reuse to the SNES: its Jacobian evaluation, the core's callback, is wrapped by PcReuseJacobian(), with
-   the same matrices. A PC type wrapping the inner PC would see neither the iterate nor the SNES's lag, which the
-   decision needs, and an SNES update hook (SNESSetUpdate()) has no context; docs/decisions.md, "The acceleration's
-   hooks". */
+   the same matrices; the reuse acts where it is enabled (set before the first Jacobian). A PC type wrapping the inner PC would see neither the
+   iterate nor the SNES's lag, which the decision needs, and an SNES update hook (SNESSetUpdate()) has no context; docs/decisions.md, "The
+   acceleration's hooks". */
 PetscErrorCode PcReuseAttach(PcReuse *r, SNES snes, const LinearCore *core)
 {
   Mat A, P;
@@ -695,11 +697,11 @@ PetscErrorCode PcReuseDestroy(PcReuse *r)
 
 /* Forgets the build, so that the next Newton step builds the preconditioner afresh, and gives up the coarse-level
    updates for the rest of the run (pc_recovery.c): every later preconditioner is a build, with its own smoother
-   estimates. What it reads (PcReuseSetUp()), its attachment (PcReuseAttach()), enabled and the counts stay. */
+   estimates. What it reads (PcReuseSetUp()), its attachment (PcReuseAttach()), enabled and the three counts stay. */
 PetscErrorCode PcReuseReset(PcReuse *r)
 {
   const PetscBool            enabled = r->enabled;
-  const PetscInt             builds = r->builds, updates = r->updates;
+  const PetscInt             builds = r->builds, updates = r->updates, finest_updates = r->finest_updates;
   Mat                        K                            = r->K;
   Contact                    contact                      = r->contact;
   const SolverOptions *const opt                          = r->opt;
@@ -710,12 +712,13 @@ PetscErrorCode PcReuseReset(PcReuse *r)
   PetscFunctionBeginUser;
   PetscCall(PcReuseDestroy(r));
   PetscCall(PcReuseSetUp(r, K, contact, opt));
-  r->core         = core; /* still attached */
-  r->jacobian     = jacobian;
-  r->jacobian_ctx = jacobian_ctx;
-  r->enabled      = enabled;
-  r->builds       = builds;
-  r->updates      = updates;
-  r->no_update    = PETSC_TRUE;
+  r->core           = core; /* still attached */
+  r->jacobian       = jacobian;
+  r->jacobian_ctx   = jacobian_ctx;
+  r->enabled        = enabled;
+  r->builds         = builds;
+  r->updates        = updates;
+  r->finest_updates = finest_updates;
+  r->no_update      = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }

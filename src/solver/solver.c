@@ -223,6 +223,10 @@ PetscErrorCode SolverCreateSNES(DM dm, Contact contact, const SolverOptions *opt
   PetscCall(SNESSetFunction(*snes, NULL, SolverFormFunction, prob->sctx));
   PetscCall(SNESSetJacobian(*snes, J, J, SolverFormJacobian, prob->sctx));
   PetscCall(MatDestroy(&J));
+  /* the preconditioner's reuse around the Jacobian's evaluation, before SNESSetFromOptions(): -snes_fd, -snes_mf and
+     the like replace both, as they replaced the core's callback; the reuse acts once it is enabled, below */
+  SolverCtxLinearCore(prob->sctx, &core);
+  PetscCall(PcReuseAttach(&prob->sctx->pc_reuse, *snes, &core));
   PetscCall(ContactSetUpSNES(contact, dm, *snes)); /* SNESVI with its bounds, or semismooth Newton */
   {
     SNESLineSearch ls;
@@ -258,8 +262,6 @@ PetscErrorCode SolverCreateSNES(DM dm, Contact contact, const SolverOptions *opt
     PetscCall(ContactGetSolverDefaults(contact, &defaults));
     prob->sctx->pc_reuse.enabled = (PetscBool)(defaults->reuse_factorization && opt->pc_reuse && !is_preonly);
   }
-  SolverCtxLinearCore(prob->sctx, &core);
-  if (prob->sctx->pc_reuse.enabled) PetscCall(PcReuseAttach(&prob->sctx->pc_reuse, *snes, &core)); /* around the Jacobian */
   PetscCall(SolverSetIterativeDefaults(*snes, contact, opt));
   {
     PetscBool petsc_presolve, fine;
