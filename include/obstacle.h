@@ -8,7 +8,13 @@
    to the obstacle's surface along n (negative when x starts inside the obstacle).
    plane:    n = the plane's normal, g = (point - x) . n;
    sphere:   the body stays outside the ball, r = x - center, n = -r/|r|, g = |r| - radius;
-   cylinder: the same with r perpendicular to the axis (in 2D a disk, like the sphere). */
+   cylinder: the same with r perpendicular to the axis (in 2D a disk, like the sphere);
+   cone:     apex P, unit axis a from the apex into the cone, half-angle alpha (in 2D a wedge). With z = (x - P) . a and
+             rho e = (x - P) - z a (e a unit vector away from the axis), the cone's surface in the plane of a and e is
+             the ray t (sin alpha e + cos alpha a), t >= 0. Its point closest to x is at t = rho sin alpha + z cos alpha:
+             for t > 0 the foot of the perpendicular, g = rho cos alpha - z sin alpha (the signed distance to the ray's
+             line, negative inside the cone) with n = -cos alpha e + sin alpha a, the surface's normal into the cone;
+             for t <= 0 the apex itself, g = |x - P| and n = (P - x)/|x - P|. */
 static inline void ObstacleGapNormal(PetscInt dim, const PetscScalar p[], const PetscReal x[], PetscReal n[], PetscReal *g)
 {
   const ObstacleType type = (ObstacleType)(PetscInt)PetscRealPart(p[OBSTACLE_TYPE]);
@@ -23,6 +29,25 @@ static inline void ObstacleGapNormal(PetscInt dim, const PetscScalar p[], const 
     return;
   }
   for (PetscInt c = 0; c < dim; ++c) r[c] = x[c] - PetscRealPart(p[OBSTACLE_POINT + c]);
+  if (type == OBSTACLE_CONE) {
+    const PetscReal sa = PetscRealPart(p[OBSTACLE_CONE_SIN]), ca = PetscRealPart(p[OBSTACLE_CONE_COS]);
+    PetscReal       z = 0.0, rho = 0.0, e[3] = {0.0, 0.0, 0.0};
+
+    for (PetscInt c = 0; c < dim; ++c) z += r[c] * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
+    for (PetscInt c = 0; c < dim; ++c) e[c] = r[c] - z * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
+    for (PetscInt c = 0; c < dim; ++c) rho += e[c] * e[c];
+    rho = PetscSqrtReal(rho);
+    if (rho * sa + z * ca > 0.0) { /* the foot of the perpendicular on the surface */
+      for (PetscInt c = 0; c < dim; ++c)
+        n[c] = (rho > 0.0 ? -ca * e[c] / rho : 0.0) + (rho > 0.0 ? sa : 1.0) * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
+      *g = rho * ca - z * sa;
+    } else { /* the apex */
+      len = PetscSqrtReal(rho * rho + z * z);
+      for (PetscInt c = 0; c < dim; ++c) n[c] = len > 0.0 ? -r[c] / len : 0.0;
+      *g = len;
+    }
+    return;
+  }
   if (type == OBSTACLE_CYLINDER && dim == 3) {
     PetscReal ra = 0.0;
 
@@ -43,7 +68,9 @@ static inline void ObstaclePack(const Obstacle *obs, PetscScalar p[])
     p[OBSTACLE_POINT + c]     = obs->point[c] + obs->translate[c];
     p[OBSTACLE_DIRECTION + c] = obs->direction[c];
   }
-  p[OBSTACLE_RADIUS] = obs->radius;
+  p[OBSTACLE_RADIUS]   = obs->radius;
+  p[OBSTACLE_CONE_SIN] = PetscSinReal(obs->half_angle * PETSC_PI / 180.0);
+  p[OBSTACLE_CONE_COS] = PetscCosReal(obs->half_angle * PETSC_PI / 180.0);
 }
 
 /* The penetration u . n - g at x for the packed obstacle p; n is returned too. */

@@ -10,10 +10,13 @@
 
 /* Parameters of the rigid obstacle, packed in this order (constants[CONST_OBSTACLE + k], ObstaclePack() in obstacle.h). */
 enum {
-  OBSTACLE_TYPE,                           /* ObstacleType */
-  OBSTACLE_POINT,                          /* plane: a point of it; sphere, cylinder: the center (x, y, z), translation included */
-  OBSTACLE_DIRECTION = OBSTACLE_POINT + 3, /* plane: unit normal from the body into the obstacle; cylinder: unit axis */
-  OBSTACLE_RADIUS    = OBSTACLE_DIRECTION + 3,
+  OBSTACLE_TYPE,  /* ObstacleType */
+  OBSTACLE_POINT, /* plane: a point of it; sphere, cylinder: the center; cone: the apex (x, y, z), translation included */
+  OBSTACLE_DIRECTION =
+      OBSTACLE_POINT + 3, /* plane: unit normal from the body into the obstacle; cylinder: unit axis; cone: unit axis from the apex into it */
+  OBSTACLE_RADIUS = OBSTACLE_DIRECTION + 3,
+  OBSTACLE_CONE_SIN, /* cone: the sine and cosine of its half-angle */
+  OBSTACLE_CONE_COS,
   OBSTACLE_NUM_PARAMS
 };
 
@@ -67,14 +70,15 @@ typedef struct {
   PetscReal         body_force[3]; /* -body_force */
 } BoundarySet;
 
-/* The rigid obstacle (-obstacle plane | sphere | cylinder). */
-typedef enum { OBSTACLE_PLANE, OBSTACLE_SPHERE, OBSTACLE_CYLINDER } ObstacleType;
+/* The rigid obstacle (-obstacle plane | sphere | cylinder | cone). */
+typedef enum { OBSTACLE_PLANE, OBSTACLE_SPHERE, OBSTACLE_CYLINDER, OBSTACLE_CONE } ObstacleType;
 extern const char *const ObstacleTypes[];
 typedef struct {
   ObstacleType type;
-  PetscReal    point[3];     /* plane: a point of it; sphere, cylinder: the center */
-  PetscReal    direction[3]; /* plane: unit normal from the body into the obstacle; cylinder: unit axis (3D) */
+  PetscReal    point[3];     /* plane: a point of it; sphere, cylinder: the center; cone: the apex */
+  PetscReal    direction[3]; /* plane: unit normal from the body into the obstacle; cylinder: unit axis (3D); cone: unit axis from the apex into it */
   PetscReal    radius;
+  PetscReal    half_angle;   /* cone: the angle between its axis and its surface, in degrees (in 2D a wedge) */
   PetscReal    translate[3]; /* rigid translation of the obstacle (-obstacle_translate) */
   PetscReal    force;        /* -obstacle_force: the force it presses with along the translation's direction (0: driven by the translation) */
 } Obstacle;
@@ -255,6 +259,7 @@ typedef struct {
 /* Checks of the contact set-up and of the contact zone's resolution (src/physics/contact_checks.c): warnings only. */
 #define CONTACT_CHECK_OVERLAP_CELLS 1.0 /* an initial overlap deeper than this many cells */
 #define CONTACT_CHECK_OVERLAP_RATIO 0.1 /*   and than this part of the overlapped part's width is warned of */
+#define CONTACT_CHECK_OVERLAP_CONE 2.5  /*   a cone's: this many times the ratio its own indentation gives (a quarter model doubles it) */
 #define CONTACT_CHECK_ZONE_CELLS_2D 4.0 /* a contact zone spanning fewer cells is warned of (bench/zone_resolution.md) */
 #define CONTACT_CHECK_ZONE_CELLS_3D 6.0 /*   in 3D (bench/zone_resolution_3d.md) */
 #define CONTACT_CHECK_STRIP_ASPECT 3.0  /* a 3D zone this many times longer than wide is a strip, a line contact: the 2D threshold */
@@ -263,24 +268,25 @@ typedef struct {
 #define CONTACT_CHECK_LOCKING_NU 0.45   /* P1/Q1 with a Poisson ratio from this one on is warned of (scripts/incompressible.py) */
 typedef struct {
   PetscBool geometry_checked, resolution_checked;
-  PetscReal overlap_cells;      /* largest initial overlap -g/h at Gamma_C's vertices, h the diameter of the face's cell */
-  PetscReal overlap_fraction;   /* part of Gamma_C's area whose faces start inside the obstacle (g < 0 at the centroid) */
-  PetscReal overlap_ratio;      /* largest initial overlap -g over the width of that part: its length in 2D, 2 sqrt(area / pi) in 3D */
-  PetscReal away_fraction;      /* part of Gamma_C's area where the obstacle's normal points into the body */
-  PetscInt  zone_faces;         /* faces of Gamma_C whose every node carries contact force */
-  PetscReal zone_cells;         /* cells across the contact zone: zone_faces in 2D, sqrt(2 zone_faces / pi) in 3D */
-  PetscReal zone_limit;         /* fewer cells are warned of: CONTACT_CHECK_ZONE_CELLS_2D or _3D */
-  PetscReal zone_width_cells;   /* 3D: the zone's narrowest width in cells (a strip's), from its faces' second moments */
-  PetscBool zone_pressed;       /* some node of Gamma_C carries contact force (the zone may span no whole face) */
-  PetscBool zone_strip;         /* 3D: the zone is CONTACT_CHECK_STRIP_ASPECT times longer than wide, a line contact */
-  PetscInt  unseen_nodes;       /* contact nodes that penetrate while the rule exerts no force on them (ContactUnseenNodes()), */
-  PetscReal unseen_force;       /*   the force the penalty law would put on them, */
-  PetscReal unseen_share;       /*   and its part of the force's magnitude (PETSC_INFINITY where the force is zero) */
-  PetscInt  curved_refined;     /* a mesh file's curved boundary (MeshBox.curved_ridges) that the solver refined on its chords: its ridges, */
-  PetscInt  curved_refinements; /*   the refinements (-dm_refine and -contact_grid_sequence), */
-  PetscReal curved_x[3];        /*   and one of the ridges */
-  PetscReal locking_nu;         /* the Poisson ratio of a P1/Q1 body from CONTACT_CHECK_LOCKING_NU on (0: none), */
-  PetscReal locking_eps_ratio;  /*   and with the penalty's eps from E, (lambda + 2 mu) / E (0 otherwise) */
+  PetscReal overlap_cells;       /* largest initial overlap -g/h at Gamma_C's vertices, h the diameter of the face's cell */
+  PetscReal overlap_fraction;    /* part of Gamma_C's area whose faces start inside the obstacle (g < 0 at the centroid) */
+  PetscReal overlap_ratio;       /* largest initial overlap -g over the width of that part: its length in 2D, 2 sqrt(area / pi) in 3D */
+  PetscReal overlap_ratio_limit; /* a larger ratio is warned of: CONTACT_CHECK_OVERLAP_RATIO, or more for a cone (ContactChecksGeometry()) */
+  PetscReal away_fraction;       /* part of Gamma_C's area where the obstacle's normal points into the body */
+  PetscInt  zone_faces;          /* faces of Gamma_C whose every node carries contact force */
+  PetscReal zone_cells;          /* cells across the contact zone: zone_faces in 2D, sqrt(2 zone_faces / pi) in 3D */
+  PetscReal zone_limit;          /* fewer cells are warned of: CONTACT_CHECK_ZONE_CELLS_2D or _3D */
+  PetscReal zone_width_cells;    /* 3D: the zone's narrowest width in cells (a strip's), from its faces' second moments */
+  PetscBool zone_pressed;        /* some node of Gamma_C carries contact force (the zone may span no whole face) */
+  PetscBool zone_strip;          /* 3D: the zone is CONTACT_CHECK_STRIP_ASPECT times longer than wide, a line contact */
+  PetscInt  unseen_nodes;        /* contact nodes that penetrate while the rule exerts no force on them (ContactUnseenNodes()), */
+  PetscReal unseen_force;        /*   the force the penalty law would put on them, */
+  PetscReal unseen_share;        /*   and its part of the force's magnitude (PETSC_INFINITY where the force is zero) */
+  PetscInt  curved_refined;      /* a mesh file's curved boundary (MeshBox.curved_ridges) that the solver refined on its chords: its ridges, */
+  PetscInt  curved_refinements;  /*   the refinements (-dm_refine and -contact_grid_sequence), */
+  PetscReal curved_x[3];         /*   and one of the ridges */
+  PetscReal locking_nu;          /* the Poisson ratio of a P1/Q1 body from CONTACT_CHECK_LOCKING_NU on (0: none), */
+  PetscReal locking_eps_ratio;   /*   and with the penalty's eps from E, (lambda + 2 mu) / E (0 otherwise) */
 } ContactChecks;
 
 /* The quantities users read of a solution (PostprocessContact()), whose error bars -bars estimates (src/estimate/bars.c). */

@@ -208,7 +208,7 @@ def problems(draw):
     method, _ = site(st.sampled_from(["penalty", "penalty", "penalty", "vi", "none"]), st.sampled_from(["lagrange", "", "PENALTY"]))
     opts["-contact_method"] = method
     obstacle, _ = site(st.sampled_from(["plane", "plane", "sphere", "cylinder"] if method != "vi" else ["plane"]),
-                       st.sampled_from(["cone", "", "sphere" if method == "vi" else "plane,sphere"]))
+                       st.sampled_from(["torus", "", "sphere" if method == "vi" else "plane,sphere"]))
     opts["-obstacle"] = obstacle
     if obstacle == "plane" and draw(st.booleans()):
         opts["-obstacle_point"], _ = site(good_vector(dim, -0.02, 0.02), bad_vector(dim))

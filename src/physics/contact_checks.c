@@ -104,6 +104,13 @@ PetscErrorCode ContactChecksGeometry(DM dm, const ContactChecksGeometryInputs *i
 
     ck->overlap_ratio = width > 0.0 ? overlap[1] / width : 0.0;
   }
+  /* A cone of half-angle alpha pressed d into a flat body overlaps it on a width 2 d tan(alpha), a ratio 1/(2 tan(alpha)):
+     0.18 for Berkovich's equivalent cone (70.3 degrees), above CONTACT_CHECK_OVERLAP_RATIO at any depth. Its limit is
+     that ratio times CONTACT_CHECK_OVERLAP_CONE, which a quarter model's halved width (a doubled ratio) stays below. */
+  ck->overlap_ratio_limit = CONTACT_CHECK_OVERLAP_RATIO;
+  if (in->scene->obstacle.type == OBSTACLE_CONE)
+    ck->overlap_ratio_limit =
+        PetscMax(CONTACT_CHECK_OVERLAP_RATIO, CONTACT_CHECK_OVERLAP_CONE / (2.0 * PetscTanReal(in->scene->obstacle.half_angle * PETSC_PI / 180.0)));
   ck->geometry_checked = PETSC_TRUE;
   PetscFunctionReturn(PETSC_SUCCESS);
 }
@@ -255,7 +262,7 @@ PetscErrorCode ContactChecksWarnings(MPI_Comm comm, const ContactChecks *ck, Pet
   PetscInt n = 0;
 
   PetscFunctionBeginUser;
-  if (ck->geometry_checked && ck->overlap_cells > CONTACT_CHECK_OVERLAP_CELLS && ck->overlap_ratio > CONTACT_CHECK_OVERLAP_RATIO) {
+  if (ck->geometry_checked && ck->overlap_cells > CONTACT_CHECK_OVERLAP_CELLS && ck->overlap_ratio > ck->overlap_ratio_limit) {
     ++n;
     if (print)
       PetscCall(PetscPrintf(comm,

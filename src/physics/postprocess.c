@@ -105,7 +105,7 @@ PetscErrorCode PostprocessView(MPI_Comm comm, const SolutionQuantities *sq)
                         sq->active_vertices, (double)sq->q.penetration_max,
                         sq->penetration_between
                             ? " (between the nodes and the rule's points, where a curved obstacle cuts the straight faces by about "
-                              "h^2/8R, which eps does not reduce)"
+                              "h^2/8R and a cone's apex reaches between them, which eps does not reduce)"
                             : "",
                         (double)sq->contact_force, (double)sq->q.energy));
   PetscFunctionReturn(PETSC_SUCCESS);

@@ -1,8 +1,8 @@
-/* The rigid obstacle: the scene's default, then -obstacle plane | sphere | cylinder and its geometry, read once. */
+/* The rigid obstacle: the scene's default, then -obstacle plane | sphere | cylinder | cone and its geometry, read once. */
 #include "app.h"
 #include "scenes.h"
 
-const char *const ObstacleTypes[] = {"plane", "sphere", "cylinder", "ObstacleType", "OBSTACLE_", NULL};
+const char *const ObstacleTypes[] = {"plane", "sphere", "cylinder", "cone", "ObstacleType", "OBSTACLE_", NULL};
 
 /* A default of a scene: the plane through point with unit normal n (from the body into the obstacle). */
 PetscErrorCode SceneSetObstaclePlane(Scene *scene, const PetscReal point[], const PetscReal n[])
@@ -78,12 +78,10 @@ static PetscErrorCode OtherTypesGetOptions(MPI_Comm comm, ObstacleType type, Pet
 {
   const struct {
     const char *name;
-    PetscBool   read[3]; /* by plane, sphere, cylinder */
-    PetscInt    min_dim;
+    PetscInt    min_dim[4]; /* the smallest dimension in which plane, sphere, cylinder, cone reads it (4: never) */
   } geometry[] = {
-      {"-obstacle_point", {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, 2}, {"-obstacle_normal", {PETSC_TRUE, PETSC_FALSE, PETSC_FALSE}, 2},
-      {"-obstacle_center", {PETSC_FALSE, PETSC_TRUE, PETSC_TRUE}, 2}, {"-obstacle_radius", {PETSC_FALSE, PETSC_TRUE, PETSC_TRUE}, 2},
-      {"-obstacle_axis", {PETSC_FALSE, PETSC_FALSE, PETSC_TRUE}, 3},
+      {"-obstacle_point", {2, 4, 4, 2}},  {"-obstacle_normal", {2, 4, 4, 4}}, {"-obstacle_center", {4, 2, 2, 4}},
+      {"-obstacle_radius", {4, 2, 2, 4}}, {"-obstacle_axis", {4, 4, 3, 2}},   {"-obstacle_half_angle", {4, 4, 4, 2}},
   };
   char      list[256] = "";
   PetscBool overridden;
@@ -92,8 +90,10 @@ static PetscErrorCode OtherTypesGetOptions(MPI_Comm comm, ObstacleType type, Pet
   PetscCall(OnCommandLine("-obstacle", &overridden));
   for (size_t k = 0; k < sizeof(geometry) / sizeof(geometry[0]) && overridden; ++k) {
     PetscBool set, given_here;
+    PetscInt  lowest = 4; /* the smallest dimension in which any type reads it */
 
-    if (geometry[k].read[type] || dim < geometry[k].min_dim) continue;
+    for (PetscInt j = 0; j < 4; ++j) lowest = PetscMin(lowest, geometry[k].min_dim[j]);
+    if (dim >= geometry[k].min_dim[type] || dim < lowest) continue;
     PetscCall(OnCommandLine(geometry[k].name, &given_here));
     if (given_here) continue;
     PetscCall(PetscOptionsHasName(NULL, NULL, geometry[k].name, &set)); /* marks it read */
@@ -121,7 +121,8 @@ PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(OptionsCheckEnum(comm, "-obstacle", ObstacleTypes, PETSC_FALSE)); /* one obstacle per run, named in full */
   PetscOptionsBegin(comm, NULL, "Rigid obstacle", "Signorini");
-  PetscCall(PetscOptionsEnum("-obstacle", "Rigid obstacle: plane, sphere (the body stays outside a ball), cylinder (in 2D a disk)", NULL,
+  PetscCall(PetscOptionsEnum("-obstacle",
+                             "Rigid obstacle: plane, sphere (the body stays outside a ball), cylinder (in 2D a disk), cone (in 2D a wedge)", NULL,
                              ObstacleTypes, (PetscEnum)obs->type, (PetscEnum *)&obs->type, &type_set));
   switch (obs->type) {
     case OBSTACLE_PLANE:
@@ -145,6 +146,21 @@ PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
         PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_axis", "Direction of the cylinder's axis", dim, required, kind, obs->direction));
         PetscCall(Normalize(comm, "-obstacle_axis", dim, obs->direction));
       }
+    } break;
+    case OBSTACLE_CONE: {
+      const char kind[] = "-obstacle cone";
+      PetscBool  set;
+
+      PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_point", "The cone's apex", dim, type_set, kind, obs->point));
+      PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_axis", "The cone's axis, from its apex into it (away from the body)", dim, type_set,
+                           kind, obs->direction));
+      PetscCall(Normalize(comm, "-obstacle_axis", dim, obs->direction));
+      PetscCall(PetscOptionsReal("-obstacle_half_angle", "The cone's half-angle, between its axis and its surface, in degrees", NULL, obs->half_angle,
+                                 &obs->half_angle, &set));
+      PetscCheck(set || !type_set, comm, PETSC_ERR_USER_INPUT, "%s needs -obstacle_half_angle (degrees, in (0, 90))", kind);
+      PetscCall(OptionsCheckFinite(comm, "-obstacle_half_angle", obs->half_angle));
+      PetscCheck(obs->half_angle > 0.0 && obs->half_angle < 90.0, comm, PETSC_ERR_USER_INPUT,
+                 "-obstacle_half_angle must lie in (0, 90) degrees (a cone between a needle and a plane), got %g", (double)obs->half_angle);
     } break;
   }
   PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_translate", "Rigid translation of the obstacle (an indenter driven by displacement)", dim,
