@@ -14,7 +14,12 @@
              the ray t (sin alpha e + cos alpha a), t >= 0. Its point closest to x is at t = rho sin alpha + z cos alpha:
              for t > 0 the foot of the perpendicular, g = rho cos alpha - z sin alpha (the signed distance to the ray's
              line, negative inside the cone) with n = -cos alpha e + sin alpha a, the surface's normal into the cone;
-             for t <= 0 the apex itself, g = |x - P| and n = (P - x)/|x - P|. */
+             for t <= 0 the apex itself, g = |x - P| and n = (P - x)/|x - P|;
+   punch:    a cylinder of axis a whose flat end, centered at P, has radius A (in 2D a half-width) and a fillet of radius
+             r >= 0 round its edge: in the plane of a and e as for the cone, the end z = 0 for rho <= A, the fillet the
+             quarter circle of center C = (A, r), the side rho = A + r. Below the end (rho <= A) g = -z and n = a; beside
+             it, below the fillet's center (rho > A, z < r), the closest point is on the fillet (the edge itself for
+             r = 0), g = |v| - r and n = -v/|v| with v = (rho - A, z - r); above it, the side, g = rho - A - r, n = -e. */
 static inline void ObstacleGapNormal(PetscInt dim, const PetscScalar p[], const PetscReal x[], PetscReal n[], PetscReal *g)
 {
   const ObstacleType type = (ObstacleType)(PetscInt)PetscRealPart(p[OBSTACLE_TYPE]);
@@ -48,6 +53,29 @@ static inline void ObstacleGapNormal(PetscInt dim, const PetscScalar p[], const 
     }
     return;
   }
+  if (type == OBSTACLE_PUNCH) {
+    const PetscReal A = PetscRealPart(p[OBSTACLE_RADIUS]), rf = PetscRealPart(p[OBSTACLE_EDGE_RADIUS]);
+    PetscReal       z = 0.0, rho = 0.0, e[3] = {0.0, 0.0, 0.0};
+
+    for (PetscInt c = 0; c < dim; ++c) z += r[c] * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
+    for (PetscInt c = 0; c < dim; ++c) e[c] = r[c] - z * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
+    for (PetscInt c = 0; c < dim; ++c) rho += e[c] * e[c];
+    rho = PetscSqrtReal(rho);
+    for (PetscInt c = 0; c < dim; ++c) e[c] = rho > 0.0 ? e[c] / rho : 0.0;
+    if (rho <= A) { /* below the flat end */
+      for (PetscInt c = 0; c < dim; ++c) n[c] = PetscRealPart(p[OBSTACLE_DIRECTION + c]);
+      *g = -z;
+    } else if (z < rf) { /* beside it, below the fillet's center: the fillet, or for r = 0 the edge */
+      const PetscReal vr = rho - A, vz = z - rf, vl = PetscSqrtReal(vr * vr + vz * vz);
+
+      for (PetscInt c = 0; c < dim; ++c) n[c] = vl > 0.0 ? -(vr * e[c] + vz * PetscRealPart(p[OBSTACLE_DIRECTION + c])) / vl : 0.0;
+      *g = vl - rf;
+    } else { /* the side */
+      for (PetscInt c = 0; c < dim; ++c) n[c] = -e[c];
+      *g = rho - A - rf;
+    }
+    return;
+  }
   if (type == OBSTACLE_CYLINDER && dim == 3) {
     PetscReal ra = 0.0;
 
@@ -68,9 +96,10 @@ static inline void ObstaclePack(const Obstacle *obs, PetscScalar p[])
     p[OBSTACLE_POINT + c]     = obs->point[c] + obs->translate[c];
     p[OBSTACLE_DIRECTION + c] = obs->direction[c];
   }
-  p[OBSTACLE_RADIUS]   = obs->radius;
-  p[OBSTACLE_CONE_SIN] = PetscSinReal(obs->half_angle * PETSC_PI / 180.0);
-  p[OBSTACLE_CONE_COS] = PetscCosReal(obs->half_angle * PETSC_PI / 180.0);
+  p[OBSTACLE_RADIUS]      = obs->radius;
+  p[OBSTACLE_CONE_SIN]    = PetscSinReal(obs->half_angle * PETSC_PI / 180.0);
+  p[OBSTACLE_CONE_COS]    = PetscCosReal(obs->half_angle * PETSC_PI / 180.0);
+  p[OBSTACLE_EDGE_RADIUS] = obs->edge_radius;
 }
 
 /* The penetration u . n - g at x for the packed obstacle p; n is returned too. */

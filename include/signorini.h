@@ -17,6 +17,7 @@ enum {
   OBSTACLE_RADIUS = OBSTACLE_DIRECTION + 3,
   OBSTACLE_CONE_SIN, /* cone: the sine and cosine of its half-angle */
   OBSTACLE_CONE_COS,
+  OBSTACLE_EDGE_RADIUS, /* punch: the radius of the fillet that rounds its edge (0: a sharp edge) */
   OBSTACLE_NUM_PARAMS
 };
 
@@ -70,8 +71,8 @@ typedef struct {
   PetscReal         body_force[3]; /* -body_force */
 } BoundarySet;
 
-/* The rigid obstacle (-obstacle plane | sphere | cylinder | cone). */
-typedef enum { OBSTACLE_PLANE, OBSTACLE_SPHERE, OBSTACLE_CYLINDER, OBSTACLE_CONE } ObstacleType;
+/* The rigid obstacle (-obstacle plane | sphere | cylinder | cone | punch). */
+typedef enum { OBSTACLE_PLANE, OBSTACLE_SPHERE, OBSTACLE_CYLINDER, OBSTACLE_CONE, OBSTACLE_PUNCH } ObstacleType;
 extern const char *const ObstacleTypes[];
 typedef struct {
   ObstacleType type;
@@ -79,6 +80,7 @@ typedef struct {
   PetscReal    direction[3]; /* plane: unit normal from the body into the obstacle; cylinder: unit axis (3D); cone: unit axis from the apex into it */
   PetscReal    radius;
   PetscReal    half_angle;   /* cone: the angle between its axis and its surface, in degrees (in 2D a wedge) */
+  PetscReal    edge_radius;  /* punch: the fillet's radius at the edge of its flat end of radius `radius` (0: a sharp edge) */
   PetscReal    translate[3]; /* rigid translation of the obstacle (-obstacle_translate) */
   PetscReal    force;        /* -obstacle_force: the force it presses with along the translation's direction (0: driven by the translation) */
 } Obstacle;

@@ -154,8 +154,8 @@ OPTION_CASES = [
     ("p1_assembly_on_p2", ["-displacement_petscspace_degree", 2, "-assembly", "p1"], "-assembly p1 needs P1 displacements"),
     # the whole value and the option named: PETSc's reader said "Unknown option plane,cylind" and "Input string 210 GPa has no
     # numeric value", and listed no choice for a misspelled quantity
-    ("two_obstacles", ["-obstacle", "plane,cylinder"], "-obstacle plane,cylinder: -obstacle takes one value (one of plane, sphere, cylinder), not a list"),
-    ("obstacle_typo", ["-obstacle", "cilinder"], "-obstacle: unknown value 'cilinder' (did you mean cylinder?); the values are plane, sphere, cylinder"),
+    ("two_obstacles", ["-obstacle", "plane,cylinder"], "-obstacle plane,cylinder: -obstacle takes one value (one of plane, sphere, cylinder, cone, punch), not a list"),
+    ("obstacle_typo", ["-obstacle", "cilinder"], "-obstacle: unknown value 'cilinder' (did you mean cylinder?); the values are plane, sphere, cylinder, cone, punch"),
     ("modulus_with_unit", ["-young_modulus", "210 GPa"], "-young_modulus 210 GPa: Input string 210 GPa has no numeric value"),
     ("quantity_typo", ["-accuracy", 0.1, "-accuracy_quantity", "energy,contact_forse"],
      "-accuracy_quantity: unknown value 'contact_forse' (did you mean contact_force?); the values are energy, contact_force, pressure_max"),

@@ -18,6 +18,7 @@ RUNS = [
     ["-dm_plex_dim", "3", "-dm_plex_box_faces", "2,2,2", "-obstacle", "cylinder", "-obstacle_center", "0.5,0.5,-2", "-obstacle_radius", "2",
      "-obstacle_axis", "1,0,0"],
     ["-dm_plex_box_faces", "4,4", "-obstacle", "cone", "-obstacle_point", "0.5,-0.1", "-obstacle_axis", "0,-1", "-obstacle_half_angle", "70.3"],
+    ["-dm_plex_box_faces", "4,4", "-obstacle", "punch", "-obstacle_point", "0.5,-0.1", "-obstacle_axis", "0,-1", "-obstacle_radius", "0.2"],
     ["-dm_plex_box_faces", "8,8", "-options_file", "options/solvers/gamg.yaml"],
     ["-scene", "general", "-dm_plex_box_faces", "4,4", "-contact_faces", "1", "-bc_clamp", "3", "-bc_slip", "2", "-bc_slip_2_components", "0",
      "-bc_traction", "4", "-bc_traction_4", "0,0"],

@@ -71,7 +71,7 @@ PetscErrorCode ContactChecksGeometry(DM dm, const ContactChecksGeometryInputs *i
       ObstacleGapNormalAt(&in->scene->obstacle, dim, xc, nob, &g);
       for (PetscInt d = 0; d < dim; ++d) dot += n[d] * nob[d];
       sums[0] += area;
-      sums[1] += dot <= 0.0 ? area : 0.0;
+      sums[1] += dot < 0.0 ? area : 0.0; /* a normal along the face (a punch's side beside the body) is not away */
       sums[2] += g < 0.0 ? area : 0.0;
       PetscCall(DMPlexGetSupport(dm, faces[i], &support));
       PetscCall(MeshCellDiameter(dm, support[0], &diam));

@@ -73,6 +73,10 @@ PetscErrorCode SceneFingerprint(const Scene *scene, const Material *mat, PetscIn
   if (ob->type != OBSTACLE_SPHERE) PetscCall(AppendVector(buf, len, "direction", dim, ob->direction));
   if (ob->type == OBSTACLE_SPHERE || ob->type == OBSTACLE_CYLINDER) PetscCall(AppendVector(buf, len, "radius", 1, &ob->radius));
   if (ob->type == OBSTACLE_CONE) PetscCall(AppendVector(buf, len, "half_angle", 1, &ob->half_angle));
+  if (ob->type == OBSTACLE_PUNCH) {
+    PetscCall(AppendVector(buf, len, "radius", 1, &ob->radius));
+    PetscCall(AppendVector(buf, len, "edge_radius", 1, &ob->edge_radius));
+  }
   PetscCall(AppendVector(buf, len, "translate", dim, ob->translate));
   if (scene->num_constants) {
     PetscReal c[CONST_SCENE_MAX - CONST_SCENE];

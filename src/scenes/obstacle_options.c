@@ -1,8 +1,8 @@
-/* The rigid obstacle: the scene's default, then -obstacle plane | sphere | cylinder | cone and its geometry, read once. */
+/* The rigid obstacle: the scene's default, then -obstacle plane | sphere | cylinder | cone | punch and its geometry, read once. */
 #include "app.h"
 #include "scenes.h"
 
-const char *const ObstacleTypes[] = {"plane", "sphere", "cylinder", "cone", "ObstacleType", "OBSTACLE_", NULL};
+const char *const ObstacleTypes[] = {"plane", "sphere", "cylinder", "cone", "punch", "ObstacleType", "OBSTACLE_", NULL};
 
 /* A default of a scene: the plane through point with unit normal n (from the body into the obstacle). */
 PetscErrorCode SceneSetObstaclePlane(Scene *scene, const PetscReal point[], const PetscReal n[])
@@ -78,10 +78,11 @@ static PetscErrorCode OtherTypesGetOptions(MPI_Comm comm, ObstacleType type, Pet
 {
   const struct {
     const char *name;
-    PetscInt    min_dim[4]; /* the smallest dimension in which plane, sphere, cylinder, cone reads it (4: never) */
+    PetscInt    min_dim[5]; /* the smallest dimension in which plane, sphere, cylinder, cone, punch reads it (4: never) */
   } geometry[] = {
-      {"-obstacle_point", {2, 4, 4, 2}},  {"-obstacle_normal", {2, 4, 4, 4}}, {"-obstacle_center", {4, 2, 2, 4}},
-      {"-obstacle_radius", {4, 2, 2, 4}}, {"-obstacle_axis", {4, 4, 3, 2}},   {"-obstacle_half_angle", {4, 4, 4, 2}},
+      {"-obstacle_point", {2, 4, 4, 2, 2}},       {"-obstacle_normal", {2, 4, 4, 4, 4}}, {"-obstacle_center", {4, 2, 2, 4, 4}},
+      {"-obstacle_radius", {4, 2, 2, 4, 2}},      {"-obstacle_axis", {4, 4, 3, 2, 2}},   {"-obstacle_half_angle", {4, 4, 4, 2, 4}},
+      {"-obstacle_edge_radius", {4, 4, 4, 4, 2}},
   };
   char      list[256] = "";
   PetscBool overridden;
@@ -92,7 +93,7 @@ static PetscErrorCode OtherTypesGetOptions(MPI_Comm comm, ObstacleType type, Pet
     PetscBool set, given_here;
     PetscInt  lowest = 4; /* the smallest dimension in which any type reads it */
 
-    for (PetscInt j = 0; j < 4; ++j) lowest = PetscMin(lowest, geometry[k].min_dim[j]);
+    for (PetscInt j = 0; j < 5; ++j) lowest = PetscMin(lowest, geometry[k].min_dim[j]);
     if (dim >= geometry[k].min_dim[type] || dim < lowest) continue;
     PetscCall(OnCommandLine(geometry[k].name, &given_here));
     if (given_here) continue;
@@ -121,9 +122,10 @@ PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
   PetscCall(DMGetDimension(dm, &dim));
   PetscCall(OptionsCheckEnum(comm, "-obstacle", ObstacleTypes, PETSC_FALSE)); /* one obstacle per run, named in full */
   PetscOptionsBegin(comm, NULL, "Rigid obstacle", "Signorini");
-  PetscCall(PetscOptionsEnum("-obstacle",
-                             "Rigid obstacle: plane, sphere (the body stays outside a ball), cylinder (in 2D a disk), cone (in 2D a wedge)", NULL,
-                             ObstacleTypes, (PetscEnum)obs->type, (PetscEnum *)&obs->type, &type_set));
+  PetscCall(PetscOptionsEnum(
+      "-obstacle",
+      "Rigid obstacle: plane, sphere (the body stays outside a ball), cylinder (in 2D a disk), cone (in 2D a wedge), punch (a flat punch)", NULL,
+      ObstacleTypes, (PetscEnum)obs->type, (PetscEnum *)&obs->type, &type_set));
   switch (obs->type) {
     case OBSTACLE_PLANE:
       PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_point", "A point of the plane", dim, PETSC_FALSE, what, obs->point));
@@ -161,6 +163,25 @@ PetscErrorCode SceneObstacleGetOptions(DM dm, Scene *scene)
       PetscCall(OptionsCheckFinite(comm, "-obstacle_half_angle", obs->half_angle));
       PetscCheck(obs->half_angle > 0.0 && obs->half_angle < 90.0, comm, PETSC_ERR_USER_INPUT,
                  "-obstacle_half_angle must lie in (0, 90) degrees (a cone between a needle and a plane), got %g", (double)obs->half_angle);
+    } break;
+    case OBSTACLE_PUNCH: {
+      const char kind[] = "-obstacle punch";
+      PetscBool  set;
+
+      PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_point", "The center of the punch's flat end", dim, type_set, kind, obs->point));
+      PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_axis", "The punch's axis, from its flat end into it (away from the body)", dim,
+                           type_set, kind, obs->direction));
+      PetscCall(Normalize(comm, "-obstacle_axis", dim, obs->direction));
+      PetscCall(
+          PetscOptionsReal("-obstacle_radius", "The radius of the punch's flat end (in 2D its half-width)", NULL, obs->radius, &obs->radius, &set));
+      PetscCall(OptionsCheckFinite(comm, "-obstacle_radius", obs->radius));
+      PetscCheck(obs->radius > 0.0, comm, PETSC_ERR_USER_INPUT, "%s needs a positive -obstacle_radius (its flat end's), got %g", kind,
+                 (double)obs->radius);
+      PetscCall(PetscOptionsReal("-obstacle_edge_radius", "The radius of the fillet round the punch's edge (0: a sharp edge)", NULL, obs->edge_radius,
+                                 &obs->edge_radius, NULL));
+      PetscCall(OptionsCheckFinite(comm, "-obstacle_edge_radius", obs->edge_radius));
+      PetscCheck(obs->edge_radius >= 0.0, comm, PETSC_ERR_USER_INPUT, "-obstacle_edge_radius must be >= 0 (0: a sharp edge), got %g",
+                 (double)obs->edge_radius);
     } break;
   }
   PetscCall(ReadVector(PetscOptionsObject, comm, "-obstacle_translate", "Rigid translation of the obstacle (an indenter driven by displacement)", dim,
