@@ -3,11 +3,13 @@ cone, -obstacle_half_angle; a wedge in 2D): the written gap of every contact nod
 the cone's surface, the penalty tending to SNESVI as eps falls, 2 ranks equal to 1, the overlap warning of an
 indentation and of a misplaced cone, and the refusals. The flat punch (-obstacle punch: -obstacle_point the center of
 its flat end, -obstacle_axis, -obstacle_radius, -obstacle_edge_radius): the gap against a brute-force distance to its
-profile, the 2D pressure p(x) = P / (pi sqrt(a^2 - x^2)) of a rigid flat punch, and the refusals."""
+profile, the 2D pressure p(x) = P / (pi sqrt(a^2 - x^2)) of a rigid flat punch, and the refusals. A wedge unloaded
+along a load path gives the direct runs."""
 import os
 import subprocess
 import sys
 
+import h5py
 import numpy as np
 import pytest
 
@@ -227,3 +229,20 @@ PUNCH_BAD = {
 def test_punch_refusals(case):
     extra, message = PUNCH_BAD[case]
     refused(BOX2 + extra, f"punch_bad_{case}", message)
+
+
+def test_unloading_a_wedge_along_a_path_gives_the_direct_runs(outdir):
+    """-load_path 1,0.5,0 on the wedge (its translation scales with the factor): each step's force, energy and largest
+    pressure are the direct run's at that translation, to 1e-8 (frictionless contact has no history); at 0 the wedge
+    only touches, and the force is zero."""
+    base = BOX2 + cone([0.5, 1.0], [0.0, 1.0], 70.3) + ["-dm_plex_box_faces", "32,32", "-contact_monitor", "0", "-snes_rtol", "1e-12"]
+    _, h5 = run(base + ["-obstacle_translate", "0,-0.02", "-load_path", "1,0.5,0"], "wedge_path", output=os.path.join(outdir, "path.h5"))
+    with h5py.File(h5, "r") as f:
+        st = {k: f["steps"][k][:] for k in f["steps"]}
+    assert list(st["factor"]) == [1.0, 0.5, 0.0] and st["converged"].all()
+    for k, t in enumerate((1.0, 0.5)):
+        _, d = run(base + ["-obstacle_translate", f"0,{-0.02 * t:.17g}"], f"wedge_direct_{k}", output=os.path.join(outdir, f"direct_{k}.h5"))
+        attrs, _ = load(d)
+        for q in ("contact_force", "energy", "pressure_max"):
+            assert abs(st[q][k] - attrs[q]) <= 1e-8 * abs(attrs[q]), (k, q, st[q][k], attrs[q])
+    assert abs(st["contact_force"][2]) <= 1e-12 * abs(st["contact_force"][0])
