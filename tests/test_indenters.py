@@ -246,3 +246,19 @@ def test_unloading_a_wedge_along_a_path_gives_the_direct_runs(outdir):
         for q in ("contact_force", "energy", "pressure_max"):
             assert abs(st[q][k] - attrs[q]) <= 1e-8 * abs(attrs[q]), (k, q, st[q][k], attrs[q])
     assert abs(st["contact_force"][2]) <= 1e-12 * abs(st["contact_force"][0])
+
+
+def test_force_control_and_the_penetration_tolerance_under_a_wedge(outdir):
+    """Force control moves the wedge down until it presses with -obstacle_force, to 1e-8 along its direction; the
+    augmented Lagrangian reaches -contact_penetration_tol at the nodes and the rule's points."""
+    wedge = BOX2 + cone([0.5, 1.0], [0.0, 1.0], 70.3) + ["-dm_plex_box_faces", "32,32", "-contact_monitor", "0"]
+    _, h5 = run(wedge + ["-obstacle_translate", "0,-0.01", "-obstacle_force", "0.003"], "wedge_force", output=os.path.join(outdir, "force.h5"))
+    attrs, _ = load(h5)
+    assert attrs["converged"] == 1 and attrs["force_control_its"] >= 2
+    assert abs(-attrs["contact_force_y"] - 0.003) <= 1e-8 * 0.003, attrs["contact_force_y"]
+    assert attrs["obstacle_translate_y"] < -0.01  # it moved past its first position
+    _, h5 = run(wedge + ["-obstacle_translate", "0,-0.02", "-contact_method", "al", "-contact_penetration_tol", "1e-4"], "wedge_al",
+                output=os.path.join(outdir, "al.h5"))
+    attrs, _ = load(h5)
+    assert attrs["converged"] == 1 and attrs["penetration_tol_solves"] >= 2
+    assert attrs["penetration_tol_measured"] <= 1e-4
