@@ -100,15 +100,18 @@ def test_penalty_tends_to_snesvi_under_a_wedge(outdir, quadrature):
     assert dist[1] < dist[0] / 50 and dist[1] < 1e-4, dist
 
 
-def test_two_ranks_equal_one_under_a_cone(outdir):
-    """A 3D cone pressed into the block with the penalty and with SNESVI (its rotated frames: the cone's normal turns
-    around the axis node by node): 2 ranks give 1 rank's answer."""
-    args = BOX3 + cone([0.5, 0.5, 1.0], [0.0, 0.0, 1.0], 65.0) + ["-obstacle_translate", "0,0,-0.1", "-dm_plex_box_faces", "8,8,8",
-                                                               "-contact_monitor", "0"]
+@pytest.mark.parametrize("shape", ["cone", "punch"])
+def test_two_ranks_equal_one_under_a_cone(outdir, shape):
+    """A 3D cone, and a flat punch with a rounded edge, pressed into the block with the penalty and with SNESVI (its
+    rotated frames: the cone's normal turns around the axis node by node, the fillet's too): 2 ranks give 1 rank's
+    answer."""
+    obstacle = cone([0.5, 0.5, 1.0], [0.0, 0.0, 1.0], 65.0) if shape == "cone" else punch([0.5, 0.5, 1.0], [0.0, 0.0, 1.0], 0.2, 0.1)
+    args = BOX3 + obstacle + ["-obstacle_translate", "0,0,-0.1" if shape == "cone" else "0,0,-0.02", "-dm_plex_box_faces", "8,8,8",
+                              "-contact_monitor", "0"]
     for method in ("penalty", "vi"):
         got = []
         for ranks in (1, 2):
-            _, h5 = run(args + ["-contact_method", method], f"cone_np{ranks}_{method}", np_=ranks, output=os.path.join(outdir, f"{method}_{ranks}.h5"))
+            _, h5 = run(args + ["-contact_method", method], f"{shape}_np{ranks}_{method}", np_=ranks, output=os.path.join(outdir, f"{method}_{ranks}.h5"))
             got.append(load(h5))
         (r1, f1), (r2, f2) = got
         u1, u2 = sorted_by_position(f1, "displacement"), sorted_by_position(f2, "displacement")
