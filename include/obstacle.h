@@ -4,6 +4,19 @@
 #pragma once
 #include "signorini.h"
 
+/* The coordinates of r = x - P about an obstacle's axis a (p[OBSTACLE_DIRECTION]): z = r . a along it, rho the distance
+   from it, and e the unit vector of r - z a (zero on the axis). */
+static inline void ObstacleAxialFrame(PetscInt dim, const PetscScalar p[], const PetscReal r[], PetscReal *z, PetscReal *rho, PetscReal e[])
+{
+  *z   = 0.0;
+  *rho = 0.0;
+  for (PetscInt c = 0; c < dim; ++c) *z += r[c] * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
+  for (PetscInt c = 0; c < dim; ++c) e[c] = r[c] - *z * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
+  for (PetscInt c = 0; c < dim; ++c) *rho += e[c] * e[c];
+  *rho = PetscSqrtReal(*rho);
+  for (PetscInt c = 0; c < dim; ++c) e[c] = *rho > 0.0 ? e[c] / *rho : 0.0;
+}
+
 /* p: the packed parameters (OBSTACLE_* order). n points from the body into the obstacle; g is the distance from x
    to the obstacle's surface along n (negative when x starts inside the obstacle).
    plane:    n = the plane's normal, g = (point - x) . n;
@@ -36,15 +49,12 @@ static inline void ObstacleGapNormal(PetscInt dim, const PetscScalar p[], const 
   for (PetscInt c = 0; c < dim; ++c) r[c] = x[c] - PetscRealPart(p[OBSTACLE_POINT + c]);
   if (type == OBSTACLE_CONE) {
     const PetscReal sa = PetscRealPart(p[OBSTACLE_CONE_SIN]), ca = PetscRealPart(p[OBSTACLE_CONE_COS]);
-    PetscReal       z = 0.0, rho = 0.0, e[3] = {0.0, 0.0, 0.0};
+    PetscReal       z, rho, e[3];
 
-    for (PetscInt c = 0; c < dim; ++c) z += r[c] * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
-    for (PetscInt c = 0; c < dim; ++c) e[c] = r[c] - z * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
-    for (PetscInt c = 0; c < dim; ++c) rho += e[c] * e[c];
-    rho = PetscSqrtReal(rho);
-    if (rho * sa + z * ca > 0.0) { /* the foot of the perpendicular on the surface */
+    ObstacleAxialFrame(dim, p, r, &z, &rho, e);
+    if (rho * sa + z * ca > 0.0) { /* the foot of the perpendicular on the surface (on the axis: the axis) */
       for (PetscInt c = 0; c < dim; ++c)
-        n[c] = (rho > 0.0 ? -ca * e[c] / rho : 0.0) + (rho > 0.0 ? sa : 1.0) * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
+        n[c] = rho > 0.0 ? -ca * e[c] + sa * PetscRealPart(p[OBSTACLE_DIRECTION + c]) : PetscRealPart(p[OBSTACLE_DIRECTION + c]);
       *g = rho * ca - z * sa;
     } else { /* the apex */
       len = PetscSqrtReal(rho * rho + z * z);
@@ -55,13 +65,9 @@ static inline void ObstacleGapNormal(PetscInt dim, const PetscScalar p[], const 
   }
   if (type == OBSTACLE_PUNCH) {
     const PetscReal A = PetscRealPart(p[OBSTACLE_RADIUS]), rf = PetscRealPart(p[OBSTACLE_EDGE_RADIUS]);
-    PetscReal       z = 0.0, rho = 0.0, e[3] = {0.0, 0.0, 0.0};
+    PetscReal       z, rho, e[3];
 
-    for (PetscInt c = 0; c < dim; ++c) z += r[c] * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
-    for (PetscInt c = 0; c < dim; ++c) e[c] = r[c] - z * PetscRealPart(p[OBSTACLE_DIRECTION + c]);
-    for (PetscInt c = 0; c < dim; ++c) rho += e[c] * e[c];
-    rho = PetscSqrtReal(rho);
-    for (PetscInt c = 0; c < dim; ++c) e[c] = rho > 0.0 ? e[c] / rho : 0.0;
+    ObstacleAxialFrame(dim, p, r, &z, &rho, e);
     if (rho <= A) { /* below the flat end */
       for (PetscInt c = 0; c < dim; ++c) n[c] = PetscRealPart(p[OBSTACLE_DIRECTION + c]);
       *g = -z;
@@ -96,9 +102,10 @@ static inline void ObstaclePack(const Obstacle *obs, PetscScalar p[])
     p[OBSTACLE_POINT + c]     = obs->point[c] + obs->translate[c];
     p[OBSTACLE_DIRECTION + c] = obs->direction[c];
   }
-  p[OBSTACLE_RADIUS]      = obs->radius;
-  p[OBSTACLE_CONE_SIN]    = PetscSinReal(obs->half_angle * PETSC_PI / 180.0);
-  p[OBSTACLE_CONE_COS]    = PetscCosReal(obs->half_angle * PETSC_PI / 180.0);
+  p[OBSTACLE_RADIUS] = obs->radius;
+  /* a cone's half-angle as its sine and cosine, so that the kernels take no trigonometric function */
+  p[OBSTACLE_CONE_SIN]    = obs->type == OBSTACLE_CONE ? PetscSinReal(obs->half_angle * PETSC_PI / 180.0) : 0.0;
+  p[OBSTACLE_CONE_COS]    = obs->type == OBSTACLE_CONE ? PetscCosReal(obs->half_angle * PETSC_PI / 180.0) : 1.0;
   p[OBSTACLE_EDGE_RADIUS] = obs->edge_radius;
 }
 

@@ -37,12 +37,11 @@ PetscErrorCode DriverFinalize(void)
   PetscFunctionReturn(PETSC_SUCCESS);
 }
 
-/* The drivers of the run's flow; checkpoint writes the run's output as it stands (the adaptive cycles write each
+/* The drivers of the run's flow (registered by DriverRegisterAll() first); checkpoint writes the run's output as it stands (the adaptive cycles write each
    finished cycle, so that an interrupted run keeps them). */
 PetscErrorCode DriversCreate(OutputWriter checkpoint, Drivers *list)
 {
   PetscFunctionBeginUser;
-  PetscCall(DriverRegisterAll());
   PetscCall(PetscNew(list));
   for (PetscInt k = 0; k < DRIVER_FLOW_N; ++k) {
     DriverCreateFn create;
